@@ -1,0 +1,28 @@
+// app/run_command.h -- `cdlab run`: scene -> simulation -> PNG frames, video, pause dumps.
+#pragma once
+
+#include <filesystem>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace app {
+
+struct RunOptions {
+    std::filesystem::path scene;
+    std::filesystem::path out_dir;            ///< default: out/<scene stem>
+    std::optional<int> frames;                ///< overrides the scene's frame count
+    std::optional<std::filesystem::path> video;  ///< default: <out_dir>/<scene stem>.mp4
+    bool no_video = false;
+    bool no_frames = false;                   ///< skip the per-frame PNGs
+    std::optional<std::string> broad_phase;   ///< overrides the scene's broad phase
+    std::vector<int> pause_at;                ///< frames to dump
+    bool hud_timing = true;                   ///< step time in the HUD (off: bit-identical frames)
+    bool progress = true;                     ///< progress bar when stderr is a terminal
+};
+
+/// Exit codes: 0 success, 1 output or runtime failure, 2 bad input (scene, flags).
+int runScene(const RunOptions& options, std::ostream& out, std::ostream& err);
+
+}  // namespace app

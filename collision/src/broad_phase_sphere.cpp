@@ -1,0 +1,37 @@
+// collision/src/broad_phase_sphere.cpp -- bounding-sphere broad phase.
+#include "broad_phase_sphere.h"
+
+#include <algorithm>
+
+namespace collision {
+
+void SphereBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) {
+    counters.volumes_updated += moved_;
+    moved_ = 0;
+    items_.clear();
+    for (ProxyId id = 0; id < table_.capacity(); ++id) {
+        if (!table_.contains(id)) continue;
+        const BoundingSphere& s = table_[id].sphere;
+        items_.push_back(Item{s.center.x() - s.radius, s.center.x() + s.radius, id});
+    }
+    std::sort(items_.begin(), items_.end(), [](const Item& x, const Item& y) {
+        return x.lo != y.lo ? x.lo < y.lo : x.id < y.id;
+    });
+    pairs.clear();
+    for (std::size_t i = 0; i < items_.size(); ++i) {
+        const BoundingSphere& si = table_[items_[i].id].sphere;
+        // Closed intervals: a sphere starting exactly where this one ends is still tested.
+        for (std::size_t j = i + 1; j < items_.size() && items_[j].lo <= items_[i].hi; ++j) {
+            ++counters.volume_tests;
+            if (si.overlaps(table_[items_[j].id].sphere)) {
+                const ProxyId a = items_[i].id;
+                const ProxyId b = items_[j].id;
+                pairs.push_back(a < b ? ProxyPair{a, b} : ProxyPair{b, a});
+            }
+        }
+    }
+    std::sort(pairs.begin(), pairs.end());
+    counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
+}
+
+}  // namespace collision

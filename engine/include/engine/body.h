@@ -1,0 +1,57 @@
+// engine/body.h -- a rigid body: its shape, mass properties and state.
+// State is (position of the centre of mass, unit orientation, linear momentum P, angular momentum
+// L, world frame); velocities are derived: v = P/m, w = R I_body^-1 R^T L.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "collision/bounding_volumes.h"
+#include "collision/math.h"
+#include "collision/shape.h"
+
+namespace engine {
+
+using collision::Mat3;
+using collision::Pose;
+using collision::Quat;
+using collision::Real;
+using collision::Vec3;
+
+using BodyId = std::int32_t;
+
+/// Mass properties about the centre of mass, in the body frame.
+struct MassProperties {
+    Real mass = 0;                    ///< kg, > 0
+    Vec3 center_of_mass = Vec3::Zero();  ///< in the shape's input frame, before re-centring
+    Mat3 inertia = Mat3::Identity();  ///< kg m^2 about the centre of mass, symmetric positive
+};
+
+struct Body {
+    std::string name;
+    collision::Shape shape;             ///< local frame origin = centre of mass
+    collision::LocalBounds local_bounds;
+    Real mass = 1;
+    Real inv_mass = 1;
+    Mat3 inertia_body = Mat3::Identity();
+    Mat3 inv_inertia_body = Mat3::Identity();
+
+    Vec3 position = Vec3::Zero();       ///< m, centre of mass, world
+    Quat orientation = Quat::Identity();
+    Vec3 linear_momentum = Vec3::Zero();   ///< kg m/s
+    Vec3 angular_momentum = Vec3::Zero();  ///< kg m^2/s, world frame, about the centre of mass
+
+    Pose pose() const { return Pose{position, orientation}; }
+    Vec3 velocity() const { return linear_momentum * inv_mass; }
+    /// World angular velocity (rad/s).
+    Vec3 angularVelocity() const;
+    /// World inverse inertia R I^-1 R^T.
+    Mat3 invInertiaWorld() const;
+    /// 1/2 m v^2 + 1/2 w.L (J).
+    Real kineticEnergy() const;
+};
+
+/// Builds a body from a shape and its mass properties; fits the local bounding volumes.
+Body makeBody(std::string name, collision::Shape shape, const MassProperties& mass);
+
+}  // namespace engine

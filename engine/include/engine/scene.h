@@ -1,0 +1,67 @@
+// engine/scene.h -- scene files (YAML): world, output, camera, what to draw, and the bodies.
+// Every error names the place: "scene.yaml:12:7: bodies[3].radius: must be > 0".
+#pragma once
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "engine/body.h"
+#include "engine/world.h"
+
+namespace engine {
+
+struct CameraSettings {
+    Vec3 position{0, 8, 24};
+    Vec3 look_at = Vec3::Zero();
+    Vec3 up = Vec3::UnitY();
+    Real fov_deg = 45;
+};
+
+struct OutputSettings {
+    int width = 960;
+    int height = 540;
+    int fps = 30;
+};
+
+/// What the renderer draws. Volume flags select which bounding volumes get wireframes.
+struct DrawSettings {
+    bool bodies = true;
+    bool sphere = true;
+    bool aabb = false;
+    bool obb = false;
+    bool bounds = true;
+    bool hud = true;
+};
+
+struct Scene {
+    std::string name;               ///< file stem
+    WorldSettings world;
+    int frames = 120;               ///< frames to write (frame 0 is the initial state)
+    int steps_per_frame = 1;        ///< integrator steps between two frames
+    OutputSettings output;
+    CameraSettings camera;
+    DrawSettings draw;
+    std::vector<Body> bodies;
+};
+
+/// A bad scene file. what() is "FILE:LINE:COL: key.path: what is wrong" (1-based line and column).
+class SceneError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+/// Reads and validates a scene file; mesh paths are relative to the scene file's folder.
+/// Throws SceneError on any problem: unreadable file, malformed YAML, unknown key, wrong type,
+/// out-of-range value, NaN/Inf, missing or broken mesh.
+Scene loadScene(const std::filesystem::path& file);
+
+/// Same, from text; `display_name` prefixes the messages, `base_dir` resolves mesh paths.
+Scene parseScene(const std::string& yaml_text, const std::string& display_name,
+                 const std::filesystem::path& base_dir);
+
+/// Builds a World holding the scene's bodies, with volumes and pairs already detected.
+World makeWorld(const Scene& scene);
+
+}  // namespace engine

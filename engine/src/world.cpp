@@ -1,0 +1,202 @@
+// engine/src/world.cpp -- the fixed step and the collision pipeline.
+// Bodies are processed in id order and pairs come out of the broad phase sorted, so every step
+// does the same floating-point operations in the same order: runs are bit-identical.
+#include "engine/world.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <utility>
+
+#include "collision/narrow_phase.h"
+
+namespace engine {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+std::unique_ptr<collision::BroadPhase> makeBroadPhase(const std::string& name) {
+    const collision::BroadPhaseEntry* entry = collision::findBroadPhase(name);
+    if (entry == nullptr) {
+        throw std::invalid_argument("unknown broad phase '" + name +
+                                    "' (expected one of: " + collision::broadPhaseNames() + ")");
+    }
+    return entry->create();
+}
+
+}  // namespace
+
+std::string_view bodyStateName(BodyState state) {
+    switch (state) {
+        case BodyState::Apart: return "apart";
+        case BodyState::Flagged: return "flagged";
+        case BodyState::Colliding: return "colliding";
+    }
+    return "apart";
+}
+
+World::World(WorldSettings settings)
+    : settings_(std::move(settings)), broad_phase_(makeBroadPhase(settings_.broad_phase)) {}
+
+World::~World() = default;
+World::World(World&&) noexcept = default;
+World& World::operator=(World&&) noexcept = default;
+
+BodyId World::addBody(Body body) {
+    const BodyId id = static_cast<BodyId>(bodies_.size());
+    bodies_.push_back(std::move(body));
+    states_.push_back(BodyState::Apart);
+    const Body& b = bodies_.back();
+    const Pose pose = b.pose();
+    volumes_.push_back(collision::ProxyVolumes{
+        collision::computeWorldAabb(b.shape, pose),
+        collision::transformSphere(b.local_bounds.sphere, pose),
+        collision::transformObb(b.local_bounds.obb, pose)});
+    if (proxies_inserted_) broad_phase_->insert(id, volumes_.back());
+    return id;
+}
+
+void World::setBroadPhase(const std::string& name) {
+    broad_phase_ = makeBroadPhase(name);
+    settings_.broad_phase = name;
+    proxies_inserted_ = false;
+}
+
+void World::integrate(Real dt) {
+    // Semi-implicit (symplectic) Euler: momentum first, then position with the new velocity.
+    // No torques act, so L stays constant; the orientation turns by the exact rotation of the
+    // current angular velocity w = R I^-1 R^T L over dt, which keeps q unit up to rounding.
+    for (Body& b : bodies_) {
+        b.linear_momentum += b.mass * settings_.gravity * dt;
+        b.position += b.velocity() * dt;
+        const Vec3 w = b.angularVelocity();
+        const Real angle = w.norm() * dt;
+        if (angle > 0) {
+            const Quat turn(Eigen::AngleAxis<Real>(angle, w.normalized()));
+            b.orientation = (turn * b.orientation).normalized();
+        }
+    }
+}
+
+void World::reflectOffBounds() {
+    // The coursework's "reflect objects off the edge of the scene": a body whose exact world AABB
+    // crosses a face of the bounds while moving outward has that velocity component negated.
+    // Kinetic energy is unchanged by the flip.
+    // Runs after updateVolumes: the flip changes momenta only, so the AABBs stay valid.
+    const collision::Aabb& bounds = settings_.bounds;
+    for (std::size_t i = 0; i < bodies_.size(); ++i) {
+        Body& b = bodies_[i];
+        const collision::Aabb& box = volumes_[i].aabb;
+        for (int k = 0; k < 3; ++k) {
+            const Real p = b.linear_momentum[k];
+            if ((box.min[k] < bounds.min[k] && p < 0) || (box.max[k] > bounds.max[k] && p > 0)) {
+                b.linear_momentum[k] = -p;
+            }
+        }
+    }
+}
+
+void World::updateVolumes() {
+    for (std::size_t i = 0; i < bodies_.size(); ++i) {
+        const Body& b = bodies_[i];
+        const Pose pose = b.pose();
+        collision::ProxyVolumes& v = volumes_[i];
+        v.aabb = collision::computeWorldAabb(b.shape, pose);
+        v.sphere = collision::transformSphere(b.local_bounds.sphere, pose);
+        v.obb = collision::transformObb(b.local_bounds.obb, pose);
+        const auto id = static_cast<collision::ProxyId>(i);
+        if (proxies_inserted_) {
+            broad_phase_->move(id, v);
+        } else {
+            broad_phase_->insert(id, v);
+        }
+    }
+    proxies_inserted_ = true;
+}
+
+void World::runCollisionPipeline() {
+    Clock::time_point t = Clock::now();
+    stats_.broad = {};
+    broad_phase_->findPairs(flagged_, stats_.broad);
+    stats_.broad_phase_s = secondsSince(t);
+
+    t = Clock::now();
+    colliding_.clear();
+    stats_.narrow_tests = 0;
+    stats_.triangle_tests = 0;
+    for (const collision::ProxyPair& pair : flagged_) {
+        const Body& a = bodies_[pair.a];
+        const Body& b = bodies_[pair.b];
+        const collision::CollideOutput out = collision::collide(a.shape, a.pose(), b.shape, b.pose());
+        ++stats_.narrow_tests;
+        stats_.triangle_tests += out.triangle_tests;
+        if (collision::isColliding(out.state)) colliding_.push_back(pair);
+    }
+    stats_.narrow_phase_s = secondsSince(t);
+
+    std::fill(states_.begin(), states_.end(), BodyState::Apart);
+    for (const collision::ProxyPair& p : flagged_) {
+        states_[p.a] = std::max(states_[p.a], BodyState::Flagged);
+        states_[p.b] = std::max(states_[p.b], BodyState::Flagged);
+    }
+    for (const collision::ProxyPair& p : colliding_) {
+        states_[p.a] = BodyState::Colliding;
+        states_[p.b] = BodyState::Colliding;
+    }
+}
+
+void World::detect() {
+    const Clock::time_point start = Clock::now();
+    stats_.integrate_s = 0;
+    const Clock::time_point t = Clock::now();
+    updateVolumes();
+    stats_.volumes_s = secondsSince(t);
+    runCollisionPipeline();
+    stats_.total_s = secondsSince(start);
+}
+
+void World::step() {
+    const Clock::time_point start = Clock::now();
+    Clock::time_point t = start;
+    integrate(settings_.time_step);
+    time_ += settings_.time_step;
+    ++step_count_;
+    stats_.integrate_s = secondsSince(t);
+
+    t = Clock::now();
+    updateVolumes();
+    reflectOffBounds();
+    stats_.volumes_s = secondsSince(t);
+    runCollisionPipeline();
+    stats_.total_s = secondsSince(start);
+}
+
+std::uint64_t World::stateHash() const {
+    // FNV-1a over the exact bit patterns of the state.
+    std::uint64_t h = 1469598103934665603ull;
+    auto mix = [&h](const void* data, std::size_t n) {
+        const auto* bytes = static_cast<const unsigned char*>(data);
+        for (std::size_t i = 0; i < n; ++i) {
+            h ^= bytes[i];
+            h *= 1099511628211ull;
+        }
+    };
+    auto mixVec = [&mix](const Vec3& v) { mix(v.data(), sizeof(Real) * 3); };
+    mix(&time_, sizeof(time_));
+    for (const Body& b : bodies_) {
+        mixVec(b.position);
+        mix(b.orientation.coeffs().data(), sizeof(Real) * 4);
+        mixVec(b.linear_momentum);
+        mixVec(b.angular_momentum);
+    }
+    for (BodyState s : states_) mix(&s, sizeof(s));
+    return h;
+}
+
+}  // namespace engine

@@ -1,0 +1,61 @@
+// render/image.h -- an RGB8 picture, the PNG writer and the ffmpeg video pipe.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace render {
+
+/// A failure to render or to write output: message says what and where.
+class RenderError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+/// Row-major RGB8, row 0 at the top.
+struct Image {
+    int width = 0;
+    int height = 0;
+    std::vector<std::uint8_t> rgb;  ///< width * height * 3 bytes
+
+    const std::uint8_t* pixel(int x, int y) const { return &rgb[(std::size_t(y) * width + x) * 3]; }
+};
+
+/// Writes an 8-bit RGB PNG (libpng). Writes to a temporary name and renames, so a file that
+/// exists is complete. Throws RenderError.
+void writePng(const std::filesystem::path& file, const Image& image);
+/// Reads an 8-bit RGB or RGBA PNG (for tests and tools). Throws RenderError.
+Image readPng(const std::filesystem::path& file);
+
+/// True when `ffmpeg` can be run from PATH.
+bool ffmpegAvailable();
+
+/// Pipes raw frames to ffmpeg: H.264, yuv420p, +faststart, so browsers play the file.
+/// The output appears under its final name only after finish() succeeded.
+class VideoWriter {
+public:
+    /// Starts ffmpeg; throws RenderError when it cannot (missing ffmpeg, odd size).
+    VideoWriter(const std::filesystem::path& file, int width, int height, int fps);
+    ~VideoWriter();  ///< abandons an unfinished video (the partial file is removed)
+    VideoWriter(const VideoWriter&) = delete;
+    VideoWriter& operator=(const VideoWriter&) = delete;
+
+    void addFrame(const Image& image);  ///< throws RenderError if ffmpeg died
+    void finish();                      ///< waits for ffmpeg; throws RenderError on failure
+
+private:
+    void abandon() noexcept;  ///< kills ffmpeg (our child, by pid) and removes the partial file
+
+    std::filesystem::path file_;
+    std::filesystem::path partial_;
+    int width_;
+    int height_;
+    std::FILE* pipe_ = nullptr;
+    int pid_ = -1;  ///< ffmpeg's process id while it runs
+};
+
+}  // namespace render

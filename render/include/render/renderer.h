@@ -1,0 +1,60 @@
+// render/renderer.h -- software rendering of a World through OSMesa (no display needed):
+// shaded bodies, bounding-volume wireframes coloured by overlap state, world bounds, HUD text.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "collision/debug_draw.h"
+#include "engine/scene.h"
+#include "engine/world.h"
+#include "render/image.h"
+
+namespace render {
+
+/// Colours of the overlap states: green apart, yellow flagged, red colliding.
+collision::Color stateColor(engine::BodyState state);
+
+/// The clear colour behind everything, a dark blue-grey: exactly RGB8 (26, 28, 36).
+inline constexpr collision::Color kBackgroundColor{26 / 255.0f, 28 / 255.0f, 36 / 255.0f, 1.0f};
+/// The shaded bodies' base colour (a neutral grey-blue) before lighting.
+inline constexpr collision::Color kBodyColor{0.56f, 0.63f, 0.74f, 1.0f};
+
+/// What one frame shows. With draw.hud and any volume drawn, a colour legend
+/// (apart / flagged / colliding) goes bottom-left.
+struct FrameOptions {
+    engine::DrawSettings draw;
+    bool draw_structure = false;  ///< the broad phase's own structure (BroadPhase::draw)
+    std::string hud_text;         ///< the HUD line, top-left; empty = none
+};
+
+class Renderer {
+public:
+    /// Creates an off-screen OSMesa context of that size (pixels, > 0); throws RenderError.
+    /// Frames are rendered 2x2 supersampled when OSMesa allows the size, then box-filtered.
+    Renderer(int width, int height);
+    ~Renderer();
+    Renderer(const Renderer&) = delete;
+    Renderer& operator=(const Renderer&) = delete;
+
+    /// Renders the world's current state. Deterministic: the same world state, camera and
+    /// options give a bit-identical image. `world` must have run detect() or step() so that its
+    /// volumes and states match its bodies (volumes it lacks are not drawn).
+    Image render(const engine::World& world, const engine::CameraSettings& camera,
+                 const FrameOptions& options);
+
+    int width() const;
+    int height() const;
+    /// Supersampling factor per axis actually used (1 or 2).
+    int supersample() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+/// The default HUD line: "frame F  t=1.23 s  sap  flagged N  colliding M  step 0.12 ms".
+/// `include_timing` false leaves the step time out so that frames are bit-identical run to run.
+std::string hudLine(const engine::World& world, int frame, bool include_timing);
+
+}  // namespace render
