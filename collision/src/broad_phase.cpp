@@ -3,8 +3,14 @@
 #include "collision/broad_phase.h"
 
 #include "broad_phase_brute.h"
+#include "broad_phase_grid.h"
+#include "broad_phase_hgrid.h"
+#include "broad_phase_obb.h"
+#include "broad_phase_octree.h"
 #include "broad_phase_sap.h"
+#include "broad_phase_sap1.h"
 #include "broad_phase_sphere.h"
+#include "broad_phase_tree.h"
 
 namespace collision {
 
@@ -23,6 +29,25 @@ const BroadPhaseEntry kRegistry[] = {
      }},
     {"sap", "sweep-and-prune on AABBs, insertion-sort coherence (I-COLLIDE)", "aabb", "brute",
      []() -> std::unique_ptr<BroadPhase> { return std::make_unique<SweepAndPrune>(); }},
+    {"sap1", "single-axis sort and sweep, axis of greatest spread, insertion-sort coherence",
+     "aabb", "brute",
+     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<SortAndSweep1>(); }},
+    {"grid", "uniform grid over the bodies, cell size from the median body size", "aabb", "brute",
+     []() -> std::unique_ptr<BroadPhase> {
+         return std::make_unique<GridBroadPhase>(GridBroadPhase::Mode::Dense);
+     }},
+    {"hash", "spatial hash: unbounded uniform grid of hashed cells", "aabb", "brute",
+     []() -> std::unique_ptr<BroadPhase> {
+         return std::make_unique<GridBroadPhase>(GridBroadPhase::Mode::Hashed);
+     }},
+    {"hgrid", "hierarchical hash grid (Mirtich TR-97-23 §2.2)", "aabb", "brute",
+     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<HierarchicalGrid>(); }},
+    {"tree", "dynamic AABB tree: fat leaves, SAH insertion, rotations", "aabb", "brute",
+     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<DynamicAabbTree>(); }},
+    {"octree", "loose octree (k = 2)", "aabb", "brute",
+     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<LooseOctree>(); }},
+    {"obb", "OBB separating-axis test after a sweep over the OBBs' AABBs", "obb", "obb-brute",
+     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<ObbBroadPhase>(); }},
     {"obb-brute", "all pairs of OBBs, separating-axis test (reference)", "obb", "obb-brute",
      []() -> std::unique_ptr<BroadPhase> { return std::make_unique<Brute>(Brute::Volume::Obb); }},
 };

@@ -1,0 +1,72 @@
+// collision/src/broad_phase_cells.h -- shared pieces of the cell-based broad phases (grid, hash,
+// hierarchical grid): integer cell coordinates, a cell-key hash, and the cell-size estimate.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "collision/math.h"
+#include "proxy_table.h"
+
+namespace collision {
+
+/// Integer cell coordinates along each axis. 64-bit so that small cells far from the origin
+/// (1e6 m / 1e-3 m) do not overflow; clamped to +-2^52 to stay exact as a double.
+struct CellCoord {
+    std::int64_t x = 0, y = 0, z = 0;
+    friend bool operator==(const CellCoord&, const CellCoord&) = default;
+};
+
+inline std::int64_t cellIndex(Real value, Real inv_size) {
+    const Real c = std::floor(value * inv_size);
+    constexpr Real kLimit = Real(4503599627370496.0);  // 2^52
+    return static_cast<std::int64_t>(std::clamp(c, -kLimit, kLimit));
+}
+
+inline CellCoord cellOf(const Vec3& p, Real inv_size) {
+    return CellCoord{cellIndex(p.x(), inv_size), cellIndex(p.y(), inv_size),
+                     cellIndex(p.z(), inv_size)};
+}
+
+/// A well-mixed 64-bit hash of a cell (and a level, for the hierarchical grid).
+inline std::uint64_t hashCell(const CellCoord& c, std::uint64_t level = 0) {
+    std::uint64_t h = 0x9E3779B97F4A7C15ull * (level + 1);
+    for (std::int64_t v : {c.x, c.y, c.z}) {
+        h ^= static_cast<std::uint64_t>(v) + 0x9E3779B97F4A7C15ull + (h << 6) + (h >> 2);
+        h *= 0xBF58476D1CE4E5B9ull;
+        h ^= h >> 31;
+    }
+    return h;
+}
+
+/// A cell size suited to the population: twice the median of the proxies' largest AABB extents
+/// (the median ignores a few huge or tiny outliers). Never zero: falls back to the mean, then 1.
+inline Real medianCellSize(const ProxyTable& table) {
+    std::vector<Real> extents;
+    extents.reserve(static_cast<std::size_t>(table.count()));
+    for (ProxyId id = 0; id < table.capacity(); ++id) {
+        if (table.contains(id)) extents.push_back(table[id].aabb.extents().maxCoeff());
+    }
+    if (extents.empty()) return 1;
+    const std::size_t mid = extents.size() / 2;
+    std::nth_element(extents.begin(), extents.begin() + static_cast<std::ptrdiff_t>(mid),
+                     extents.end());
+    Real size = 2 * extents[mid];
+    if (!(size > 0)) {
+        Real sum = 0;
+        for (Real e : extents) sum += e;
+        size = 2 * sum / Real(extents.size());
+    }
+    return size > 0 ? size : Real(1);
+}
+
+/// Next power of two >= n (n >= 1).
+inline std::size_t nextPowerOfTwo(std::size_t n) {
+    std::size_t p = 1;
+    while (p < n) p <<= 1;
+    return p;
+}
+
+}  // namespace collision

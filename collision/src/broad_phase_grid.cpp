@@ -1,0 +1,145 @@
+// collision/src/broad_phase_grid.cpp -- uniform grid and spatial hash, rebuilt every frame.
+// Why each overlapping pair is reported exactly once: for overlapping boxes the lowest corner m
+// of their intersection lies in both boxes, and cell indices are monotone in the coordinate
+// (floor of a positive scaling, then a clamp), so the cell of m is in both boxes' cell ranges.
+// Only that cell reports the pair.
+#include "broad_phase_grid.h"
+
+#include <algorithm>
+
+#include "collision/debug_draw.h"
+
+namespace collision {
+
+CellCoord GridBroadPhase::clampToGrid(const CellCoord& c) const {
+    if (mode_ == Mode::Hashed) return c;
+    return CellCoord{std::clamp<std::int64_t>(c.x, 0, dims_.x - 1),
+                     std::clamp<std::int64_t>(c.y, 0, dims_.y - 1),
+                     std::clamp<std::int64_t>(c.z, 0, dims_.z - 1)};
+}
+
+std::uint64_t GridBroadPhase::bucketOf(const CellCoord& c) const {
+    if (mode_ == Mode::Dense) {
+        return static_cast<std::uint64_t>((c.z * dims_.y + c.y) * dims_.x + c.x);
+    }
+    return hashCell(c) & (bucket_count_ - 1);
+}
+
+void GridBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) {
+    counters.volumes_updated += moved_;
+    moved_ = 0;
+    pairs.clear();
+    entries_.clear();
+    big_.clear();
+    if (table_.count() == 0) return;
+
+    cell_size_ = medianCellSize(table_);
+    if (mode_ == Mode::Dense) {
+        Aabb all{Vec3::Constant(std::numeric_limits<Real>::max()),
+                 Vec3::Constant(std::numeric_limits<Real>::lowest())};
+        for (ProxyId id = 0; id < table_.capacity(); ++id) {
+            if (!table_.contains(id)) continue;
+            all.min = all.min.cwiseMin(table_[id].aabb.min);
+            all.max = all.max.cwiseMax(table_[id].aabb.max);
+        }
+        origin_ = all.min;
+        // At most ~2n cells: a grid far larger than the population is mostly empty memory.
+        const Real limit = std::max<Real>(64, 2 * Real(table_.count()));
+        for (;;) {
+            const Vec3 d = (all.extents() / cell_size_).array().ceil().max(Real(1));
+            if (d.prod() <= limit) {
+                dims_ = CellCoord{static_cast<std::int64_t>(d.x()), static_cast<std::int64_t>(d.y()),
+                                  static_cast<std::int64_t>(d.z())};
+                break;
+            }
+            cell_size_ *= 2;
+        }
+    } else {
+        origin_.setZero();
+    }
+    const Real inv = Real(1) / cell_size_;
+
+    // Bin every proxy into the cells its AABB covers.
+    for (ProxyId id = 0; id < table_.capacity(); ++id) {
+        if (!table_.contains(id)) continue;
+        const Aabb& box = table_[id].aabb;
+        const CellCoord lo = clampToGrid(cellOf(box.min - origin_, inv));
+        const CellCoord hi = clampToGrid(cellOf(box.max - origin_, inv));
+        const std::int64_t n = (hi.x - lo.x + 1) * (hi.y - lo.y + 1) * (hi.z - lo.z + 1);
+        if (n > kMaxCellsPerProxy || n <= 0) {
+            big_.push_back(id);
+            continue;
+        }
+        for (std::int64_t z = lo.z; z <= hi.z; ++z) {
+            for (std::int64_t y = lo.y; y <= hi.y; ++y) {
+                for (std::int64_t x = lo.x; x <= hi.x; ++x) {
+                    entries_.push_back(Entry{0, CellCoord{x, y, z}, id});
+                }
+            }
+        }
+    }
+    bucket_count_ = mode_ == Mode::Dense
+                        ? static_cast<std::uint64_t>(dims_.x * dims_.y * dims_.z)
+                        : nextPowerOfTwo(std::max<std::size_t>(2 * entries_.size(), 16));
+    for (Entry& e : entries_) e.bucket = bucketOf(e.cell);
+
+    // Counting sort by bucket; stable, so entries keep proxy order within a bucket.
+    bucket_start_.assign(bucket_count_ + 1, 0);
+    for (const Entry& e : entries_) ++bucket_start_[e.bucket + 1];
+    for (std::size_t b = 0; b < bucket_count_; ++b) bucket_start_[b + 1] += bucket_start_[b];
+    sorted_.resize(entries_.size());
+    {
+        std::vector<std::uint32_t> fill(bucket_start_.begin(), bucket_start_.end() - 1);
+        for (const Entry& e : entries_) sorted_[fill[e.bucket]++] = e;
+    }
+
+    for (std::size_t b = 0; b < bucket_count_; ++b) {
+        const std::uint32_t begin = bucket_start_[b];
+        const std::uint32_t end = bucket_start_[b + 1];
+        for (std::uint32_t i = begin; i < end; ++i) {
+            const Entry& ei = sorted_[i];
+            const Aabb& bi = table_[ei.id].aabb;
+            for (std::uint32_t j = i + 1; j < end; ++j) {
+                const Entry& ej = sorted_[j];
+                if (!(ej.cell == ei.cell) || ej.id == ei.id) continue;
+                ++counters.volume_tests;
+                const Aabb& bj = table_[ej.id].aabb;
+                if (!bi.overlaps(bj)) continue;
+                const CellCoord owner =
+                    clampToGrid(cellOf(bi.min.cwiseMax(bj.min) - origin_, inv));
+                if (owner == ei.cell) {
+                    pairs.push_back(ei.id < ej.id ? ProxyPair{ei.id, ej.id}
+                                                  : ProxyPair{ej.id, ei.id});
+                }
+            }
+        }
+    }
+
+    // Oversized proxies against everyone (each big-big pair once: from the larger id).
+    std::vector<char> is_big(static_cast<std::size_t>(table_.capacity()), 0);
+    for (ProxyId id : big_) is_big[id] = 1;
+    for (ProxyId b : big_) {
+        const Aabb& bb = table_[b].aabb;
+        for (ProxyId o = 0; o < table_.capacity(); ++o) {
+            if (o == b || !table_.contains(o) || (is_big[o] && o < b)) continue;
+            ++counters.volume_tests;
+            if (bb.overlaps(table_[o].aabb)) {
+                pairs.push_back(b < o ? ProxyPair{b, o} : ProxyPair{o, b});
+            }
+        }
+    }
+    std::sort(pairs.begin(), pairs.end());
+    counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
+}
+
+void GridBroadPhase::draw(DebugDraw& draw) const {
+    const Color color{0.5f, 0.5f, 1.0f, 1};
+    for (std::size_t i = 0; i < sorted_.size(); ++i) {
+        if (i > 0 && sorted_[i].cell == sorted_[i - 1].cell) continue;
+        const CellCoord& c = sorted_[i].cell;
+        const Vec3 lo = origin_ + Vec3(Real(c.x), Real(c.y), Real(c.z)) * cell_size_;
+        draw.drawAabb(Aabb{lo, lo + Vec3::Constant(cell_size_)}, color);
+    }
+}
+
+}  // namespace collision

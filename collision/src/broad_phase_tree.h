@@ -1,0 +1,60 @@
+// collision/src/broad_phase_tree.h -- dynamic AABB tree with fattened leaves.
+#pragma once
+
+#include <vector>
+
+#include "collision/broad_phase.h"
+#include "proxy_table.h"
+
+namespace collision {
+
+/// Incremental bounding-volume tree over the proxies' AABBs (the design of Box2D's
+/// b2DynamicTree and Bullet's btDbvt; Catto, "Dynamic Bounding Volume Hierarchies", GDC 2019).
+/// Leaves hold AABBs fattened by a margin proportional to the box's size, so a proxy that moves
+/// a little is not touched at all; one that leaves its fat box is removed and re-inserted.
+/// Insertion descends by the surface-area heuristic (the sibling that least increases the total
+/// area of the ancestors), then AVL-style rotations keep the tree balanced. Pairs: each proxy
+/// queries the tree with its exact AABB and keeps partners of higher id, tested exactly.
+class DynamicAabbTree : public BroadPhase {
+public:
+    std::string_view name() const override { return "tree"; }
+    void insert(ProxyId id, const ProxyVolumes& v) override;
+    void remove(ProxyId id) override;
+    void move(ProxyId id, const ProxyVolumes& v) override;
+    void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
+    void draw(DebugDraw& draw) const override;
+    std::string validate() const override;
+
+    /// Relative fattening of leaves: margin = kFatRatio * largest extent (+ a floor for points).
+    static constexpr Real kFatRatio = Real(0.1);
+
+private:
+    static constexpr int kNull = -1;
+    struct Node {
+        Aabb box;
+        int parent = kNull;
+        int child1 = kNull;
+        int child2 = kNull;
+        int height = 0;  // leaf = 0; free = -1
+        ProxyId proxy = -1;
+        bool isLeaf() const { return child1 == kNull; }
+    };
+
+    int allocateNode();
+    void freeNode(int node);
+    void insertLeaf(int leaf);
+    void removeLeaf(int leaf);
+    int balance(int a);
+    Aabb fatten(const Aabb& box) const;
+    std::string validateNode(int node, int parent) const;
+
+    ProxyTable table_;
+    std::vector<Node> nodes_;
+    std::vector<int> leaf_of_;  // proxy id -> leaf node
+    int root_ = kNull;
+    int free_list_ = kNull;
+    std::int64_t moved_ = 0;
+    std::vector<int> stack_;
+};
+
+}  // namespace collision
