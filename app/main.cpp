@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 
+#include "bench_broadphase.h"
 #include "collision/broad_phase.h"
 #include "run_command.h"
 
@@ -32,8 +33,43 @@ int main(int argc, char** argv) {
     bool no_timing = false;
     run_cmd->add_flag("--no-hud-timing", no_timing,
                       "leave the step time out of the HUD so frames are bit-identical");
+    run_cmd->add_flag("--check-broadphase", run.check_broad_phase,
+                      "verify every step's pairs against the brute-force reference; stop with a "
+                      "report (exit 3) at the first mismatch");
+    std::string stats;
+    run_cmd->add_option("--stats", stats, "write per-frame counters and stage times to FILE.csv");
     bool quiet = false;
     run_cmd->add_flag("--quiet", quiet, "no progress bar");
+
+    // BEGIN bench subcommand (registered by app/bench_*.cpp)
+    CLI::App* bench_cmd = cli.add_subcommand("bench", "performance benchmarks");
+    bench_cmd->require_subcommand(1);
+    app::BenchOptions bench_bp;
+    std::string bench_bp_json;
+    CLI::App* bench_bp_cmd = bench_cmd->add_subcommand(
+        "broadphase", "cdlab's broad phases beside Bullet and FCL on moving boxes");
+    bench_bp_cmd->add_option("--sizes", bench_bp.sizes, "box counts, comma-separated")
+        ->delimiter(',')
+        ->capture_default_str();
+    bench_bp_cmd->add_option("--frames", bench_bp.frames, "measured frames per method")
+        ->capture_default_str();
+    bench_bp_cmd
+        ->add_option("--methods", bench_bp.methods,
+                     "comma-separated (default: every AABB broad phase and the default peers)")
+        ->delimiter(',');
+    bench_bp_cmd->add_option("--workload", bench_bp.workload, "uniform, mixed or both")
+        ->check(CLI::IsMember({"uniform", "mixed", "both"}))
+        ->capture_default_str();
+    bench_bp_cmd->add_option("--json", bench_bp_json, "also write the rows as JSON to FILE");
+    bench_bp_cmd->add_option("--seed", bench_bp.seed, "workload seed")->capture_default_str();
+    bench_bp_cmd
+        ->add_option("--budget", bench_bp.budget_seconds,
+                     "stop a method after this many seconds of frame time (0: no limit)")
+        ->capture_default_str();
+    bool bench_bp_in_process = false;
+    bench_bp_cmd->add_flag("--in-process", bench_bp_in_process,
+                           "do not fork per method (no per-method peak memory)");
+    // END bench subcommand
 
     try {
         cli.parse(argc, argv);
@@ -47,9 +83,17 @@ int main(int argc, char** argv) {
         if (!video.empty()) run.video = video;
         if (run_cmd->count("--frames") > 0) run.frames = frames;
         if (!broad_phase.empty()) run.broad_phase = broad_phase;
+        if (!stats.empty()) run.stats_csv = stats;
         run.hud_timing = !no_timing;
         run.progress = !quiet;
         return app::runScene(run, std::cout, std::cerr);
     }
+    // BEGIN bench dispatch
+    if (bench_bp_cmd->parsed()) {
+        if (!bench_bp_json.empty()) bench_bp.json = bench_bp_json;
+        bench_bp.isolate = !bench_bp_in_process;
+        return app::runBenchBroadphase(bench_bp, std::cout, std::cerr);
+    }
+    // END bench dispatch
     return 2;
 }

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <iterator>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -27,6 +28,7 @@ namespace {
 constexpr int kExitOk = 0;
 constexpr int kExitFailure = 1;
 constexpr int kExitBadInput = 2;
+constexpr int kExitCheckFailed = 3;
 
 void writeTextAtomically(const fs::path& file, const std::string& text) {
     const fs::path partial = fs::path(file.string() + ".partial");
@@ -77,6 +79,102 @@ public:
 private:
     bool enabled_;
     int total_;
+};
+
+// Per-frame sums of the step counters, for --stats.
+struct FrameStats {
+    collision::BroadPhaseCounters broad;
+    std::int64_t narrow_tests = 0;
+    std::int64_t triangle_tests = 0;
+    double integrate_s = 0, volumes_s = 0, broad_s = 0, narrow_s = 0, total_s = 0;
+
+    void add(const engine::StepStats& s) {
+        broad.volume_tests += s.broad.volume_tests;
+        broad.pairs_flagged += s.broad.pairs_flagged;
+        broad.volumes_updated += s.broad.volumes_updated;
+        broad.swaps += s.broad.swaps;
+        narrow_tests += s.narrow_tests;
+        triangle_tests += s.triangle_tests;
+        integrate_s += s.integrate_s;
+        volumes_s += s.volumes_s;
+        broad_s += s.broad_phase_s;
+        narrow_s += s.narrow_phase_s;
+        total_s += s.total_s;
+    }
+};
+
+constexpr const char* kStatsHeader =
+    "frame,time,broadphase,bodies,flagged,colliding,volume_tests,volumes_updated,swaps,"
+    "narrow_tests,triangle_tests,integrate_ms,volumes_ms,broadphase_ms,narrowphase_ms,step_ms\n";
+
+std::string statsRow(int frame, const engine::World& world, const FrameStats& f) {
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "%d,%.9g,%s,%zu,%zu,%zu,%lld,%lld,%lld,%lld,%lld,%.6f,%.6f,%.6f,%.6f,%.6f\n",
+                  frame, double(world.time()), std::string(world.broadPhase().name()).c_str(),
+                  world.bodies().size(), world.flaggedPairs().size(),
+                  world.collidingPairs().size(), (long long)f.broad.volume_tests,
+                  (long long)f.broad.volumes_updated, (long long)f.broad.swaps,
+                  (long long)f.narrow_tests, (long long)f.triangle_tests, 1e3 * f.integrate_s,
+                  1e3 * f.volumes_s, 1e3 * f.broad_s, 1e3 * f.narrow_s, 1e3 * f.total_s);
+    return line;
+}
+
+// --check-broadphase: runs the registry's reference beside the world's broad phase on the same
+// volumes and describes the first difference.
+class BroadPhaseChecker {
+public:
+    explicit BroadPhaseChecker(const std::string& name) {
+        const collision::BroadPhaseEntry* entry = collision::findBroadPhase(name);
+        reference_name_ = std::string(entry->reference);
+        reference_ = collision::findBroadPhase(entry->reference)->create();
+    }
+
+    /// Empty when the world's flagged pairs equal the reference's; else a report.
+    std::string check(const engine::World& world) {
+        const auto volumes = world.volumes();
+        for (std::size_t i = 0; i < volumes.size(); ++i) {
+            const auto id = static_cast<collision::ProxyId>(i);
+            if (i < inserted_) {
+                reference_->move(id, volumes[i]);
+            } else {
+                reference_->insert(id, volumes[i]);
+            }
+        }
+        inserted_ = volumes.size();
+        collision::BroadPhaseCounters ignored;
+        reference_->findPairs(expected_, ignored);
+        const auto got = world.flaggedPairs();
+        if (std::equal(got.begin(), got.end(), expected_.begin(), expected_.end())) return {};
+        std::vector<collision::ProxyPair> missing;
+        std::vector<collision::ProxyPair> extra;
+        std::set_difference(expected_.begin(), expected_.end(), got.begin(), got.end(),
+                            std::back_inserter(missing));
+        std::set_difference(got.begin(), got.end(), expected_.begin(), expected_.end(),
+                            std::back_inserter(extra));
+        std::ostringstream out;
+        const auto bodies = world.bodies();
+        auto describe = [&](const char* what, const std::vector<collision::ProxyPair>& list) {
+            out << "  " << what << " (" << list.size() << "):";
+            for (std::size_t k = 0; k < list.size() && k < 20; ++k) {
+                out << " (" << list[k].a << " " << bodies[list[k].a].name << ", " << list[k].b
+                    << " " << bodies[list[k].b].name << ")";
+            }
+            out << (list.size() > 20 ? " ..." : "") << "\n";
+        };
+        out << "broad phase '" << world.broadPhase().name() << "' reports " << got.size()
+            << " pairs, reference '" << reference_name_ << "' reports " << expected_.size()
+            << "\n";
+        describe("missed", missing);
+        describe("extra", extra);
+        return out.str();
+    }
+
+private:
+    std::string reference_name_;
+    std::unique_ptr<collision::BroadPhase> reference_;
+    std::vector<collision::ProxyPair> expected_;
+    std::size_t inserted_ = 0;
 };
 
 std::string frameName(int frame) {
@@ -132,6 +230,9 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
     try {
         prepareOutputDir(out_dir);
         if (want_video && video_path.has_parent_path()) prepareOutputDir(video_path.parent_path());
+        if (options.stats_csv && options.stats_csv->has_parent_path()) {
+            prepareOutputDir(options.stats_csv->parent_path());
+        }
         std::error_code ec;
         fs::remove(out_dir / "summary.json", ec);
 
@@ -147,17 +248,39 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         render::FrameOptions pause_options = frame_options;
         pause_options.draw.sphere = pause_options.draw.aabb = pause_options.draw.obb = true;
 
+        std::unique_ptr<BroadPhaseChecker> checker;
+        if (options.check_broad_phase) {
+            checker = std::make_unique<BroadPhaseChecker>(scene.world.broad_phase);
+        }
+        std::string stats_text;
+        if (options.stats_csv) stats_text = kStatsHeader;
         ProgressBar progress(options.progress && ::isatty(STDERR_FILENO), scene.frames);
         std::int64_t flagged_total = 0;
         std::int64_t colliding_total = 0;
         double step_seconds = 0;
         for (int frame = 0; frame < scene.frames; ++frame) {
-            if (frame > 0) {
+            FrameStats frame_stats;
+            auto checkStep = [&](int step) -> bool {
+                if (!checker) return true;
+                const std::string report = checker->check(world);
+                if (report.empty()) return true;
+                err << "check-broadphase: MISMATCH at frame " << frame << ", step " << step
+                    << ", t=" << world.time() << " s\n"
+                    << report;
+                return false;
+            };
+            if (frame == 0) {
+                frame_stats.add(world.lastStats());
+                if (!checkStep(0)) return kExitCheckFailed;
+            } else {
                 for (int s = 0; s < scene.steps_per_frame; ++s) {
                     world.step();
+                    frame_stats.add(world.lastStats());
                     step_seconds += world.lastStats().total_s;
+                    if (!checkStep(static_cast<int>(world.stepCount()))) return kExitCheckFailed;
                 }
             }
+            if (options.stats_csv) stats_text += statsRow(frame, world, frame_stats);
             flagged_total += static_cast<std::int64_t>(world.flaggedPairs().size());
             colliding_total += static_cast<std::int64_t>(world.collidingPairs().size());
             frame_options.hud_text =
@@ -177,6 +300,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
             progress.update(frame + 1);
         }
         if (video) video->finish();
+        if (options.stats_csv) writeTextAtomically(*options.stats_csv, stats_text);
 
         nlohmann::ordered_json summary;
         summary["scene"] = options.scene.string();
@@ -191,13 +315,16 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         summary["mean_step_ms"] =
             world.stepCount() > 0 ? 1e3 * step_seconds / double(world.stepCount()) : 0.0;
         summary["video"] = want_video ? video_path.string() : "";
+        summary["checked_broadphase"] = options.check_broad_phase;
         writeTextAtomically(out_dir / "summary.json", summary.dump(1) + "\n");
 
         out << "wrote " << (options.no_frames ? 0 : scene.frames) << " frames to "
             << out_dir.string();
         if (want_video) out << " and " << video_path.string();
         out << " (" << world.bodies().size() << " bodies, " << world.stepCount() << " steps, "
-            << scene.world.broad_phase << ")\n";
+            << scene.world.broad_phase << (options.check_broad_phase ? ", every step checked"
+                                                                    : "")
+            << ")\n";
     } catch (const render::RenderError& e) {
         err << "error: " << e.what() << "\n";
         return kExitFailure;

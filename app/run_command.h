@@ -20,9 +20,12 @@ struct RunOptions {
     std::vector<int> pause_at;                ///< frames to dump
     bool hud_timing = true;                   ///< step time in the HUD (off: bit-identical frames)
     bool progress = true;                     ///< progress bar when stderr is a terminal
+    bool check_broad_phase = false;           ///< compare every step with the brute reference
+    std::optional<std::filesystem::path> stats_csv;  ///< one row of counters per frame
 };
 
-/// Exit codes: 0 success, 1 output or runtime failure, 2 bad input (scene, flags).
+/// Exit codes: 0 success, 1 output or runtime failure, 2 bad input (scene, flags),
+/// 3 --check-broadphase found a step where the broad phase differs from its reference.
 int runScene(const RunOptions& options, std::ostream& out, std::ostream& err);
 
 }  // namespace app

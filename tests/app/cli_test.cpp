@@ -81,7 +81,7 @@ TEST(Cli, RunWritesFramesVideoPauseDumpsAndSummary) {
     const nlohmann::json& left = p0["bodies"][0];
     EXPECT_EQ(left["name"], "left");
     EXPECT_EQ(left["shape"], "sphere");
-    EXPECT_EQ(left["position"][0], -0.6);
+    EXPECT_EQ(left["position"][0], -0.45);
     EXPECT_EQ(left["orientation_wxyz"].size(), 4u);
     EXPECT_NEAR(left["sphere"]["radius"].get<double>(), 0.5, 1e-9);
     EXPECT_EQ(left["aabb"]["min"].size(), 3u);

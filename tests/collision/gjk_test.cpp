@@ -12,8 +12,8 @@
 namespace {
 
 using collision::ConvexCore;
-using collision::GjkState;
 using collision::gjkDistance;
+using collision::GjkState;
 using collision::Pose;
 using collision::Quat;
 using collision::Real;
@@ -37,7 +37,7 @@ TEST(Gjk, PointToBoxMatchesClosedFormOnRandomPoses) {
     int overlapping = 0;
     for (int n = 0; n < 5000; ++n) {
         Pose pose_point;
-        pose_point.position = rng.vec(-4, 4);
+        pose_point.position = rng.vec(-2.5, 2.5);
         const RelativePose rel = relativePose(Pose{}, pose_point);
         const auto out = gjkDistance(core_box, point, rel, Real(3));
         const Real expected = pointBoxDistance(pose_point.position, box.half_extents);
@@ -82,8 +82,8 @@ TEST(Gjk, DegenerateInputNeverProducesNaN) {
     RelativePose same;
     for (const ConvexCore* a : {&zero_box, &point, &zero_segment, &flat_tri}) {
         for (const ConvexCore* b : {&zero_box, &point, &zero_segment, &flat_tri}) {
-            for (const Vec3& offset : {Vec3(0, 0, 0), Vec3(1e-300, 0, 0), Vec3(1, 1, 1),
-                                       Vec3(1e150, -1e150, 3)}) {
+            for (const Vec3& offset :
+                 {Vec3(0, 0, 0), Vec3(1e-300, 0, 0), Vec3(1, 1, 1), Vec3(1e150, -1e150, 3)}) {
                 RelativePose rel;
                 rel.position = offset;
                 const auto out = gjkDistance(*a, *b, rel, Real(1));

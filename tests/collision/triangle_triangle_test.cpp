@@ -95,16 +95,16 @@ struct Tri {
 
 // Every vertex order of both triangles and both argument orders must agree.
 bool intersectAllOrders(const Tri& t1, const Tri& t2, bool expected) {
-    const std::array<std::array<int, 3>, 6> perms{{{0, 1, 2}, {1, 2, 0}, {2, 0, 1}, {0, 2, 1},
-                                                   {2, 1, 0}, {1, 0, 2}}};
+    const std::array<std::array<int, 3>, 6> perms{
+        {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}, {0, 2, 1}, {2, 1, 0}, {1, 0, 2}}};
     const std::array<Vec3, 3> v1{t1.p, t1.q, t1.r};
     const std::array<Vec3, 3> v2{t2.p, t2.q, t2.r};
     for (const auto& a : perms) {
         for (const auto& b : perms) {
-            const bool x = testTriangleTriangle(v1[a[0]], v1[a[1]], v1[a[2]], v2[b[0]], v2[b[1]],
-                                                v2[b[2]]);
-            const bool y = testTriangleTriangle(v2[b[0]], v2[b[1]], v2[b[2]], v1[a[0]], v1[a[1]],
-                                                v1[a[2]]);
+            const bool x =
+                testTriangleTriangle(v1[a[0]], v1[a[1]], v1[a[2]], v2[b[0]], v2[b[1]], v2[b[2]]);
+            const bool y =
+                testTriangleTriangle(v2[b[0]], v2[b[1]], v2[b[2]], v1[a[0]], v1[a[1]], v1[a[2]]);
             if (x != expected || y != expected) return false;
         }
     }
@@ -113,8 +113,8 @@ bool intersectAllOrders(const Tri& t1, const Tri& t2, bool expected) {
 
 TEST(TriangleTriangle, CrossingAndSeparated) {
     const Tri t1{Vec3(0, 0, 0), Vec3(2, 0, 0), Vec3(0, 2, 0)};
-    EXPECT_TRUE(intersectAllOrders(t1, {Vec3(0.5, 0.5, -1), Vec3(0.5, 0.5, 1), Vec3(3, 3, 0.5)},
-                                   true));
+    EXPECT_TRUE(
+        intersectAllOrders(t1, {Vec3(0.5, 0.5, -1), Vec3(0.5, 0.5, 1), Vec3(3, 3, 0.5)}, true));
     EXPECT_TRUE(intersectAllOrders(t1, {Vec3(5, 5, -1), Vec3(5, 5, 1), Vec3(6, 6, 0)}, false));
     // Plane crossing but beside the triangle (the line of intersection misses it).
     EXPECT_TRUE(intersectAllOrders(t1, {Vec3(3, -1, -1), Vec3(3, 3, -1), Vec3(3, 1, 1)}, false));
@@ -124,8 +124,8 @@ TEST(TriangleTriangle, CoplanarOverlapTouchAndMiss) {
     const Tri t1{Vec3(0, 0, 0), Vec3(4, 0, 0), Vec3(0, 4, 0)};
     EXPECT_TRUE(intersectAllOrders(t1, {Vec3(1, 1, 0), Vec3(5, 1, 0), Vec3(1, 5, 0)}, true));
     // Contained.
-    EXPECT_TRUE(intersectAllOrders(t1, {Vec3(0.5, 0.5, 0), Vec3(1, 0.5, 0), Vec3(0.5, 1, 0)},
-                                   true));
+    EXPECT_TRUE(
+        intersectAllOrders(t1, {Vec3(0.5, 0.5, 0), Vec3(1, 0.5, 0), Vec3(0.5, 1, 0)}, true));
     // Shared edge, triangles on opposite sides.
     EXPECT_TRUE(intersectAllOrders(t1, {Vec3(4, 0, 0), Vec3(0, 4, 0), Vec3(4, 4, 0)}, true));
     // Shared vertex only.
@@ -134,8 +134,7 @@ TEST(TriangleTriangle, CoplanarOverlapTouchAndMiss) {
     EXPECT_TRUE(intersectAllOrders(t1, {Vec3(2, 2, 0), Vec3(5, 3, 0), Vec3(3, 5, 0)}, true));
     // Near miss: the same, moved off the hypotenuse by one ulp of 2.
     const double off = std::nextafter(2.0, 3.0);
-    EXPECT_TRUE(intersectAllOrders(t1, {Vec3(off, off, 0), Vec3(5, 3, 0), Vec3(3, 5, 0)},
-                                   false));
+    EXPECT_TRUE(intersectAllOrders(t1, {Vec3(off, off, 0), Vec3(5, 3, 0), Vec3(3, 5, 0)}, false));
 }
 
 TEST(TriangleTriangle, NonCoplanarTouching) {
@@ -155,8 +154,7 @@ TEST(TriangleTriangle, NonCoplanarTouching) {
     const double beyond = std::nextafter(2.0, 3.0);
     EXPECT_TRUE(intersectAllOrders(
         t1, {Vec3(beyond, beyond, -1), Vec3(beyond, beyond, 1), Vec3(5, 5, 0)}, false));
-    EXPECT_TRUE(
-        intersectAllOrders(t1, {Vec3(2, 2, -1), Vec3(2, 2, 1), Vec3(5, 5, 0)}, true));
+    EXPECT_TRUE(intersectAllOrders(t1, {Vec3(2, 2, -1), Vec3(2, 2, 1), Vec3(5, 5, 0)}, true));
 }
 
 TEST(TriangleTriangle, DegenerateTrianglesAreSegments) {
@@ -232,9 +230,9 @@ TEST(TriangleTriangle, RandomGridTrianglesMatchExactSeparatingAxes) {
             auto v = [&](const IVec& p) {
                 return Vec3(p[0] * unit + shift, p[1] * unit + shift, p[2] * unit + shift);
             };
-            ASSERT_EQ(testTriangleTriangle(v(t1[0]), v(t1[1]), v(t1[2]), v(t2[0]), v(t2[1]),
-                                           v(t2[2])),
-                      expected)
+            ASSERT_EQ(
+                testTriangleTriangle(v(t1[0]), v(t1[1]), v(t1[2]), v(t2[0]), v(t2[1]), v(t2[2])),
+                expected)
                 << "pair " << n;
         }
         expected ? ++hits : ++misses;

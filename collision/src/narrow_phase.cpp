@@ -1,0 +1,472 @@
+// collision/src/narrow_phase.cpp -- collide(): dispatch through a [ShapeType][ShapeType] table of
+// free functions (each pair written once; the swapped flag reorders the arguments), closed forms
+// for sphere/box/capsule pairs, GJK (gjk.h) for every other convex pair, triangle-level tests for
+// meshes.
+// Invariants: every pair routine computes in the first shape's frame from one RelativePose built
+// by subtracting positions first; the touching tolerance is kTouchRelativeTolerance times the
+// larger bounding radius of the two shapes, and |signed distance| <= tolerance is Touching in
+// every routine; collide(a, b) and collide(b, a) run the same routine on the same arguments
+// (pairs of one type are ordered by a canonical key), so they return identical outputs.
+#include "collision/narrow_phase.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <vector>
+
+#include "collision/assert.h"
+#include "gjk.h"
+#include "triangle_triangle.h"
+
+namespace collision {
+
+namespace {
+
+struct PairContext {
+    Real tolerance = 0;  ///< absolute touching tolerance
+    Real scale = 0;      ///< larger bounding radius of the two shapes
+};
+
+using PairFn = CollideOutput (*)(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                                 const PairContext& ctx);
+
+// Segment between the closest points of segments p1q1 and p2q2: RTCD 5.1.9, with the parallel
+// test relative (denominator a*e - b^2 = a*e*sin^2(angle)) so near-parallel segments take the
+// robust branch; degenerate segments (points) are handled.
+Real distanceSegmentSegment(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2,
+                            Real length_epsilon) {
+    const Vec3 d1 = q1 - p1;
+    const Vec3 d2 = q2 - p2;
+    const Vec3 r = p1 - p2;
+    const Real a = d1.squaredNorm();
+    const Real e = d2.squaredNorm();
+    const Real f = d2.dot(r);
+    const Real eps2 = length_epsilon * length_epsilon;
+    Real s = 0;
+    Real t = 0;
+    if (a <= eps2 && e <= eps2) {
+        s = t = 0;
+    } else if (a <= eps2) {
+        t = std::clamp(f / e, Real(0), Real(1));
+    } else {
+        const Real c = d1.dot(r);
+        if (e <= eps2) {
+            s = std::clamp(-c / a, Real(0), Real(1));
+        } else {
+            const Real b = d1.dot(d2);
+            const Real denom = a * e - b * b;
+            // Parallel (up to rounding): any s works; s = 0, then t and s are re-optimised below.
+            if (denom > Real(16) * kEpsilon * a * e) {
+                s = std::clamp((b * f - c * e) / denom, Real(0), Real(1));
+            }
+            t = (b * s + f) / e;
+            if (t < 0) {
+                t = 0;
+                s = std::clamp(-c / a, Real(0), Real(1));
+            } else if (t > 1) {
+                t = 1;
+                s = std::clamp((b - c) / a, Real(0), Real(1));
+            }
+        }
+    }
+    return ((p1 + d1 * s) - (p2 + d2 * t)).norm();
+}
+
+// ---- Closed forms. Signed distance: positive gap, or minus the penetration depth. ----
+
+CollideOutput collideSphereSphere(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                                  const PairContext& ctx) {
+    return classifySignedDistance(b_in_a.position.norm() - a.radius - b.radius, ctx.tolerance);
+}
+
+// RTCD 5.1.3 (closest point on an OBB), in the box frame; inside the box the depth is the radius
+// plus the distance to the nearest face.
+CollideOutput collideSphereBox(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                               const PairContext& ctx) {
+    const Vec3 center = -(b_in_a.rotation.transpose() * b_in_a.position);
+    const Vec3& h = b.half_extents;
+    const Vec3 closest = center.cwiseMax(-h).cwiseMin(h);
+    const Vec3 outside = center - closest;
+    if (!outside.isZero()) {
+        return classifySignedDistance(outside.norm() - a.radius, ctx.tolerance);
+    }
+    const Real face_gap = (h - center.cwiseAbs()).minCoeff();
+    return classifySignedDistance(-(face_gap + a.radius), ctx.tolerance);
+}
+
+// RTCD 5.1.2: the sphere centre against the capsule's segment, in the capsule frame.
+CollideOutput collideSphereCapsule(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                                   const PairContext& ctx) {
+    const Vec3 center = -(b_in_a.rotation.transpose() * b_in_a.position);
+    const Vec3 closest(0, std::clamp(center.y(), -b.half_height, b.half_height), 0);
+    return classifySignedDistance((center - closest).norm() - a.radius - b.radius, ctx.tolerance);
+}
+
+CollideOutput collideCapsuleCapsule(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                                    const PairContext& ctx) {
+    const Vec3 tip_a(0, a.half_height, 0);
+    const Vec3 tip_b = b_in_a.rotation.col(1) * b.half_height;
+    const Real d = distanceSegmentSegment(-tip_a, tip_a, b_in_a.position - tip_b,
+                                          b_in_a.position + tip_b, kEpsilon * ctx.scale);
+    return classifySignedDistance(d - a.radius - b.radius, ctx.tolerance);
+}
+
+// Capsule-box: GJK on segment vs box, inflated by the radius (distance(segment, box) <= r).
+CollideOutput collideCapsuleBox(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                                const PairContext& ctx) {
+    return collideConvexCores(ConvexCore::fromShape(a), ConvexCore::fromShape(b), b_in_a,
+                              ctx.tolerance, ctx.scale);
+}
+
+CollideOutput collideConvexGeneric(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                                   const PairContext& ctx) {
+    return collideConvexCores(ConvexCore::fromShape(a), ConvexCore::fromShape(b), b_in_a,
+                              ctx.tolerance, ctx.scale);
+}
+
+// 15-axis separating-axis test in A's frame (RTCD 4.4.1; Gottschalk et al. 1996 §4). For boxes the
+// minimum overlap over these axes is the exact penetration depth (the axes include every face
+// normal of the Minkowski difference), and a positive maximum gap is a lower bound on the
+// distance. Each axis carries a rounding bound (gap error <= 8 eps (|t.L| + ra + rb) / |L|), and
+// only verdicts that survive it are taken here; the rest, and every Separated distance, go to GJK.
+// Cross axes of (nearly) parallel edges, |L|^2 < kParallelCross, are skipped: their planes are
+// covered by face axes up to the rounding the bound would report anyway.
+CollideOutput collideBoxBox(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                            const PairContext& ctx) {
+    constexpr Real kParallelCross = Real(1e-12);
+    const Mat3& rot = b_in_a.rotation;
+    const Vec3& t = b_in_a.position;
+    const Vec3& ea = a.half_extents;
+    const Vec3& eb = b.half_extents;
+    Real gap_lo = -std::numeric_limits<Real>::infinity();  // max over axes of gap - error
+    Real gap_hi = -std::numeric_limits<Real>::infinity();  // max over axes of gap + error
+    auto testAxis = [&](const Vec3& axis) {
+        const Real len2 = axis.squaredNorm();
+        if (len2 < kParallelCross) return;
+        const Real ra = ea.dot(axis.cwiseAbs());
+        const Real rb = eb.dot((rot.transpose() * axis).cwiseAbs());
+        const Real dist = std::abs(t.dot(axis));
+        const Real inv_len = 1 / std::sqrt(len2);
+        const Real gap = (dist - ra - rb) * inv_len;
+        const Real err = Real(8) * kEpsilon * (dist + ra + rb) * inv_len;
+        gap_lo = std::max(gap_lo, gap - err);
+        gap_hi = std::max(gap_hi, gap + err);
+    };
+    for (int i = 0; i < 3; ++i) testAxis(Vec3::Unit(i));
+    for (int j = 0; j < 3; ++j) testAxis(rot.col(j));
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) testAxis(Vec3::Unit(i).cross(rot.col(j)));
+    }
+    CollideOutput out;
+    if (gap_hi < -ctx.tolerance) {
+        out.state = ContactState::Penetrating;  // exact depth > tolerance
+        return out;
+    }
+    if (gap_lo >= -ctx.tolerance && gap_hi <= 0) {
+        out.state = ContactState::Touching;  // depth in [0, tolerance]
+        return out;
+    }
+    // Separated or undecided by the axes: GJK gives the distance (or the EPA decision).
+    out = collideConvexCores(ConvexCore::fromShape(a), ConvexCore::fromShape(b), b_in_a,
+                             ctx.tolerance, ctx.scale);
+    if (out.state == ContactState::Separated) {
+        // GJK's |v| is accurate to rounding; the axes' gap is a proven lower bound.
+        out.distance = std::max(out.distance, gap_lo);
+    } else if (gap_lo > ctx.tolerance) {
+        // The axes prove a gap; a disagreeing GJK can only be rounding.
+        out.state = ContactState::Separated;
+        out.distance = gap_lo;
+    }
+    return out;
+}
+
+// ---- Meshes: surfaces, tested triangle by triangle. ----
+
+struct Box3 {
+    Vec3 min = Vec3::Constant(std::numeric_limits<Real>::infinity());
+    Vec3 max = Vec3::Constant(-std::numeric_limits<Real>::infinity());
+    void add(const Vec3& p) {
+        min = min.cwiseMin(p);
+        max = max.cwiseMax(p);
+    }
+    void inflate(Real r) {
+        min.array() -= r;
+        max.array() += r;
+    }
+    bool overlaps(const Box3& o) const {
+        return (min.array() <= o.max.array()).all() && (o.min.array() <= max.array()).all();
+    }
+};
+
+Box3 triangleBox(const Vec3& p, const Vec3& q, const Vec3& r) {
+    Box3 box;
+    box.add(p);
+    box.add(q);
+    box.add(r);
+    return box;
+}
+
+// A triangle of the mesh against the convex shape: GJK on the triangle as a 3-point convex set.
+// A Penetrating triangle ends the scan; Touching ones do not, so the state (Penetrating over
+// Touching) does not depend on triangle order.
+CollideOutput collideMeshConvex(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                                const PairContext& ctx) {
+    CDLAB_ASSERT(a.mesh, "mesh shape without triangles");
+    const TriangleMesh& mesh = *a.mesh;
+    const ConvexCore core_b = ConvexCore::fromShape(b);
+    // B's exact AABB in A's frame from its support points along A's axes.
+    Box3 box_b;
+    for (int k = 0; k < 3; ++k) {
+        const Vec3 axis_in_b = b_in_a.rotation.row(k).transpose();
+        const Real hi = b_in_a.position[k] + b_in_a.rotation.row(k).dot(core_b.support(axis_in_b));
+        const Real lo = b_in_a.position[k] + b_in_a.rotation.row(k).dot(core_b.support(-axis_in_b));
+        box_b.min[k] = lo;
+        box_b.max[k] = hi;
+    }
+    box_b.inflate(core_b.radius + ctx.tolerance);
+
+    CollideOutput out;
+    out.state = ContactState::Separated;
+    bool touching = false;
+    bool failed = false;
+    for (const auto& tri : mesh.triangles) {
+        const Vec3& p = mesh.vertices[static_cast<std::size_t>(tri[0])];
+        const Vec3& q = mesh.vertices[static_cast<std::size_t>(tri[1])];
+        const Vec3& r = mesh.vertices[static_cast<std::size_t>(tri[2])];
+        if (!triangleBox(p, q, r).overlaps(box_b)) continue;
+        ++out.triangle_tests;
+        const CollideOutput res = collideConvexCores(ConvexCore::triangle(p, q, r), core_b, b_in_a,
+                                                     ctx.tolerance, ctx.scale);
+        out.iterations += res.iterations;
+        if (res.state == ContactState::Penetrating) {
+            out.state = ContactState::Penetrating;
+            return out;
+        }
+        touching = touching || res.state == ContactState::Touching;
+        failed = failed || res.state == ContactState::Failed;
+    }
+    if (touching) {
+        out.state = ContactState::Touching;
+    } else if (failed) {
+        out.state = ContactState::Failed;
+    }
+    return out;
+}
+
+// Does triangle (p, q, r) have corners farther than `tolerance` on both sides of the plane of
+// (u, v, w)? Two intersecting triangles that each straddle the other's plane cross (Penetrating);
+// otherwise they only touch.
+bool straddles(const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& u, const Vec3& v,
+               const Vec3& w, Real tolerance) {
+    const Vec3 n = (v - u).cross(w - u);
+    const Real len = n.norm();
+    if (!(len > 0)) return false;
+    const Vec3 unit = n / len;
+    const Real dp = unit.dot(p - u);
+    const Real dq = unit.dot(q - u);
+    const Real dr = unit.dot(r - u);
+    return std::max({dp, dq, dr}) > tolerance && std::min({dp, dq, dr}) < -tolerance;
+}
+
+// Mesh-mesh: B's vertices go to A's frame once; each mesh's triangles are culled against the
+// other's (tolerance-inflated) AABB, and the survivors are tested pairwise with the exact
+// triangle-triangle test. Brute force over survivors; hierarchies come later.
+CollideOutput collideMeshMesh(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                              const PairContext& ctx) {
+    CDLAB_ASSERT(a.mesh && b.mesh, "mesh shape without triangles");
+    const TriangleMesh& mesh_a = *a.mesh;
+    const TriangleMesh& mesh_b = *b.mesh;
+    // Scratch reused across calls: no allocation per pair once warm.
+    thread_local std::vector<Vec3> vertices_b;
+    thread_local std::vector<std::int32_t> survivors_a;
+    thread_local std::vector<std::int32_t> survivors_b;
+    thread_local std::vector<Box3> boxes_b;
+    vertices_b.resize(mesh_b.vertices.size());
+    for (std::size_t i = 0; i < mesh_b.vertices.size(); ++i) {
+        vertices_b[i] = b_in_a.rotation * mesh_b.vertices[i] + b_in_a.position;
+    }
+    Box3 box_a;
+    for (const Vec3& p : mesh_a.vertices) box_a.add(p);
+    Box3 box_b;
+    for (const Vec3& p : vertices_b) box_b.add(p);
+    box_a.inflate(ctx.tolerance);
+    box_b.inflate(ctx.tolerance);
+
+    survivors_a.clear();
+    for (std::size_t i = 0; i < mesh_a.triangles.size(); ++i) {
+        const auto& tri = mesh_a.triangles[i];
+        if (triangleBox(mesh_a.vertices[static_cast<std::size_t>(tri[0])],
+                        mesh_a.vertices[static_cast<std::size_t>(tri[1])],
+                        mesh_a.vertices[static_cast<std::size_t>(tri[2])])
+                .overlaps(box_b)) {
+            survivors_a.push_back(static_cast<std::int32_t>(i));
+        }
+    }
+    survivors_b.clear();
+    boxes_b.clear();
+    for (std::size_t j = 0; j < mesh_b.triangles.size(); ++j) {
+        const auto& tri = mesh_b.triangles[j];
+        const Box3 box = triangleBox(vertices_b[static_cast<std::size_t>(tri[0])],
+                                     vertices_b[static_cast<std::size_t>(tri[1])],
+                                     vertices_b[static_cast<std::size_t>(tri[2])]);
+        if (box.overlaps(box_a)) {
+            survivors_b.push_back(static_cast<std::int32_t>(j));
+            boxes_b.push_back(box);
+        }
+    }
+
+    CollideOutput out;
+    out.state = ContactState::Separated;
+    bool touching = false;
+    for (const std::int32_t i : survivors_a) {
+        const auto& ta = mesh_a.triangles[static_cast<std::size_t>(i)];
+        const Vec3& p1 = mesh_a.vertices[static_cast<std::size_t>(ta[0])];
+        const Vec3& q1 = mesh_a.vertices[static_cast<std::size_t>(ta[1])];
+        const Vec3& r1 = mesh_a.vertices[static_cast<std::size_t>(ta[2])];
+        Box3 box1 = triangleBox(p1, q1, r1);
+        box1.inflate(ctx.tolerance);
+        for (std::size_t k = 0; k < survivors_b.size(); ++k) {
+            if (!box1.overlaps(boxes_b[k])) continue;
+            const auto& tb = mesh_b.triangles[static_cast<std::size_t>(survivors_b[k])];
+            const Vec3& p2 = vertices_b[static_cast<std::size_t>(tb[0])];
+            const Vec3& q2 = vertices_b[static_cast<std::size_t>(tb[1])];
+            const Vec3& r2 = vertices_b[static_cast<std::size_t>(tb[2])];
+            ++out.triangle_tests;
+            if (!testTriangleTriangle(p1, q1, r1, p2, q2, r2)) continue;
+            if (straddles(p1, q1, r1, p2, q2, r2, ctx.tolerance) &&
+                straddles(p2, q2, r2, p1, q1, r1, ctx.tolerance)) {
+                out.state = ContactState::Penetrating;
+                return out;
+            }
+            touching = true;
+        }
+    }
+    if (touching) out.state = ContactState::Touching;
+    return out;
+}
+
+// ---- Dispatch. ----
+
+struct PairEntry {
+    PairFn fn = nullptr;
+    bool swapped = false;  ///< call fn(b, a): the routine is written for (column, row) types
+};
+
+using PairTable = std::array<std::array<PairEntry, kShapeTypeCount>, kShapeTypeCount>;
+
+constexpr PairTable makePairTable() {
+    PairTable table{};
+    auto set = [&table](ShapeType first, ShapeType second, PairFn fn) {
+        const auto i = static_cast<std::size_t>(first);
+        const auto j = static_cast<std::size_t>(second);
+        table[i][j] = PairEntry{fn, false};
+        if (i != j) table[j][i] = PairEntry{fn, true};
+    };
+    constexpr std::array<ShapeType, 4> kConvex{ShapeType::Sphere, ShapeType::Box,
+                                               ShapeType::Capsule, ShapeType::ConvexHull};
+    // GJK covers every convex pair first; closed forms override it (Jolt, parry).
+    for (const ShapeType s : kConvex) {
+        for (const ShapeType t : kConvex) set(s, t, collideConvexGeneric);
+        set(ShapeType::Mesh, s, collideMeshConvex);
+    }
+    set(ShapeType::Mesh, ShapeType::Mesh, collideMeshMesh);
+    set(ShapeType::Sphere, ShapeType::Sphere, collideSphereSphere);
+    set(ShapeType::Sphere, ShapeType::Box, collideSphereBox);
+    set(ShapeType::Sphere, ShapeType::Capsule, collideSphereCapsule);
+    set(ShapeType::Capsule, ShapeType::Capsule, collideCapsuleCapsule);
+    set(ShapeType::Capsule, ShapeType::Box, collideCapsuleBox);
+    set(ShapeType::Box, ShapeType::Box, collideBoxBox);
+    return table;
+}
+
+constexpr PairTable kPairTable = makePairTable();
+
+// Largest distance of the shape from its local origin: the length scale of its coordinates.
+Real boundingRadius(const Shape& shape) {
+    switch (shape.type) {
+        case ShapeType::Sphere:
+            return shape.radius;
+        case ShapeType::Box:
+            return shape.half_extents.norm();
+        case ShapeType::Capsule:
+            return shape.half_height + shape.radius;
+        case ShapeType::ConvexHull:
+        case ShapeType::Mesh:
+            return ConvexCore::fromShape(shape).boundingRadius();
+    }
+    return 0;
+}
+
+bool isFinite(const Shape& shape, const Pose& pose) {
+    return std::isfinite(shape.radius) && std::isfinite(shape.half_height) &&
+           shape.half_extents.allFinite() && pose.position.allFinite() &&
+           pose.orientation.coeffs().allFinite();
+}
+
+// A strict order on (shape, pose) used to run same-type pairs in one canonical order.
+bool canonicalLess(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b) {
+    const std::array<Real, 14> ka{pose_a.position.x(),
+                                  pose_a.position.y(),
+                                  pose_a.position.z(),
+                                  pose_a.orientation.w(),
+                                  pose_a.orientation.x(),
+                                  pose_a.orientation.y(),
+                                  pose_a.orientation.z(),
+                                  a.radius,
+                                  a.half_height,
+                                  a.half_extents.x(),
+                                  a.half_extents.y(),
+                                  a.half_extents.z(),
+                                  0,
+                                  0};
+    const std::array<Real, 14> kb{pose_b.position.x(),
+                                  pose_b.position.y(),
+                                  pose_b.position.z(),
+                                  pose_b.orientation.w(),
+                                  pose_b.orientation.x(),
+                                  pose_b.orientation.y(),
+                                  pose_b.orientation.z(),
+                                  b.radius,
+                                  b.half_height,
+                                  b.half_extents.x(),
+                                  b.half_extents.y(),
+                                  b.half_extents.z(),
+                                  0,
+                                  0};
+    if (ka != kb) return ka < kb;
+    if (a.hull != b.hull) return std::less<const ConvexPolytope*>()(a.hull.get(), b.hull.get());
+    return std::less<const TriangleMesh*>()(a.mesh.get(), b.mesh.get());
+}
+
+}  // namespace
+
+CollideOutput collide(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b) {
+    if (!isFinite(a, pose_a) || !isFinite(b, pose_b)) {
+        CollideOutput failed;
+        failed.state = ContactState::Failed;
+        return failed;
+    }
+    const PairEntry& entry =
+        kPairTable[static_cast<std::size_t>(a.type)][static_cast<std::size_t>(b.type)];
+    CDLAB_ASSERT(entry.fn != nullptr, "pair table hole");
+    bool swap = entry.swapped;
+    if (a.type == b.type) swap = canonicalLess(b, pose_b, a, pose_a);
+    const Shape& first = swap ? b : a;
+    const Shape& second = swap ? a : b;
+    const Pose& pose_first = swap ? pose_b : pose_a;
+    const Pose& pose_second = swap ? pose_a : pose_b;
+
+    PairContext ctx;
+    ctx.scale = std::max(boundingRadius(a), boundingRadius(b));
+    ctx.tolerance = kTouchRelativeTolerance * ctx.scale;
+    CollideOutput out = entry.fn(first, second, relativePose(pose_first, pose_second), ctx);
+    if (!std::isfinite(out.distance)) {
+        out.state = ContactState::Failed;
+        out.distance = 0;
+    }
+    return out;
+}
+
+}  // namespace collision

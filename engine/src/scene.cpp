@@ -1,0 +1,709 @@
+// engine/src/scene.cpp -- YAML scene files -> Scene (validated) -> World. yaml-cpp stays here.
+// Every value is checked where it is read, and every failure throws SceneError with the yaml
+// node's position, "FILE:LINE:COL: key.path: what is wrong", so no NaN/Inf, unknown key or
+// out-of-range value gets past this file. Hull and mesh bodies are built once per
+// (file, scale, shape) and share their geometry.
+//
+// Conventions: `position` is the body's centre of mass (hull and mesh vertices are re-centred
+// on it); `euler_deg: [x, y, z]` is intrinsic X, then Y, then Z, i.e. R = Rx(x) Ry(y) Rz(z);
+// `angular_velocity` is in the world frame.
+#include "engine/scene.h"
+
+#include <yaml-cpp/depthguard.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <initializer_list>
+#include <map>
+#include <memory>
+#include <numbers>
+#include <set>
+#include <sstream>
+#include <string_view>
+#include <system_error>
+#include <tuple>
+#include <utility>
+
+#include "collision/broad_phase.h"
+#include "collision/convex_hull.h"
+#include "engine/mass_properties.h"
+#include "engine/mesh_import.h"
+
+namespace engine {
+
+namespace {
+
+namespace fs = std::filesystem;
+using collision::Shape;
+using collision::ShapeType;
+
+// A unit quaternion is recovered from wxyz only when its length is clearly non-zero.
+constexpr Real kMinQuaternionNorm = Real(1e-6);
+// `up` and the view direction count as parallel when the sine of their angle is below this.
+constexpr Real kMinUpSine = Real(1e-6);
+// Zero-volume boxes (allowed, with an explicit mass) keep every principal moment at least
+// m (kMinGyrationFraction L)^2, L = largest half extent (at least 1 mm), so I stays invertible.
+constexpr Real kMinGyrationFraction = Real(1e-3);
+
+constexpr std::string_view kBodyKeys[] = {
+    "name",  "shape",    "radius",           "half_height", "half_extents", "file",
+    "scale", "position", "orientation_wxyz", "euler_deg",   "velocity",     "angular_velocity",
+    "mass",  "density"};
+
+struct Entry {
+    std::string key;
+    YAML::Node key_node;
+    YAML::Node value;
+};
+
+std::string join(std::initializer_list<std::string_view> names) {
+    std::string out;
+    for (const std::string_view n : names) {
+        if (!out.empty()) out += ", ";
+        out += n;
+    }
+    return out;
+}
+
+std::string childPath(const std::string& path, const std::string& key) {
+    return path.empty() ? key : path + "." + key;
+}
+
+std::string indexPath(const std::string& path, std::size_t i) {
+    return path + "[" + std::to_string(i) + "]";
+}
+
+// Geometry imported for hull and mesh bodies: re-centred shape and its properties at density 1.
+struct PreparedShape {
+    Shape shape;
+    MassProperties unit;  // mass = volume
+};
+
+class SceneParser {
+  public:
+    SceneParser(std::string display_name, fs::path base_dir)
+        : file_(std::move(display_name)), base_dir_(std::move(base_dir)) {}
+
+    Scene parse(const std::string& text);
+
+  private:
+    [[noreturn]] void fail(const YAML::Mark& mark, const std::string& path,
+                           const std::string& what) const;
+    [[noreturn]] void fail(const YAML::Node& node, const std::string& path,
+                           const std::string& what) const {
+        fail(node.Mark(), path, what);
+    }
+
+    std::vector<Entry> entries(const YAML::Node& map, const std::string& path,
+                               std::initializer_list<std::string_view> allowed) const;
+    std::vector<Entry> entries(const YAML::Node& map, const std::string& path,
+                               const std::vector<std::string_view>& allowed) const;
+    const Entry* find(const std::vector<Entry>& es, std::string_view key) const;
+    const Entry& require(const std::vector<Entry>& es, std::string_view key,
+                         const YAML::Node& parent, const std::string& path) const;
+
+    Real readReal(const YAML::Node& n, const std::string& path) const;
+    int readInt(const YAML::Node& n, const std::string& path) const;
+    bool readBool(const YAML::Node& n, const std::string& path) const;
+    std::string readString(const YAML::Node& n, const std::string& path) const;
+    Vec3 readVec3(const YAML::Node& n, const std::string& path) const;
+
+    void parseWorld(const YAML::Node& n, Scene& scene) const;
+    void parseOutput(const YAML::Node& n, Scene& scene) const;
+    void parseCamera(const YAML::Node& n, Scene& scene) const;
+    void parseDraw(const YAML::Node& n, Scene& scene) const;
+    Body parseBody(const YAML::Node& n, std::size_t index, const Scene& scene);
+    const PreparedShape& prepareMeshShape(ShapeType type, const std::string& file, Real scale,
+                                          const Entry& file_entry, const std::string& path);
+
+    std::string file_;
+    fs::path base_dir_;
+    std::map<std::pair<std::string, Real>, std::shared_ptr<const MeshImportOutput>> import_cache_;
+    std::map<std::tuple<std::string, Real, int>, PreparedShape> mesh_cache_;
+};
+
+// Control characters from the file are escaped and very long messages are cut, so an error
+// line stays one printable line whatever the input.
+std::string printable(const std::string& text) {
+    constexpr std::size_t kMaxMessage = 1000;
+    std::string out;
+    for (const char ch : text) {
+        const auto c = static_cast<unsigned char>(ch);
+        if (c < 0x20 || c == 0x7f) {
+            constexpr char kHex[] = "0123456789abcdef";
+            out += "\\x";
+            out += kHex[c >> 4];
+            out += kHex[c & 15];
+        } else {
+            out += ch;
+        }
+        if (out.size() > kMaxMessage) return out + "...";
+    }
+    return out;
+}
+
+std::string formatMessage(const std::string& file, const YAML::Mark& mark, const std::string& path,
+                          const std::string& what) {
+    const int line = mark.is_null() || mark.line < 0 ? 1 : mark.line + 1;
+    const int col = mark.is_null() || mark.column < 0 ? 1 : mark.column + 1;
+    return file + ":" + std::to_string(line) + ":" + std::to_string(col) + ": " +
+           (path.empty() ? "scene" : path) + ": " + printable(what);
+}
+
+void SceneParser::fail(const YAML::Mark& mark, const std::string& path,
+                       const std::string& what) const {
+    throw SceneError(formatMessage(file_, mark, path, what));
+}
+
+std::vector<Entry> SceneParser::entries(const YAML::Node& map, const std::string& path,
+                                        std::initializer_list<std::string_view> allowed) const {
+    return entries(map, path, std::vector<std::string_view>(allowed));
+}
+
+// The keys of a mapping, in file order; unknown and duplicate keys are errors at the key.
+std::vector<Entry> SceneParser::entries(const YAML::Node& map, const std::string& path,
+                                        const std::vector<std::string_view>& allowed) const {
+    if (!map.IsMap()) {
+        std::string list;
+        for (const std::string_view a : allowed)
+            list += (list.empty() ? "" : ", ") + std::string(a);
+        fail(map, path, "expected a mapping with keys: " + list);
+    }
+    std::vector<Entry> out;
+    std::set<std::string> seen;
+    for (YAML::const_iterator it = map.begin(); it != map.end(); ++it) {
+        const YAML::Node key = it->first;
+        if (!key.IsScalar()) fail(key, path, "keys must be plain names");
+        const std::string name = key.Scalar();
+        bool known = false;
+        for (const std::string_view a : allowed) known = known || a == name;
+        if (!known) {
+            std::string list;
+            for (const std::string_view a : allowed) {
+                list += (list.empty() ? "" : ", ") + std::string(a);
+            }
+            fail(key, childPath(path, name),
+                 "unknown key '" + name + "' (expected one of: " + list + ")");
+        }
+        if (!seen.insert(name).second) fail(key, childPath(path, name), "duplicate key");
+        out.push_back(Entry{name, key, it->second});
+    }
+    return out;
+}
+
+const Entry* SceneParser::find(const std::vector<Entry>& es, std::string_view key) const {
+    for (const Entry& e : es) {
+        if (e.key == key) return &e;
+    }
+    return nullptr;
+}
+
+const Entry& SceneParser::require(const std::vector<Entry>& es, std::string_view key,
+                                  const YAML::Node& parent, const std::string& path) const {
+    const Entry* e = find(es, key);
+    if (e == nullptr) fail(parent, childPath(path, std::string(key)), "required key is missing");
+    return *e;
+}
+
+Real SceneParser::readReal(const YAML::Node& n, const std::string& path) const {
+    if (!n.IsScalar()) fail(n, path, "expected a number");
+    double v = 0;
+    try {
+        v = n.as<double>();
+    } catch (const YAML::Exception&) {
+        fail(n, path, "expected a number, got '" + n.Scalar() + "'");
+    }
+    if (!std::isfinite(v)) fail(n, path, "must be finite, got '" + n.Scalar() + "'");
+    const auto r = static_cast<Real>(v);
+    if (!std::isfinite(r)) fail(n, path, "out of range, got '" + n.Scalar() + "'");
+    return r;
+}
+
+int SceneParser::readInt(const YAML::Node& n, const std::string& path) const {
+    if (!n.IsScalar()) fail(n, path, "expected an integer");
+    try {
+        return n.as<int>();
+    } catch (const YAML::Exception&) {
+        fail(n, path, "expected an integer, got '" + n.Scalar() + "'");
+    }
+}
+
+bool SceneParser::readBool(const YAML::Node& n, const std::string& path) const {
+    if (!n.IsScalar()) fail(n, path, "expected true or false");
+    try {
+        return n.as<bool>();
+    } catch (const YAML::Exception&) {
+        fail(n, path, "expected true or false, got '" + n.Scalar() + "'");
+    }
+}
+
+std::string SceneParser::readString(const YAML::Node& n, const std::string& path) const {
+    if (!n.IsScalar()) fail(n, path, "expected a string");
+    return n.Scalar();
+}
+
+Vec3 SceneParser::readVec3(const YAML::Node& n, const std::string& path) const {
+    if (!n.IsSequence() || n.size() != 3) fail(n, path, "expected a list of 3 numbers");
+    Vec3 v;
+    for (std::size_t i = 0; i < 3; ++i) {
+        const YAML::Node e = n[i];
+        if (!e.IsScalar()) fail(e, indexPath(path, i), "expected a number");
+        v[static_cast<Eigen::Index>(i)] = readReal(e, indexPath(path, i));
+    }
+    return v;
+}
+
+void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
+    const std::string path = "world";
+    const std::vector<Entry> es =
+        entries(n, path, {"bounds", "gravity", "time_step", "steps_per_frame", "frames"});
+    {
+        const Entry& b = require(es, "bounds", n, path);
+        const std::string bp = childPath(path, "bounds");
+        const std::vector<Entry> be = entries(b.value, bp, {"min", "max"});
+        const Entry& lo = require(be, "min", b.value, bp);
+        const Entry& hi = require(be, "max", b.value, bp);
+        scene.world.bounds.min = readVec3(lo.value, childPath(bp, "min"));
+        scene.world.bounds.max = readVec3(hi.value, childPath(bp, "max"));
+        for (int a = 0; a < 3; ++a) {
+            if (!(scene.world.bounds.min[a] < scene.world.bounds.max[a])) {
+                fail(hi.value, childPath(bp, "max"),
+                     std::string("must be greater than min on every axis (axis ") + "xyz"[a] + ")");
+            }
+        }
+    }
+    for (const Entry& e : es) {
+        const std::string p = childPath(path, e.key);
+        if (e.key == "gravity") {
+            scene.world.gravity = readVec3(e.value, p);
+        } else if (e.key == "time_step") {
+            const Real dt = readReal(e.value, p);
+            if (!(dt > 0 && dt <= 1)) fail(e.value, p, "must be > 0 and <= 1 (seconds)");
+            scene.world.time_step = dt;
+        } else if (e.key == "steps_per_frame") {
+            scene.steps_per_frame = readInt(e.value, p);
+            if (scene.steps_per_frame < 1) fail(e.value, p, "must be >= 1");
+        } else if (e.key == "frames") {
+            scene.frames = readInt(e.value, p);
+            if (scene.frames < 1) fail(e.value, p, "must be >= 1");
+        }
+    }
+}
+
+void SceneParser::parseOutput(const YAML::Node& n, Scene& scene) const {
+    const std::string path = "output";
+    for (const Entry& e : entries(n, path, {"width", "height", "fps"})) {
+        const std::string p = childPath(path, e.key);
+        const int v = readInt(e.value, p);
+        if (e.key == "fps") {
+            if (v < 1 || v > 240) fail(e.value, p, "must be in 1..240");
+            scene.output.fps = v;
+        } else {
+            if (v < 16 || v > 8192) fail(e.value, p, "must be in 16..8192");
+            if (v % 2 != 0) fail(e.value, p, "must be even (video encoders need it)");
+            (e.key == "width" ? scene.output.width : scene.output.height) = v;
+        }
+    }
+}
+
+void SceneParser::parseCamera(const YAML::Node& n, Scene& scene) const {
+    const std::string path = "camera";
+    const std::vector<Entry> es = entries(n, path, {"position", "look_at", "up", "fov_deg"});
+    CameraSettings& cam = scene.camera;
+    for (const Entry& e : es) {
+        const std::string p = childPath(path, e.key);
+        if (e.key == "position") cam.position = readVec3(e.value, p);
+        if (e.key == "look_at") cam.look_at = readVec3(e.value, p);
+        if (e.key == "up") cam.up = readVec3(e.value, p);
+        if (e.key == "fov_deg") {
+            cam.fov_deg = readReal(e.value, p);
+            if (!(cam.fov_deg > 0 && cam.fov_deg < 180)) {
+                fail(e.value, p, "must be > 0 and < 180 (degrees)");
+            }
+        }
+    }
+    // Report a bad view at the key that was given last among the three.
+    const Entry* at = nullptr;
+    for (const Entry& e : es) {
+        if (e.key == "position" || e.key == "look_at" || e.key == "up") at = &e;
+    }
+    const YAML::Node where = at != nullptr ? at->value : n;
+    const std::string where_path = at != nullptr ? childPath(path, at->key) : path;
+    const Vec3 view = cam.look_at - cam.position;
+    const Real view_len = view.norm();
+    const Real up_len = cam.up.norm();
+    if (!(view_len > 0)) fail(where, where_path, "position and look_at must differ");
+    if (!(up_len > 0)) fail(where, where_path, "up must not be zero");
+    if (!(view.cross(cam.up).norm() > kMinUpSine * view_len * up_len)) {
+        fail(where, where_path, "up must not be parallel to the view direction");
+    }
+}
+
+void SceneParser::parseDraw(const YAML::Node& n, Scene& scene) const {
+    const std::string path = "draw";
+    DrawSettings& d = scene.draw;
+    for (const Entry& e : entries(n, path, {"bodies", "volumes", "bounds", "hud"})) {
+        const std::string p = childPath(path, e.key);
+        if (e.key == "bodies") d.bodies = readBool(e.value, p);
+        if (e.key == "bounds") d.bounds = readBool(e.value, p);
+        if (e.key == "hud") d.hud = readBool(e.value, p);
+        if (e.key == "volumes") {
+            if (!e.value.IsSequence()) fail(e.value, p, "expected a list of: sphere, aabb, obb");
+            d.sphere = d.aabb = d.obb = false;
+            for (std::size_t i = 0; i < e.value.size(); ++i) {
+                const std::string ip = indexPath(p, i);
+                const std::string v = readString(e.value[i], ip);
+                if (v == "sphere") {
+                    d.sphere = true;
+                } else if (v == "aabb") {
+                    d.aabb = true;
+                } else if (v == "obb") {
+                    d.obb = true;
+                } else {
+                    fail(e.value[i], ip,
+                         "unknown volume '" + v + "' (expected one of: sphere, aabb, obb)");
+                }
+            }
+        }
+    }
+}
+
+const PreparedShape& SceneParser::prepareMeshShape(ShapeType type, const std::string& file,
+                                                   Real scale, const Entry& file_entry,
+                                                   const std::string& path) {
+    fs::path resolved = fs::path(file);
+    if (resolved.is_relative()) resolved = base_dir_ / resolved;
+    std::error_code ec;
+    fs::path canonical = fs::weakly_canonical(resolved, ec);
+    if (ec) canonical = resolved.lexically_normal();
+    const auto key = std::make_tuple(canonical.string(), scale, static_cast<int>(type));
+    if (const auto it = mesh_cache_.find(key); it != mesh_cache_.end()) return it->second;
+
+    // Errors about the file are reported at the `file:` key. One import per (file, scale), shared
+    // by the hull and mesh bodies made from it.
+    auto import_it = import_cache_.find({canonical.string(), scale});
+    if (import_it == import_cache_.end()) {
+        import_it =
+            import_cache_
+                .emplace(std::make_pair(canonical.string(), scale),
+                         std::make_shared<const MeshImportOutput>(importMesh(resolved, scale)))
+                .first;
+    }
+    const MeshImportOutput& imported = *import_it->second;
+    if (!imported.ok) fail(file_entry.key_node, path, imported.error);
+    const collision::ConvexHullOutput hull = collision::computeConvexHull(imported.mesh.vertices);
+    if (!hull.ok) {
+        fail(file_entry.key_node, path,
+             "cannot build the convex hull of '" + resolved.string() + "': " + hull.error);
+    }
+    // Mass properties of the solid the body is (the hull, or the mesh's own volume), then move
+    // the geometry so that the local origin is the centre of mass.
+    Shape raw =
+        type == ShapeType::ConvexHull
+            ? Shape::convexHull(std::make_shared<const collision::ConvexPolytope>(hull.hull))
+            : Shape::triangleMesh(std::make_shared<const collision::TriangleMesh>(imported.mesh),
+                                  std::make_shared<const collision::ConvexPolytope>(hull.hull));
+    const MassPropertiesOutput mp = computeMassProperties(raw, 1);
+    if (!mp.ok) fail(file_entry.key_node, path, "'" + resolved.string() + "': " + mp.error);
+    const Vec3 com = mp.props.center_of_mass;
+    collision::ConvexPolytope centred_hull = hull.hull;
+    for (Vec3& v : centred_hull.vertices) v -= com;
+    PreparedShape prepared;
+    prepared.unit = mp.props;
+    if (type == ShapeType::ConvexHull) {
+        prepared.shape = Shape::convexHull(
+            std::make_shared<const collision::ConvexPolytope>(std::move(centred_hull)));
+    } else {
+        collision::TriangleMesh centred_mesh = imported.mesh;
+        for (Vec3& v : centred_mesh.vertices) v -= com;
+        prepared.shape = Shape::triangleMesh(
+            std::make_shared<const collision::TriangleMesh>(std::move(centred_mesh)),
+            std::make_shared<const collision::ConvexPolytope>(std::move(centred_hull)));
+    }
+    return mesh_cache_.emplace(key, std::move(prepared)).first->second;
+}
+
+Body SceneParser::parseBody(const YAML::Node& n, std::size_t index, const Scene& scene) {
+    const std::string path = indexPath("bodies", index);
+    const std::vector<Entry> es =
+        entries(n, path, std::vector<std::string_view>(std::begin(kBodyKeys), std::end(kBodyKeys)));
+
+    // The shape first: it decides which keys apply.
+    const Entry& shape_entry = require(es, "shape", n, path);
+    const std::string shape_name = readString(shape_entry.value, childPath(path, "shape"));
+    ShapeType type = ShapeType::Sphere;
+    std::vector<std::string_view> shape_keys;
+    if (shape_name == "sphere") {
+        type = ShapeType::Sphere;
+        shape_keys = {"radius"};
+    } else if (shape_name == "box") {
+        type = ShapeType::Box;
+        shape_keys = {"half_extents"};
+    } else if (shape_name == "capsule") {
+        type = ShapeType::Capsule;
+        shape_keys = {"radius", "half_height"};
+    } else if (shape_name == "hull" || shape_name == "mesh") {
+        type = shape_name == "hull" ? ShapeType::ConvexHull : ShapeType::Mesh;
+        shape_keys = {"file", "scale"};
+    } else {
+        fail(shape_entry.value, childPath(path, "shape"),
+             "unknown shape '" + shape_name +
+                 "' (expected one of: " + join({"sphere", "box", "capsule", "hull", "mesh"}) + ")");
+    }
+    constexpr std::string_view kShapeSpecific[] = {"radius", "half_height", "half_extents", "file",
+                                                   "scale"};
+    for (const Entry& e : es) {
+        for (const std::string_view k : kShapeSpecific) {
+            if (e.key != k) continue;
+            bool applies = false;
+            for (const std::string_view s : shape_keys) applies = applies || s == k;
+            if (!applies) {
+                fail(e.key_node, childPath(path, e.key),
+                     "does not apply to shape '" + shape_name + "'");
+            }
+        }
+    }
+    // Pairs that exclude each other: reported at whichever comes second in the file.
+    constexpr std::pair<std::string_view, std::string_view> kExclusive[] = {
+        {"mass", "density"}, {"orientation_wxyz", "euler_deg"}};
+    for (const auto& [a, b] : kExclusive) {
+        const Entry* ea = find(es, a);
+        const Entry* eb = find(es, b);
+        if (ea != nullptr && eb != nullptr) {
+            const Entry* second = ea->key_node.Mark().pos > eb->key_node.Mark().pos ? ea : eb;
+            fail(second->key_node, childPath(path, second->key),
+                 "give either '" + std::string(a) + "' or '" + std::string(b) + "', not both");
+        }
+    }
+
+    std::string name = shape_name + std::to_string(index);
+    Vec3 position = Vec3::Zero();
+    Quat orientation = Quat::Identity();
+    Vec3 velocity = Vec3::Zero();
+    Vec3 angular_velocity = Vec3::Zero();
+    Real radius = 0;
+    Real half_height = 0;
+    Vec3 half_extents = Vec3::Zero();
+    Real scale = 1;
+    const Entry* file_entry = nullptr;
+    const Entry* mass_entry = nullptr;
+    const Entry* density_entry = nullptr;
+    Real mass = 0;
+    Real density = 1000;
+
+    require(es, "position", n, path);
+    for (const std::string_view k : shape_keys) {
+        if (k != "scale") require(es, k, n, path);
+    }
+    for (const Entry& e : es) {
+        const std::string p = childPath(path, e.key);
+        const YAML::Node& v = e.value;
+        if (e.key == "name") {
+            name = readString(v, p);
+        } else if (e.key == "radius") {
+            radius = readReal(v, p);
+            if (!(radius > 0)) fail(v, p, "must be > 0");
+        } else if (e.key == "half_height") {
+            half_height = readReal(v, p);
+            if (!(half_height >= 0)) fail(v, p, "must be >= 0");
+        } else if (e.key == "half_extents") {
+            half_extents = readVec3(v, p);
+            for (int a = 0; a < 3; ++a) {
+                if (!(half_extents[a] >= 0)) fail(v[a], indexPath(p, a), "must be >= 0");
+            }
+        } else if (e.key == "file") {
+            readString(v, p);
+            if (v.Scalar().empty()) fail(v, p, "must not be empty");
+            file_entry = &e;
+        } else if (e.key == "scale") {
+            scale = readReal(v, p);
+            if (!(scale > 0)) fail(v, p, "must be > 0");
+        } else if (e.key == "position") {
+            position = readVec3(v, p);
+            if (!scene.world.bounds.contains(position)) {
+                fail(v, p, "is outside the world bounds");
+            }
+        } else if (e.key == "orientation_wxyz") {
+            if (!v.IsSequence() || v.size() != 4) fail(v, p, "expected a list of 4 numbers");
+            Real q[4];
+            for (std::size_t i = 0; i < 4; ++i) q[i] = readReal(v[i], indexPath(p, i));
+            const Quat raw(q[0], q[1], q[2], q[3]);
+            const Real len = raw.norm();
+            if (!(len > kMinQuaternionNorm) || !std::isfinite(len)) {
+                fail(v, p, "must be a non-zero quaternion (it is normalised)");
+            }
+            orientation = Quat(raw.coeffs() / len);
+        } else if (e.key == "euler_deg") {
+            const Vec3 deg = readVec3(v, p);
+            const Vec3 rad = deg * (std::numbers::pi_v<Real> / 180);
+            // Intrinsic X, then Y, then Z: R = Rx Ry Rz.
+            orientation = Quat(Eigen::AngleAxis<Real>(rad.x(), Vec3::UnitX())) *
+                          Quat(Eigen::AngleAxis<Real>(rad.y(), Vec3::UnitY())) *
+                          Quat(Eigen::AngleAxis<Real>(rad.z(), Vec3::UnitZ()));
+            orientation.normalize();
+        } else if (e.key == "velocity") {
+            velocity = readVec3(v, p);
+        } else if (e.key == "angular_velocity") {
+            angular_velocity = readVec3(v, p);
+        } else if (e.key == "mass") {
+            mass = readReal(v, p);
+            if (!(mass > 0)) fail(v, p, "must be > 0 (kg)");
+            mass_entry = &e;
+        } else if (e.key == "density") {
+            density = readReal(v, p);
+            if (!(density > 0)) fail(v, p, "must be > 0 (kg/m^3)");
+            density_entry = &e;
+        }
+    }
+
+    // Geometry and its properties at density 1 (mass = volume).
+    Shape shape;
+    MassProperties unit;
+    // Mass problems are reported at `mass` or `density`, else at the shape's size key.
+    const Entry* mass_at = mass_entry != nullptr      ? mass_entry
+                           : density_entry != nullptr ? density_entry
+                                                      : find(es, shape_keys.front());
+    const std::string mass_path = childPath(path, mass_at->key);
+    const YAML::Node mass_node = mass_at->value;
+    if (type == ShapeType::ConvexHull || type == ShapeType::Mesh) {
+        const PreparedShape& prepared = prepareMeshShape(type, file_entry->value.Scalar(), scale,
+                                                         *file_entry, childPath(path, "file"));
+        shape = prepared.shape;
+        unit = prepared.unit;
+    } else {
+        shape = type == ShapeType::Sphere ? Shape::sphere(radius)
+                : type == ShapeType::Box  ? Shape::box(half_extents)
+                                          : Shape::capsule(radius, half_height);
+        const MassPropertiesOutput mp = computeMassProperties(shape, 1);
+        if (mp.ok) {
+            unit = mp.props;
+        } else if (type == ShapeType::Box) {
+            // A flat or degenerate box: only an explicit mass defines it. Thin-plate / rod limit
+            // of the cuboid formula, with a floor so that the inertia stays invertible.
+            if (mass_entry == nullptr) {
+                fail(find(es, "half_extents")->value, childPath(path, "half_extents"),
+                     "a box with zero volume needs 'mass' (a density gives it no mass)");
+            }
+            const Vec3 h2 = half_extents.cwiseProduct(half_extents);
+            const Real l = std::max(half_extents.maxCoeff(), Real(1e-3));
+            const Real floor2 = (kMinGyrationFraction * l) * (kMinGyrationFraction * l);
+            const Vec3 moments = (Vec3(h2.y() + h2.z(), h2.z() + h2.x(), h2.x() + h2.y()) / 3)
+                                     .cwiseMax(Vec3::Constant(floor2));
+            unit.mass = 1;  // per kg: scaled by the mass below
+            unit.inertia = moments.asDiagonal();
+        } else {
+            fail(mass_node, mass_path, mp.error);
+        }
+    }
+    const Real scale_to = mass_entry != nullptr ? mass / unit.mass : density;
+    MassProperties props = unit;
+    props.mass = unit.mass * scale_to;
+    props.inertia = unit.inertia * scale_to;
+    if (mass_entry != nullptr) props.mass = mass;
+    const Mat3 inv = props.inertia.inverse();
+    if (!std::isfinite(props.mass) || !(props.mass > 0) || !props.inertia.allFinite() ||
+        !inv.allFinite() || !(props.inertia.diagonal().minCoeff() > 0)) {
+        std::ostringstream what;
+        what << "gives degenerate mass properties (mass " << props.mass
+             << " kg): the body is too small, too large, too light or too heavy";
+        fail(mass_node, mass_path, what.str());
+    }
+
+    Body body = makeBody(std::move(name), std::move(shape), props);
+    body.position = position;
+    body.orientation = orientation;
+    body.linear_momentum = props.mass * velocity;
+    const Mat3 r = orientation.toRotationMatrix();
+    body.angular_momentum = r * props.inertia * r.transpose() * angular_velocity;
+    return body;
+}
+
+Scene SceneParser::parse(const std::string& text) {
+    YAML::Node root;
+    try {
+        root = YAML::Load(text);
+    } catch (const YAML::DeepRecursion& e) {
+        fail(e.mark, "malformed YAML", "nesting is too deep");
+    } catch (const YAML::ParserException& e) {
+        fail(e.mark, "malformed YAML", e.msg);
+    } catch (const YAML::Exception& e) {
+        fail(e.mark, "malformed YAML", e.msg);
+    }
+    Scene scene;
+    scene.name = fs::path(file_).stem().string();
+    if (!root.IsMap()) {
+        fail(root, "scene",
+             "expected a mapping with keys: world, broadphase, output, camera, draw, bodies");
+    }
+    const std::vector<Entry> es =
+        entries(root, "", {"world", "broadphase", "output", "camera", "draw", "bodies"});
+    parseWorld(require(es, "world", root, "").value, scene);
+    for (const Entry& e : es) {
+        if (e.key == "broadphase") {
+            const std::string name = readString(e.value, "broadphase");
+            if (collision::findBroadPhase(name) == nullptr) {
+                fail(e.value, "broadphase",
+                     "unknown broad phase '" + name +
+                         "' (expected one of: " + collision::broadPhaseNames() + ")");
+            }
+            scene.world.broad_phase = name;
+        } else if (e.key == "output") {
+            parseOutput(e.value, scene);
+        } else if (e.key == "camera") {
+            parseCamera(e.value, scene);
+        } else if (e.key == "draw") {
+            parseDraw(e.value, scene);
+        } else if (e.key == "bodies") {
+            if (e.value.IsNull()) continue;  // "bodies:" with nothing after it: no bodies
+            if (!e.value.IsSequence()) fail(e.value, "bodies", "expected a list of bodies");
+            for (std::size_t i = 0; i < e.value.size(); ++i) {
+                scene.bodies.push_back(parseBody(e.value[i], i, scene));
+            }
+        }
+    }
+    return scene;
+}
+
+}  // namespace
+
+Scene parseScene(const std::string& yaml_text, const std::string& display_name,
+                 const std::filesystem::path& base_dir) {
+    SceneParser parser(display_name, base_dir);
+    try {
+        return parser.parse(yaml_text);
+    } catch (const SceneError&) {
+        throw;
+    } catch (const YAML::Exception& e) {
+        // Safety net: any yaml-cpp failure not caught at its key still names a position.
+        throw SceneError(formatMessage(display_name, e.mark, "scene", e.msg));
+    } catch (const std::exception& e) {
+        throw SceneError(formatMessage(display_name, YAML::Mark::null_mark(), "scene", e.what()));
+    }
+}
+
+Scene loadScene(const std::filesystem::path& file) {
+    std::error_code ec;
+    if (!fs::is_regular_file(file, ec)) {
+        throw SceneError(file.string() + ":1:1: scene: cannot open the file (" +
+                         (fs::exists(file, ec) ? "not a regular file" : "no such file") + ")");
+    }
+    std::ifstream in(file, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (!in.good() && !in.eof()) {
+        throw SceneError(file.string() + ":1:1: scene: cannot read the file");
+    }
+    fs::path base = file.parent_path();
+    if (base.empty()) base = ".";
+    return parseScene(text.str(), file.string(), base);
+}
+
+World makeWorld(const Scene& scene) {
+    World world(scene.world);
+    for (const Body& b : scene.bodies) world.addBody(b);
+    world.detect();
+    return world;
+}
+
+}  // namespace engine

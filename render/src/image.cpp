@@ -1,0 +1,285 @@
+// render/src/image.cpp -- PNG files through libpng's simplified API, and the ffmpeg video pipe.
+// Invariant: an output file exists under its final name only when it is complete. Every writer
+// writes a sibling ".partial" file and renames it at the end; failures remove the partial file.
+#include "render/image.h"
+
+#include <fcntl.h>
+#include <png.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <string_view>
+#include <system_error>
+
+extern char** environ;
+
+namespace render {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string errnoText(int err) { return std::error_code(err, std::generic_category()).message(); }
+
+void removeQuietly(const fs::path& file) {
+    std::error_code ec;
+    fs::remove(file, ec);
+}
+
+// Writes to a pipe without letting SIGPIPE kill the process when the reader has died: the
+// signal is blocked in this thread for the duration, and a SIGPIPE raised by our write is
+// consumed before unblocking (the classic library-safe pattern; the process's handlers are
+// never touched). Returns false when the reader is gone or the write failed.
+class SigpipeGuard {
+public:
+    SigpipeGuard() {
+        sigemptyset(&pipe_set_);
+        sigaddset(&pipe_set_, SIGPIPE);
+        sigset_t pending;
+        sigemptyset(&pending);
+        sigpending(&pending);
+        was_pending_ = sigismember(&pending, SIGPIPE) == 1;
+        pthread_sigmask(SIG_BLOCK, &pipe_set_, &old_mask_);
+    }
+    ~SigpipeGuard() {
+        if (!was_pending_) {
+            // Swallow the SIGPIPE our own write raised, if any, so unblocking does not deliver it.
+            const timespec zero{0, 0};
+            while (sigtimedwait(&pipe_set_, nullptr, &zero) == SIGPIPE) {
+            }
+        }
+        pthread_sigmask(SIG_SETMASK, &old_mask_, nullptr);
+    }
+    SigpipeGuard(const SigpipeGuard&) = delete;
+    SigpipeGuard& operator=(const SigpipeGuard&) = delete;
+
+private:
+    sigset_t pipe_set_;
+    sigset_t old_mask_;
+    bool was_pending_ = false;
+};
+
+void checkImage(const Image& image, const char* what) {
+    if (image.width <= 0 || image.height <= 0 ||
+        image.rgb.size() != std::size_t(image.width) * std::size_t(image.height) * 3) {
+        throw RenderError(std::string(what) + ": image is " + std::to_string(image.width) + "x" +
+                          std::to_string(image.height) + " with " +
+                          std::to_string(image.rgb.size()) + " bytes (expected w*h*3)");
+    }
+}
+
+fs::path partialName(const fs::path& file) {
+    fs::path partial = file;
+    partial += ".partial";
+    return partial;
+}
+
+}  // namespace
+
+void writePng(const fs::path& file, const Image& image) {
+    checkImage(image, file.c_str());
+    const fs::path partial = partialName(file);
+    std::FILE* f = std::fopen(partial.c_str(), "wb");
+    if (!f) {
+        throw RenderError(file.string() + ": cannot write PNG: " + errnoText(errno));
+    }
+    png_image png{};
+    png.version = PNG_IMAGE_VERSION;
+    png.width = static_cast<png_uint_32>(image.width);
+    png.height = static_cast<png_uint_32>(image.height);
+    png.format = PNG_FORMAT_RGB;
+    const int ok = png_image_write_to_stdio(&png, f, 0, image.rgb.data(), 0, nullptr);
+    const std::string png_message = png.message;
+    png_image_free(&png);
+    const bool flushed = std::fflush(f) == 0 && std::ferror(f) == 0;
+    const int flush_errno = errno;
+    const bool closed = std::fclose(f) == 0;
+    if (!ok || !flushed || !closed) {
+        removeQuietly(partial);
+        throw RenderError(file.string() +
+                          ": cannot write PNG: " + (!ok ? png_message : errnoText(flush_errno)));
+    }
+    std::error_code ec;
+    fs::rename(partial, file, ec);
+    if (ec) {
+        removeQuietly(partial);
+        throw RenderError(file.string() + ": cannot rename " + partial.string() + ": " +
+                          ec.message());
+    }
+}
+
+Image readPng(const fs::path& file) {
+    png_image png{};
+    png.version = PNG_IMAGE_VERSION;
+    if (!png_image_begin_read_from_file(&png, file.c_str())) {
+        const std::string message = png.message;
+        png_image_free(&png);
+        throw RenderError(file.string() + ": cannot read PNG: " + message);
+    }
+    png.format = PNG_FORMAT_RGB;
+    Image image;
+    image.width = static_cast<int>(png.width);
+    image.height = static_cast<int>(png.height);
+    image.rgb.resize(PNG_IMAGE_SIZE(png));
+    // An alpha channel is composited onto black, the way a viewer without alpha shows it.
+    const png_color black{0, 0, 0};
+    if (!png_image_finish_read(&png, &black, image.rgb.data(), 0, nullptr)) {
+        const std::string message = png.message;
+        png_image_free(&png);
+        throw RenderError(file.string() + ": cannot read PNG: " + message);
+    }
+    return image;
+}
+
+bool ffmpegAvailable() {
+    const char* path = std::getenv("PATH");
+    if (!path) return false;
+    std::string_view rest(path);
+    while (true) {
+        const std::size_t colon = rest.find(':');
+        const std::string_view dir = rest.substr(0, colon);
+        const fs::path candidate = fs::path(dir.empty() ? "." : std::string(dir)) / "ffmpeg";
+        struct stat st {};
+        if (::stat(candidate.c_str(), &st) == 0 && S_ISREG(st.st_mode) &&
+            ::access(candidate.c_str(), X_OK) == 0) {
+            return true;
+        }
+        if (colon == std::string_view::npos) return false;
+        rest.remove_prefix(colon + 1);
+    }
+}
+
+VideoWriter::VideoWriter(const fs::path& file, int width, int height, int fps)
+    : file_(file), width_(width), height_(height) {
+    if (width <= 0 || height <= 0 || width % 2 != 0 || height % 2 != 0) {
+        throw RenderError(file.string() + ": video size " + std::to_string(width) + "x" +
+                          std::to_string(height) + " must be positive and even (H.264 yuv420p)");
+    }
+    if (fps <= 0) {
+        throw RenderError(file.string() + ": video fps " + std::to_string(fps) + " must be > 0");
+    }
+    // ffmpeg picks the container from the extension, so the partial name keeps it last:
+    // "clip.mp4" is written as "clip.partial.mp4".
+    const fs::path ext = file.has_extension() ? file.extension() : fs::path(".mp4");
+    partial_ = file;
+    partial_.replace_extension(".partial" + ext.string());
+    removeQuietly(partial_);
+
+    int fds[2];
+    if (::pipe2(fds, O_CLOEXEC) != 0) {
+        throw RenderError(file.string() + ": cannot create a pipe to ffmpeg: " + errnoText(errno));
+    }
+    const std::string size = std::to_string(width) + "x" + std::to_string(height);
+    const std::string rate = std::to_string(fps);
+    const std::string out = partial_.string();
+    const char* argv[] = {"ffmpeg",    "-y",         "-loglevel", "error",     "-f",
+                          "rawvideo",  "-pix_fmt",   "rgb24",     "-s",        size.c_str(),
+                          "-r",        rate.c_str(), "-i",        "-",         "-c:v",
+                          "libx264",   "-pix_fmt",   "yuv420p",   "-movflags", "+faststart",
+                          out.c_str(), nullptr};
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    // dup2 clears close-on-exec on fd 0 only; the child never holds our write end, so closing
+    // it is the end-of-stream that lets ffmpeg finish.
+    posix_spawn_file_actions_adddup2(&actions, fds[0], STDIN_FILENO);
+    pid_t pid = -1;
+    const int spawn_error =
+        ::posix_spawnp(&pid, "ffmpeg", &actions, nullptr, const_cast<char* const*>(argv), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    ::close(fds[0]);
+    if (spawn_error != 0) {
+        ::close(fds[1]);
+        throw RenderError(file.string() + ": cannot start ffmpeg: " + errnoText(spawn_error));
+    }
+    pid_ = pid;
+    pipe_ = ::fdopen(fds[1], "wb");
+    if (!pipe_) {
+        ::close(fds[1]);
+        abandon();
+        throw RenderError(file.string() + ": cannot open the pipe to ffmpeg: " + errnoText(errno));
+    }
+}
+
+VideoWriter::~VideoWriter() { abandon(); }
+
+void VideoWriter::abandon() noexcept {
+    if (pipe_) {
+        SigpipeGuard guard;
+        std::fclose(pipe_);
+        pipe_ = nullptr;
+    }
+    if (pid_ > 0) {
+        // Our own child, by id: stop it rather than let it encode a video nobody keeps.
+        ::kill(pid_, SIGKILL);
+        int status = 0;
+        while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+        }
+        pid_ = -1;
+    }
+    if (!partial_.empty()) removeQuietly(partial_);
+}
+
+void VideoWriter::addFrame(const Image& image) {
+    if (!pipe_) throw RenderError(file_.string() + ": video already finished or abandoned");
+    if (image.width != width_ || image.height != height_ ||
+        image.rgb.size() != std::size_t(width_) * std::size_t(height_) * 3) {
+        throw RenderError(file_.string() + ": frame is " + std::to_string(image.width) + "x" +
+                          std::to_string(image.height) + ", video is " + std::to_string(width_) +
+                          "x" + std::to_string(height_));
+    }
+    bool ok = false;
+    {
+        SigpipeGuard guard;
+        ok = std::fwrite(image.rgb.data(), 1, image.rgb.size(), pipe_) == image.rgb.size();
+    }
+    if (!ok) {
+        const int err = errno;
+        abandon();
+        throw RenderError(file_.string() + ": ffmpeg stopped accepting frames: " + errnoText(err));
+    }
+}
+
+void VideoWriter::finish() {
+    if (!pipe_ || pid_ <= 0) {
+        throw RenderError(file_.string() + ": video already finished or abandoned");
+    }
+    bool closed = false;
+    {
+        SigpipeGuard guard;
+        closed = std::fclose(pipe_) == 0;
+    }
+    pipe_ = nullptr;
+    int status = 0;
+    pid_t waited = -1;
+    while ((waited = ::waitpid(pid_, &status, 0)) < 0 && errno == EINTR) {
+    }
+    pid_ = -1;
+    const bool exited_ok = waited > 0 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
+    std::error_code ec;
+    const bool has_output = fs::file_size(partial_, ec) > 0 && !ec;
+    if (!closed || !exited_ok || !has_output) {
+        removeQuietly(partial_);
+        std::string why =
+            !closed      ? "the pipe to ffmpeg broke"
+            : !exited_ok ? (WIFEXITED(status)
+                                ? "ffmpeg exited with status " + std::to_string(WEXITSTATUS(status))
+                                : std::string("ffmpeg was killed by a signal"))
+                         : std::string("ffmpeg wrote no output");
+        throw RenderError(file_.string() + ": video failed: " + why);
+    }
+    fs::rename(partial_, file_, ec);
+    if (ec) {
+        removeQuietly(partial_);
+        throw RenderError(file_.string() + ": cannot rename " + partial_.string() + ": " +
+                          ec.message());
+    }
+    partial_.clear();
+}
+
+}  // namespace render

@@ -1,0 +1,807 @@
+// render/src/renderer.cpp -- OSMesa software rendering of a World: shaded bodies, bounding-volume
+// wireframes coloured by overlap state, world bounds, broad-phase structure, HUD text.
+// Invariant: a frame is a pure function of (world state, camera, options, size). Nothing reads a
+// clock, geometry is generated in a fixed order, and all vertices are eye-relative, so the same
+// state renders bit-identical pixels and large world coordinates do not lose float precision.
+#include "render/renderer.h"
+
+#include <GL/gl.h>
+#include <GL/osmesa.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <vector>
+
+#include "collision/bounding_volumes.h"
+#include "collision/shape.h"
+#include "font.h"
+
+namespace render {
+namespace {
+
+using collision::Color;
+using collision::Mat3;
+using collision::Pose;
+using collision::Real;
+using collision::Vec3;
+
+constexpr Color kBoundsColor{0.74f, 0.76f, 0.82f, 1.0f};
+constexpr Color kGridColor{0.22f, 0.24f, 0.29f, 1.0f};
+constexpr float kHiddenLineAlpha = 0.3f;  ///< lines behind a body show through this faintly
+constexpr int kMaxSupersample = 2;
+constexpr Real kPi = Real(3.14159265358979323846);
+/// sin of the smallest angle between view direction and `up` that still defines a camera roll.
+constexpr Real kParallelSine = Real(1e-6);
+/// Near plane never closer than this fraction of the far plane (24-bit depth stays useful).
+constexpr Real kNearFarRatio = Real(1e-4);
+
+// ---------------------------------------------------------------------------------------------
+// Camera: gluLookAt / gluPerspective conventions, computed here (no GLU) so tests can mirror it.
+
+struct CameraFrame {
+    Vec3 eye = Vec3::Zero();
+    Vec3 forward = -Vec3::UnitZ();
+    Vec3 right = Vec3::UnitX();
+    Vec3 up = Vec3::UnitY();
+    Real tan_half_fov = 1;
+    Real aspect = 1;
+    Real focal_px = 1;  ///< pixels (of the GL framebuffer) per unit of x/z in eye space
+    Real near_plane = 0.1;
+    Real far_plane = 100;
+
+    Vec3 toEye(const Vec3& world) const { return world - eye; }
+    Real depth(const Vec3& world) const { return forward.dot(world - eye); }
+};
+
+CameraFrame makeCameraFrame(const engine::CameraSettings& camera, int gl_width, int gl_height) {
+    CameraFrame frame;
+    frame.eye = camera.position;
+    const Vec3 view = camera.look_at - camera.position;
+    const Real scale = std::max({camera.position.norm(), camera.look_at.norm(), Real(1)});
+    if (view.norm() > 64 * collision::kEpsilon * scale) frame.forward = view.normalized();
+    Vec3 up = camera.up;
+    Vec3 right = frame.forward.cross(up);
+    if (!(right.norm() > kParallelSine * up.norm())) {
+        // `up` is zero or parallel to the view: pick the world axis least aligned with it.
+        up = std::abs(frame.forward.y()) < Real(0.9) ? Vec3::UnitY() : Vec3::UnitZ();
+        right = frame.forward.cross(up);
+    }
+    frame.right = right.normalized();
+    frame.up = frame.right.cross(frame.forward);
+    const Real fov = std::clamp(camera.fov_deg, Real(1), Real(179));
+    frame.tan_half_fov = std::tan(fov * kPi / 360);
+    frame.aspect = Real(gl_width) / Real(gl_height);
+    frame.focal_px = Real(gl_height) / (2 * frame.tan_half_fov);
+    return frame;
+}
+
+// Grows [near, far] to hold a sphere (centre, radius).
+struct DepthRange {
+    Real lo = std::numeric_limits<Real>::infinity();
+    Real hi = -std::numeric_limits<Real>::infinity();
+    void add(const CameraFrame& cam, const Vec3& center, Real radius) {
+        if (!std::isfinite(radius) || !center.allFinite()) return;
+        const Real d = cam.depth(center);
+        lo = std::min(lo, d - radius);
+        hi = std::max(hi, d + radius);
+    }
+};
+
+void setClipPlanes(CameraFrame& cam, const DepthRange& range) {
+    if (!(range.hi > 0)) {
+        cam.far_plane = 1;
+        cam.near_plane = kNearFarRatio;
+        return;
+    }
+    const Real margin = Real(0.01) * (range.hi - std::max(range.lo, Real(0))) + 1e-6 * range.hi;
+    cam.far_plane = range.hi + margin;
+    cam.near_plane = std::max(range.lo - margin, kNearFarRatio * cam.far_plane);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Geometry buffers: eye-relative float vertices, filled in a fixed order every frame.
+
+struct TriangleBuffer {
+    std::vector<float> positions;
+    std::vector<float> normals;
+
+    void clear() {
+        positions.clear();
+        normals.clear();
+    }
+    void add(const Vec3& p_eye, const Vec3& n_world) {
+        positions.insert(positions.end(), {float(p_eye.x()), float(p_eye.y()), float(p_eye.z())});
+        normals.insert(normals.end(), {float(n_world.x()), float(n_world.y()), float(n_world.z())});
+    }
+    GLsizei count() const { return GLsizei(positions.size() / 3); }
+};
+
+struct LineBuffer {
+    std::vector<float> positions;
+    std::vector<float> colors;
+    std::vector<float> faint_colors;  ///< same colours at kHiddenLineAlpha
+
+    void clear() {
+        positions.clear();
+        colors.clear();
+        faint_colors.clear();
+    }
+    void add(const Vec3& a_eye, const Vec3& b_eye, const Color& c) {
+        positions.insert(positions.end(), {float(a_eye.x()), float(a_eye.y()), float(a_eye.z()),
+                                           float(b_eye.x()), float(b_eye.y()), float(b_eye.z())});
+        colors.insert(colors.end(), {c.r, c.g, c.b, c.a, c.r, c.g, c.b, c.a});
+        const float fa = c.a * kHiddenLineAlpha;
+        faint_colors.insert(faint_colors.end(), {c.r, c.g, c.b, fa, c.r, c.g, c.b, fa});
+    }
+    GLsizei count() const { return GLsizei(positions.size() / 3); }
+};
+
+/// Segments around a circle of `radius` centred at `center` so that each spans about
+/// `px_per_segment` framebuffer pixels, a multiple of 4 in [lo, hi].
+int segmentsFor(const CameraFrame& cam, const Vec3& center, Real radius, Real px_per_segment,
+                int lo, int hi) {
+    const Real depth = cam.depth(center);
+    const Real px = depth > cam.near_plane ? radius * cam.focal_px / depth
+                                           : std::numeric_limits<Real>::infinity();
+    const Real wanted = 2 * kPi * px / px_per_segment;
+    const int n = std::isfinite(wanted) ? int(std::min(wanted, Real(hi))) : hi;
+    return std::clamp((n + 3) / 4 * 4, lo, hi);
+}
+
+// The DebugDraw that the broad phase and the volume overlays draw through: it records lines.
+class GlDebugDraw final : public collision::DebugDraw {
+public:
+    GlDebugDraw(const CameraFrame& cam, LineBuffer& target) : cam_(cam), target_(&target) {}
+
+    /// Where lines go from now on; sphere silhouettes go to `outlines` (thinner lines) when given.
+    void setTarget(LineBuffer& target, LineBuffer* outlines = nullptr) {
+        target_ = &target;
+        outlines_ = outlines;
+    }
+
+    void drawLine(const Vec3& a, const Vec3& b, const Color& color) override {
+        target_->add(cam_.toEye(a), cam_.toEye(b), color);
+    }
+
+    // Three great circles, as the base does, but with as many segments as the on-screen size
+    // needs (round at 4K, cheap for a thousand small spheres), plus the silhouette: the circle
+    // where the view cone touches the sphere. The great circles lie a little behind the rim as
+    // seen in perspective, so without it a sphere's outline would only show faintly.
+    void drawSphere(const collision::BoundingSphere& sphere, const Color& color) override {
+        if (!(sphere.radius > 0) || !sphere.center.allFinite()) return;
+        const int n = segmentsFor(cam_, sphere.center, sphere.radius, 6, 24, 128);
+        for (int axis = 0; axis < 3; ++axis) {
+            circle(sphere.center, Vec3::Unit((axis + 1) % 3) * sphere.radius,
+                   Vec3::Unit((axis + 2) % 3) * sphere.radius, n, color);
+        }
+        // The tangent cone from the eye touches the sphere on a circle: with d the distance to
+        // the centre, its plane lies r^2/d in front of the centre and its radius is
+        // r sqrt(1 - r^2/d^2) (right triangle eye-centre-tangent point).
+        const Vec3 to_center = sphere.center - cam_.eye;
+        const Real d = to_center.norm();
+        if (!(d > sphere.radius)) return;  // the eye is inside: no silhouette
+        const Vec3 w = to_center / d;
+        const Real k = sphere.radius / d;
+        const Vec3 center = sphere.center - w * (sphere.radius * k);
+        const Real radius = sphere.radius * std::sqrt(1 - k * k);
+        const Vec3 helper = std::abs(w.x()) < Real(0.6) ? Vec3::UnitX() : Vec3::UnitY();
+        const Vec3 u = w.cross(helper).normalized();
+        const Vec3 v = w.cross(u);
+        LineBuffer* great_circles = target_;
+        if (outlines_) target_ = outlines_;
+        circle(center, u * radius, v * radius, n, color);
+        target_ = great_circles;
+    }
+
+private:
+    /// center + cos(t) u + sin(t) v over a full turn in n segments.
+    void circle(const Vec3& center, const Vec3& u, const Vec3& v, int n, const Color& color) {
+        Vec3 prev = center + u;
+        for (int i = 1; i <= n; ++i) {
+            const Real t = 2 * kPi * Real(i) / Real(n);
+            const Vec3 p =
+                i == n ? Vec3(center + u) : Vec3(center + std::cos(t) * u + std::sin(t) * v);
+            drawLine(prev, p, color);
+            prev = p;
+        }
+    }
+
+    const CameraFrame& cam_;
+    LineBuffer* target_;
+    LineBuffer* outlines_ = nullptr;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Tessellation. Local frame first, then the body pose; normals go to world space.
+
+/// Unit-sphere directions on a latitude-longitude grid, y up: (stacks + 1) rings of
+/// (slices + 1) points, ring 0 at +y. Cached per slice count.
+struct UnitSphereGrid {
+    int slices = 0;
+    int stacks = 0;
+    std::vector<Vec3> dirs;
+    const Vec3& at(int ring, int j) const { return dirs[std::size_t(ring) * (slices + 1) + j]; }
+};
+
+UnitSphereGrid makeUnitSphereGrid(int slices) {
+    UnitSphereGrid grid;
+    grid.slices = slices;
+    grid.stacks = slices / 2;
+    grid.dirs.reserve(std::size_t(grid.stacks + 1) * (slices + 1));
+    for (int i = 0; i <= grid.stacks; ++i) {
+        const Real phi = kPi * Real(i) / Real(grid.stacks);
+        const Real y = i == 0 ? Real(1) : i == grid.stacks ? Real(-1) : std::cos(phi);
+        const Real r = i == 0 || i == grid.stacks ? Real(0) : std::sin(phi);
+        for (int j = 0; j <= slices; ++j) {
+            const Real theta = 2 * kPi * Real(j % slices) / Real(slices);
+            grid.dirs.emplace_back(r * std::cos(theta), y, r * std::sin(theta));
+        }
+    }
+    return grid;
+}
+
+/// A capsule of radius r around the segment (0,-h,0)-(0,h,0); h = 0 gives a sphere. Smooth
+/// normals: the upper hemisphere is shifted by +h, the lower by -h, and the band between the
+/// two copies of the equator is the cylinder (its normals are the equator's, radial).
+void tessellateCapsule(const UnitSphereGrid& grid, Real radius, Real half_height, const Pose& pose,
+                       const CameraFrame& cam, TriangleBuffer& out) {
+    struct Ring {
+        int index;
+        Real offset;
+    };
+    std::vector<Ring> rings;
+    rings.reserve(std::size_t(grid.stacks) + 2);
+    const int equator = grid.stacks / 2;
+    for (int i = 0; i <= equator; ++i) rings.push_back({i, half_height});
+    for (int i = half_height > 0 ? equator : equator + 1; i <= grid.stacks; ++i) {
+        rings.push_back({i, -half_height});
+    }
+    const Mat3 rot = pose.rotation();
+    const Vec3 eye_pos = cam.toEye(pose.position);
+    auto emit = [&](const Ring& ring, int j) {
+        const Vec3& d = grid.at(ring.index, j);
+        const Vec3 local(d.x() * radius, d.y() * radius + ring.offset, d.z() * radius);
+        out.add(eye_pos + rot * local, rot * d);
+    };
+    for (std::size_t k = 0; k + 1 < rings.size(); ++k) {
+        const Ring& a = rings[k];
+        const Ring& b = rings[k + 1];
+        for (int j = 0; j < grid.slices; ++j) {
+            if (a.index != 0) {  // ring 0 is the pole: its quads are triangles
+                emit(a, j);
+                emit(b, j);
+                emit(a, j + 1);
+            }
+            if (b.index != grid.stacks) {
+                emit(a, j + 1);
+                emit(b, j);
+                emit(b, j + 1);
+            }
+        }
+    }
+}
+
+void tessellateBox(const Vec3& half, const Pose& pose, const CameraFrame& cam,
+                   TriangleBuffer& out) {
+    const Mat3 rot = pose.rotation();
+    const Vec3 eye_pos = cam.toEye(pose.position);
+    for (int axis = 0; axis < 3; ++axis) {
+        const int u = (axis + 1) % 3;
+        const int v = (axis + 2) % 3;
+        for (const Real sign : {Real(1), Real(-1)}) {
+            const Vec3 n = Vec3::Unit(axis) * sign;
+            Vec3 corner[4];
+            const Real su[4] = {-1, 1, 1, -1};
+            const Real sv[4] = {-1, -1, 1, 1};
+            for (int k = 0; k < 4; ++k) {
+                Vec3 c = Vec3::Zero();
+                c[axis] = sign * half[axis];
+                c[u] = su[k] * half[u];
+                c[v] = sv[k] * half[v];
+                corner[k] = eye_pos + rot * c;
+            }
+            const Vec3 nw = rot * n;
+            for (const int k : {0, 1, 2, 0, 2, 3}) out.add(corner[k], nw);
+        }
+    }
+}
+
+/// Flat-shaded triangles (hull faces, mesh triangles). The normal is turned toward the camera,
+/// so open meshes and inconsistent winding still shade as seen; degenerate triangles are skipped.
+template <typename Triangles>
+void tessellateTriangles(const std::vector<Vec3>& vertices, const Triangles& triangles,
+                         const Pose& pose, const CameraFrame& cam, TriangleBuffer& out) {
+    const Mat3 rot = pose.rotation();
+    const Vec3 eye_pos = cam.toEye(pose.position);
+    const auto n_vertices = static_cast<std::int64_t>(vertices.size());
+    for (const auto& tri : triangles) {
+        if (tri[0] < 0 || tri[1] < 0 || tri[2] < 0 || tri[0] >= n_vertices ||
+            tri[1] >= n_vertices || tri[2] >= n_vertices) {
+            continue;
+        }
+        const Vec3 a = eye_pos + rot * vertices[std::size_t(tri[0])];
+        const Vec3 b = eye_pos + rot * vertices[std::size_t(tri[1])];
+        const Vec3 c = eye_pos + rot * vertices[std::size_t(tri[2])];
+        const Vec3 e1 = b - a;
+        const Vec3 e2 = c - a;
+        const Vec3 cross = e1.cross(e2);
+        const Real len = cross.norm();
+        // Area relative to the edge lengths: a sliver this thin has no meaningful normal.
+        if (!(len > 16 * collision::kEpsilon * (e1.squaredNorm() + e2.squaredNorm()))) continue;
+        Vec3 n = cross / len;
+        if (n.dot(a) > 0) n = -n;  // eye at the origin: face the viewer
+        out.add(a, n);
+        out.add(b, n);
+        out.add(c, n);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// OSMesa context, RAII.
+
+class OsMesaContext {
+public:
+    OsMesaContext(int width, int height) : width_(width), height_(height) {
+        context_ = OSMesaCreateContextExt(OSMESA_RGBA, 24, 0, 0, nullptr);
+        if (!context_) throw RenderError("OSMesa: cannot create an RGBA context with 24-bit depth");
+        buffer_.resize(std::size_t(width) * std::size_t(height) * 4);
+        makeCurrent();
+        if (!glGetString(GL_VERSION)) {
+            OSMesaDestroyContext(context_);
+            throw RenderError("OSMesa: GL_VERSION is NULL (is libGL linked beside libOSMesa?)");
+        }
+    }
+    ~OsMesaContext() { OSMesaDestroyContext(context_); }
+    OsMesaContext(const OsMesaContext&) = delete;
+    OsMesaContext& operator=(const OsMesaContext&) = delete;
+
+    /// Contexts are current per thread: every frame binds its own before drawing.
+    void makeCurrent() {
+        if (!OSMesaMakeCurrent(context_, buffer_.data(), GL_UNSIGNED_BYTE, width_, height_)) {
+            throw RenderError("OSMesa: cannot make a " + std::to_string(width_) + "x" +
+                              std::to_string(height_) + " context current");
+        }
+    }
+
+private:
+    OSMesaContext context_ = nullptr;
+    int width_;
+    int height_;
+    std::vector<GLubyte> buffer_;
+};
+
+int maxOsMesaSize() {
+    GLint max_width = 0;
+    GLint max_height = 0;
+    OSMesaGetIntegerv(OSMESA_MAX_WIDTH, &max_width);
+    OSMesaGetIntegerv(OSMESA_MAX_HEIGHT, &max_height);
+    const int m = std::min(max_width, max_height);
+    return m > 0 ? m : 4096;
+}
+
+int supersampleFor(int width, int height) {
+    if (width <= 0 || height <= 0) {
+        throw RenderError("render size " + std::to_string(width) + "x" + std::to_string(height) +
+                          " must be positive");
+    }
+    const int max_size = maxOsMesaSize();
+    for (int ss = kMaxSupersample; ss > 1; --ss) {
+        if (std::max(width, height) * ss <= max_size) return ss;
+    }
+    if (std::max(width, height) > max_size) {
+        throw RenderError("render size " + std::to_string(width) + "x" + std::to_string(height) +
+                          " exceeds OSMesa's maximum " + std::to_string(max_size));
+    }
+    return 1;
+}
+
+font::Rgb toRgb8(const Color& c) {
+    auto channel = [](float v) {
+        return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
+    };
+    return {channel(c.r), channel(c.g), channel(c.b)};
+}
+
+/// "Nice" grid spacing (1, 2 or 5 times a power of ten) giving about `target` cells over `extent`.
+Real gridStep(Real extent, Real target) {
+    const Real raw = extent / target;
+    const Real p = std::pow(Real(10), std::floor(std::log10(raw)));
+    for (const Real m : {Real(1), Real(2), Real(5)}) {
+        if (m * p >= raw) return m * p;
+    }
+    return 10 * p;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+collision::Color stateColor(engine::BodyState state) {
+    switch (state) {
+        case engine::BodyState::Apart:
+            return {0.1f, 0.85f, 0.2f, 1.0f};
+        case engine::BodyState::Flagged:
+            return {1.0f, 0.85f, 0.0f, 1.0f};
+        case engine::BodyState::Colliding:
+            return {1.0f, 0.1f, 0.1f, 1.0f};
+    }
+    return {1.0f, 0.0f, 1.0f, 1.0f};
+}
+
+struct Renderer::Impl {
+    Impl(int w, int h) : width(w), height(h), ss(supersampleFor(w, h)), context(w * ss, h * ss) {}
+
+    int width;
+    int height;
+    int ss;
+    OsMesaContext context;
+    std::map<int, UnitSphereGrid> sphere_grids;  ///< by slice count
+    TriangleBuffer triangles;
+    LineBuffer frame_lines;      ///< world bounds and floor grid
+    LineBuffer structure_lines;  ///< the broad phase's own drawing
+    LineBuffer volume_lines;     ///< bounding volumes
+    LineBuffer outline_lines;    ///< bounding spheres' silhouettes
+    std::vector<GLubyte> readback;
+
+    const UnitSphereGrid& sphereGrid(int slices) {
+        auto it = sphere_grids.find(slices);
+        if (it == sphere_grids.end()) {
+            it = sphere_grids.emplace(slices, makeUnitSphereGrid(slices)).first;
+        }
+        return it->second;
+    }
+
+    CameraFrame setUpCamera(const engine::World& world, const engine::CameraSettings& camera);
+    void setUpGl(const CameraFrame& cam);
+    void buildBodies(const engine::World& world, const CameraFrame& cam);
+    void buildLines(const engine::World& world, const CameraFrame& cam,
+                    const FrameOptions& options);
+    void drawTriangles();
+    void drawLines(const LineBuffer& lines, float width_px);
+    Image readPixels();
+    void drawOverlays(Image& image, const FrameOptions& options) const;
+};
+
+CameraFrame Renderer::Impl::setUpCamera(const engine::World& world,
+                                        const engine::CameraSettings& camera) {
+    CameraFrame cam = makeCameraFrame(camera, width * ss, height * ss);
+    // Clip planes hug everything that may be drawn: the bounds and every body's volumes (the
+    // AABB's and OBB's circumspheres enclose the body and its wireframes).
+    DepthRange range;
+    const collision::Aabb& bounds = world.settings().bounds;
+    range.add(cam, bounds.center(), Real(0.5) * bounds.extents().norm());
+    const auto bodies = world.bodies();
+    const auto volumes = world.volumes();
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+        const engine::Body& body = bodies[i];
+        const Pose pose = body.pose();
+        range.add(cam, pose.apply(body.local_bounds.sphere.center),
+                  body.local_bounds.sphere.radius);
+        if (i < volumes.size()) {
+            const collision::ProxyVolumes& v = volumes[i];
+            range.add(cam, v.sphere.center, v.sphere.radius);
+            range.add(cam, v.aabb.center(), Real(0.5) * v.aabb.extents().norm());
+            range.add(cam, v.obb.center, v.obb.half_extents.norm());
+        }
+    }
+    setClipPlanes(cam, range);
+    return cam;
+}
+
+void Renderer::Impl::setUpGl(const CameraFrame& cam) {
+    glViewport(0, 0, width * ss, height * ss);
+    glClearColor(kBackgroundColor.r, kBackgroundColor.g, kBackgroundColor.b, 1.0f);
+    glClearDepth(1.0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+
+    // gluPerspective. GL matrices are column-major: each line below is one column.
+    const double f = 1.0 / double(cam.tan_half_fov);
+    const double n = double(cam.near_plane);
+    const double fa = double(cam.far_plane);
+    // clang-format off
+    const GLdouble projection[16] = {f / double(cam.aspect), 0, 0,                     0,
+                                     0,                      f, 0,                     0,
+                                     0,                      0, (fa + n) / (n - fa),  -1,
+                                     0,                      0, 2 * fa * n / (n - fa), 0};
+    // clang-format on
+    glMatrixMode(GL_PROJECTION);
+    glLoadMatrixd(projection);
+
+    glMatrixMode(GL_MODELVIEW);
+    glLoadIdentity();
+    // Lights in eye space (set under the identity): a key light from the upper left behind the
+    // viewer and a dim fill from the lower right, so shapes read the same from any camera.
+    const GLfloat key_dir[4] = {-0.38f, 0.62f, 0.69f, 0.0f};
+    const GLfloat key_diffuse[4] = {0.78f, 0.78f, 0.76f, 1.0f};
+    const GLfloat key_specular[4] = {0.35f, 0.35f, 0.35f, 1.0f};
+    const GLfloat fill_dir[4] = {0.62f, -0.30f, 0.72f, 0.0f};
+    const GLfloat fill_diffuse[4] = {0.26f, 0.28f, 0.32f, 1.0f};
+    const GLfloat black[4] = {0, 0, 0, 1};
+    const GLfloat ambient[4] = {0.20f, 0.20f, 0.22f, 1.0f};
+    glLightfv(GL_LIGHT0, GL_POSITION, key_dir);
+    glLightfv(GL_LIGHT0, GL_DIFFUSE, key_diffuse);
+    glLightfv(GL_LIGHT0, GL_SPECULAR, key_specular);
+    glLightfv(GL_LIGHT0, GL_AMBIENT, black);
+    glLightfv(GL_LIGHT1, GL_POSITION, fill_dir);
+    glLightfv(GL_LIGHT1, GL_DIFFUSE, fill_diffuse);
+    glLightfv(GL_LIGHT1, GL_SPECULAR, black);
+    glLightfv(GL_LIGHT1, GL_AMBIENT, black);
+    glLightModelfv(GL_LIGHT_MODEL_AMBIENT, ambient);
+    glLightModeli(GL_LIGHT_MODEL_TWO_SIDE, GL_FALSE);
+    glLightModeli(GL_LIGHT_MODEL_LOCAL_VIEWER, GL_FALSE);
+    glEnable(GL_LIGHT0);
+    glEnable(GL_LIGHT1);
+
+    // World to eye: rotation only, because vertices are already eye-relative (gluLookAt rows
+    // right, up, -forward).
+    // clang-format off
+    const GLdouble view[16] = {cam.right.x(), cam.up.x(), -cam.forward.x(), 0,
+                               cam.right.y(), cam.up.y(), -cam.forward.y(), 0,
+                               cam.right.z(), cam.up.z(), -cam.forward.z(), 0,
+                               0,             0,          0,                1};
+    // clang-format on
+    glLoadMatrixd(view);
+
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LEQUAL);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_DITHER);
+    glShadeModel(GL_SMOOTH);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+}
+
+void Renderer::Impl::buildBodies(const engine::World& world, const CameraFrame& cam) {
+    triangles.clear();
+    for (const engine::Body& body : world.bodies()) {
+        const collision::Shape& shape = body.shape;
+        const Pose pose = body.pose();
+        if (!pose.position.allFinite() || !pose.orientation.coeffs().allFinite()) continue;
+        switch (shape.type) {
+            case collision::ShapeType::Sphere:
+            case collision::ShapeType::Capsule: {
+                const Real h = shape.type == collision::ShapeType::Capsule ? shape.half_height : 0;
+                const int slices = segmentsFor(cam, pose.position, shape.radius + h, 10, 12, 64);
+                tessellateCapsule(sphereGrid(slices), shape.radius, h, pose, cam, triangles);
+                break;
+            }
+            case collision::ShapeType::Box:
+                tessellateBox(shape.half_extents, pose, cam, triangles);
+                break;
+            case collision::ShapeType::ConvexHull:
+                if (shape.hull) {
+                    tessellateTriangles(shape.hull->vertices, shape.hull->faces, pose, cam,
+                                        triangles);
+                }
+                break;
+            case collision::ShapeType::Mesh:
+                if (shape.mesh) {
+                    tessellateTriangles(shape.mesh->vertices, shape.mesh->triangles, pose, cam,
+                                        triangles);
+                }
+                break;
+        }
+    }
+}
+
+void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& cam,
+                                const FrameOptions& options) {
+    frame_lines.clear();
+    structure_lines.clear();
+    volume_lines.clear();
+    outline_lines.clear();
+    GlDebugDraw debug(cam, frame_lines);
+
+    if (options.draw.bounds) {
+        const collision::Aabb& b = world.settings().bounds;
+        // A faint floor grid on the bottom face (y is up in scenes), then the box itself.
+        const Real ext = std::max(b.extents().x(), b.extents().z());
+        if (ext > 0 && std::isfinite(ext)) {
+            const Real step = gridStep(ext, 10);
+            const Real y = b.min.y();
+            for (Real x = std::ceil(b.min.x() / step) * step; x < b.max.x(); x += step) {
+                if (x > b.min.x()) debug.drawLine({x, y, b.min.z()}, {x, y, b.max.z()}, kGridColor);
+            }
+            for (Real z = std::ceil(b.min.z() / step) * step; z < b.max.z(); z += step) {
+                if (z > b.min.z()) debug.drawLine({b.min.x(), y, z}, {b.max.x(), y, z}, kGridColor);
+            }
+        }
+        debug.drawAabb(b, kBoundsColor);
+    }
+
+    if (options.draw_structure) {
+        debug.setTarget(structure_lines);
+        world.broadPhase().draw(debug);
+    }
+
+    const auto volumes = world.volumes();
+    const auto states = world.states();
+    debug.setTarget(volume_lines, &outline_lines);
+    for (std::size_t i = 0; i < volumes.size() && i < world.bodies().size(); ++i) {
+        const Color color = stateColor(i < states.size() ? states[i] : engine::BodyState::Apart);
+        const collision::ProxyVolumes& v = volumes[i];
+        if (options.draw.sphere) debug.drawSphere(v.sphere, color);
+        if (options.draw.aabb) debug.drawAabb(v.aabb, color);
+        if (options.draw.obb) debug.drawObb(v.obb, color);
+    }
+}
+
+void Renderer::Impl::drawTriangles() {
+    if (triangles.count() == 0) return;
+    glEnable(GL_LIGHTING);
+    glEnable(GL_COLOR_MATERIAL);
+    glColorMaterial(GL_FRONT_AND_BACK, GL_AMBIENT_AND_DIFFUSE);
+    const GLfloat specular[4] = {0.30f, 0.30f, 0.30f, 1.0f};
+    glMaterialfv(GL_FRONT_AND_BACK, GL_SPECULAR, specular);
+    glMaterialf(GL_FRONT_AND_BACK, GL_SHININESS, 40.0f);
+    glColor4f(kBodyColor.r, kBodyColor.g, kBodyColor.b, 1.0f);
+    // Pushed back a little so wireframes lying on the surface (a sphere's bounding sphere, a
+    // box's OBB) win the depth test instead of z-fighting; the slope term covers the rim.
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(1.5f, 2.0f);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+
+    glEnableClientState(GL_VERTEX_ARRAY);
+    glEnableClientState(GL_NORMAL_ARRAY);
+    glVertexPointer(3, GL_FLOAT, 0, triangles.positions.data());
+    glNormalPointer(GL_FLOAT, 0, triangles.normals.data());
+    glDrawArrays(GL_TRIANGLES, 0, triangles.count());
+    glDisableClientState(GL_NORMAL_ARRAY);
+    glDisableClientState(GL_VERTEX_ARRAY);
+
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    glDisable(GL_COLOR_MATERIAL);
+    glDisable(GL_LIGHTING);
+}
+
+void Renderer::Impl::drawLines(const LineBuffer& lines, float width_px) {
+    if (lines.count() == 0) return;
+    glDisable(GL_LIGHTING);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glDepthMask(GL_FALSE);  // wireframes never hide each other
+    glLineWidth(width_px * float(ss));
+    glEnableClientState(GL_VERTEX_ARRAY);
+    glEnableClientState(GL_COLOR_ARRAY);
+    glVertexPointer(3, GL_FLOAT, 0, lines.positions.data());
+    // Pass 1: the parts behind a body, faint (x-ray). Pass 2: the visible parts, full colour.
+    glDepthFunc(GL_GREATER);
+    glColorPointer(4, GL_FLOAT, 0, lines.faint_colors.data());
+    glDrawArrays(GL_LINES, 0, lines.count());
+    glDepthFunc(GL_LEQUAL);
+    glColorPointer(4, GL_FLOAT, 0, lines.colors.data());
+    glDrawArrays(GL_LINES, 0, lines.count());
+    glDisableClientState(GL_COLOR_ARRAY);
+    glDisableClientState(GL_VERTEX_ARRAY);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+}
+
+Image Renderer::Impl::readPixels() {
+    const int gw = width * ss;
+    const int gh = height * ss;
+    glFinish();
+    readback.resize(std::size_t(gw) * std::size_t(gh) * 3);
+    glReadPixels(0, 0, gw, gh, GL_RGB, GL_UNSIGNED_BYTE, readback.data());
+
+    Image image;
+    image.width = width;
+    image.height = height;
+    image.rgb.resize(std::size_t(width) * std::size_t(height) * 3);
+    // GL rows run bottom-up: flip so row 0 is the top, and box-filter each ss x ss block.
+    const int n = ss * ss;
+    for (int y = 0; y < height; ++y) {
+        for (int x = 0; x < width; ++x) {
+            int sum[3] = {0, 0, 0};
+            for (int dy = 0; dy < ss; ++dy) {
+                const int gl_row = gh - 1 - (y * ss + dy);
+                const GLubyte* src =
+                    &readback[(std::size_t(gl_row) * gw + std::size_t(x) * ss) * 3];
+                for (int dx = 0; dx < ss; ++dx) {
+                    sum[0] += src[dx * 3 + 0];
+                    sum[1] += src[dx * 3 + 1];
+                    sum[2] += src[dx * 3 + 2];
+                }
+            }
+            std::uint8_t* dst = &image.rgb[(std::size_t(y) * width + x) * 3];
+            for (int k = 0; k < 3; ++k) dst[k] = static_cast<std::uint8_t>((sum[k] + n / 2) / n);
+        }
+    }
+    return image;
+}
+
+void Renderer::Impl::drawOverlays(Image& image, const FrameOptions& options) const {
+    // Text is pixel art: integer scale, 2x from 720p, 3x from 1440p.
+    const int scale = height >= 1440 ? 3 : height >= 720 ? 2 : 1;
+    const int margin = 6 * scale;
+    const font::Rgb text_color{236, 238, 242};
+    const font::Rgb plate{0, 0, 0};
+    const int pad = 3 * scale;
+    if (!options.hud_text.empty()) {
+        const int w = font::textWidth(options.hud_text, scale);
+        const int h = font::textHeight(options.hud_text, scale);
+        font::blendRect(image, margin - pad, margin - pad, w + 2 * pad + scale, h + 2 * pad + scale,
+                        plate, 0.45f);
+        font::drawText(image, margin, margin, options.hud_text, scale, text_color);
+    }
+    const bool any_volume = options.draw.sphere || options.draw.aabb || options.draw.obb;
+    if (options.draw.hud && any_volume) {
+        struct Entry {
+            engine::BodyState state;
+            const char* label;
+        };
+        const Entry entries[] = {{engine::BodyState::Apart, "apart"},
+                                 {engine::BodyState::Flagged, "flagged"},
+                                 {engine::BodyState::Colliding, "colliding"}};
+        const int swatch = font::kCapHeight * scale;
+        const int gap = 4 * scale;
+        int total = 0;
+        for (const Entry& e : entries) {
+            total += swatch + gap + font::textWidth(e.label, scale) + 3 * gap;
+        }
+        total -= 3 * gap;
+        const int y = height - margin - swatch;
+        font::blendRect(image, margin - pad, y - pad, total + 2 * pad + scale,
+                        swatch + 2 * pad + scale, plate, 0.45f);
+        int x = margin;
+        for (const Entry& e : entries) {
+            font::fillRect(image, x + scale, y + scale, swatch, swatch, {12, 12, 16});
+            font::fillRect(image, x, y, swatch, swatch, toRgb8(stateColor(e.state)));
+            x += swatch + gap;
+            font::drawText(image, x, y, e.label, scale, text_color);
+            x += font::textWidth(e.label, scale) + 3 * gap;
+        }
+    }
+}
+
+Renderer::Renderer(int width, int height) : impl_(std::make_unique<Impl>(width, height)) {}
+
+Renderer::~Renderer() = default;
+
+int Renderer::width() const { return impl_->width; }
+int Renderer::height() const { return impl_->height; }
+int Renderer::supersample() const { return impl_->ss; }
+
+Image Renderer::render(const engine::World& world, const engine::CameraSettings& camera,
+                       const FrameOptions& options) {
+    Impl& im = *impl_;
+    im.context.makeCurrent();
+    const CameraFrame cam = im.setUpCamera(world, camera);
+    im.setUpGl(cam);
+    if (options.draw.bodies) {
+        im.buildBodies(world, cam);
+        im.drawTriangles();
+    }
+    im.buildLines(world, cam, options);
+    im.drawLines(im.frame_lines, 1.0f);
+    im.drawLines(im.structure_lines, 1.0f);
+    im.drawLines(im.outline_lines, 1.0f);
+    im.drawLines(im.volume_lines, 2.0f);
+    const GLenum error = glGetError();
+    if (error != GL_NO_ERROR) {
+        throw RenderError("OpenGL error " + std::to_string(error) + " while rendering a frame");
+    }
+    Image image = im.readPixels();
+    im.drawOverlays(image, options);
+    return image;
+}
+
+std::string hudLine(const engine::World& world, int frame, bool include_timing) {
+    const std::string_view bp = world.broadPhase().name();
+    char buffer[256];
+    int n =
+        std::snprintf(buffer, sizeof buffer, "frame %d  t=%.3f s  %.*s  flagged %zu  colliding %zu",
+                      frame, double(world.time()), int(bp.size()), bp.data(),
+                      world.flaggedPairs().size(), world.collidingPairs().size());
+    std::string line(buffer, std::size_t(std::clamp(n, 0, int(sizeof buffer) - 1)));
+    if (include_timing) {
+        n = std::snprintf(buffer, sizeof buffer, "  step %.2f ms", 1e3 * world.lastStats().total_s);
+        line.append(buffer, std::size_t(std::clamp(n, 0, int(sizeof buffer) - 1)));
+    }
+    return line;
+}
+
+}  // namespace render

@@ -1,0 +1,656 @@
+// tests/engine/scene_test.cpp -- scene files: a full round trip, defaults, every error class with
+// its exact line:col, orientation conventions, mesh paths, mass vs density, makeWorld.
+#include "engine/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <string>
+
+#include "engine/mass_properties.h"
+
+namespace engine {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr Real kPi = std::numbers::pi_v<Real>;
+
+const fs::path kSourceDir = CDLAB_SOURCE_DIR;
+// Mesh paths in the test scenes are relative to this folder, like a file in scenes/.
+const fs::path kScenesDir = kSourceDir / "scenes";
+
+Scene parse(const std::string& text) { return parseScene(text, "test.yaml", kScenesDir); }
+
+// The error message, or "" when the scene parsed.
+std::string errorOf(const std::string& text, const fs::path& base = kScenesDir) {
+    try {
+        parseScene(text, "test.yaml", base);
+    } catch (const SceneError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+// Asserts the exact "test.yaml:LINE:COL: path: " prefix and a fragment of the message.
+#define EXPECT_SCENE_ERROR(text, prefix, fragment)                                  \
+    do {                                                                            \
+        const std::string err_ = errorOf(text);                                     \
+        EXPECT_EQ(err_.rfind(std::string("test.yaml:") + (prefix), 0), 0u) << err_; \
+        EXPECT_NE(err_.find(fragment), std::string::npos) << err_;                  \
+    } while (false)
+
+// A minimal valid scene; the error tests append one body or replace a line.
+const std::string kHeader =
+    "world:\n"                                             // 1
+    "  bounds: {min: [-10, -6, -10], max: [10, 6, 10]}\n"  // 2
+    "bodies:\n";                                           // 3
+
+std::string withBody(const std::string& body_lines) { return kHeader + body_lines; }
+
+const char* const kFullScene = R"(world:
+  bounds: {min: [-10, -6, -10], max: [10, 6, 10]}
+  gravity: [0, -9.81, 0]
+  time_step: 0.01
+  steps_per_frame: 2
+  frames: 240
+broadphase: brute
+output: {width: 640, height: 360, fps: 25}
+camera: {position: [1, 8, 24], look_at: [0, 1, 0], up: [0, 1, 0], fov_deg: 50}
+draw:
+  bodies: false
+  volumes: [aabb, obb]
+  bounds: false
+  hud: false
+bodies:
+  - name: ball
+    shape: sphere
+    radius: 0.5
+    position: [0, 1, 0]
+    velocity: [1, 0, 0]
+    angular_velocity: [0, 2, 0]
+    mass: 2.0
+  - name: crate
+    shape: box
+    half_extents: [0.5, 0.3, 0.2]
+    position: [2, 0, 0]
+    orientation_wxyz: [2, 0, 0, 0]
+    density: 500
+  - shape: capsule
+    radius: 0.25
+    half_height: 0.6
+    position: [-2, 0, 0]
+    euler_deg: [0, 30, 0]
+  - name: gem
+    shape: hull
+    file: ../assets/crystal.obj
+    scale: 2
+    position: [0, 0, 3]
+  - name: ring
+    shape: mesh
+    file: ../assets/torus.obj
+    scale: 0.5
+    position: [0, 0, -3]
+    density: 800
+)";
+
+TEST(Scene, FullSceneRoundTrip) {
+    const Scene s = parse(kFullScene);
+    EXPECT_EQ(s.name, "test");
+    EXPECT_EQ(s.world.bounds.min, Vec3(-10, -6, -10));
+    EXPECT_EQ(s.world.bounds.max, Vec3(10, 6, 10));
+    EXPECT_EQ(s.world.gravity, Vec3(0, -9.81, 0));
+    EXPECT_EQ(s.world.time_step, 0.01);
+    EXPECT_EQ(s.world.broad_phase, "brute");
+    EXPECT_EQ(s.steps_per_frame, 2);
+    EXPECT_EQ(s.frames, 240);
+    EXPECT_EQ(s.output.width, 640);
+    EXPECT_EQ(s.output.height, 360);
+    EXPECT_EQ(s.output.fps, 25);
+    EXPECT_EQ(s.camera.position, Vec3(1, 8, 24));
+    EXPECT_EQ(s.camera.look_at, Vec3(0, 1, 0));
+    EXPECT_EQ(s.camera.up, Vec3(0, 1, 0));
+    EXPECT_EQ(s.camera.fov_deg, 50);
+    EXPECT_FALSE(s.draw.bodies);
+    EXPECT_FALSE(s.draw.sphere);
+    EXPECT_TRUE(s.draw.aabb);
+    EXPECT_TRUE(s.draw.obb);
+    EXPECT_FALSE(s.draw.bounds);
+    EXPECT_FALSE(s.draw.hud);
+    ASSERT_EQ(s.bodies.size(), 5u);
+
+    const Body& ball = s.bodies[0];
+    EXPECT_EQ(ball.name, "ball");
+    EXPECT_EQ(ball.shape.type, collision::ShapeType::Sphere);
+    EXPECT_EQ(ball.shape.radius, 0.5);
+    EXPECT_EQ(ball.position, Vec3(0, 1, 0));
+    EXPECT_EQ(ball.mass, 2.0);
+    EXPECT_LE((ball.velocity() - Vec3(1, 0, 0)).norm(), 1e-15);
+    EXPECT_LE((ball.angularVelocity() - Vec3(0, 2, 0)).norm(), 1e-12);
+    // Solid sphere: I = 2/5 m r^2.
+    EXPECT_NEAR(ball.inertia_body(0, 0), 0.4 * 2 * 0.25, 1e-15);
+
+    const Body& crate = s.bodies[1];
+    EXPECT_EQ(crate.shape.type, collision::ShapeType::Box);
+    EXPECT_EQ(crate.shape.half_extents, Vec3(0.5, 0.3, 0.2));
+    EXPECT_NEAR(crate.mass, 500 * 1.0 * 0.6 * 0.4, 1e-12);
+    // [2, 0, 0, 0] is normalised to the identity.
+    EXPECT_EQ(crate.orientation.coeffs(), Quat::Identity().coeffs());
+
+    const Body& pill = s.bodies[2];
+    EXPECT_EQ(pill.name, "capsule2");  // default name: shape + index
+    EXPECT_EQ(pill.shape.half_height, 0.6);
+    EXPECT_NEAR(pill.mass, 1000 * (kPi * 0.0625 * 1.2 + 4.0 / 3 * kPi * 0.015625), 1e-9);
+    EXPECT_NEAR(
+        pill.orientation.angularDistance(Quat(Eigen::AngleAxis<Real>(kPi / 6, Vec3::UnitY()))), 0,
+        1e-12);
+
+    const Body& gem = s.bodies[3];
+    EXPECT_EQ(gem.shape.type, collision::ShapeType::ConvexHull);
+    ASSERT_TRUE(gem.shape.hull);
+    EXPECT_EQ(gem.position, Vec3(0, 0, 3));
+
+    const Body& ring = s.bodies[4];
+    EXPECT_EQ(ring.shape.type, collision::ShapeType::Mesh);
+    ASSERT_TRUE(ring.shape.mesh && ring.shape.hull);
+    EXPECT_EQ(ring.shape.mesh->triangles.size(), 768u);
+    // Torus at scale 0.5: outer radius (1 + 0.35) / 2.
+    Real max_r = 0;
+    for (const Vec3& v : ring.shape.mesh->vertices) max_r = std::max(max_r, v.norm());
+    EXPECT_NEAR(max_r, 0.675, 1e-3);
+    EXPECT_NEAR(ring.mass, 800 * shapeVolume(ring.shape), 1e-9);
+}
+
+TEST(Scene, Defaults) {
+    const Scene s =
+        parse(withBody("  - shape: sphere\n    radius: 0.5\n    position: [0, 0, 0]\n"));
+    EXPECT_EQ(s.world.gravity, Vec3::Zero());
+    EXPECT_EQ(s.world.time_step, Real(1) / 60);
+    EXPECT_EQ(s.world.broad_phase, "sap");
+    EXPECT_EQ(s.steps_per_frame, 1);
+    EXPECT_EQ(s.frames, 120);
+    EXPECT_EQ(s.output.width, 960);
+    EXPECT_EQ(s.output.height, 540);
+    EXPECT_EQ(s.output.fps, 30);
+    EXPECT_EQ(s.camera.position, Vec3(0, 8, 24));
+    EXPECT_EQ(s.camera.look_at, Vec3::Zero());
+    EXPECT_EQ(s.camera.up, Vec3::UnitY());
+    EXPECT_EQ(s.camera.fov_deg, 45);
+    EXPECT_TRUE(s.draw.bodies);
+    EXPECT_TRUE(s.draw.sphere);
+    EXPECT_FALSE(s.draw.aabb);
+    EXPECT_FALSE(s.draw.obb);
+    EXPECT_TRUE(s.draw.bounds);
+    EXPECT_TRUE(s.draw.hud);
+    ASSERT_EQ(s.bodies.size(), 1u);
+    const Body& b = s.bodies[0];
+    EXPECT_EQ(b.name, "sphere0");
+    EXPECT_NEAR(b.mass, 1000 * 4.0 / 3 * kPi * 0.125, 1e-9);  // density 1000
+    EXPECT_EQ(b.orientation.coeffs(), Quat::Identity().coeffs());
+    EXPECT_EQ(b.linear_momentum, Vec3::Zero());
+    EXPECT_EQ(b.angular_momentum, Vec3::Zero());
+    // Bodies are optional.
+    EXPECT_TRUE(parse(kHeader).bodies.empty());
+}
+
+// --- errors: every class, with its exact position ----------------------------------------------
+
+TEST(SceneErrors, UnknownKeysAtEveryLevel) {
+    EXPECT_SCENE_ERROR("wrld:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n", "1:1: wrld: ",
+                       "unknown key 'wrld' (expected one of: world, broadphase, output, camera, "
+                       "draw, bodies)");
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radus: 0.5\n    position: [0, 0, 0]\n"),
+                       "5:5: bodies[0].radus: ", "unknown key 'radus' (expected one of: name,");
+    EXPECT_SCENE_ERROR("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  gravty: [0,0,0]\n",
+                       "3:3: world.gravty: ", "unknown key 'gravty'");
+    EXPECT_SCENE_ERROR(kHeader + "output: {width: 64, heigth: 64}\n", "4:21: output.heigth: ",
+                       "unknown key 'heigth' (expected one of: width, height, fps)");
+    EXPECT_SCENE_ERROR("world:\n  bounds: {min: [0,0,0], max: [1,1,1], mid: [0,0,0]}\n",
+                       "2:40: world.bounds.mid: ", "unknown key 'mid'");
+}
+
+TEST(SceneErrors, DuplicateKey) {
+    EXPECT_SCENE_ERROR(
+        withBody("  - shape: sphere\n    radius: 0.5\n    radius: 0.6\n    position: [0, 0, 0]\n"),
+        "6:5: bodies[0].radius: ", "duplicate key");
+}
+
+TEST(SceneErrors, WrongTypes) {
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: big\n    position: [0, 0, 0]\n"),
+                       "5:13: bodies[0].radius: ", "expected a number");
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: [1]\n    position: [0, 0, 0]\n"),
+                       "5:13: bodies[0].radius: ", "expected a number");
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 0.5\n    position: [0, 0]\n"),
+                       "6:15: bodies[0].position: ", "expected a list of 3 numbers");
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 0.5\n    position: 3\n"),
+                       "6:15: bodies[0].position: ", "expected a list of 3 numbers");
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 0.5\n    position: [0, x, 0]\n"),
+                       "6:19: bodies[0].position[1]: ", "expected a number");
+    EXPECT_SCENE_ERROR(kHeader + "draw: {hud: maybe}\n",
+                       "4:13: draw.hud: ", "expected true or false");
+    EXPECT_SCENE_ERROR("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  frames: 2.5\n",
+                       "3:11: world.frames: ", "expected an integer");
+    EXPECT_SCENE_ERROR("world: 3\n", "1:8: world: ", "expected a mapping");
+    EXPECT_SCENE_ERROR(kHeader + "  shape: sphere\n", "4:3: bodies: ", "expected a list");
+    EXPECT_SCENE_ERROR(withBody("  - 42\n"), "4:5: bodies[0]: ", "expected a mapping");
+    EXPECT_SCENE_ERROR(withBody("  - shape: [sphere]\n    radius: 1\n    position: [0, 0, 0]\n"),
+                       "4:12: bodies[0].shape: ", "expected a string");
+}
+
+TEST(SceneErrors, NonFiniteNumbersRejected) {
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: .nan\n    position: [0, 0, 0]\n"),
+                       "5:13: bodies[0].radius: ", "must be finite");
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 0.5\n    position: [0, .inf, 0]\n"),
+                       "6:19: bodies[0].position[1]: ", "must be finite");
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 0.5\n    position: [0, 0, 0]\n"
+                                "    velocity: [-.Inf, 0, 0]\n"),
+                       "7:16: bodies[0].velocity[0]: ", "must be finite");
+    EXPECT_SCENE_ERROR("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  time_step: .NaN\n",
+                       "3:14: world.time_step: ", "must be finite");
+    // Overflowing literal: not representable.
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 1e999\n    position: [0, 0, 0]\n"),
+                       "5:13: bodies[0].radius: ", "");
+}
+
+TEST(SceneErrors, OutOfRangeValues) {
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 0\n    position: [0, 0, 0]\n"),
+                       "5:13: bodies[0].radius: ", "must be > 0");
+    EXPECT_SCENE_ERROR(withBody("  - shape: capsule\n    radius: 1\n    half_height: -0.1\n"
+                                "    position: [0, 0, 0]\n"),
+                       "6:18: bodies[0].half_height: ", "must be >= 0");
+    EXPECT_SCENE_ERROR(
+        withBody("  - shape: box\n    half_extents: [1, -1, 1]\n    position: [0, 0, 0]\n"),
+        "5:23: bodies[0].half_extents[1]: ", "must be >= 0");
+    EXPECT_SCENE_ERROR(withBody("  - shape: mesh\n    file: ../assets/torus.obj\n    scale: 0\n"
+                                "    position: [0, 0, 0]\n"),
+                       "6:12: bodies[0].scale: ", "must be > 0");
+    EXPECT_SCENE_ERROR(
+        withBody("  - shape: sphere\n    radius: 1\n    position: [0, 0, 0]\n    mass: -2\n"),
+        "7:11: bodies[0].mass: ", "must be > 0");
+    EXPECT_SCENE_ERROR(
+        withBody("  - shape: sphere\n    radius: 1\n    position: [0, 0, 0]\n    density: 0\n"),
+        "7:14: bodies[0].density: ", "must be > 0");
+    EXPECT_SCENE_ERROR("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  time_step: 0\n",
+                       "3:14: world.time_step: ", "must be > 0 and <= 1");
+    EXPECT_SCENE_ERROR("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  time_step: 2\n",
+                       "3:14: world.time_step: ", "must be > 0 and <= 1");
+    EXPECT_SCENE_ERROR("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  steps_per_frame: 0\n",
+                       "3:20: world.steps_per_frame: ", "must be >= 1");
+    EXPECT_SCENE_ERROR("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  frames: 0\n",
+                       "3:11: world.frames: ", "must be >= 1");
+    EXPECT_SCENE_ERROR(
+        "world:\n  bounds: {min: [0,0,0], max: [1,0,1]}\n",
+        "2:31: world.bounds.max: ", "must be greater than min on every axis (axis y)");
+    EXPECT_SCENE_ERROR(kHeader + "output: {width: 641}\n", "4:17: output.width: ", "must be even");
+    EXPECT_SCENE_ERROR(kHeader + "output: {height: 8}\n",
+                       "4:18: output.height: ", "must be in 16..8192");
+    EXPECT_SCENE_ERROR(kHeader + "output: {fps: 0}\n", "4:15: output.fps: ", "must be in 1..240");
+    EXPECT_SCENE_ERROR(kHeader + "camera: {fov_deg: 180}\n",
+                       "4:19: camera.fov_deg: ", "must be > 0 and < 180");
+    EXPECT_SCENE_ERROR(kHeader + "camera: {position: [0, 5, 0], look_at: [0, 0, 0]}\n",
+                       "4:40: camera.look_at: ", "up must not be parallel to the view direction");
+    EXPECT_SCENE_ERROR(kHeader + "camera: {up: [0, 0, 0]}\n",
+                       "4:14: camera.up: ", "up must not be zero");
+    EXPECT_SCENE_ERROR(kHeader + "draw: {volumes: [sphere, kdop]}\n", "4:26: draw.volumes[1]: ",
+                       "unknown volume 'kdop' (expected one of: sphere, aabb, obb)");
+}
+
+TEST(SceneErrors, UnknownNamesListTheChoices) {
+    const std::string err = errorOf(kHeader + "broadphase: quadtree\n");
+    EXPECT_EQ(err.rfind("test.yaml:4:13: broadphase: unknown broad phase 'quadtree' "
+                        "(expected one of: " +
+                            collision::broadPhaseNames() + ")",
+                        0),
+              0u)
+        << err;
+    EXPECT_SCENE_ERROR(withBody("  - shape: cone\n    position: [0, 0, 0]\n"),
+                       "4:12: bodies[0].shape: ",
+                       "unknown shape 'cone' (expected one of: sphere, box, capsule, hull, mesh)");
+}
+
+TEST(SceneErrors, KeysThatDoNotApplyToTheShape) {
+    EXPECT_SCENE_ERROR(withBody("  - shape: box\n    half_extents: [1, 1, 1]\n    radius: 0.5\n"
+                                "    position: [0, 0, 0]\n"),
+                       "6:5: bodies[0].radius: ", "does not apply to shape 'box'");
+    EXPECT_SCENE_ERROR(
+        withBody("  - shape: sphere\n    radius: 1\n    scale: 2\n    position: [0, 0, 0]\n"),
+        "6:5: bodies[0].scale: ", "does not apply to shape 'sphere'");
+    EXPECT_SCENE_ERROR(
+        withBody("  - shape: sphere\n    radius: 1\n    half_height: 2\n    position: [0, 0, 0]\n"),
+        "6:5: bodies[0].half_height: ", "does not apply to shape 'sphere'");
+}
+
+TEST(SceneErrors, MissingRequiredKeys) {
+    // Reported at the mapping that lacks the key.
+    EXPECT_SCENE_ERROR("broadphase: sap\n", "1:1: world: ", "required key is missing");
+    EXPECT_SCENE_ERROR("world:\n  gravity: [0, 0, 0]\n",
+                       "2:3: world.bounds: ", "required key is missing");
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 1\n"),
+                       "4:5: bodies[0].position: ", "required key is missing");
+    EXPECT_SCENE_ERROR(withBody("  - radius: 1\n    position: [0, 0, 0]\n"),
+                       "4:5: bodies[0].shape: ", "required key is missing");
+    EXPECT_SCENE_ERROR(withBody("  - shape: capsule\n    radius: 1\n    position: [0, 0, 0]\n"),
+                       "4:5: bodies[0].half_height: ", "required key is missing");
+    EXPECT_SCENE_ERROR(withBody("  - shape: mesh\n    position: [0, 0, 0]\n"),
+                       "4:5: bodies[0].file: ", "required key is missing");
+}
+
+TEST(SceneErrors, ExclusiveKeys) {
+    EXPECT_SCENE_ERROR(
+        withBody("  - shape: sphere\n    radius: 1\n    position: [0, 0, 0]\n    mass: 1\n"
+                 "    density: 2\n"),
+        "8:5: bodies[0].density: ", "give either 'mass' or 'density', not both");
+    EXPECT_SCENE_ERROR(
+        withBody("  - shape: sphere\n    radius: 1\n    euler_deg: [0, 0, 0]\n"
+                 "    position: [0, 0, 0]\n    orientation_wxyz: [1, 0, 0, 0]\n"),
+        "8:5: bodies[0].orientation_wxyz: ", "give either 'orientation_wxyz' or 'euler_deg'");
+}
+
+TEST(SceneErrors, BadQuaternion) {
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 1\n    position: [0, 0, 0]\n"
+                                "    orientation_wxyz: [0, 0, 0, 0]\n"),
+                       "7:23: bodies[0].orientation_wxyz: ", "non-zero quaternion");
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 1\n    position: [0, 0, 0]\n"
+                                "    orientation_wxyz: [1, 0, 0]\n"),
+                       "7:23: bodies[0].orientation_wxyz: ", "expected a list of 4 numbers");
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 1\n    position: [0, 0, 0]\n"
+                                "    orientation_wxyz: [1, 0, .nan, 0]\n"),
+                       "7:30: bodies[0].orientation_wxyz[2]: ", "must be finite");
+}
+
+TEST(SceneErrors, BodyOutsideBounds) {
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 1\n    position: [0, 7, 0]\n"),
+                       "6:15: bodies[0].position: ", "outside the world bounds");
+    // Exactly on the boundary is inside.
+    EXPECT_EQ(errorOf(withBody("  - shape: sphere\n    radius: 1\n    position: [10, 6, 0]\n")),
+              "");
+}
+
+TEST(SceneErrors, MalformedYamlReportsTheParserPosition) {
+    const std::string err = errorOf("world:\n  bounds: {min: [0, 0, 0], max: [1, 1, 1]\nbodies:\n");
+    EXPECT_EQ(err.rfind("test.yaml:", 0), 0u) << err;
+    EXPECT_NE(err.find(": malformed YAML: "), std::string::npos) << err;
+    // An unclosed flow sequence: yaml-cpp reports the end of the input, line 3 column 1.
+    EXPECT_SCENE_ERROR("world:\n  gravity: [0, 0\n",
+                       "3:1: malformed YAML: ", "end of sequence flow not found");
+    EXPECT_SCENE_ERROR("world: {bounds: [}\n", "1:", "malformed YAML");
+    EXPECT_SCENE_ERROR("\t- x\n", "1:", "");
+    EXPECT_SCENE_ERROR("", "1:1: scene: ", "expected a mapping");
+    EXPECT_SCENE_ERROR("- 1\n- 2\n", "1:1: scene: ", "expected a mapping");
+}
+
+// --- meshes ------------------------------------------------------------------------------------
+
+class SceneMeshes : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        dir_ = fs::temp_directory_path() / ("cdlab_scene_" + std::string(info->name()));
+        fs::remove_all(dir_);
+        fs::create_directories(dir_ / "meshes");
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+    void write(const fs::path& rel, const std::string& text) {
+        std::ofstream(dir_ / rel, std::ios::binary) << text;
+    }
+    fs::path dir_;
+};
+
+// A unit cube centred at (5, 0, 0): its file origin is not its centre of mass.
+const char* const kOffsetCubeObj =
+    "v 4.5 -0.5 -0.5\nv 5.5 -0.5 -0.5\nv 5.5 0.5 -0.5\nv 4.5 0.5 -0.5\n"
+    "v 4.5 -0.5 0.5\nv 5.5 -0.5 0.5\nv 5.5 0.5 0.5\nv 4.5 0.5 0.5\n"
+    "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n";
+
+TEST_F(SceneMeshes, MeshPathIsRelativeToTheSceneFile) {
+    write("meshes/cube.obj", kOffsetCubeObj);
+    write("scene.yaml", kHeader +
+                            "  - shape: mesh\n    file: meshes/cube.obj\n"
+                            "    position: [1, 2, 3]\n    density: 10\n");
+    const Scene s = loadScene(dir_ / "scene.yaml");
+    EXPECT_EQ(s.name, "scene");
+    ASSERT_EQ(s.bodies.size(), 1u);
+    const Body& b = s.bodies[0];
+    EXPECT_NEAR(b.mass, 10.0, 1e-12);
+    // Re-centred: the local origin is the centre of mass, and `position` is where it goes.
+    EXPECT_EQ(b.position, Vec3(1, 2, 3));
+    for (const Vec3& v : b.shape.mesh->vertices) EXPECT_NEAR(v.cwiseAbs().maxCoeff(), 0.5, 1e-12);
+    for (const Vec3& v : b.shape.hull->vertices) EXPECT_NEAR(v.cwiseAbs().maxCoeff(), 0.5, 1e-12);
+    const MassPropertiesOutput local = computeMassProperties(b.shape, 1);
+    ASSERT_TRUE(local.ok) << local.error;
+    EXPECT_LE(local.props.center_of_mass.norm(), 1e-12);
+    // A cube's inertia: m/6 s^2.
+    EXPECT_NEAR(b.inertia_body(0, 0), 10.0 / 6, 1e-12);
+    EXPECT_NEAR(b.inertia_body(0, 1), 0, 1e-12);
+
+    // The same file through parseScene with the project's scenes/ folder as the base.
+    const Scene t =
+        parse(withBody("  - shape: hull\n    file: ../assets/spaceship.obj\n"
+                       "    position: [0, 0, 0]\n"));
+    ASSERT_EQ(t.bodies.size(), 1u);
+    EXPECT_GT(t.bodies[0].shape.hull->vertices.size(), 8u);
+}
+
+TEST_F(SceneMeshes, ImportedOnceAndShared) {
+    std::string text = kHeader;
+    for (int i = 0; i < 4; ++i) {
+        text += "  - shape: mesh\n    file: ../assets/torus.obj\n    position: [" +
+                std::to_string(i) + ", 0, 0]\n";
+    }
+    text += "  - shape: mesh\n    file: ../scenes/../assets/torus.obj\n    position: [0, 1, 0]\n";
+    text +=
+        "  - shape: mesh\n    file: ../assets/torus.obj\n    scale: 2\n    position: [0, 2, 0]\n";
+    text += "  - shape: hull\n    file: ../assets/torus.obj\n    position: [0, 3, 0]\n";
+    const Scene s = parse(text);
+    ASSERT_EQ(s.bodies.size(), 7u);
+    for (int i = 1; i < 5; ++i) {
+        EXPECT_EQ(s.bodies[i].shape.mesh.get(), s.bodies[0].shape.mesh.get());
+        EXPECT_EQ(s.bodies[i].shape.hull.get(), s.bodies[0].shape.hull.get());
+    }
+    EXPECT_NE(s.bodies[5].shape.mesh.get(), s.bodies[0].shape.mesh.get());  // other scale
+    EXPECT_NE(s.bodies[6].shape.hull.get(), s.bodies[0].shape.hull.get());  // hull: own COM
+    // The hull fills the hole: ~1.5 times the torus's mass at the same density.
+    EXPECT_GT(s.bodies[6].mass, 1.3 * s.bodies[0].mass);
+}
+
+TEST_F(SceneMeshes, MeshErrorsAreReportedAtTheFileKey) {
+    EXPECT_SCENE_ERROR(withBody("  - shape: mesh\n    position: [0, 0, 0]\n"
+                                "    file: ../assets/missing.obj\n"),
+                       "6:5: bodies[0].file: ", "no such file");
+    write("meshes/garbage.obj", std::string(200, '\x07') + "\x01\x02\x03");
+    write("meshes/flat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    write("meshes/open.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\n");
+    write("meshes/lines.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2 3\n");
+    auto error = [&](const std::string& shape, const std::string& file) {
+        return errorOf(withBody("  - shape: " + shape + "\n    file: meshes/" + file +
+                                "\n    position: [0, 0, 0]\n"),
+                       dir_);
+    };
+    const std::string garbage = error("mesh", "garbage.obj");
+    EXPECT_EQ(garbage.rfind("test.yaml:5:5: bodies[0].file: ", 0), 0u) << garbage;
+    const std::string flat = error("hull", "flat.obj");
+    EXPECT_EQ(flat.rfind("test.yaml:5:5: bodies[0].file: ", 0), 0u) << flat;
+    EXPECT_NE(flat.find("convex hull"), std::string::npos) << flat;
+    const std::string open = error("mesh", "open.obj");
+    EXPECT_EQ(open.rfind("test.yaml:5:5: bodies[0].file: ", 0), 0u) << open;
+    EXPECT_NE(open.find("not closed"), std::string::npos) << open;
+    // The open tetrahedron is fine as a hull: the hull is closed.
+    EXPECT_EQ(error("hull", "open.obj"), "");
+    const std::string lines = error("mesh", "lines.obj");
+    EXPECT_EQ(lines.rfind("test.yaml:5:5: bodies[0].file: ", 0), 0u) << lines;
+}
+
+TEST_F(SceneMeshes, LoadSceneFileErrors) {
+    try {
+        loadScene(dir_ / "absent.yaml");
+        FAIL() << "no error";
+    } catch (const SceneError& e) {
+        EXPECT_EQ(std::string(e.what()), (dir_ / "absent.yaml").string() +
+                                             ":1:1: scene: cannot open the file (no such file)");
+    }
+    write("bad.yaml", "world:\n  bounds: {min: [0, 0, 0], max: [1, 1, 1]}\n  frames: -1\n");
+    try {
+        loadScene(dir_ / "bad.yaml");
+        FAIL() << "no error";
+    } catch (const SceneError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  (dir_ / "bad.yaml").string() + ":3:11: world.frames: must be >= 1");
+    }
+}
+
+// --- conventions -------------------------------------------------------------------------------
+
+TEST(Scene, EulerMatchesQuaternion) {
+    auto orientationOf = [](const std::string& key_line) {
+        const Scene s =
+            parse(withBody("  - shape: box\n    half_extents: [1, 2, 3]\n"
+                           "    position: [0, 0, 0]\n" +
+                           key_line));
+        return s.bodies.at(0).orientation;
+    };
+    // A single axis: 30 degrees about y = (cos 15, 0, sin 15, 0).
+    const Quat a = orientationOf("    euler_deg: [0, 30, 0]\n");
+    const Real c = std::cos(kPi / 12);
+    const Real s = std::sin(kPi / 12);
+    const Quat b = orientationOf("    orientation_wxyz: [" + std::to_string(c) + ", 0, " +
+                                 std::to_string(s) + ", 0]\n");
+    EXPECT_LE(a.angularDistance(b), 1e-6);
+    // Intrinsic X then Y: R = Rx(90) Ry(90) sends x to y and z to x (extrinsic order would send
+    // x to -z).
+    const Quat xy = orientationOf("    euler_deg: [90, 90, 0]\n");
+    EXPECT_LE((xy * Vec3::UnitX() - Vec3::UnitY()).norm(), 1e-12);
+    EXPECT_LE((xy * Vec3::UnitZ() - Vec3::UnitX()).norm(), 1e-12);
+    // General angles against the product of the three axis rotations.
+    const Quat g = orientationOf("    euler_deg: [10, -20, 35]\n");
+    const Quat expected = Quat(Eigen::AngleAxis<Real>(10 * kPi / 180, Vec3::UnitX())) *
+                          Quat(Eigen::AngleAxis<Real>(-20 * kPi / 180, Vec3::UnitY())) *
+                          Quat(Eigen::AngleAxis<Real>(35 * kPi / 180, Vec3::UnitZ()));
+    EXPECT_LE(g.angularDistance(expected), 1e-12);
+    const Quat q =
+        orientationOf("    orientation_wxyz: [" + std::to_string(expected.w()) + ", " +
+                      std::to_string(expected.x()) + ", " + std::to_string(expected.y()) + ", " +
+                      std::to_string(expected.z()) + "]\n");
+    EXPECT_LE(g.angularDistance(q), 1e-5);
+    EXPECT_NEAR(q.norm(), 1, 1e-15);
+}
+
+TEST(Scene, AngularVelocityIsWorldFrame) {
+    const Scene s =
+        parse(withBody("  - shape: box\n    half_extents: [1, 0.2, 0.5]\n"
+                       "    position: [0, 0, 0]\n    euler_deg: [20, 40, 60]\n"
+                       "    angular_velocity: [0.3, -1, 2]\n"));
+    const Body& b = s.bodies.at(0);
+    EXPECT_LE((b.angularVelocity() - Vec3(0.3, -1, 2)).norm(), 1e-12);
+}
+
+TEST(Scene, MassVersusDensity) {
+    const std::string base =
+        "  - shape: capsule\n    radius: 0.3\n    half_height: 0.5\n"
+        "    position: [0, 0, 0]\n";
+    const Scene by_density = parse(withBody(base + "    density: 250\n"));
+    const Scene by_mass = parse(withBody(base + "    mass: 3\n"));
+    const Body& d = by_density.bodies.at(0);
+    const Body& m = by_mass.bodies.at(0);
+    const Real volume = shapeVolume(d.shape);
+    EXPECT_NEAR(d.mass, 250 * volume, 1e-12);
+    EXPECT_EQ(m.mass, 3);
+    // Same shape: inertia per kilogram is the same.
+    EXPECT_LE((d.inertia_body / d.mass - m.inertia_body / m.mass).norm(), 1e-12);
+
+    // Meshes too.
+    const std::string mesh =
+        "  - shape: mesh\n    file: ../assets/crystal.obj\n"
+        "    position: [0, 0, 0]\n";
+    const Body md = parse(withBody(mesh + "    density: 2\n")).bodies.at(0);
+    const Body mm = parse(withBody(mesh + "    mass: 7\n")).bodies.at(0);
+    EXPECT_NEAR(md.mass, 2 * shapeVolume(md.shape), 1e-12);
+    EXPECT_EQ(mm.mass, 7);
+    EXPECT_LE((md.inertia_body / md.mass - mm.inertia_body / mm.mass).norm(), 1e-12);
+}
+
+TEST(Scene, ZeroSizeBoxNeedsAMass) {
+    const std::string plate =
+        "  - shape: box\n    half_extents: [1, 0, 0.5]\n"
+        "    position: [0, 0, 0]\n";
+    EXPECT_SCENE_ERROR(withBody(plate), "5:19: bodies[0].half_extents: ", "needs 'mass'");
+    const Body b = parse(withBody(plate + "    mass: 2\n")).bodies.at(0);
+    EXPECT_EQ(b.mass, 2);
+    // Thin plate: I_yy = m/3 (a^2 + c^2); the others are invertible.
+    EXPECT_NEAR(b.inertia_body(1, 1), 2.0 / 3 * 1.25, 1e-12);
+    EXPECT_TRUE(b.inv_inertia_body.allFinite());
+    const Body point = parse(withBody("  - shape: box\n    half_extents: [0, 0, 0]\n"
+                                      "    position: [0, 0, 0]\n    mass: 1\n"))
+                           .bodies.at(0);
+    EXPECT_TRUE(point.inv_inertia_body.allFinite());
+}
+
+// --- robustness --------------------------------------------------------------------------------
+
+// Every prefix of a valid scene either parses or throws SceneError: never anything else.
+TEST(SceneErrors, EveryTruncationFailsCleanly) {
+    const std::string full = kFullScene;
+    int errors = 0;
+    int parsed = 0;
+    for (std::size_t n = 0; n < full.size(); n += 3) {
+        try {
+            parse(full.substr(0, n));
+            ++parsed;
+        } catch (const SceneError& e) {
+            ++errors;
+            EXPECT_EQ(std::string(e.what()).rfind("test.yaml:", 0), 0u) << e.what();
+        }
+    }
+    EXPECT_GT(errors, 0);
+    EXPECT_GT(parsed, 0);
+}
+
+TEST(SceneErrors, HostileYamlFailsCleanly) {
+    const std::string deep = std::string(5000, '[') + std::string(5000, ']');
+    const std::string cases[] = {
+        deep,
+        "world: *undefined\n",
+        "? [a, b]\n: 1\n",
+        "world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\nbodies:\n  - !!binary AAAA\n",
+        std::string("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n") +
+            std::string("\0\0\xff\xfe", 4),
+        "world:\n  bounds: {min: [-1e308,-1e308,-1e308], max: [1e308,1e308,1e308]}\n"
+        "bodies:\n  - shape: sphere\n    radius: 1e300\n    position: [0, 0, 0]\n",
+        "world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n"
+        "bodies:\n  - shape: sphere\n    radius: 1e-300\n    position: [0, 0, 0]\n",
+        "world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  frames: 99999999999999999999\n",
+    };
+    for (const std::string& text : cases) {
+        const std::string err = errorOf(text);
+        EXPECT_EQ(err.rfind("test.yaml:", 0), 0u) << "input: " << text.substr(0, 80);
+        // One printable line.
+        for (const char c : err) EXPECT_GE(static_cast<unsigned char>(c), 0x20) << err;
+    }
+    EXPECT_SCENE_ERROR(deep, "1:", "malformed YAML: nesting is too deep");
+    EXPECT_SCENE_ERROR("? [a, b]\n: 1\n", "1:3: scene: ", "keys must be plain names");
+    EXPECT_SCENE_ERROR(cases[5], "5:13: bodies[0].radius: ", "degenerate mass properties");
+    EXPECT_SCENE_ERROR(cases[6], "5:13: bodies[0].radius: ", "degenerate mass properties");
+}
+
+// --- the world -----------------------------------------------------------------------------------
+
+TEST(Scene, MakeWorldAddsBodiesInOrderAndDetects) {
+    const Scene s =
+        parse(withBody("  - name: a\n    shape: sphere\n    radius: 0.5\n"
+                       "    position: [0, 0, 0]\n"
+                       "  - name: b\n    shape: sphere\n    radius: 0.5\n"
+                       "    position: [0.8, 0, 0]\n"
+                       "  - name: c\n    shape: box\n    half_extents: [0.5, 0.5, 0.5]\n"
+                       "    position: [5, 0, 0]\n"));
+    const World w = makeWorld(s);
+    ASSERT_EQ(w.bodies().size(), 3u);
+    EXPECT_EQ(w.bodies()[0].name, "a");
+    EXPECT_EQ(w.bodies()[2].name, "c");
+    EXPECT_EQ(w.settings().broad_phase, "sap");
+    ASSERT_EQ(w.flaggedPairs().size(), 1u);
+    EXPECT_EQ(w.flaggedPairs()[0], (collision::ProxyPair{0, 1}));
+}
+
+}  // namespace
+}  // namespace engine

@@ -1,0 +1,571 @@
+// tests/render/render_test.cpp -- render checks: pixel colours at projected points (not whole-image
+// goldens), determinism, PNG round trip, output error paths, the ffmpeg pipe, the HUD.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "collision/convex_hull.h"
+#include "collision/shape.h"
+#include "engine/body.h"
+#include "engine/world.h"
+#include "render/image.h"
+#include "render/renderer.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using engine::Mat3;
+using engine::Quat;
+using engine::Real;
+using engine::Vec3;
+using Rgb = std::array<int, 3>;
+
+constexpr int kWidth = 160;
+constexpr int kHeight = 120;
+constexpr double kPi = 3.14159265358979323846;
+
+engine::Body makeShapeBody(const std::string& name, collision::Shape shape, const Vec3& position,
+                           const Quat& orientation = Quat::Identity()) {
+    engine::MassProperties mass;
+    mass.mass = 1;
+    mass.inertia = Mat3::Identity() * Real(0.4);
+    engine::Body body = engine::makeBody(name, std::move(shape), mass);
+    body.position = position;
+    body.orientation = orientation;
+    return body;
+}
+
+engine::Body sphereBody(const std::string& name, Real radius, const Vec3& position) {
+    return makeShapeBody(name, collision::Shape::sphere(radius), position);
+}
+
+// Two overlapping spheres on the left (colliding: red) and one alone on the right (apart: green),
+// seen head-on from +z:
+//
+//        y
+//        |   ( A )( B )        ( C )
+//   -----+--------------------------- x      camera at (0, 0, 9) looking at the origin
+//            x=-3  x=-1.6      x=2.6
+//
+// The bounds are far outside the view, so every pixel that is not a body or a line is background.
+engine::World makeThreeSphereWorld() {
+    engine::WorldSettings settings;
+    settings.bounds = collision::Aabb{Vec3::Constant(-20), Vec3::Constant(20)};
+    engine::World world(settings);
+    world.addBody(sphereBody("a", 1, Vec3(-3, 0, 0)));
+    world.addBody(sphereBody("b", 1, Vec3(-1.6, 0.2, 0)));
+    world.addBody(sphereBody("c", 1, Vec3(2.6, 0, 0)));
+    world.detect();
+    return world;
+}
+
+engine::CameraSettings headOnCamera() {
+    engine::CameraSettings camera;
+    camera.position = Vec3(0, 0, 9);
+    camera.look_at = Vec3::Zero();
+    camera.up = Vec3::UnitY();
+    camera.fov_deg = 45;
+    return camera;
+}
+
+render::FrameOptions plainOptions() {
+    render::FrameOptions options;
+    options.draw.bodies = true;
+    options.draw.sphere = true;
+    options.draw.aabb = false;
+    options.draw.obb = false;
+    options.draw.bounds = false;
+    options.draw.hud = false;
+    return options;
+}
+
+// Pinhole projection written out independently of the renderer (gluLookAt + gluPerspective):
+// pixel x to the right, y down, (0, 0) the top-left corner of the image.
+struct PixelPos {
+    double x;
+    double y;
+};
+
+PixelPos project(const engine::CameraSettings& camera, int width, int height, const Vec3& p) {
+    const Vec3 f = (camera.look_at - camera.position).normalized();
+    const Vec3 r = f.cross(camera.up).normalized();
+    const Vec3 u = r.cross(f);
+    const Vec3 d = p - camera.position;
+    const double t = std::tan(double(camera.fov_deg) * kPi / 360.0);
+    const double aspect = double(width) / double(height);
+    const double ndc_x = double(d.dot(r)) / (double(d.dot(f)) * t * aspect);
+    const double ndc_y = double(d.dot(u)) / (double(d.dot(f)) * t);
+    return {(ndc_x + 1) * 0.5 * width, (1 - ndc_y) * 0.5 * height};
+}
+
+Rgb pixelAt(const render::Image& image, int x, int y) {
+    const std::uint8_t* p = image.pixel(x, y);
+    return {p[0], p[1], p[2]};
+}
+
+Rgb toRgb(const collision::Color& c) {
+    return {int(std::lround(c.r * 255)), int(std::lround(c.g * 255)), int(std::lround(c.b * 255))};
+}
+
+bool close(const Rgb& a, const Rgb& b, int tolerance) {
+    for (int k = 0; k < 3; ++k) {
+        if (std::abs(a[k] - b[k]) > tolerance) return false;
+    }
+    return true;
+}
+
+// True when some pixel within `radius` of `at` is within `tolerance` of `color` per channel.
+bool colorNear(const render::Image& image, PixelPos at, const Rgb& color, int radius = 2,
+               int tolerance = 40) {
+    const int cx = int(std::floor(at.x));
+    const int cy = int(std::floor(at.y));
+    for (int y = cy - radius; y <= cy + radius; ++y) {
+        for (int x = cx - radius; x <= cx + radius; ++x) {
+            if (x < 0 || y < 0 || x >= image.width || y >= image.height) continue;
+            if (close(pixelAt(image, x, y), color, tolerance)) return true;
+        }
+    }
+    return false;
+}
+
+class TempDir {
+public:
+    TempDir() {
+        const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        path_ = fs::temp_directory_path() /
+                ("cdlab_render_" + std::to_string(::getpid()) + "_" + info->name());
+        fs::remove_all(path_);
+        fs::create_directories(path_);
+    }
+    ~TempDir() {
+        std::error_code ec;
+        fs::remove_all(path_, ec);
+    }
+    const fs::path& path() const { return path_; }
+
+private:
+    fs::path path_;
+};
+
+render::Image renderThreeSpheres(render::Renderer& renderer,
+                                 const render::FrameOptions& options = plainOptions()) {
+    const engine::World world = makeThreeSphereWorld();
+    return renderer.render(world, headOnCamera(), options);
+}
+
+// ---------------------------------------------------------------------------------------------
+
+TEST(RenderScene, TestWorldHasOneCollidingPairAndOneLoneSphere) {
+    const engine::World world = makeThreeSphereWorld();
+    ASSERT_EQ(world.states().size(), 3u);
+    EXPECT_EQ(world.states()[0], engine::BodyState::Colliding);
+    EXPECT_EQ(world.states()[1], engine::BodyState::Colliding);
+    EXPECT_EQ(world.states()[2], engine::BodyState::Apart);
+}
+
+TEST(Renderer, ImageHasRequestedSize) {
+    render::Renderer renderer(kWidth, kHeight);
+    const render::Image image = renderThreeSpheres(renderer);
+    EXPECT_EQ(image.width, kWidth);
+    EXPECT_EQ(image.height, kHeight);
+    EXPECT_EQ(image.rgb.size(), std::size_t(kWidth) * kHeight * 3);
+}
+
+TEST(Renderer, SphereOutlinesTakeTheirStateColour) {
+    render::Renderer renderer(kWidth, kHeight);
+    const render::Image image = renderThreeSpheres(renderer);
+    const engine::CameraSettings cam = headOnCamera();
+    const Rgb red = toRgb(render::stateColor(engine::BodyState::Colliding));
+    const Rgb green = toRgb(render::stateColor(engine::BodyState::Apart));
+
+    // Points of the bounding spheres' great circles that sit on the outline seen from +z.
+    const std::vector<Vec3> red_points = {
+        {-4, 0, 0}, {-3, 1, 0}, {-3, -1, 0}, {-1.6, 1.2, 0}, {-0.6, 0.2, 0}};
+    const std::vector<Vec3> green_points = {{1.6, 0, 0}, {3.6, 0, 0}, {2.6, 1, 0}, {2.6, -1, 0}};
+    for (const Vec3& p : red_points) {
+        const PixelPos px = project(cam, kWidth, kHeight, p);
+        EXPECT_TRUE(colorNear(image, px, red)) << "no red near " << px.x << "," << px.y;
+        EXPECT_FALSE(colorNear(image, px, green)) << "green near " << px.x << "," << px.y;
+    }
+    for (const Vec3& p : green_points) {
+        const PixelPos px = project(cam, kWidth, kHeight, p);
+        EXPECT_TRUE(colorNear(image, px, green)) << "no green near " << px.x << "," << px.y;
+        EXPECT_FALSE(colorNear(image, px, red)) << "red near " << px.x << "," << px.y;
+    }
+}
+
+TEST(Renderer, BackgroundIsTheBackgroundColour) {
+    render::Renderer renderer(kWidth, kHeight);
+    const render::Image image = renderThreeSpheres(renderer);
+    const Rgb background = toRgb(render::kBackgroundColor);
+    EXPECT_EQ(background, (Rgb{26, 28, 36}));
+    // Corners, the top and bottom middle, and the gap between B and C.
+    const engine::CameraSettings cam = headOnCamera();
+    const PixelPos gap = project(cam, kWidth, kHeight, Vec3(0.5, 0, 0));
+    const std::vector<std::array<int, 2>> spots = {{0, 0},
+                                                   {kWidth - 1, 0},
+                                                   {0, kHeight - 1},
+                                                   {kWidth - 1, kHeight - 1},
+                                                   {kWidth / 2, 5},
+                                                   {kWidth / 2, kHeight - 6},
+                                                   {int(gap.x), int(gap.y)}};
+    for (const auto& s : spots) {
+        EXPECT_EQ(pixelAt(image, s[0], s[1]), background) << "at " << s[0] << "," << s[1];
+    }
+}
+
+TEST(Renderer, BodiesAreShadedGreyBlueInsideTheirOutline) {
+    render::Renderer renderer(kWidth, kHeight);
+    const render::Image image = renderThreeSpheres(renderer);
+    const engine::CameraSettings cam = headOnCamera();
+    // A body pixel between the wire circles (the YZ circle projects to a thin ellipse left of
+    // this point, the XZ circle to the horizontal through the centre): lit, blue > red.
+    const PixelPos px = project(cam, kWidth, kHeight, Vec3(2.6 + 0.35, -0.35, 0.86));
+    const Rgb c = pixelAt(image, int(px.x), int(px.y));
+    EXPECT_GT(c[2], c[0]);
+    EXPECT_GT(c[0] + c[1] + c[2], 3 * 60) << "too dark";
+    EXPECT_FALSE(close(c, toRgb(render::kBackgroundColor), 10));
+    EXPECT_FALSE(close(c, toRgb(render::stateColor(engine::BodyState::Apart)), 60));
+
+    render::FrameOptions no_bodies = plainOptions();
+    no_bodies.draw.bodies = false;
+    const render::Image wire = renderThreeSpheres(renderer, no_bodies);
+    EXPECT_EQ(pixelAt(wire, int(px.x), int(px.y)), toRgb(render::kBackgroundColor));
+}
+
+TEST(Renderer, SameStateRendersBitIdentical) {
+    render::Renderer renderer(kWidth, kHeight);
+    render::FrameOptions options = plainOptions();
+    options.draw.aabb = options.draw.obb = options.draw.bounds = options.draw.hud = true;
+    options.hud_text = "frame 3  t=0.050 s  sap";
+    const render::Image first = renderThreeSpheres(renderer, options);
+    const render::Image second = renderThreeSpheres(renderer, options);
+    EXPECT_EQ(first.rgb, second.rgb);
+    render::Renderer other(kWidth, kHeight);
+    const render::Image third = renderThreeSpheres(other, options);
+    EXPECT_EQ(first.rgb, third.rgb);
+}
+
+// Metamorphic: moving the whole scene and the camera far from the origin must not change the
+// picture beyond rounding (vertices are eye-relative before they become floats).
+TEST(Renderer, TranslatingSceneAndCameraKeepsThePicture) {
+    const Vec3 shift(1e5, -1e5, 1e5);
+    engine::WorldSettings settings;
+    settings.bounds = collision::Aabb{Vec3::Constant(-20) + shift, Vec3::Constant(20) + shift};
+    engine::World far_world(settings);
+    far_world.addBody(sphereBody("a", 1, Vec3(-3, 0, 0) + shift));
+    far_world.addBody(sphereBody("b", 1, Vec3(-1.6, 0.2, 0) + shift));
+    far_world.addBody(sphereBody("c", 1, Vec3(2.6, 0, 0) + shift));
+    far_world.detect();
+    engine::CameraSettings far_camera = headOnCamera();
+    far_camera.position += shift;
+    far_camera.look_at += shift;
+
+    render::Renderer renderer(kWidth, kHeight);
+    const render::Image near_image = renderThreeSpheres(renderer);
+    const render::Image far_image = renderer.render(far_world, far_camera, plainOptions());
+    int differing = 0;
+    for (int y = 0; y < kHeight; ++y) {
+        for (int x = 0; x < kWidth; ++x) {
+            differing += !close(pixelAt(near_image, x, y), pixelAt(far_image, x, y), 8);
+        }
+    }
+    EXPECT_LT(differing, kWidth * kHeight / 200) << differing << " pixels differ";
+}
+
+TEST(Renderer, EveryShapeTypeIsDrawn) {
+    engine::WorldSettings settings;
+    settings.bounds = collision::Aabb{Vec3::Constant(-20), Vec3::Constant(20)};
+    engine::World world(settings);
+    // A capsule turned 90 degrees about z lies along x.
+    const Quat turn(Eigen::AngleAxis<Real>(Real(kPi / 2), Vec3::UnitZ()));
+    world.addBody(
+        makeShapeBody("capsule", collision::Shape::capsule(0.4, 1.0), Vec3(-3, 1.5, 0), turn));
+    world.addBody(
+        makeShapeBody("box", collision::Shape::box(Vec3(0.6, 0.6, 0.6)), Vec3(0, 1.5, 0)));
+    const std::vector<Vec3> tetra = {
+        {-0.8, -0.6, -0.6}, {0.8, -0.6, -0.6}, {0, 0.8, -0.6}, {0, 0, 0.8}};
+    const collision::ConvexHullOutput hull = collision::computeConvexHull(tetra);
+    ASSERT_TRUE(hull.ok) << hull.error;
+    auto polytope = std::make_shared<const collision::ConvexPolytope>(hull.hull);
+    world.addBody(makeShapeBody("hull", collision::Shape::convexHull(polytope), Vec3(3, 1.5, 0)));
+    auto mesh = std::make_shared<collision::TriangleMesh>();
+    mesh->vertices = tetra;
+    mesh->triangles = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}};
+    world.addBody(
+        makeShapeBody("mesh", collision::Shape::triangleMesh(mesh, polytope), Vec3(0, -1.8, 0)));
+    world.detect();
+
+    render::Renderer renderer(kWidth, kHeight);
+    render::FrameOptions options = plainOptions();
+    options.draw.sphere = false;  // bodies only
+    const render::Image image = renderer.render(world, headOnCamera(), options);
+    const engine::CameraSettings cam = headOnCamera();
+    const Rgb background = toRgb(render::kBackgroundColor);
+    auto shaded = [&](const Vec3& p) {
+        const PixelPos px = project(cam, kWidth, kHeight, p);
+        return pixelAt(image, int(px.x), int(px.y)) != background;
+    };
+    EXPECT_TRUE(shaded(Vec3(-3, 1.5, 0.4)));         // capsule centre
+    EXPECT_TRUE(shaded(Vec3(-3 + 1.2, 1.5, 0.3)));   // capsule cap, along world x
+    EXPECT_FALSE(shaded(Vec3(-3, 1.5 + 0.9, 0)));    // above the thin capsule: nothing
+    EXPECT_TRUE(shaded(Vec3(0, 1.5, 0.6)));          // box face
+    EXPECT_TRUE(shaded(Vec3(0.5, 1.5 + 0.5, 0.6)));  // box corner region
+    EXPECT_TRUE(shaded(Vec3(3, 1.5, 0.5)));          // hull
+    EXPECT_TRUE(shaded(Vec3(0, -1.8, 0.5)));         // mesh
+    EXPECT_FALSE(shaded(Vec3(1.5, 0, 0)));           // between them
+}
+
+TEST(Renderer, WorldBoundsAreDrawnAsAGreyBox) {
+    engine::WorldSettings settings;
+    settings.bounds = collision::Aabb{Vec3::Constant(-2), Vec3::Constant(2)};
+    engine::World world(settings);
+    world.addBody(sphereBody("s", 0.3, Vec3::Zero()));
+    world.detect();
+    render::Renderer renderer(kWidth, kHeight);
+    render::FrameOptions options = plainOptions();
+    options.draw.bounds = true;
+    const render::Image image = renderer.render(world, headOnCamera(), options);
+    const engine::CameraSettings cam = headOnCamera();
+    // The middle of the near top edge and of a near vertical edge.
+    for (const Vec3& p : {Vec3(0, 2, 2), Vec3(2, 0, 2), Vec3(0, -2, -2)}) {
+        const PixelPos px = project(cam, kWidth, kHeight, p);
+        const bool grey = colorNear(image, px, {189, 194, 209}, 2, 50);
+        EXPECT_TRUE(grey) << "no bounds line near " << px.x << "," << px.y;
+    }
+}
+
+TEST(Renderer, VolumeSelectionControlsWhichWireframesAppear) {
+    render::Renderer renderer(kWidth, kHeight);
+    const engine::CameraSettings cam = headOnCamera();
+    const Rgb green = toRgb(render::stateColor(engine::BodyState::Apart));
+    // The AABB corner of C lies outside its bounding sphere: green only when aabb is drawn.
+    const PixelPos corner = project(cam, kWidth, kHeight, Vec3(3.6, 1, 1));
+    render::FrameOptions options = plainOptions();
+    options.draw.sphere = false;
+    EXPECT_FALSE(colorNear(renderThreeSpheres(renderer, options), corner, green, 1));
+    options.draw.aabb = true;
+    EXPECT_TRUE(colorNear(renderThreeSpheres(renderer, options), corner, green, 1));
+}
+
+TEST(Renderer, DrawStructureRendersWithoutError) {
+    render::Renderer renderer(kWidth, kHeight);
+    render::FrameOptions options = plainOptions();
+    options.draw_structure = true;
+    EXPECT_NO_THROW(renderThreeSpheres(renderer, options));
+}
+
+TEST(Renderer, HudTextChangesTopLeftPixelsOnly) {
+    render::Renderer renderer(kWidth, kHeight);
+    const render::Image plain = renderThreeSpheres(renderer);
+    render::FrameOptions options = plainOptions();
+    options.hud_text = "frame 12";
+    const render::Image hud = renderThreeSpheres(renderer, options);
+    int changed_top_left = 0;
+    int changed_elsewhere = 0;
+    for (int y = 0; y < kHeight; ++y) {
+        for (int x = 0; x < kWidth; ++x) {
+            if (pixelAt(plain, x, y) == pixelAt(hud, x, y)) continue;
+            (x < 70 && y < 20 ? changed_top_left : changed_elsewhere) += 1;
+        }
+    }
+    EXPECT_GT(changed_top_left, 50);
+    EXPECT_EQ(changed_elsewhere, 0);
+}
+
+TEST(Renderer, HudTextIsScaledUpFrom720p) {
+    auto hudRows = [](int width, int height) {
+        render::Renderer renderer(width, height);
+        render::FrameOptions options = plainOptions();
+        const render::Image plain = renderThreeSpheres(renderer, options);
+        options.hud_text = "frame 1";
+        const render::Image hud = renderThreeSpheres(renderer, options);
+        int last_row = -1;
+        for (int y = 0; y < height; ++y) {
+            for (int x = 0; x < width / 4; ++x) {
+                if (pixelAt(plain, x, y) != pixelAt(hud, x, y)) last_row = y;
+            }
+        }
+        return last_row;
+    };
+    const int small = hudRows(640, 360);
+    const int large = hudRows(1280, 720);
+    EXPECT_GT(small, 0);
+    EXPECT_GE(large, 2 * small - 2) << "720p text is not 2x";
+}
+
+TEST(Renderer, LegendAppearsBottomLeftWithTheHud) {
+    render::Renderer renderer(kWidth, kHeight);
+    render::FrameOptions options = plainOptions();
+    const render::Image plain = renderThreeSpheres(renderer, options);
+    options.draw.hud = true;
+    const render::Image legend = renderThreeSpheres(renderer, options);
+    int changed = 0;
+    for (int y = kHeight - 20; y < kHeight; ++y) {
+        for (int x = 0; x < kWidth; ++x) changed += pixelAt(plain, x, y) != pixelAt(legend, x, y);
+    }
+    EXPECT_GT(changed, 50);
+}
+
+TEST(Renderer, RejectsNonPositiveSize) {
+    EXPECT_THROW(render::Renderer(0, 10), render::RenderError);
+    EXPECT_THROW(render::Renderer(10, -1), render::RenderError);
+}
+
+TEST(StateColor, MatchesTheDocumentedColours) {
+    EXPECT_EQ(toRgb(render::stateColor(engine::BodyState::Apart)), (Rgb{26, 217, 51}));
+    EXPECT_EQ(toRgb(render::stateColor(engine::BodyState::Flagged)), (Rgb{255, 217, 0}));
+    EXPECT_EQ(toRgb(render::stateColor(engine::BodyState::Colliding)), (Rgb{255, 26, 26}));
+}
+
+TEST(HudLine, ShowsFrameTimeBroadPhaseAndCounts) {
+    const engine::World world = makeThreeSphereWorld();
+    EXPECT_EQ(render::hudLine(world, 12, false),
+              "frame 12  t=0.000 s  sap  flagged 1  colliding 1");
+    const std::string timed = render::hudLine(world, 12, true);
+    EXPECT_EQ(timed.rfind("frame 12  t=0.000 s  sap  flagged 1  colliding 1  step ", 0), 0u)
+        << timed;
+    EXPECT_EQ(timed.substr(timed.size() - 3), " ms");
+}
+
+// ---------------------------------------------------------------------------------------------
+
+TEST(Png, WriteThenReadRoundTripsExactly) {
+    TempDir dir;
+    render::Renderer renderer(kWidth, kHeight);
+    render::FrameOptions options = plainOptions();
+    options.hud_text = "round trip";
+    const render::Image image = renderThreeSpheres(renderer, options);
+    const fs::path file = dir.path() / "frame.png";
+    render::writePng(file, image);
+    ASSERT_TRUE(fs::exists(file));
+    EXPECT_FALSE(fs::exists(dir.path() / "frame.png.partial"));
+    const render::Image back = render::readPng(file);
+    EXPECT_EQ(back.width, image.width);
+    EXPECT_EQ(back.height, image.height);
+    EXPECT_EQ(back.rgb, image.rgb);
+}
+
+TEST(Png, WritingIntoAMissingDirectoryThrows) {
+    TempDir dir;
+    render::Image image;
+    image.width = 4;
+    image.height = 2;
+    image.rgb.assign(4 * 2 * 3, 128);
+    const fs::path file = dir.path() / "no_such_dir" / "frame.png";
+    EXPECT_THROW(render::writePng(file, image), render::RenderError);
+    EXPECT_FALSE(fs::exists(file));
+}
+
+TEST(Png, WritingAMalformedImageThrows) {
+    TempDir dir;
+    render::Image image;
+    image.width = 4;
+    image.height = 2;
+    image.rgb.assign(5, 0);
+    EXPECT_THROW(render::writePng(dir.path() / "bad.png", image), render::RenderError);
+    EXPECT_FALSE(fs::exists(dir.path() / "bad.png"));
+}
+
+TEST(Png, ReadingAMissingOrBrokenFileThrows) {
+    TempDir dir;
+    EXPECT_THROW(render::readPng(dir.path() / "missing.png"), render::RenderError);
+    const fs::path junk = dir.path() / "junk.png";
+    std::ofstream(junk) << "not a png";
+    EXPECT_THROW(render::readPng(junk), render::RenderError);
+}
+
+// ---------------------------------------------------------------------------------------------
+
+TEST(Video, TenFramesMakeANonEmptyMp4) {
+    if (!render::ffmpegAvailable()) GTEST_SKIP() << "ffmpeg not on PATH";
+    TempDir dir;
+    engine::World world = makeThreeSphereWorld();
+    render::Renderer renderer(kWidth, kHeight);
+    const fs::path file = dir.path() / "clip.mp4";
+    {
+        render::VideoWriter video(file, kWidth, kHeight, 30);
+        for (int frame = 0; frame < 10; ++frame) {
+            render::FrameOptions options = plainOptions();
+            options.hud_text = render::hudLine(world, frame, false);
+            video.addFrame(renderer.render(world, headOnCamera(), options));
+            world.step();
+        }
+        EXPECT_FALSE(fs::exists(file)) << "visible before finish()";
+        video.finish();
+    }
+    ASSERT_TRUE(fs::exists(file));
+    EXPECT_GT(fs::file_size(file), 1000u);
+    EXPECT_FALSE(fs::exists(dir.path() / "clip.partial.mp4"));
+    // An MP4 starts with an 'ftyp' box.
+    std::ifstream in(file, std::ios::binary);
+    char head[8] = {};
+    in.read(head, 8);
+    EXPECT_EQ(std::string(head + 4, 4), "ftyp");
+}
+
+TEST(Video, AnUnfinishedVideoLeavesNoFile) {
+    if (!render::ffmpegAvailable()) GTEST_SKIP() << "ffmpeg not on PATH";
+    TempDir dir;
+    const fs::path file = dir.path() / "abandoned.mp4";
+    {
+        render::VideoWriter video(file, kWidth, kHeight, 30);
+        render::Renderer renderer(kWidth, kHeight);
+        video.addFrame(renderThreeSpheres(renderer));
+    }
+    EXPECT_FALSE(fs::exists(file));
+    EXPECT_TRUE(fs::is_empty(dir.path()));
+}
+
+TEST(Video, OddSizeOrWrongFrameSizeThrows) {
+    if (!render::ffmpegAvailable()) GTEST_SKIP() << "ffmpeg not on PATH";
+    TempDir dir;
+    EXPECT_THROW(render::VideoWriter(dir.path() / "odd.mp4", 161, 120, 30), render::RenderError);
+    EXPECT_THROW(render::VideoWriter(dir.path() / "fps.mp4", 160, 120, 0), render::RenderError);
+    render::VideoWriter video(dir.path() / "size.mp4", 160, 120, 30);
+    render::Image small;
+    small.width = 2;
+    small.height = 2;
+    small.rgb.assign(12, 0);
+    EXPECT_THROW(video.addFrame(small), render::RenderError);
+}
+
+// Regression guard for SIGPIPE: an ffmpeg that dies at once must turn into a RenderError, not
+// kill the test process when we write into its closed pipe.
+//
+//   us --frames--> [pipe] --x  fake "ffmpeg" (exit 3)
+TEST(Video, AnFfmpegThatDiesBecomesARenderError) {
+    TempDir dir;
+    const fs::path fake = dir.path() / "ffmpeg";
+    std::ofstream(fake) << "#!/bin/sh\nexit 3\n";
+    fs::permissions(fake, fs::perms::owner_all);
+    const char* old_path = std::getenv("PATH");
+    const std::string saved = old_path ? old_path : "";
+    ::setenv("PATH", dir.path().c_str(), 1);
+    bool threw = false;
+    try {
+        render::VideoWriter video(dir.path() / "dead.mp4", kWidth, kHeight, 30);
+        render::Image frame;
+        frame.width = kWidth;
+        frame.height = kHeight;
+        frame.rgb.assign(std::size_t(kWidth) * kHeight * 3, 7);
+        for (int i = 0; i < 50; ++i) video.addFrame(frame);  // > the 64 KiB pipe buffer
+        video.finish();
+    } catch (const render::RenderError&) {
+        threw = true;
+    }
+    ::setenv("PATH", saved.c_str(), 1);
+    EXPECT_TRUE(threw);
+    EXPECT_FALSE(fs::exists(dir.path() / "dead.mp4"));
+    EXPECT_FALSE(fs::exists(dir.path() / "dead.partial.mp4"));
+}
+
+}  // namespace
