@@ -262,7 +262,7 @@ void appendPeerMethods([[maybe_unused]] std::vector<BenchMethodEntry>& methods) 
     bullet("bullet-dbvt", "Bullet btDbvtBroadphase, defaults (Bullet's default broad phase)",
            BulletKind::Dbvt, true, 0, "");
     bullet("bullet-dbvt-deferred", "Bullet btDbvtBroadphase, m_deferedcollide = true",
-           BulletKind::DbvtDeferred, false, 0, "");
+           BulletKind::DbvtDeferred, true, 0, "");
     bullet("bullet-sap",
            "Bullet btAxisSweep3 (bt32BitAxisSweep3 from 16k), no raycast accelerator",
            BulletKind::AxisSweep, true, 50000, sweep_skip);
@@ -293,9 +293,9 @@ void appendPeerMethods([[maybe_unused]] std::vector<BenchMethodEntry>& methods) 
     fcl("fcl-dtree-rebuild", "FCL DynamicAABBTreeCollisionManager, clear + registerObjects",
         FclManager::Tree, FclUpdate::Rebuild, false);
     fcl("fcl-sap-update", "FCL SaPCollisionManager, update(all objects)",
-        FclManager::SweepAndPrune, FclUpdate::Update, true);
+        FclManager::SweepAndPrune, FclUpdate::Update, false);
     fcl("fcl-sap-rebuild", "FCL SaPCollisionManager, clear + registerObjects",
-        FclManager::SweepAndPrune, FclUpdate::Rebuild, false);
+        FclManager::SweepAndPrune, FclUpdate::Rebuild, true);
 #endif
 }
 

@@ -33,6 +33,9 @@ int main(int argc, char** argv) {
     bool no_timing = false;
     run_cmd->add_flag("--no-hud-timing", no_timing,
                       "leave the step time out of the HUD so frames are bit-identical");
+    run_cmd->add_flag("--draw-structure", run.draw_structure,
+                      "draw the broad phase's own structure: grid/hash cells, hierarchical-grid "
+                      "cells by level, SAP intervals, tree and octree nodes by depth");
     run_cmd->add_flag("--check-broadphase", run.check_broad_phase,
                       "verify every step's pairs against the brute-force reference; stop with a "
                       "report (exit 3) at the first mismatch");

@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "engine/scene.h"
+#include "broadphase_check.h"
 #include "pause_dump.h"
 #include "render/image.h"
 #include "render/renderer.h"
@@ -120,63 +121,6 @@ std::string statsRow(int frame, const engine::World& world, const FrameStats& f)
     return line;
 }
 
-// --check-broadphase: runs the registry's reference beside the world's broad phase on the same
-// volumes and describes the first difference.
-class BroadPhaseChecker {
-public:
-    explicit BroadPhaseChecker(const std::string& name) {
-        const collision::BroadPhaseEntry* entry = collision::findBroadPhase(name);
-        reference_name_ = std::string(entry->reference);
-        reference_ = collision::findBroadPhase(entry->reference)->create();
-    }
-
-    /// Empty when the world's flagged pairs equal the reference's; else a report.
-    std::string check(const engine::World& world) {
-        const auto volumes = world.volumes();
-        for (std::size_t i = 0; i < volumes.size(); ++i) {
-            const auto id = static_cast<collision::ProxyId>(i);
-            if (i < inserted_) {
-                reference_->move(id, volumes[i]);
-            } else {
-                reference_->insert(id, volumes[i]);
-            }
-        }
-        inserted_ = volumes.size();
-        collision::BroadPhaseCounters ignored;
-        reference_->findPairs(expected_, ignored);
-        const auto got = world.flaggedPairs();
-        if (std::equal(got.begin(), got.end(), expected_.begin(), expected_.end())) return {};
-        std::vector<collision::ProxyPair> missing;
-        std::vector<collision::ProxyPair> extra;
-        std::set_difference(expected_.begin(), expected_.end(), got.begin(), got.end(),
-                            std::back_inserter(missing));
-        std::set_difference(got.begin(), got.end(), expected_.begin(), expected_.end(),
-                            std::back_inserter(extra));
-        std::ostringstream out;
-        const auto bodies = world.bodies();
-        auto describe = [&](const char* what, const std::vector<collision::ProxyPair>& list) {
-            out << "  " << what << " (" << list.size() << "):";
-            for (std::size_t k = 0; k < list.size() && k < 20; ++k) {
-                out << " (" << list[k].a << " " << bodies[list[k].a].name << ", " << list[k].b
-                    << " " << bodies[list[k].b].name << ")";
-            }
-            out << (list.size() > 20 ? " ..." : "") << "\n";
-        };
-        out << "broad phase '" << world.broadPhase().name() << "' reports " << got.size()
-            << " pairs, reference '" << reference_name_ << "' reports " << expected_.size()
-            << "\n";
-        describe("missed", missing);
-        describe("extra", extra);
-        return out.str();
-    }
-
-private:
-    std::string reference_name_;
-    std::unique_ptr<collision::BroadPhase> reference_;
-    std::vector<collision::ProxyPair> expected_;
-    std::size_t inserted_ = 0;
-};
-
 std::string frameName(int frame) {
     char name[32];
     std::snprintf(name, sizeof name, "frame_%05d.png", frame);
@@ -245,6 +189,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         }
         render::FrameOptions frame_options;
         frame_options.draw = scene.draw;
+        frame_options.draw_structure = scene.draw.structure || options.draw_structure;
         render::FrameOptions pause_options = frame_options;
         pause_options.draw.sphere = pause_options.draw.aabb = pause_options.draw.obb = true;
 

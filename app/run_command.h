@@ -20,6 +20,7 @@ struct RunOptions {
     std::vector<int> pause_at;                ///< frames to dump
     bool hud_timing = true;                   ///< step time in the HUD (off: bit-identical frames)
     bool progress = true;                     ///< progress bar when stderr is a terminal
+    bool draw_structure = false;              ///< draw the broad phase's own structure
     bool check_broad_phase = false;           ///< compare every step with the brute reference
     std::optional<std::filesystem::path> stats_csv;  ///< one row of counters per frame
 };

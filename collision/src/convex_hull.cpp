@@ -39,7 +39,7 @@ struct HorizonEdge {
 };
 
 class Quickhull {
-  public:
+public:
     Quickhull(const std::vector<Vec3>& pts, Real tol) : p_(pts), tol_(tol) {}
 
     // Builds the hull; false with `error` set when the set is degenerate or numerics fail.
@@ -47,7 +47,7 @@ class Quickhull {
     // Live faces as vertex-index triples (indices into the input array).
     std::vector<std::array<std::int32_t, 3>> liveFaces() const;
 
-  private:
+private:
     Real distance(const Face& f, std::int32_t i) const { return f.normal.dot(p_[i]) - f.offset; }
     void setPlane(Face& f, const Vec3& fallback_normal) const;
     bool initialSimplex(std::string& error);

@@ -81,13 +81,13 @@ struct PreparedShape {
 };
 
 class SceneParser {
-  public:
+public:
     SceneParser(std::string display_name, fs::path base_dir)
         : file_(std::move(display_name)), base_dir_(std::move(base_dir)) {}
 
     Scene parse(const std::string& text);
 
-  private:
+private:
     [[noreturn]] void fail(const YAML::Mark& mark, const std::string& path,
                            const std::string& what) const;
     [[noreturn]] void fail(const YAML::Node& node, const std::string& path,
@@ -343,11 +343,12 @@ void SceneParser::parseCamera(const YAML::Node& n, Scene& scene) const {
 void SceneParser::parseDraw(const YAML::Node& n, Scene& scene) const {
     const std::string path = "draw";
     DrawSettings& d = scene.draw;
-    for (const Entry& e : entries(n, path, {"bodies", "volumes", "bounds", "hud"})) {
+    for (const Entry& e : entries(n, path, {"bodies", "volumes", "bounds", "hud", "structure"})) {
         const std::string p = childPath(path, e.key);
         if (e.key == "bodies") d.bodies = readBool(e.value, p);
         if (e.key == "bounds") d.bounds = readBool(e.value, p);
         if (e.key == "hud") d.hud = readBool(e.value, p);
+        if (e.key == "structure") d.structure = readBool(e.value, p);
         if (e.key == "volumes") {
             if (!e.value.IsSequence()) fail(e.value, p, "expected a list of: sphere, aabb, obb");
             d.sphere = d.aabb = d.obb = false;

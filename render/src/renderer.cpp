@@ -790,15 +790,26 @@ Image Renderer::render(const engine::World& world, const engine::CameraSettings&
 }
 
 std::string hudLine(const engine::World& world, int frame, bool include_timing) {
+    // Line 1: where we are and what the phases found. Line 2: the cost model's counters
+    // (F = Nv Cv + Np Cp + Nu Cu) and, with timing, the time per stage.
+    const engine::StepStats& st = world.lastStats();
     const std::string_view bp = world.broadPhase().name();
-    char buffer[256];
-    int n =
-        std::snprintf(buffer, sizeof buffer, "frame %d  t=%.3f s  %.*s  flagged %zu  colliding %zu",
-                      frame, double(world.time()), int(bp.size()), bp.data(),
-                      world.flaggedPairs().size(), world.collidingPairs().size());
+    char buffer[512];
+    int n = std::snprintf(buffer, sizeof buffer,
+                          "frame %d  t=%.3f s  %.*s  flagged %zu  colliding %zu\n"
+                          "BV tests %lld  updated %lld  narrow tests %lld  triangle tests %lld",
+                          frame, double(world.time()), int(bp.size()), bp.data(),
+                          world.flaggedPairs().size(), world.collidingPairs().size(),
+                          static_cast<long long>(st.broad.volume_tests),
+                          static_cast<long long>(st.broad.volumes_updated),
+                          static_cast<long long>(st.narrow_tests),
+                          static_cast<long long>(st.triangle_tests));
     std::string line(buffer, std::size_t(std::clamp(n, 0, int(sizeof buffer) - 1)));
     if (include_timing) {
-        n = std::snprintf(buffer, sizeof buffer, "  step %.2f ms", 1e3 * world.lastStats().total_s);
+        n = std::snprintf(buffer, sizeof buffer,
+                          "\nstep %.3f ms  volumes %.3f  broad %.3f  narrow %.3f ms",
+                          1e3 * st.total_s, 1e3 * st.volumes_s, 1e3 * st.broad_phase_s,
+                          1e3 * st.narrow_phase_s);
         line.append(buffer, std::size_t(std::clamp(n, 0, int(sizeof buffer) - 1)));
     }
     return line;

@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -184,6 +185,40 @@ TEST(Cli, BroadPhaseFlagOverridesTheScene) {
     EXPECT_EQ(p["broadphase"], "sphere");
     EXPECT_TRUE(fs::exists(work / "o" / "frame_00001.png"));
     EXPECT_FALSE(fs::exists(work / "o" / "frame_00002.png"));
+    fs::remove_all(work);
+}
+
+TEST(Cli, StatsCsvHasOneRowPerFrameAndCheckBroadphasePasses) {
+    const fs::path work = tempDir("stats");
+    const fs::path csv = work / "stats" / "run.csv";
+    const Result r = runCdlab("run " + kTiny + " --no-video --check-broadphase --draw-structure "
+                              "--broadphase hgrid --pause-at 5 --stats " + csv.string() +
+                                  " --out " + (work / "o").string(),
+                              work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("every step checked"), std::string::npos) << r.out;
+    std::istringstream lines(slurp(csv));
+    std::string line;
+    std::getline(lines, line);
+    EXPECT_EQ(line.rfind("frame,time,broadphase,bodies,flagged,colliding,volume_tests", 0), 0u);
+    int rows = 0;
+    std::string last;
+    while (std::getline(lines, line)) {
+        EXPECT_EQ(std::count(line.begin(), line.end(), ','), 15) << line;
+        last = line;
+        ++rows;
+    }
+    EXPECT_EQ(rows, 6);
+    // The last row's flagged/colliding counts are those of the frame-5 pause dump.
+    const nlohmann::json p = nlohmann::json::parse(slurp(work / "o" / "pause_5.json"));
+    std::vector<std::string> cells;
+    std::stringstream row(last);
+    for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+    ASSERT_EQ(cells.size(), 16u);
+    EXPECT_EQ(cells[0], "5");
+    EXPECT_EQ(cells[2], "hgrid");
+    EXPECT_EQ(std::stoul(cells[4]), p["flagged_pairs"].size());
+    EXPECT_EQ(std::stoul(cells[5]), p["colliding_pairs"].size());
     fs::remove_all(work);
 }
 

@@ -11,8 +11,8 @@
 #include <vector>
 
 // Private narrow-phase headers (collision/src is not on the test's include path).
-#include "../../collision/src/gjk.h"
-#include "../../collision/src/triangle_triangle.h"
+#include "gjk.h"
+#include "triangle_triangle.h"
 #include "test_random.h"
 
 namespace {

@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 using collision::Vec3;
 
 class MeshImport : public ::testing::Test {
-  protected:
+protected:
     void SetUp() override {
         const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
         dir_ = fs::temp_directory_path() / ("cdlab_mesh_import_" + std::string(info->name()));

@@ -64,6 +64,7 @@ draw:
   volumes: [aabb, obb]
   bounds: false
   hud: false
+  structure: true
 bodies:
   - name: ball
     shape: sphere
@@ -119,6 +120,7 @@ TEST(Scene, FullSceneRoundTrip) {
     EXPECT_TRUE(s.draw.obb);
     EXPECT_FALSE(s.draw.bounds);
     EXPECT_FALSE(s.draw.hud);
+    EXPECT_TRUE(s.draw.structure);
     ASSERT_EQ(s.bodies.size(), 5u);
 
     const Body& ball = s.bodies[0];
@@ -184,6 +186,7 @@ TEST(Scene, Defaults) {
     EXPECT_FALSE(s.draw.obb);
     EXPECT_TRUE(s.draw.bounds);
     EXPECT_TRUE(s.draw.hud);
+    EXPECT_FALSE(s.draw.structure);
     ASSERT_EQ(s.bodies.size(), 1u);
     const Body& b = s.bodies[0];
     EXPECT_EQ(b.name, "sphere0");
@@ -384,7 +387,7 @@ TEST(SceneErrors, MalformedYamlReportsTheParserPosition) {
 // --- meshes ------------------------------------------------------------------------------------
 
 class SceneMeshes : public ::testing::Test {
-  protected:
+protected:
     void SetUp() override {
         const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
         dir_ = fs::temp_directory_path() / ("cdlab_scene_" + std::string(info->name()));

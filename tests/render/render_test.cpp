@@ -428,10 +428,19 @@ TEST(StateColor, MatchesTheDocumentedColours) {
 
 TEST(HudLine, ShowsFrameTimeBroadPhaseAndCounts) {
     const engine::World world = makeThreeSphereWorld();
+    const engine::StepStats& st = world.lastStats();
+    const std::string counters =
+        "BV tests " + std::to_string(st.broad.volume_tests) + "  updated " +
+        std::to_string(st.broad.volumes_updated) + "  narrow tests " +
+        std::to_string(st.narrow_tests) + "  triangle tests " + std::to_string(st.triangle_tests);
     EXPECT_EQ(render::hudLine(world, 12, false),
-              "frame 12  t=0.000 s  sap  flagged 1  colliding 1");
+              "frame 12  t=0.000 s  sap  flagged 1  colliding 1\n" + counters);
+    EXPECT_EQ(st.narrow_tests, 1);  // the one flagged pair went to the narrow phase
     const std::string timed = render::hudLine(world, 12, true);
-    EXPECT_EQ(timed.rfind("frame 12  t=0.000 s  sap  flagged 1  colliding 1  step ", 0), 0u)
+    EXPECT_EQ(timed.rfind("frame 12  t=0.000 s  sap  flagged 1  colliding 1\n" + counters +
+                              "\nstep ",
+                          0),
+              0u)
         << timed;
     EXPECT_EQ(timed.substr(timed.size() - 3), " ms");
 }

@@ -33,6 +33,7 @@ struct DrawSettings {
     bool obb = false;
     bool bounds = true;
     bool hud = true;
+    bool structure = false;  ///< the broad phase's own structure (cells, intervals, nodes)
 };
 
 struct Scene {
