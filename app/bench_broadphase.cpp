@@ -152,8 +152,9 @@ RunResult measure(const BenchMethodEntry& entry, const MovingBoxes& initial,
 
     r.frames_run = static_cast<int>(times.size());
     r.median_ms = median(times);
-    r.mean_ms = times.empty() ? 0 : std::accumulate(times.begin(), times.end(), 0.0) /
-                                        static_cast<double>(times.size());
+    r.mean_ms = times.empty() ? 0
+                              : std::accumulate(times.begin(), times.end(), 0.0) /
+                                    static_cast<double>(times.size());
     const std::size_t edge = std::min<std::size_t>(kEdgeFrames, times.size());
     r.first_median_ms = median(std::vector<double>(times.begin(), times.begin() + edge));
     r.last_median_ms = median(std::vector<double>(times.end() - edge, times.end()));
@@ -187,7 +188,8 @@ RunResult measureIsolated(const BenchMethodEntry& entry, const MovingBoxes& init
     if (pid == 0) {
         ::close(fds[0]);
         // A stuck method ends with SIGALRM instead of stalling the run.
-        if (options.budget_seconds > 0) ::alarm(static_cast<unsigned>(options.budget_seconds * 10 + 600));
+        if (options.budget_seconds > 0)
+            ::alarm(static_cast<unsigned>(options.budget_seconds * 10 + 600));
         RunResult child;
         try {
             child = measure(entry, initial, reference, options);
@@ -273,14 +275,14 @@ void printTable(std::ostream& out, const std::vector<Row>& rows, int frames) {
         const std::string check = r.mismatched_frames == 0
                                       ? "ok"
                                       : "MISMATCH(" + std::to_string(r.mismatched_frames) + ")";
-        std::snprintf(line, sizeof(line), "%-26s %10s %10s %10s %10s %10s %10lld %10s %8s %9s  %s\n",
-                      (row.method + (row.peer ? " [peer]" : "")).c_str(),
-                      format("%.2f", r.insert_ms).c_str(), format("%.4f", r.median_ms).c_str(),
-                      format("%.4f", r.mean_ms).c_str(), format("%.4f", r.first_median_ms).c_str(),
-                      format("%.4f", r.last_median_ms).c_str(),
-                      static_cast<long long>(r.pairs_last),
-                      (format("%.2f", row.ratio) + (std::isfinite(row.ratio) ? "x" : "")).c_str(),
-                      format("%.1f", r.peak_mb).c_str(), frames_text.c_str(), check.c_str());
+        std::snprintf(
+            line, sizeof(line), "%-26s %10s %10s %10s %10s %10s %10lld %10s %8s %9s  %s\n",
+            (row.method + (row.peer ? " [peer]" : "")).c_str(), format("%.2f", r.insert_ms).c_str(),
+            format("%.4f", r.median_ms).c_str(), format("%.4f", r.mean_ms).c_str(),
+            format("%.4f", r.first_median_ms).c_str(), format("%.4f", r.last_median_ms).c_str(),
+            static_cast<long long>(r.pairs_last),
+            (format("%.2f", row.ratio) + (std::isfinite(row.ratio) ? "x" : "")).c_str(),
+            format("%.1f", r.peak_mb).c_str(), frames_text.c_str(), check.c_str());
         out << line;
     }
 }
@@ -446,8 +448,8 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
                           per_body_last, options.frames, 2 * per_body_first, 2 * per_body_last);
             out << head;
             err << "[" << workloadName(kind) << " N=" << n << "] reference pairs for "
-                << options.frames + 1 << " frames in "
-                << format("%.1f", threadCpuSeconds() - t_ref) << " s\n";
+                << options.frames + 1 << " frames in " << format("%.1f", threadCpuSeconds() - t_ref)
+                << " s\n";
 
             std::vector<Row> rows;
             for (const BenchMethodEntry* m : methods) {
@@ -470,17 +472,16 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
                     err << "FAILED: " << r.note << '\n';
                     failed = true;
                 } else {
-                    err << format("%.4f", r.median_ms) << " ms/frame median, "
-                        << r.frames_run << " frames\n";
+                    err << format("%.4f", r.median_ms) << " ms/frame median, " << r.frames_run
+                        << " frames\n";
                 }
                 if (r.mismatched_frames > 0) {
                     failed = true;
                     const std::string msg =
-                        "MISMATCH: " + m->name + " (" + row.workload + ", N=" +
-                        std::to_string(n) + ") disagrees with the reference on " +
-                        std::to_string(r.mismatched_frames) + " frame(s); first at frame " +
-                        std::to_string(r.first_mismatch_frame) + ": " +
-                        std::to_string(r.got_pairs) + " pairs, expected " +
+                        "MISMATCH: " + m->name + " (" + row.workload + ", N=" + std::to_string(n) +
+                        ") disagrees with the reference on " + std::to_string(r.mismatched_frames) +
+                        " frame(s); first at frame " + std::to_string(r.first_mismatch_frame) +
+                        ": " + std::to_string(r.got_pairs) + " pairs, expected " +
                         std::to_string(r.expected_pairs) + "\n";
                     out << "!!! " << msg;
                     err << "!!! " << msg;
@@ -500,8 +501,8 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
             for (Row& row : rows) {
                 if (row.skipped || row.result.failed) continue;
                 if (best != nullptr) row.ratio = row.result.median_ms / best_peer;
-                if (!row.peer && (fastest == nullptr ||
-                                  row.result.median_ms < fastest->result.median_ms)) {
+                if (!row.peer &&
+                    (fastest == nullptr || row.result.median_ms < fastest->result.median_ms)) {
                     fastest = &row;
                 }
             }
@@ -520,8 +521,7 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
                 if (row.skipped || r.failed) continue;
                 if (r.budget_hit) {
                     out << "  * " << row.method << ": stopped after " << r.frames_run
-                        << " frames (--budget " << options.budget_seconds
-                        << " s of frame time)\n";
+                        << " frames (--budget " << options.budget_seconds << " s of frame time)\n";
                 }
                 if (r.raw_pairs_last >= 0) {
                     out << "  " << row.method << ": pair cache held " << r.raw_pairs_last

@@ -17,8 +17,8 @@ struct BenchOptions {
     /// Method names (see benchMethods()); empty: every AABB-based cdlab broad phase and the
     /// default peer configurations found at configure time.
     std::vector<std::string> methods;
-    std::string workload = "both";                ///< uniform | mixed | both
-    std::optional<std::filesystem::path> json;    ///< machine-readable rows
+    std::string workload = "both";              ///< uniform | mixed | both
+    std::optional<std::filesystem::path> json;  ///< machine-readable rows
     std::uint64_t seed = 1;
     /// A method stops early (reporting the frames it ran) once its frames took this much thread
     /// CPU time in total, so an O(n^2) method cannot stall the run. <= 0: no limit.

@@ -41,7 +41,9 @@ std::vector<BenchMethodEntry> makeMethods() {
         m.description = std::string(entry.description);
         m.default_set = true;
         const collision::BroadPhaseEntry* e = &entry;
-        m.create = [e]() -> std::unique_ptr<BenchMethod> { return std::make_unique<CdlabMethod>(*e); };
+        m.create = [e]() -> std::unique_ptr<BenchMethod> {
+            return std::make_unique<CdlabMethod>(*e);
+        };
         methods.push_back(std::move(m));
     }
     appendPeerMethods(methods);

@@ -38,8 +38,8 @@ public:
 struct BenchMethodEntry {
     std::string name;
     std::string description;
-    bool peer = false;          ///< a Bullet or FCL configuration (the "best peer" is among these)
-    bool default_set = false;   ///< run when no --methods is given
+    bool peer = false;         ///< a Bullet or FCL configuration (the "best peer" is among these)
+    bool default_set = false;  ///< run when no --methods is given
     /// Skipped in the default set from this many boxes on (0: never), with `skip_reason`.
     int default_max_n = 0;
     std::string skip_reason;

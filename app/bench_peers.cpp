@@ -49,12 +49,14 @@ enum class BulletKind { Dbvt, DbvtDeferred, AxisSweep, AxisSweepRaycast };
 // contains the exact one and Bullet's pair cache stays a superset of the exact pairs.
 btScalar roundDown(collision::Real x) {
     btScalar s = static_cast<btScalar>(x);
-    if (static_cast<collision::Real>(s) > x) s = std::nextafter(s, -std::numeric_limits<btScalar>::infinity());
+    if (static_cast<collision::Real>(s) > x)
+        s = std::nextafter(s, -std::numeric_limits<btScalar>::infinity());
     return s;
 }
 btScalar roundUp(collision::Real x) {
     btScalar s = static_cast<btScalar>(x);
-    if (static_cast<collision::Real>(s) < x) s = std::nextafter(s, std::numeric_limits<btScalar>::infinity());
+    if (static_cast<collision::Real>(s) < x)
+        s = std::nextafter(s, std::numeric_limits<btScalar>::infinity());
     return s;
 }
 btVector3 lowerCorner(const collision::Aabb& box) {
@@ -123,15 +125,17 @@ public:
     void findPairs() override { broad_phase_->calculateOverlappingPairs(nullptr); }
     PairSummary summary(const MovingBoxes& boxes) override {
         PairSummary out;
-        btBroadphasePairArray& cache = broad_phase_->getOverlappingPairCache()->getOverlappingPairArray();
+        btBroadphasePairArray& cache =
+            broad_phase_->getOverlappingPairCache()->getOverlappingPairArray();
         raw_pairs_ = cache.size();
         for (int k = 0; k < cache.size(); ++k) {
             const btBroadphasePair& p = cache[k];
             if (p.m_pProxy0 == nullptr || p.m_pProxy1 == nullptr) continue;
-            addExactPair(boxes,
-                         static_cast<int>(reinterpret_cast<std::intptr_t>(p.m_pProxy0->m_clientObject)),
-                         static_cast<int>(reinterpret_cast<std::intptr_t>(p.m_pProxy1->m_clientObject)),
-                         out);
+            addExactPair(
+                boxes,
+                static_cast<int>(reinterpret_cast<std::intptr_t>(p.m_pProxy0->m_clientObject)),
+                static_cast<int>(reinterpret_cast<std::intptr_t>(p.m_pProxy1->m_clientObject)),
+                out);
         }
         return out;
     }
@@ -203,8 +207,12 @@ public:
             raw_[i]->computeAABB();
         }
         switch (update_) {
-            case FclUpdate::Refit: manager_->update(); break;
-            case FclUpdate::Update: manager_->update(raw_); break;
+            case FclUpdate::Refit:
+                manager_->update();
+                break;
+            case FclUpdate::Update:
+                manager_->update(raw_);
+                break;
             case FclUpdate::UpdateEach:
                 for (fcl::CollisionObjectd* o : raw_) manager_->update(o);
                 break;
@@ -263,15 +271,14 @@ void appendPeerMethods([[maybe_unused]] std::vector<BenchMethodEntry>& methods) 
            BulletKind::Dbvt, true, 0, "");
     bullet("bullet-dbvt-deferred", "Bullet btDbvtBroadphase, m_deferedcollide = true",
            BulletKind::DbvtDeferred, true, 0, "");
-    bullet("bullet-sap",
-           "Bullet btAxisSweep3 (bt32BitAxisSweep3 from 16k), no raycast accelerator",
+    bullet("bullet-sap", "Bullet btAxisSweep3 (bt32BitAxisSweep3 from 16k), no raycast accelerator",
            BulletKind::AxisSweep, true, 50000, sweep_skip);
     bullet("bullet-sap-raycast", "Bullet btAxisSweep3 with its raycast accelerator (default)",
            BulletKind::AxisSweepRaycast, false, 50000, sweep_skip);
 #endif
 #ifdef CDLAB_HAVE_FCL
-    auto fcl = [&](std::string name, std::string description, FclManager manager,
-                   FclUpdate update, bool in_default) {
+    auto fcl = [&](std::string name, std::string description, FclManager manager, FclUpdate update,
+                   bool in_default) {
         BenchMethodEntry m;
         m.name = std::move(name);
         m.description = std::move(description);
@@ -292,8 +299,8 @@ void appendPeerMethods([[maybe_unused]] std::vector<BenchMethodEntry>& methods) 
         FclManager::Tree, FclUpdate::Reinsert, false);
     fcl("fcl-dtree-rebuild", "FCL DynamicAABBTreeCollisionManager, clear + registerObjects",
         FclManager::Tree, FclUpdate::Rebuild, false);
-    fcl("fcl-sap-update", "FCL SaPCollisionManager, update(all objects)",
-        FclManager::SweepAndPrune, FclUpdate::Update, false);
+    fcl("fcl-sap-update", "FCL SaPCollisionManager, update(all objects)", FclManager::SweepAndPrune,
+        FclUpdate::Update, false);
     fcl("fcl-sap-rebuild", "FCL SaPCollisionManager, clear + registerObjects",
         FclManager::SweepAndPrune, FclUpdate::Rebuild, true);
 #endif

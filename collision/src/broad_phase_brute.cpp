@@ -19,16 +19,14 @@ void BruteForceBroadPhase::findPairs(std::vector<ProxyPair>& pairs,
     const ProxyId n = table_.capacity();
     for (ProxyId a = 0; a < n; ++a) {
         if (!table_.contains(a)) continue;
-        const ProxyVolumes& va = table_[a];
         for (ProxyId b = a + 1; b < n; ++b) {
             if (!table_.contains(b)) continue;
-            const ProxyVolumes& vb = table_[b];
             ++counters.volume_tests;
             bool hit = false;
             switch (volume_) {
-                case Volume::Aabb: hit = va.aabb.overlaps(vb.aabb); break;
-                case Volume::Sphere: hit = va.sphere.overlaps(vb.sphere); break;
-                case Volume::Obb: hit = va.obb.overlaps(vb.obb); break;
+                case Volume::Aabb: hit = table_.aabb(a).overlaps(table_.aabb(b)); break;
+                case Volume::Sphere: hit = table_.sphere(a).overlaps(table_.sphere(b)); break;
+                case Volume::Obb: hit = table_.obb(a).overlaps(table_.obb(b)); break;
             }
             if (hit) pairs.push_back(ProxyPair{a, b});
         }

@@ -11,7 +11,11 @@ namespace collision {
 class BruteForceBroadPhase : public BroadPhase {
 public:
     enum class Volume { Aabb, Sphere, Obb };
-    explicit BruteForceBroadPhase(Volume volume) : volume_(volume) {}
+    explicit BruteForceBroadPhase(Volume volume)
+        : volume_(volume),
+          table_(volume == Volume::Aabb     ? ProxyTable::kAabb
+                 : volume == Volume::Sphere ? ProxyTable::kSphere
+                                            : ProxyTable::kObb) {}
 
     std::string_view name() const override;
     void insert(ProxyId id, const ProxyVolumes& v) override { table_.insert(id, v); }

@@ -47,7 +47,7 @@ inline Real medianCellSize(const ProxyTable& table) {
     std::vector<Real> extents;
     extents.reserve(static_cast<std::size_t>(table.count()));
     for (ProxyId id = 0; id < table.capacity(); ++id) {
-        if (table.contains(id)) extents.push_back(table[id].aabb.extents().maxCoeff());
+        if (table.contains(id)) extents.push_back(table.aabb(id).extents().maxCoeff());
     }
     if (extents.empty()) return 1;
     const std::size_t mid = extents.size() / 2;

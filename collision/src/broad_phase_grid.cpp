@@ -39,8 +39,8 @@ void GridBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters
                  Vec3::Constant(std::numeric_limits<Real>::lowest())};
         for (ProxyId id = 0; id < table_.capacity(); ++id) {
             if (!table_.contains(id)) continue;
-            all.min = all.min.cwiseMin(table_[id].aabb.min);
-            all.max = all.max.cwiseMax(table_[id].aabb.max);
+            all.min = all.min.cwiseMin(table_.aabb(id).min);
+            all.max = all.max.cwiseMax(table_.aabb(id).max);
         }
         origin_ = all.min;
         // At most ~2n cells: a grid far larger than the population is mostly empty memory.
@@ -62,7 +62,7 @@ void GridBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters
     // Bin every proxy into the cells its AABB covers.
     for (ProxyId id = 0; id < table_.capacity(); ++id) {
         if (!table_.contains(id)) continue;
-        const Aabb& box = table_[id].aabb;
+        const Aabb& box = table_.aabb(id);
         const CellCoord lo = clampToGrid(cellOf(box.min - origin_, inv));
         const CellCoord hi = clampToGrid(cellOf(box.max - origin_, inv));
         const std::int64_t n = (hi.x - lo.x + 1) * (hi.y - lo.y + 1) * (hi.z - lo.z + 1);
@@ -98,12 +98,12 @@ void GridBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters
         const std::uint32_t end = bucket_start_[b + 1];
         for (std::uint32_t i = begin; i < end; ++i) {
             const Entry& ei = sorted_[i];
-            const Aabb& bi = table_[ei.id].aabb;
+            const Aabb& bi = table_.aabb(ei.id);
             for (std::uint32_t j = i + 1; j < end; ++j) {
                 const Entry& ej = sorted_[j];
                 if (!(ej.cell == ei.cell) || ej.id == ei.id) continue;
                 ++counters.volume_tests;
-                const Aabb& bj = table_[ej.id].aabb;
+                const Aabb& bj = table_.aabb(ej.id);
                 if (!bi.overlaps(bj)) continue;
                 const CellCoord owner =
                     clampToGrid(cellOf(bi.min.cwiseMax(bj.min) - origin_, inv));
@@ -119,11 +119,11 @@ void GridBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters
     std::vector<char> is_big(static_cast<std::size_t>(table_.capacity()), 0);
     for (ProxyId id : big_) is_big[id] = 1;
     for (ProxyId b : big_) {
-        const Aabb& bb = table_[b].aabb;
+        const Aabb& bb = table_.aabb(b);
         for (ProxyId o = 0; o < table_.capacity(); ++o) {
             if (o == b || !table_.contains(o) || (is_big[o] && o < b)) continue;
             ++counters.volume_tests;
-            if (bb.overlaps(table_[o].aabb)) {
+            if (bb.overlaps(table_.aabb(o))) {
                 pairs.push_back(b < o ? ProxyPair{b, o} : ProxyPair{o, b});
             }
         }

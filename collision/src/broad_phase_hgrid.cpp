@@ -1,94 +1,194 @@
-// collision/src/broad_phase_hgrid.cpp -- hierarchical hash grid, rebuilt every frame.
-// Completeness: let a, b overlap with level(a) <= level(b) = L. At level L both boxes are entered
-// in (or looked up through) every cell their AABBs touch, and a point of their intersection lies
-// in a cell both touch, so a's lookup at level L meets b. Pairs may be met in several shared
-// cells; the final sort + unique removes the repeats.
+// collision/src/broad_phase_hgrid.cpp -- hierarchical grid of sorted columns, rebuilt each frame.
+// Completeness and uniqueness, same level: members' extents are <= the column width w (cells
+// are s_top / 2^k, widened by 2^-20 so rounding of floor((v - o) / w) cannot split two values
+// less than a cell apart by two columns); so overlapping a, b sit in columns at most one apart in
+// y and in z. Sweeping column C against each of its 3 x 3 neighbours D, a finds exactly the
+// members of D greater than itself in (min x, id) whose min x <= a's max x -- among them every
+// overlapping one, since min_b.x <= max_a.x. The smaller of the two finds the pair; the larger
+// skips it. Across levels: a at a finer level scans, in each coarser level j, the columns
+// within that level's largest extent E_j of its box and the min-x window [min_a.x - E_j,
+// max_a.x], widened by a few ulps; a pair across levels is found only from its finer member.
 #include "broad_phase_hgrid.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <numeric>
+#include <type_traits>
+#include <sstream>
 
 #include "collision/debug_draw.h"
 
 namespace collision {
 
-void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) {
-    counters.volumes_updated += moved_;
-    moved_ = 0;
-    pairs.clear();
-    entries_.clear();
-    if (table_.count() == 0) return;
+namespace {
 
-    // s0: the smallest non-zero extent, so the finest objects sit at level 0.
-    Real smallest = std::numeric_limits<Real>::max();
-    Real largest = 0;
-    for (ProxyId id = 0; id < table_.capacity(); ++id) {
-        if (!table_.contains(id)) continue;
-        const Real e = table_[id].aabb.extents().maxCoeff();
-        if (e > 0) smallest = std::min(smallest, e);
-        largest = std::max(largest, e);
-    }
-    base_size_ = largest > 0 ? smallest : Real(1);
-    // Keep the level count bounded for absurd ratios: coarsen the base instead.
-    while (largest / base_size_ > std::ldexp(Real(1), kMaxLevels - 1)) base_size_ *= 2;
+constexpr int kDigitBits = 11;
+constexpr std::size_t kBuckets = std::size_t(1) << kDigitBits;
 
-    level_of_.assign(static_cast<std::size_t>(table_.capacity()), -1);
-    level_used_.assign(kMaxLevels, 0);
-    for (ProxyId id = 0; id < table_.capacity(); ++id) {
-        if (!table_.contains(id)) continue;
-        const Aabb& box = table_[id].aabb;
-        const Real e = box.extents().maxCoeff();
-        int level = 0;
-        while (level + 1 < kMaxLevels && cellSize(level) < e) ++level;
-        level_of_[id] = level;
-        level_used_[level] = 1;
-        const Real inv = Real(1) / cellSize(level);
-        const CellCoord lo = cellOf(box.min, inv);
-        const CellCoord hi = cellOf(box.max, inv);
-        for (std::int64_t z = lo.z; z <= hi.z; ++z) {
-            for (std::int64_t y = lo.y; y <= hi.y; ++y) {
-                for (std::int64_t x = lo.x; x <= hi.x; ++x) {
-                    const CellCoord c{x, y, z};
-                    entries_.push_back(Entry{hashCell(c, std::uint64_t(level)), c, level, id});
-                }
-            }
+// Order-preserving map of a coordinate to an unsigned integer (-0 and +0 map alike).
+template <typename T>
+std::uint64_t orderedBits(T v) {
+    if (v == 0) v = 0;
+    using U = std::conditional_t<sizeof(T) == 8, std::uint64_t, std::uint32_t>;
+    constexpr int kTop = int(sizeof(T)) * 8 - 1;
+    const U b = std::bit_cast<U>(v);
+    return (b >> kTop) ? U(~b) : U(b | (U(1) << kTop));
+}
+
+// LSD radix sort of 64-bit keys, 11 bits per pass, skipping digits that are all equal; stable.
+void radixSortKeys(std::vector<std::uint64_t>& keys, std::vector<std::uint64_t>& scratch,
+                   int bits) {
+    scratch.resize(keys.size());
+    std::array<std::uint32_t, kBuckets> count;
+    for (int shift = 0; shift < bits; shift += kDigitBits) {
+        count.fill(0);
+        for (std::uint64_t k : keys) ++count[(k >> shift) & (kBuckets - 1)];
+        if (count[(keys[0] >> shift) & (kBuckets - 1)] == keys.size()) continue;
+        std::uint32_t sum = 0;
+        for (std::uint32_t& c : count) {
+            const std::uint32_t here = c;
+            c = sum;
+            sum += here;
         }
+        for (std::uint64_t k : keys) scratch[count[(k >> shift) & (kBuckets - 1)]++] = k;
+        keys.swap(scratch);
     }
-    bucket_count_ = nextPowerOfTwo(std::max<std::size_t>(2 * entries_.size(), 16));
-    const std::uint64_t mask = bucket_count_ - 1;
-    bucket_start_.assign(bucket_count_ + 1, 0);
-    for (const Entry& e : entries_) ++bucket_start_[(e.hash & mask) + 1];
-    for (std::size_t b = 0; b < bucket_count_; ++b) bucket_start_[b + 1] += bucket_start_[b];
-    sorted_.resize(entries_.size());
-    {
-        std::vector<std::uint32_t> fill(bucket_start_.begin(), bucket_start_.end() - 1);
-        for (const Entry& e : entries_) sorted_[fill[e.hash & mask]++] = e;
-    }
+}
 
-    for (ProxyId a = 0; a < table_.capacity(); ++a) {
-        if (!table_.contains(a)) continue;
-        const Aabb& box = table_[a].aabb;
-        const int own = level_of_[a];
-        for (int level = own; level < kMaxLevels; ++level) {
-            if (!level_used_[level]) continue;
-            const Real inv = Real(1) / cellSize(level);
-            const CellCoord lo = cellOf(box.min, inv);
-            const CellCoord hi = cellOf(box.max, inv);
-            for (std::int64_t z = lo.z; z <= hi.z; ++z) {
-                for (std::int64_t y = lo.y; y <= hi.y; ++y) {
-                    for (std::int64_t x = lo.x; x <= hi.x; ++x) {
-                        const CellCoord c{x, y, z};
-                        const std::uint64_t bucket = hashCell(c, std::uint64_t(level)) & mask;
-                        for (std::uint32_t i = bucket_start_[bucket];
-                             i < bucket_start_[bucket + 1]; ++i) {
-                            const Entry& e = sorted_[i];
-                            if (e.level != level || !(e.cell == c)) continue;
-                            // Same level: each pair from its lower id only.
-                            if (e.id == a || (level == own && e.id < a)) continue;
-                            ++counters.volume_tests;
-                            if (box.overlaps(table_[e.id].aabb)) {
-                                pairs.push_back(a < e.id ? ProxyPair{a, e.id}
-                                                         : ProxyPair{e.id, a});
+// Stable LSD radix sort of `order` (indices) by key[index].
+void radixSortIndices(std::vector<std::uint32_t>& order, std::vector<std::uint32_t>& scratch,
+                      const std::vector<std::uint64_t>& key) {
+    scratch.resize(order.size());
+    std::array<std::uint32_t, kBuckets> count;
+    for (int shift = 0; shift < 64; shift += kDigitBits) {
+        count.fill(0);
+        for (std::uint32_t i : order) ++count[(key[i] >> shift) & (kBuckets - 1)];
+        if (count[(key[order[0]] >> shift) & (kBuckets - 1)] == order.size()) continue;
+        std::uint32_t sum = 0;
+        for (std::uint32_t& c : count) {
+            const std::uint32_t here = c;
+            c = sum;
+            sum += here;
+        }
+        for (std::uint32_t i : order) scratch[count[(key[i] >> shift) & (kBuckets - 1)]++] = i;
+        order.swap(scratch);
+    }
+}
+
+int bitsFor(std::uint64_t n) {
+    int b = 1;
+    while ((std::uint64_t(1) << b) < n) ++b;
+    return b;
+}
+
+}  // namespace
+
+std::int64_t HierarchicalGrid::column(const Level& level, int axis, Real v) const {
+    const Real origin = axis == 1 ? level.origin_y : level.origin_z;
+    const std::int64_t n = axis == 1 ? level.ny : level.nz;
+    const Real c = std::floor((v - origin) / level.cell);
+    return static_cast<std::int64_t>(std::clamp(c, Real(0), Real(n - 1)));
+}
+
+void HierarchicalGrid::buildLevel(Level& level, const std::vector<ProxyId>& members) {
+    const std::size_t n = members.size();
+    level.count = n;
+    Real lo_y = std::numeric_limits<Real>::max(), hi_y = std::numeric_limits<Real>::lowest();
+    Real lo_z = lo_y, hi_z = hi_y;
+    level.top_extent = 0;
+    for (ProxyId id : members) {
+        const Aabb& b = table_.aabb(id);
+        lo_y = std::min(lo_y, b.min.y());
+        hi_y = std::max(hi_y, b.min.y());
+        lo_z = std::min(lo_z, b.min.z());
+        hi_z = std::max(hi_z, b.min.z());
+        level.top_extent = std::max(level.top_extent, b.extents().maxCoeff());
+    }
+    level.origin_y = lo_y;
+    level.origin_z = lo_z;
+    // Widen the columns a little (see the file comment); at most ~2 columns per member, else
+    // coarser columns (still >= every extent, so still correct).
+    level.cell *= Real(1) + std::ldexp(Real(1), -20);
+    const Real limit = std::max<Real>(64, 2 * Real(n));
+    for (;;) {
+        const Real ny = std::floor((hi_y - lo_y) / level.cell) + 1;
+        const Real nz = std::floor((hi_z - lo_z) / level.cell) + 1;
+        if (ny * nz <= limit) {
+            level.ny = static_cast<std::int64_t>(ny);
+            level.nz = static_cast<std::int64_t>(nz);
+            break;
+        }
+        level.cell *= 2;
+    }
+    const std::size_t columns = static_cast<std::size_t>(level.ny * level.nz);
+
+    // Sort by min x (stable over the id order members come in), then stably by column.
+    sort_keys_.resize(n);
+    order_.resize(n);
+    column_of_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const Aabb& b = table_.aabb(members[i]);
+        sort_keys_[i] = orderedBits(b.min.x());
+        order_[i] = static_cast<std::uint32_t>(i);
+        column_of_[i] =
+            static_cast<std::uint32_t>(column(level, 2, b.min.z()) * level.ny + column(level, 1, b.min.y()));
+    }
+    radixSortIndices(order_, order_scratch_, sort_keys_);
+    level.start.assign(columns + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) ++level.start[column_of_[i] + 1];
+    for (std::size_t c = 0; c < columns; ++c) level.start[c + 1] += level.start[c];
+    level.id.resize(n);
+    level.box.resize(n);
+    for (std::uint32_t i : order_) {
+        const std::uint32_t slot = level.start[column_of_[i]]++;
+        const Aabb& b = table_.aabb(members[i]);
+        level.id[slot] = members[i];
+        level.box[slot] =
+            PackedBox{b.min.x(), b.max.x(), b.min.y(), b.max.y(), b.min.z(), b.max.z()};
+    }
+    for (std::size_t c = columns; c > 0; --c) level.start[c] = level.start[c - 1];
+    level.start[0] = 0;
+}
+
+void HierarchicalGrid::sweepLevel(const Level& lv, BroadPhaseCounters& counters) {
+    const PackedBox* const box = lv.box.data();
+    const ProxyId* const ids = lv.id.data();
+    const std::uint32_t* const start = lv.start.data();
+    std::int64_t tests = 0;  // a local, so the pushes below cannot force it through memory
+    for (std::int64_t cz = 0; cz < lv.nz; ++cz) {
+        for (std::int64_t cy = 0; cy < lv.ny; ++cy) {
+            const std::int64_t c = cz * lv.ny + cy;
+            const std::uint32_t c0 = start[c];
+            const std::uint32_t c1 = start[c + 1];
+            if (c0 == c1) continue;
+            for (std::int64_t dz = std::max<std::int64_t>(cz - 1, 0);
+                 dz <= std::min(cz + 1, lv.nz - 1); ++dz) {
+                for (std::int64_t dy = std::max<std::int64_t>(cy - 1, 0);
+                     dy <= std::min(cy + 1, lv.ny - 1); ++dy) {
+                    const std::int64_t d = dz * lv.ny + dy;
+                    const std::uint32_t d1 = start[d + 1];
+                    std::uint32_t p = start[d];
+                    for (std::uint32_t i = c0; i < c1 && p < d1; ++i) {
+                        const PackedBox& a = box[i];
+                        const ProxyId a_id = ids[i];
+                        // Skip members of D not greater than a in (min x, id).
+                        while (p < d1 && (box[p].min_x < a.min_x ||
+                                          (box[p].min_x == a.min_x && ids[p] <= a_id))) {
+                            ++p;
+                        }
+                        for (std::uint32_t q = p; q < d1 && box[q].min_x <= a.max_x; ++q) {
+                            ++tests;
+                            const PackedBox& b = box[q];
+                            // x overlaps already: a.min_x <= b.min_x <= a.max_x.
+                            const bool hit = (b.min_y <= a.max_y) & (a.min_y <= b.max_y) &
+                                             (b.min_z <= a.max_z) & (a.min_z <= b.max_z);
+                            if (hit) {
+                                const ProxyId b_id = ids[q];
+                                const ProxyId lo = std::min(a_id, b_id);
+                                const ProxyId hi = std::max(a_id, b_id);
+                                keys_.push_back((std::uint64_t(std::uint32_t(lo)) << 32) |
+                                                std::uint32_t(hi));
                             }
                         }
                     }
@@ -96,20 +196,151 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
             }
         }
     }
-    std::sort(pairs.begin(), pairs.end());
-    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    counters.volume_tests += tests;
+}
+
+void HierarchicalGrid::queryCoarser(const PackedBox& a, ProxyId a_id, const Level& lv,
+                                    BroadPhaseCounters& counters) {
+    const Real e = lv.top_extent;
+    // A few ulps of the coordinates, so rounding never narrows the scanned window.
+    const Real slack =
+        4 * kEpsilon * (e + std::abs(a.min_x) + std::abs(a.min_y) + std::abs(a.min_z));
+    const std::int64_t y0 = column(lv, 1, a.min_y - e - slack);
+    const std::int64_t y1 = column(lv, 1, a.max_y);
+    const std::int64_t z0 = column(lv, 2, a.min_z - e - slack);
+    const std::int64_t z1 = column(lv, 2, a.max_z);
+    const Real x_from = a.min_x - e - slack;
+    const PackedBox* const box = lv.box.data();
+    for (std::int64_t z = z0; z <= z1; ++z) {
+        for (std::int64_t y = y0; y <= y1; ++y) {
+            const std::int64_t d = z * lv.ny + y;
+            const PackedBox* first = box + lv.start[d];
+            const PackedBox* last = box + lv.start[d + 1];
+            const PackedBox* q = std::partition_point(
+                first, last, [x_from](const PackedBox& b) { return b.min_x < x_from; });
+            for (; q < last && q->min_x <= a.max_x; ++q) {
+                ++counters.volume_tests;
+                const bool hit = (q->min_x <= a.max_x) & (a.min_x <= q->max_x) &
+                                 (q->min_y <= a.max_y) & (a.min_y <= q->max_y) &
+                                 (q->min_z <= a.max_z) & (a.min_z <= q->max_z);
+                if (hit) {
+                    const ProxyId b_id = lv.id[static_cast<std::size_t>(q - box)];
+                    const ProxyId lo = std::min(a_id, b_id);
+                    const ProxyId hi = std::max(a_id, b_id);
+                    keys_.push_back((std::uint64_t(std::uint32_t(lo)) << 32) |
+                                    std::uint32_t(hi));
+                }
+            }
+        }
+    }
+}
+
+void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) {
+    counters.volumes_updated += moved_;
+    moved_ = 0;
+    pairs.clear();
+    level_count_ = 0;
+    if (table_.count() == 0) return;
+
+    // Levels: cells s_top / 2^k, down to the smallest extent (at most kMaxLevels).
+    Real largest = 0;
+    for (ProxyId id = 0; id < table_.capacity(); ++id) {
+        if (table_.contains(id)) largest = std::max(largest, table_.aabb(id).extents().maxCoeff());
+    }
+    const Real top = largest > 0 ? largest : Real(1);
+    for (auto& m : members_) m.clear();
+    int finest = 0;
+    for (ProxyId id = 0; id < table_.capacity(); ++id) {
+        if (!table_.contains(id)) continue;
+        const Real e = table_.aabb(id).extents().maxCoeff();
+        int k = kMaxLevels - 1;  // zero-size boxes: the finest level
+        if (e > 0) {
+            int exponent = 0;
+            std::frexp(top / e, &exponent);  // top / e in [2^(exponent-1), 2^exponent)
+            k = std::clamp(exponent - 1, 0, kMaxLevels - 1);
+            while (k > 0 && std::ldexp(top, -k) < e) --k;  // guard rounding: cell >= extent
+        }
+        members_[k].push_back(id);
+        finest = std::max(finest, k);
+    }
+    level_count_ = finest + 1;
+    for (int k = 0; k < level_count_; ++k) {
+        levels_[k].cell = std::ldexp(top, -k);
+        levels_[k].count = 0;
+        if (!members_[k].empty()) buildLevel(levels_[k], members_[k]);
+    }
+
+    keys_.clear();
+    for (int k = 0; k < level_count_; ++k) {
+        const Level& own = levels_[k];
+        if (own.count == 0) continue;
+        sweepLevel(own, counters);
+        for (int j = k - 1; j >= 0; --j) {
+            if (levels_[j].count == 0) continue;
+            for (std::size_t i = 0; i < own.count; ++i) {
+                queryCoarser(own.box[i], own.id[i], levels_[j], counters);
+            }
+        }
+    }
+    // (a, b) order: one radix sort on the bits the ids use.
+    const int id_bits = bitsFor(static_cast<std::uint64_t>(table_.capacity()));
+    if (keys_.size() > 64) {
+        radixSortKeys(keys_, scratch_, 32 + id_bits);
+    } else {
+        std::sort(keys_.begin(), keys_.end());
+    }
+    pairs.resize(keys_.size());
+    for (std::size_t i = 0; i < keys_.size(); ++i) {
+        pairs[i] = ProxyPair{static_cast<ProxyId>(keys_[i] >> 32),
+                             static_cast<ProxyId>(keys_[i] & 0xFFFFFFFFu)};
+    }
     counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
 }
 
 void HierarchicalGrid::draw(DebugDraw& draw) const {
-    // Occupied cells coloured by level: fine levels blue, coarse levels orange.
-    for (const Entry& e : entries_) {
-        const float t = std::min(1.0f, float(e.level) / 6.0f);
-        const Color color{0.3f + 0.7f * t, 0.5f, 1.0f - 0.7f * t, 1};
-        const Real s = cellSize(e.level);
-        const Vec3 lo = Vec3(Real(e.cell.x), Real(e.cell.y), Real(e.cell.z)) * s;
-        draw.drawAabb(Aabb{lo, lo + Vec3::Constant(s)}, color);
+    // Occupied columns' cells (one cell tall at each member), coloured by level: coarse levels
+    // orange, fine levels blue.
+    for (int k = 0; k < level_count_; ++k) {
+        const Level& lv = levels_[k];
+        const float t = level_count_ > 1 ? float(k) / float(level_count_ - 1) : 0.0f;
+        const Color color{1.0f - 0.7f * t, 0.55f, 0.3f + 0.7f * t, 1};
+        for (std::size_t i = 0; i < lv.count; ++i) {
+            const PackedBox& b = lv.box[i];
+            const Real y = lv.origin_y + Real(column(lv, 1, b.min_y)) * lv.cell;
+            const Real z = lv.origin_z + Real(column(lv, 2, b.min_z)) * lv.cell;
+            const Real x = std::floor(b.min_x / lv.cell) * lv.cell;
+            const Vec3 lo(x, y, z);
+            draw.drawAabb(Aabb{lo, lo + Vec3::Constant(lv.cell)}, color);
+        }
     }
+}
+
+std::string HierarchicalGrid::validate() const {
+    std::ostringstream out;
+    std::size_t total = 0;
+    for (int k = 0; k < level_count_; ++k) {
+        const Level& lv = levels_[k];
+        total += lv.count;
+        for (std::size_t i = 0; i < lv.count; ++i) {
+            const ProxyId id = lv.id[i];
+            if (!table_.contains(id)) {
+                out << "level " << k << " holds absent proxy " << id << "; ";
+                continue;
+            }
+            if (table_.aabb(id).extents().maxCoeff() > lv.cell) {
+                out << "proxy " << id << " larger than its level's cells; ";
+            }
+            if (i > 0 && lv.box[i].min_x < lv.box[i - 1].min_x &&
+                column(lv, 1, lv.box[i].min_y) == column(lv, 1, lv.box[i - 1].min_y) &&
+                column(lv, 2, lv.box[i].min_z) == column(lv, 2, lv.box[i - 1].min_z)) {
+                out << "level " << k << " column out of x order at " << i << "; ";
+            }
+        }
+    }
+    if (level_count_ > 0 && total != static_cast<std::size_t>(table_.count())) {
+        out << "levels hold " << total << " proxies of " << table_.count() << "; ";
+    }
+    return out.str();
 }
 
 }  // namespace collision

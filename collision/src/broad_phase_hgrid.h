@@ -1,22 +1,28 @@
 // collision/src/broad_phase_hgrid.h -- hierarchical grid (Mirtich, MERL TR-97-23, §2-2.2).
 #pragma once
 
+#include <array>
 #include <vector>
 
-#include "broad_phase_cells.h"
 #include "collision/broad_phase.h"
 #include "proxy_table.h"
 
 namespace collision {
 
-/// Hierarchical hash grid after Mirtich, "Efficient Algorithms for Two-Phase Collision
-/// Detection" (TR-97-23 §2.2). Level L has cells of size s0 * 2^L, s0 = the smallest non-zero
-/// AABB extent. Each proxy lives at the finest level whose cells are at least as large as its
-/// AABB's largest extent, so it touches at most 2 x 2 x 2 cells there, and is entered in those
-/// cells of one shared hash table keyed by (level, cell). Two boxes overlap only if they share a
-/// cell at the coarser of their two levels (TR-97-23 §2.2), so each proxy looks itself up at its
-/// own level (partners of higher id) and at every coarser occupied level. This keeps the cost per
-/// proxy bounded whatever the size ratio (1:10^4 costs ~14 levels, not 10^12 cells).
+/// Hierarchical grid after Mirtich, "Efficient Algorithms for Two-Phase Collision Detection"
+/// (TR-97-23 §2-2.2). Levels have cells of size s_top / 2^k, s_top = the largest AABB extent;
+/// each proxy lives at the finest level whose cells are at least its largest extent, entered
+/// once, by its AABB's minimum corner. Two boxes can overlap only if the one at the finer (or
+/// same) level finds the other within one cell of itself at the coarser level, so the pair is
+/// met exactly once, at the coarser of the two levels (TR-97-23 §2.2).
+///
+/// Within a level the cells are columns of a 2-D grid over (y, z), each column sorted by min x
+/// (then id). Pairs inside a level come from merging each column with its 3 x 3 neighbourhood,
+/// one pointer per neighbour sweeping forward in x (sort and sweep, Baraff 1992), each pair
+/// found from the box with the smaller (min x, id); a box looks up coarser levels' columns by
+/// binary search on min x. Rebuilt each frame by radix sorts; pairs put in (a, b) order by one
+/// more radix sort. Cost per frame O(n + candidates + pairs) whatever the size ratio, and no
+/// heap allocation once the buffers have grown.
 class HierarchicalGrid : public BroadPhase {
 public:
     std::string_view name() const override { return "hgrid"; }
@@ -28,27 +34,41 @@ public:
     }
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
     void draw(DebugDraw& draw) const override;
+    std::string validate() const override;
 
-    static constexpr int kMaxLevels = 48;
+    static constexpr int kMaxLevels = 40;
 
 private:
-    struct Entry {
-        std::uint64_t hash;
-        CellCoord cell;
-        std::int32_t level;
-        ProxyId id;
+    struct PackedBox {
+        Real min_x, max_x, min_y, max_y, min_z, max_z;
     };
-    Real cellSize(int level) const { return std::ldexp(base_size_, level); }
+    struct Level {
+        Real cell = 1;            // column width in y and z (>= every member's largest extent)
+        Real top_extent = 0;      // largest extent among the members
+        Real origin_y = 0, origin_z = 0;
+        std::int64_t ny = 1, nz = 1;
+        std::vector<std::uint32_t> start;  // column -> first member (prefix sums), size cols+1
+        std::vector<ProxyId> id;           // members sorted by (column, min x, id)
+        std::vector<PackedBox> box;
+        std::size_t count = 0;
+    };
+    void buildLevel(Level& level, const std::vector<ProxyId>& members);
+    std::int64_t column(const Level& level, int axis, Real v) const;
+    void sweepLevel(const Level& level, BroadPhaseCounters& counters);
+    void queryCoarser(const PackedBox& a, ProxyId id, const Level& coarse,
+                      BroadPhaseCounters& counters);
 
     ProxyTable table_;
     std::int64_t moved_ = 0;
-    Real base_size_ = 1;
-    std::vector<std::int32_t> level_of_;
-    std::vector<char> level_used_;
-    std::vector<Entry> entries_;
-    std::vector<Entry> sorted_;
-    std::vector<std::uint32_t> bucket_start_;
-    std::uint64_t bucket_count_ = 0;
+    int level_count_ = 0;
+    std::array<Level, kMaxLevels> levels_;
+    std::array<std::vector<ProxyId>, kMaxLevels> members_;
+    std::vector<std::uint64_t> keys_;
+    std::vector<std::uint64_t> scratch_;
+    std::vector<std::uint64_t> sort_keys_;
+    std::vector<std::uint32_t> order_;
+    std::vector<std::uint32_t> order_scratch_;
+    std::vector<std::uint32_t> column_of_;
 };
 
 }  // namespace collision

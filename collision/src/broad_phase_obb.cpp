@@ -11,7 +11,7 @@ void ObbBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters&
     items_.clear();
     for (ProxyId id = 0; id < table_.capacity(); ++id) {
         if (!table_.contains(id)) continue;
-        const Obb& o = table_[id].obb;
+        const Obb& o = table_.obb(id);
         // The OBB's enclosing AABB, grown by more than the SAT's own tolerance
         // (Obb::overlaps accepts a gap of up to 16 eps x size), so the stage never drops a pair
         // the SAT would accept.
@@ -33,7 +33,7 @@ void ObbBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters&
             ++counters.volume_tests;
             if (!a.box.overlaps(b.box)) continue;
             ++counters.volume_tests;
-            if (table_[a.id].obb.overlaps(table_[b.id].obb)) {
+            if (table_.obb(a.id).overlaps(table_.obb(b.id))) {
                 pairs.push_back(a.id < b.id ? ProxyPair{a.id, b.id} : ProxyPair{b.id, a.id});
             }
         }

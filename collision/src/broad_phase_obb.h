@@ -28,7 +28,7 @@ private:
         Aabb box;
         ProxyId id;
     };
-    ProxyTable table_;
+    ProxyTable table_{ProxyTable::kObb};
     std::vector<Item> items_;
     std::int64_t moved_ = 0;
 };

@@ -24,7 +24,7 @@ void LooseOctree::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& c
     Real largest = 0;
     for (ProxyId id = 0; id < table_.capacity(); ++id) {
         if (!table_.contains(id)) continue;
-        const Aabb& box = table_[id].aabb;
+        const Aabb& box = table_.aabb(id);
         lo = lo.cwiseMin(box.center());
         hi = hi.cwiseMax(box.center());
         largest = std::max(largest, box.extents().maxCoeff());
@@ -37,7 +37,7 @@ void LooseOctree::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& c
 
     for (ProxyId id = 0; id < table_.capacity(); ++id) {
         if (!table_.contains(id)) continue;
-        const Aabb& box = table_[id].aabb;
+        const Aabb& box = table_.aabb(id);
         const Vec3 c = box.center();
         const Real extent = box.extents().maxCoeff();
         int index = 0;
@@ -63,7 +63,7 @@ void LooseOctree::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& c
 
     for (ProxyId a = 0; a < table_.capacity(); ++a) {
         if (!table_.contains(a)) continue;
-        const Aabb& box = table_[a].aabb;
+        const Aabb& box = table_.aabb(a);
         stack_.clear();
         stack_.push_back(0);
         while (!stack_.empty()) {
@@ -78,7 +78,7 @@ void LooseOctree::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& c
             for (ProxyId b : n.proxies) {
                 if (b <= a) continue;
                 ++counters.volume_tests;
-                if (box.overlaps(table_[b].aabb)) pairs.push_back(ProxyPair{a, b});
+                if (box.overlaps(table_.aabb(b))) pairs.push_back(ProxyPair{a, b});
             }
             for (int c : n.child) {
                 if (c >= 0) stack_.push_back(c);

@@ -39,7 +39,7 @@ void SweepAndPrune::move(ProxyId id, const ProxyVolumes& v) {
 void SweepAndPrune::refreshValues() {
     for (int axis = 0; axis < 3; ++axis) {
         for (Endpoint& e : axes_[axis]) {
-            const Aabb& box = table_[e.id].aabb;
+            const Aabb& box = table_.aabb(e.id);
             e.value = e.is_max ? box.max[axis] : box.min[axis];
         }
     }
@@ -51,7 +51,7 @@ void SweepAndPrune::rebuild(BroadPhaseCounters& counters) {
         list.clear();
         for (ProxyId id = 0; id < table_.capacity(); ++id) {
             if (!table_.contains(id)) continue;
-            const Aabb& box = table_[id].aabb;
+            const Aabb& box = table_.aabb(id);
             list.push_back(Endpoint{box.min[axis], id, false});
             list.push_back(Endpoint{box.max[axis], id, true});
         }
@@ -67,10 +67,10 @@ void SweepAndPrune::rebuild(BroadPhaseCounters& counters) {
             active_.pop_back();
             continue;
         }
-        const Aabb& box = table_[e.id].aabb;
+        const Aabb& box = table_.aabb(e.id);
         for (ProxyId other : active_) {
             ++counters.volume_tests;
-            if (box.overlaps(table_[other].aabb)) pairs_.insert(key(e.id, other));
+            if (box.overlaps(table_.aabb(other))) pairs_.insert(key(e.id, other));
         }
         active_.push_back(e.id);
     }
@@ -88,7 +88,7 @@ void SweepAndPrune::insertionSort(int axis, BroadPhaseCounters& counters) {
                 if (!e.is_max && f.is_max) {
                     // e's min passes f's max going down: the intervals begin to overlap here.
                     ++counters.volume_tests;
-                    if (table_[e.id].aabb.overlaps(table_[f.id].aabb)) {
+                    if (table_.aabb(e.id).overlaps(table_.aabb(f.id))) {
                         pairs_.insert(key(e.id, f.id));
                     }
                 } else if (e.is_max && !f.is_max) {
@@ -130,7 +130,7 @@ void SweepAndPrune::draw(DebugDraw& draw) const {
     for (int axis = 0; axis < 3; ++axis) {
         for (ProxyId id = 0; id < table_.capacity(); ++id) {
             if (!table_.contains(id)) continue;
-            const Aabb& box = table_[id].aabb;
+            const Aabb& box = table_.aabb(id);
             Vec3 a = Vec3::Zero();
             Vec3 b = Vec3::Zero();
             a[axis] = box.min[axis];
@@ -163,7 +163,7 @@ std::string SweepAndPrune::validate() const {
         const ProxyId b = static_cast<ProxyId>(k & 0xFFFFFFFFu);
         if (!table_.contains(a) || !table_.contains(b)) {
             out << "pair (" << a << "," << b << ") names an absent proxy; ";
-        } else if (!table_[a].aabb.overlaps(table_[b].aabb)) {
+        } else if (!table_.aabb(a).overlaps(table_.aabb(b))) {
             out << "pair (" << a << "," << b << ") does not overlap; ";
         }
     }

@@ -32,7 +32,7 @@ int SortAndSweep1::chooseAxis() const {
     bool first = true;
     int n = 0;
     for (const Item& it : items_) {
-        const Vec3 c = table_[it.id].aabb.center();
+        const Vec3 c = table_.aabb(it.id).center();
         if (first) {
             origin = c;
             first = false;
@@ -62,7 +62,7 @@ void SortAndSweep1::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters&
     }
     const int axis = chooseAxis();
     for (Item& it : items_) {
-        const Aabb& box = table_[it.id].aabb;
+        const Aabb& box = table_.aabb(it.id);
         it.lo = box.min[axis];
         it.hi = box.max[axis];
     }
@@ -88,12 +88,12 @@ void SortAndSweep1::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters&
     const std::size_t n = items_.size();
     for (std::size_t i = 0; i < n; ++i) {
         const Item& a = items_[i];
-        const Aabb& box = table_[a.id].aabb;
+        const Aabb& box = table_.aabb(a.id);
         // Closed intervals: a proxy starting exactly where this one ends still overlaps.
         for (std::size_t j = i + 1; j < n && items_[j].lo <= a.hi; ++j) {
             ++counters.volume_tests;
             const ProxyId b = items_[j].id;
-            if (box.overlaps(table_[b].aabb)) {
+            if (box.overlaps(table_.aabb(b))) {
                 pairs.push_back(a.id < b ? ProxyPair{a.id, b} : ProxyPair{b, a.id});
             }
         }

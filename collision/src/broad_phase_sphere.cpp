@@ -11,7 +11,7 @@ void SphereBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     items_.clear();
     for (ProxyId id = 0; id < table_.capacity(); ++id) {
         if (!table_.contains(id)) continue;
-        const BoundingSphere& s = table_[id].sphere;
+        const BoundingSphere& s = table_.sphere(id);
         items_.push_back(Item{s.center.x() - s.radius, s.center.x() + s.radius, id});
     }
     std::sort(items_.begin(), items_.end(), [](const Item& x, const Item& y) {
@@ -19,11 +19,11 @@ void SphereBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     });
     pairs.clear();
     for (std::size_t i = 0; i < items_.size(); ++i) {
-        const BoundingSphere& si = table_[items_[i].id].sphere;
+        const BoundingSphere& si = table_.sphere(items_[i].id);
         // Closed intervals: a sphere starting exactly where this one ends is still tested.
         for (std::size_t j = i + 1; j < items_.size() && items_[j].lo <= items_[i].hi; ++j) {
             ++counters.volume_tests;
-            if (si.overlaps(table_[items_[j].id].sphere)) {
+            if (si.overlaps(table_.sphere(items_[j].id))) {
                 const ProxyId a = items_[i].id;
                 const ProxyId b = items_[j].id;
                 pairs.push_back(a < b ? ProxyPair{a, b} : ProxyPair{b, a});

@@ -28,7 +28,7 @@ private:
         Real hi;
         ProxyId id;
     };
-    ProxyTable table_;
+    ProxyTable table_{ProxyTable::kSphere};
     std::vector<Item> items_;
     std::int64_t moved_ = 0;
 };

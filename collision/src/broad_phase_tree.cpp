@@ -218,7 +218,7 @@ void DynamicAabbTree::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounter
     if (root_ == kNull) return;
     for (ProxyId a = 0; a < table_.capacity(); ++a) {
         if (!table_.contains(a)) continue;
-        const Aabb& box = table_[a].aabb;
+        const Aabb& box = table_.aabb(a);
         stack_.clear();
         stack_.push_back(root_);
         while (!stack_.empty()) {
@@ -229,7 +229,7 @@ void DynamicAabbTree::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounter
             if (!n.box.overlaps(box)) continue;
             if (n.isLeaf()) {
                 // The fat box overlapped; the exact boxes decide.
-                if (n.proxy > a && box.overlaps(table_[n.proxy].aabb)) {
+                if (n.proxy > a && box.overlaps(table_.aabb(n.proxy))) {
                     pairs.push_back(ProxyPair{a, n.proxy});
                 }
             } else {
@@ -267,7 +267,7 @@ std::string DynamicAabbTree::validateNode(int node, int parent) const {
         if (n.height != 0) out << "leaf " << node << " height " << n.height << "; ";
         if (!table_.contains(n.proxy)) {
             out << "leaf " << node << " holds an absent proxy; ";
-        } else if (!containsBox(n.box, table_[n.proxy].aabb)) {
+        } else if (!containsBox(n.box, table_.aabb(n.proxy))) {
             out << "leaf " << node << " fat box misses its AABB; ";
         }
         return out.str();
