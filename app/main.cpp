@@ -44,6 +44,10 @@ int main(int argc, char** argv) {
     bool quiet = false;
     run_cmd->add_flag("--quiet", quiet, "no progress bar");
 
+    // BEGIN ccd subcommand
+    // END ccd subcommand
+    // BEGIN query subcommand
+    // END query subcommand
     // BEGIN bench subcommand (registered by app/bench_*.cpp)
     CLI::App* bench_cmd = cli.add_subcommand("bench", "performance benchmarks");
     bench_cmd->require_subcommand(1);
@@ -91,6 +95,10 @@ int main(int argc, char** argv) {
         run.progress = !quiet;
         return app::runScene(run, std::cout, std::cerr);
     }
+    // BEGIN ccd dispatch
+    // END ccd dispatch
+    // BEGIN query dispatch
+    // END query dispatch
     // BEGIN bench dispatch
     if (bench_bp_cmd->parsed()) {
         if (!bench_bp_json.empty()) bench_bp.json = bench_bp_json;
