@@ -187,8 +187,8 @@ void HierarchicalGrid::sweepLevel(const Level& lv, BroadPhaseCounters& counters)
                                 const ProxyId b_id = ids[q];
                                 const ProxyId lo = std::min(a_id, b_id);
                                 const ProxyId hi = std::max(a_id, b_id);
-                                keys_.push_back((std::uint64_t(std::uint32_t(lo)) << 32) |
-                                                std::uint32_t(hi));
+                                keys_.push_back((std::uint64_t(lo) << id_shift_) |
+                                                std::uint64_t(hi));
                             }
                         }
                     }
@@ -227,8 +227,7 @@ void HierarchicalGrid::queryCoarser(const PackedBox& a, ProxyId a_id, const Leve
                     const ProxyId b_id = lv.id[static_cast<std::size_t>(q - box)];
                     const ProxyId lo = std::min(a_id, b_id);
                     const ProxyId hi = std::max(a_id, b_id);
-                    keys_.push_back((std::uint64_t(std::uint32_t(lo)) << 32) |
-                                    std::uint32_t(hi));
+                    keys_.push_back((std::uint64_t(lo) << id_shift_) | std::uint64_t(hi));
                 }
             }
         }
@@ -270,6 +269,9 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
         if (!members_[k].empty()) buildLevel(levels_[k], members_[k]);
     }
 
+    // Pair keys pack (a, b) into 2 x id_shift_ bits, so the final radix sort makes as few
+    // passes as the ids need (3 passes of 11 bits for up to 2^16 proxies).
+    id_shift_ = bitsFor(static_cast<std::uint64_t>(table_.capacity()));
     keys_.clear();
     for (int k = 0; k < level_count_; ++k) {
         const Level& own = levels_[k];
@@ -282,17 +284,17 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
             }
         }
     }
-    // (a, b) order: one radix sort on the bits the ids use.
-    const int id_bits = bitsFor(static_cast<std::uint64_t>(table_.capacity()));
+    // (a, b) order: one radix sort of the packed keys.
     if (keys_.size() > 64) {
-        radixSortKeys(keys_, scratch_, 32 + id_bits);
+        radixSortKeys(keys_, scratch_, 2 * id_shift_);
     } else {
         std::sort(keys_.begin(), keys_.end());
     }
     pairs.resize(keys_.size());
+    const std::uint64_t mask = (std::uint64_t(1) << id_shift_) - 1;
     for (std::size_t i = 0; i < keys_.size(); ++i) {
-        pairs[i] = ProxyPair{static_cast<ProxyId>(keys_[i] >> 32),
-                             static_cast<ProxyId>(keys_[i] & 0xFFFFFFFFu)};
+        pairs[i] = ProxyPair{static_cast<ProxyId>(keys_[i] >> id_shift_),
+                             static_cast<ProxyId>(keys_[i] & mask)};
     }
     counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
 }

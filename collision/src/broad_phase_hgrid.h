@@ -63,6 +63,7 @@ private:
     int level_count_ = 0;
     std::array<Level, kMaxLevels> levels_;
     std::array<std::vector<ProxyId>, kMaxLevels> members_;
+    int id_shift_ = 1;                 // bits per id in a packed pair key
     std::vector<std::uint64_t> keys_;
     std::vector<std::uint64_t> scratch_;
     std::vector<std::uint64_t> sort_keys_;
