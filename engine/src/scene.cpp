@@ -49,7 +49,13 @@ constexpr Real kMinGyrationFraction = Real(1e-3);
 constexpr std::string_view kBodyKeys[] = {
     "name",  "shape",    "radius",           "half_height", "half_extents", "file",
     "scale", "position", "orientation_wxyz", "euler_deg",   "velocity",     "angular_velocity",
-    "mass",  "density"};
+    "mass",  "density",  "repeat"};
+constexpr std::string_view kRepeatKeys[] = {"count", "seed", "region", "speed", "spin",
+                                            "random_orientation"};
+// Keys that `repeat` generates itself.
+constexpr std::string_view kGeneratedKeys[] = {"position", "velocity", "angular_velocity",
+                                               "orientation_wxyz", "euler_deg"};
+constexpr int kMaxRepeat = 1000000;
 
 struct Entry {
     std::string key;
@@ -113,9 +119,13 @@ private:
     void parseOutput(const YAML::Node& n, Scene& scene) const;
     void parseCamera(const YAML::Node& n, Scene& scene) const;
     void parseDraw(const YAML::Node& n, Scene& scene) const;
-    Body parseBody(const YAML::Node& n, std::size_t index, const Scene& scene);
+    /// One body, or the `repeat.count` bodies a `repeat` entry generates.
+    std::vector<Body> parseBody(const YAML::Node& n, std::size_t index, const Scene& scene);
     const PreparedShape& prepareMeshShape(ShapeType type, const std::string& file, Real scale,
                                           const Entry& file_entry, const std::string& path);
+    template <typename Place>
+    std::vector<Body> repeatBody(const Body& base, const Entry& entry, const std::string& path,
+                                 const Scene& scene, Place&& place) const;
 
     std::string file_;
     fs::path base_dir_;
@@ -425,7 +435,8 @@ const PreparedShape& SceneParser::prepareMeshShape(ShapeType type, const std::st
     return mesh_cache_.emplace(key, std::move(prepared)).first->second;
 }
 
-Body SceneParser::parseBody(const YAML::Node& n, std::size_t index, const Scene& scene) {
+std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
+                                         const Scene& scene) {
     const std::string path = indexPath("bodies", index);
     const std::vector<Entry> es =
         entries(n, path, std::vector<std::string_view>(std::begin(kBodyKeys), std::end(kBodyKeys)));
@@ -493,7 +504,19 @@ Body SceneParser::parseBody(const YAML::Node& n, std::size_t index, const Scene&
     Real mass = 0;
     Real density = 1000;
 
-    require(es, "position", n, path);
+    const Entry* repeat_entry = find(es, "repeat");
+    if (repeat_entry != nullptr) {
+        for (const Entry& e : es) {
+            for (const std::string_view k : kGeneratedKeys) {
+                if (e.key == k) {
+                    fail(e.key_node, childPath(path, e.key),
+                         "does not apply with 'repeat' (repeat generates it)");
+                }
+            }
+        }
+    } else {
+        require(es, "position", n, path);
+    }
     for (const std::string_view k : shape_keys) {
         if (k != "scale") require(es, k, n, path);
     }
@@ -612,12 +635,108 @@ Body SceneParser::parseBody(const YAML::Node& n, std::size_t index, const Scene&
     }
 
     Body body = makeBody(std::move(name), std::move(shape), props);
-    body.position = position;
-    body.orientation = orientation;
-    body.linear_momentum = props.mass * velocity;
-    const Mat3 r = orientation.toRotationMatrix();
-    body.angular_momentum = r * props.inertia * r.transpose() * angular_velocity;
-    return body;
+    auto place = [&props](Body& b, const Vec3& p, const Quat& q, const Vec3& v, const Vec3& w) {
+        b.position = p;
+        b.orientation = q;
+        b.linear_momentum = props.mass * v;
+        const Mat3 r = q.toRotationMatrix();
+        b.angular_momentum = r * props.inertia * r.transpose() * w;
+    };
+    if (repeat_entry == nullptr) {
+        place(body, position, orientation, velocity, angular_velocity);
+        return {std::move(body)};
+    }
+    return repeatBody(body, *repeat_entry, childPath(path, "repeat"), scene, place);
+}
+
+template <typename Place>
+std::vector<Body> SceneParser::repeatBody(const Body& base, const Entry& entry,
+                                          const std::string& path, const Scene& scene,
+                                          Place&& place) const {
+    const YAML::Node& n = entry.value;
+    if (!n.IsMap()) fail(n, path, "expected a mapping with keys: " + join({"count", "seed",
+                                       "region", "speed", "spin", "random_orientation"}));
+    const std::vector<Entry> es = entries(
+        n, path, std::vector<std::string_view>(std::begin(kRepeatKeys), std::end(kRepeatKeys)));
+    const Entry& count_entry = require(es, "count", n, path);
+    const int count = readInt(count_entry.value, childPath(path, "count"));
+    if (count < 1 || count > kMaxRepeat) {
+        fail(count_entry.value, childPath(path, "count"),
+             "must be in 1.." + std::to_string(kMaxRepeat));
+    }
+    std::uint64_t seed = 1;
+    collision::Aabb region = scene.world.bounds;
+    Real speed = 0;
+    Real spin = 0;
+    bool random_orientation = true;
+    for (const Entry& e : es) {
+        const std::string p = childPath(path, e.key);
+        if (e.key == "seed") {
+            const int s = readInt(e.value, p);
+            if (s < 0) fail(e.value, p, "must be >= 0");
+            seed = static_cast<std::uint64_t>(s);
+        } else if (e.key == "region") {
+            const std::vector<Entry> r = entries(e.value, p, {"min", "max"});
+            region.min = readVec3(require(r, "min", e.value, p).value, childPath(p, "min"));
+            region.max = readVec3(require(r, "max", e.value, p).value, childPath(p, "max"));
+            for (int a = 0; a < 3; ++a) {
+                if (!(region.min[a] <= region.max[a])) {
+                    fail(e.value, p, "min must be <= max on every axis");
+                }
+            }
+            if (!scene.world.bounds.contains(region.min) ||
+                !scene.world.bounds.contains(region.max)) {
+                fail(e.value, p, "must lie inside the world bounds");
+            }
+        } else if (e.key == "speed") {
+            speed = readReal(e.value, p);
+            if (!(speed >= 0)) fail(e.value, p, "must be >= 0 (m/s)");
+        } else if (e.key == "spin") {
+            spin = readReal(e.value, p);
+            if (!(spin >= 0)) fail(e.value, p, "must be >= 0 (rad/s)");
+        } else if (e.key == "random_orientation") {
+            random_orientation = readBool(e.value, p);
+        }
+    }
+    // splitmix64: the same bodies from the same seed on every platform.
+    std::uint64_t state = seed * 0x9E3779B97F4A7C15ull + 0x632BE59BD9B4E019ull;
+    auto uniform = [&state]() {
+        std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        z ^= z >> 31;
+        return Real(z >> 11) * Real(0x1.0p-53);
+    };
+    auto direction = [&uniform]() {
+        // Uniform on the sphere: z uniform in [-1, 1], azimuth uniform (Archimedes).
+        const Real z = 2 * uniform() - 1;
+        const Real phi = 2 * std::numbers::pi_v<Real> * uniform();
+        const Real r = std::sqrt(std::max(Real(0), 1 - z * z));
+        return Vec3(r * std::cos(phi), r * std::sin(phi), z);
+    };
+    std::vector<Body> out;
+    out.reserve(static_cast<std::size_t>(count));
+    for (int k = 0; k < count; ++k) {
+        Body b = base;
+        b.name = base.name + "_" + std::to_string(k);
+        const Vec3 t(uniform(), uniform(), uniform());
+        const Vec3 p = region.min + (region.max - region.min).cwiseProduct(t);
+        Quat q = Quat::Identity();
+        if (random_orientation) {
+            // Shoemake's uniform random rotation.
+            const Real u1 = uniform(), u2 = uniform(), u3 = uniform();
+            const Real a = std::sqrt(1 - u1), c = std::sqrt(u1);
+            const Real tau = 2 * std::numbers::pi_v<Real>;
+            q = Quat(a * std::sin(tau * u2), a * std::cos(tau * u2), c * std::sin(tau * u3),
+                     c * std::cos(tau * u3))
+                    .normalized();
+        }
+        const Vec3 v = direction() * (speed * uniform());
+        const Vec3 w = direction() * (spin * uniform());
+        place(b, p, q, v, w);
+        out.push_back(std::move(b));
+    }
+    return out;
 }
 
 Scene SceneParser::parse(const std::string& text) {
@@ -659,7 +778,8 @@ Scene SceneParser::parse(const std::string& text) {
             if (e.value.IsNull()) continue;  // "bodies:" with nothing after it: no bodies
             if (!e.value.IsSequence()) fail(e.value, "bodies", "expected a list of bodies");
             for (std::size_t i = 0; i < e.value.size(); ++i) {
-                scene.bodies.push_back(parseBody(e.value[i], i, scene));
+                std::vector<Body> made = parseBody(e.value[i], i, scene);
+                for (Body& b : made) scene.bodies.push_back(std::move(b));
             }
         }
     }

@@ -8,6 +8,7 @@
 #include <limits>
 #include <optional>
 
+#include "collision/convex_hull.h"
 #include "collision/shape.h"
 #include "test_random.h"
 
@@ -147,6 +148,55 @@ TEST(LocalBounds, PrimitivesContainTheirSurfaceAndAreTight) {
     }
     EXPECT_NEAR(fitLocalBounds(Shape::box(Vec3(1, 2, 2))).sphere.radius, 3.0, 1e-12);
     EXPECT_NEAR(fitLocalBounds(Shape::capsule(0.5, 1)).sphere.radius, 1.5, 1e-12);
+}
+
+// A non-convex closed-ish surface: a bumpy sphere, so hull vertices and mesh vertices differ.
+TriangleMesh bumpySphere(int rings, int segments, Real radius, const Vec3& offset) {
+    TriangleMesh m;
+    for (int r = 0; r <= rings; ++r) {
+        const Real theta = Real(M_PI) * r / rings;
+        for (int s = 0; s < segments; ++s) {
+            const Real phi = 2 * Real(M_PI) * s / segments;
+            const Real bump = radius * (1 + Real(0.25) * std::sin(5 * phi) * std::sin(3 * theta));
+            m.vertices.push_back(offset + bump * Vec3(std::sin(theta) * std::cos(phi),
+                                                      std::cos(theta),
+                                                      std::sin(theta) * std::sin(phi)));
+        }
+    }
+    for (int r = 0; r < rings; ++r) {
+        for (int s = 0; s < segments; ++s) {
+            const int a = r * segments + s;
+            const int b = r * segments + (s + 1) % segments;
+            m.triangles.push_back({a, a + segments, b});
+            m.triangles.push_back({b, a + segments, b + segments});
+        }
+    }
+    return m;
+}
+
+TEST(LocalBounds, HullAndMeshVolumesContainEveryMeshVertex) {
+    for (const Vec3& offset : {Vec3(0, 0, 0), Vec3(1e6, -2e6, 3e6)}) {
+        for (Real radius : {Real(1e-4), Real(1), Real(1e4)}) {
+            auto mesh = std::make_shared<TriangleMesh>(bumpySphere(12, 20, radius, offset));
+            const ConvexHullOutput hull = computeConvexHull(mesh->vertices);
+            ASSERT_TRUE(hull.ok) << hull.error;
+            auto poly = std::make_shared<ConvexPolytope>(hull.hull);
+            for (const Shape& s : {Shape::convexHull(poly), Shape::triangleMesh(mesh, poly)}) {
+                const LocalBounds b = fitLocalBounds(s);
+                const Real tol = 0;  // containment holds by construction (fit slack)
+                for (const Vec3& v : mesh->vertices) {
+                    EXPECT_LE((v - b.sphere.center).norm(), b.sphere.radius + tol);
+                    const Vec3 local = b.obb.axes.transpose() * (v - b.obb.center);
+                    EXPECT_TRUE(
+                        (local.cwiseAbs().array() <= b.obb.half_extents.array() + tol).all())
+                        << shapeTypeName(s.type) << " radius " << radius;
+                }
+                // Tight: the sphere is no larger than the bumps allow (1.25 r), far below the
+                // AABB circumsphere of the bumpy shape.
+                EXPECT_LE(b.sphere.radius, 1.26 * radius);
+            }
+        }
+    }
 }
 
 TEST(LocalBounds, PrincipalObbOfARotatedBoxFindsItsAxes) {

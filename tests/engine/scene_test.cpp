@@ -655,5 +655,61 @@ TEST(Scene, MakeWorldAddsBodiesInOrderAndDetects) {
     EXPECT_EQ(w.flaggedPairs()[0], (collision::ProxyPair{0, 1}));
 }
 
+TEST(SceneRepeat, GeneratesDeterministicBodiesInsideTheRegion) {
+    const std::string body =
+        "  - name: crate\n"
+        "    shape: box\n"
+        "    half_extents: [0.2, 0.1, 0.3]\n"
+        "    density: 500\n"
+        "    repeat: {count: 300, seed: 7, region: {min: [-5, -2, -5], max: [5, 2, 5]},\n"
+        "             speed: 3, spin: 2}\n"
+        "  - shape: sphere\n"
+        "    radius: 0.5\n"
+        "    position: [0, 0, 0]\n";
+    const Scene a = parse(withBody(body));
+    const Scene b = parse(withBody(body));
+    ASSERT_EQ(a.bodies.size(), 301u);
+    EXPECT_EQ(a.bodies[0].name, "crate_0");
+    EXPECT_EQ(a.bodies[299].name, "crate_299");
+    EXPECT_EQ(a.bodies[300].name, "sphere1");
+    Real max_speed = 0;
+    Real max_spin = 0;
+    int distinct_orientations = 0;
+    for (std::size_t i = 0; i < 300; ++i) {
+        const Body& x = a.bodies[i];
+        EXPECT_EQ(x.position, b.bodies[i].position);  // same seed, same bodies, bit for bit
+        EXPECT_EQ(x.linear_momentum, b.bodies[i].linear_momentum);
+        EXPECT_TRUE(x.position.x() >= -5 && x.position.x() <= 5 && x.position.y() >= -2 &&
+                    x.position.y() <= 2 && x.position.z() >= -5 && x.position.z() <= 5);
+        EXPECT_NEAR(x.mass, 500 * 0.4 * 0.2 * 0.6, 1e-9);
+        EXPECT_NEAR(x.orientation.norm(), 1.0, 1e-12);
+        max_speed = std::max(max_speed, x.velocity().norm());
+        max_spin = std::max(max_spin, x.angularVelocity().norm());
+        distinct_orientations += !x.orientation.isApprox(a.bodies[0].orientation);
+    }
+    EXPECT_LE(max_speed, 3 + 1e-9);
+    EXPECT_GT(max_speed, 2.5);  // the speeds really spread over [0, 3]
+    EXPECT_LE(max_spin, 2 + 1e-9);
+    EXPECT_GT(max_spin, 1.5);
+    EXPECT_GT(distinct_orientations, 290);
+    // Another seed, other bodies.
+    std::string other = body;
+    other.replace(other.find("seed: 7"), 7, "seed: 8");
+    EXPECT_NE(parse(withBody(other)).bodies[0].position, a.bodies[0].position);
+}
+
+TEST(SceneRepeat, ErrorsNameTheKey) {
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 0.5\n    position: [0, 0, 0]\n"
+                                "    repeat: {count: 3}\n"),
+                       "6:5: bodies[0].position: ", "does not apply with 'repeat'");
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 0.5\n    repeat: {count: 0}\n"),
+                       "6:21: bodies[0].repeat.count: ", "must be in 1..1000000");
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 0.5\n"
+                                "    repeat: {count: 2, region: {min: [0, 0, 0], max: [99, 1, 1]}}\n"),
+                       "6:32: bodies[0].repeat.region: ", "inside the world bounds");
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 0.5\n    repeat: {cont: 2}\n"),
+                       "6:14: bodies[0].repeat.cont: ", "unknown key 'cont'");
+}
+
 }  // namespace
 }  // namespace engine

@@ -1,0 +1,3 @@
+// Must NOT compile: render/ sits below app/.
+#include "run_command.h"
+int main() { return 0; }
