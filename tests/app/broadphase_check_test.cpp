@@ -10,7 +10,7 @@ using collision::ProxyPair;
 
 TEST(BroadPhaseCheck, EqualSetsPassAndDifferencesAreNamed) {
     std::vector<engine::Body> bodies(4);
-    for (int i = 0; i < 4; ++i) bodies[i].name = "b" + std::to_string(i);
+    for (int i = 0; i < 4; ++i) bodies[i].name = std::string("b").append(std::to_string(i));
     const std::vector<ProxyPair> reference = {{0, 1}, {1, 2}, {2, 3}};
     EXPECT_EQ(describePairMismatch("sap", "brute", reference, reference, bodies), "");
     const std::vector<ProxyPair> got = {{0, 1}, {0, 3}, {2, 3}};
