@@ -8,6 +8,7 @@
 #include "bench_broadphase.h"
 
 #include <fcntl.h>
+#include <malloc.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -177,6 +178,10 @@ RunResult measureIsolated(const BenchMethodEntry& entry, const MovingBoxes& init
     std::cout.flush();
     std::cerr.flush();
     std::fflush(nullptr);
+    // Heap the parent freed but kept mapped would be reused by the child without raising its
+    // RSS (a copy-on-write fault swaps a shared page for a private one), hiding the method's
+    // memory: hand it back to the kernel first.
+    ::malloc_trim(0);
     const pid_t pid = ::fork();
     if (pid < 0) {
         ::close(fds[0]);

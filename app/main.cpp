@@ -3,7 +3,9 @@
 #include <iostream>
 
 #include "bench_broadphase.h"
+#include "bench_ccd.h"
 #include "collision/broad_phase.h"
+#include "query_command.h"
 #include "run_command.h"
 
 int main(int argc, char** argv) {
@@ -47,6 +49,16 @@ int main(int argc, char** argv) {
     // BEGIN ccd subcommand
     // END ccd subcommand
     // BEGIN query subcommand
+    app::QueryOptions query;
+    CLI::App* query_cmd = cli.add_subcommand(
+        "query", "mesh against mesh through every BVH volume type: answer, triangle pairs, "
+                 "BV and triangle tests, build and query time side by side");
+    query_cmd->add_option("mesh_a", query.mesh_a, "mesh A (any format assimp reads)")->required();
+    query_cmd->add_option("mesh_b", query.mesh_b, "mesh B")->required();
+    query_cmd->add_option("--bv", query.bv, "volume type or all")->capture_default_str();
+    query_cmd->add_option("--pose-b", query.pose_b,
+                          "B's pose in A's frame: x,y,z,qw,qx,qy,qz (default identity)");
+    query_cmd->add_flag("--json", query.json, "machine-readable output");
     // END query subcommand
     // BEGIN bench subcommand (registered by app/bench_*.cpp)
     CLI::App* bench_cmd = cli.add_subcommand("bench", "performance benchmarks");
@@ -76,6 +88,17 @@ int main(int argc, char** argv) {
     bool bench_bp_in_process = false;
     bench_bp_cmd->add_flag("--in-process", bench_bp_in_process,
                            "do not fork per method (no per-method peak memory)");
+    app::BenchCcdOptions bench_ccd;
+    std::vector<std::string> bench_ccd_dirs;
+    std::string bench_ccd_json;
+    CLI::App* bench_ccd_cmd = bench_cmd->add_subcommand(
+        "ccd", "vertex-face and edge-edge CCD methods on the sample queries: FN, FP, us/query");
+    bench_ccd_cmd->add_option("dirs", bench_ccd_dirs,
+                              "query directories (default tests/data/ccd-sample-queries)");
+    bench_ccd_cmd->add_option("--json", bench_ccd_json, "also write the table as JSON to FILE");
+    bench_ccd_cmd->add_option("--method", bench_ccd.method, "conservative, naive or all")
+        ->check(CLI::IsMember({"conservative", "naive", "all"}))
+        ->capture_default_str();
     // END bench subcommand
 
     try {
@@ -98,12 +121,18 @@ int main(int argc, char** argv) {
     // BEGIN ccd dispatch
     // END ccd dispatch
     // BEGIN query dispatch
+    if (query_cmd->parsed()) return app::runQuery(query, std::cout, std::cerr);
     // END query dispatch
     // BEGIN bench dispatch
     if (bench_bp_cmd->parsed()) {
         if (!bench_bp_json.empty()) bench_bp.json = bench_bp_json;
         bench_bp.isolate = !bench_bp_in_process;
         return app::runBenchBroadphase(bench_bp, std::cout, std::cerr);
+    }
+    if (bench_ccd_cmd->parsed()) {
+        for (const std::string& d : bench_ccd_dirs) bench_ccd.dirs.emplace_back(d);
+        if (!bench_ccd_json.empty()) bench_ccd.json = bench_ccd_json;
+        return app::runBenchCcd(bench_ccd, std::cout, std::cerr);
     }
     // END bench dispatch
     return 2;

@@ -1,0 +1,206 @@
+// app/query_command.cpp -- `cdlab query`: loads two meshes, builds every requested BVH type, and
+// runs the first-contact and all-pairs queries with B at the given pose in A's frame.
+// Wiring only: trees and queries are collision/bvh.h; mesh loading is engine/mesh_import.h.
+#include "query_command.h"
+
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <ostream>
+#include <sstream>
+#include <vector>
+
+#include "collision/bvh.h"
+#include "engine/mesh_import.h"
+
+namespace app {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct Row {
+    std::string_view bv;
+    bool colliding = false;
+    std::vector<collision::TrianglePair> pairs;
+    collision::BvhQueryStats first;
+    collision::BvhQueryStats all;
+    std::int32_t nodes = 0;
+    double build_ms = 0;  // both trees
+    double first_us = 0;  // per query
+    double all_us = 0;    // per query
+};
+
+// Mean time per call of `fn`, repeated until ~20 ms have passed (at most 1000 calls).
+template <class Fn>
+double timePerCall(Fn&& fn) {
+    const auto start = Clock::now();
+    int calls = 0;
+    double elapsed = 0;
+    do {
+        fn();
+        ++calls;
+        elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    } while (elapsed < 0.02 && calls < 1000);
+    return elapsed / calls;
+}
+
+}  // namespace
+
+std::optional<collision::Pose> parsePose(std::string_view text, std::string* error) {
+    std::vector<double> v;
+    std::string item;
+    std::istringstream in{std::string(text)};
+    while (std::getline(in, item, ',')) {
+        std::size_t used = 0;
+        double x = 0;
+        try {
+            x = std::stod(item, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        // Allow surrounding blanks, nothing else.
+        while (used < item.size() && std::isspace(static_cast<unsigned char>(item[used]))) ++used;
+        if (used == 0 || used != item.size()) {
+            *error = "'" + item + "' is not a number";
+            return std::nullopt;
+        }
+        if (!std::isfinite(x)) {
+            *error = "'" + item + "' is not finite";
+            return std::nullopt;
+        }
+        v.push_back(x);
+    }
+    if (v.size() != 7) {
+        *error =
+            "expected 7 comma-separated numbers x,y,z,qw,qx,qy,qz, got " + std::to_string(v.size());
+        return std::nullopt;
+    }
+    const collision::Quat q(v[3], v[4], v[5], v[6]);
+    const double norm = q.norm();
+    if (!(norm > 1e-12)) {
+        *error = "the quaternion (qw,qx,qy,qz) is zero";
+        return std::nullopt;
+    }
+    return collision::Pose{collision::Vec3(v[0], v[1], v[2]), q.normalized()};
+}
+
+int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err) {
+    collision::Pose pose_b;
+    if (!options.pose_b.empty()) {
+        std::string error;
+        const auto parsed = parsePose(options.pose_b, &error);
+        if (!parsed) {
+            err << "--pose-b: " << error << "\n";
+            return 2;
+        }
+        pose_b = *parsed;
+    }
+    std::vector<std::string_view> names;
+    if (options.bv == "all") {
+        names = collision::bvhVolumeNames();
+    } else {
+        for (const std::string_view n : collision::bvhVolumeNames()) {
+            if (n == options.bv) names.push_back(n);
+        }
+        if (names.empty()) {
+            err << "--bv: unknown volume '" << options.bv << "' (all";
+            for (const std::string_view n : collision::bvhVolumeNames()) err << ", " << n;
+            err << ")\n";
+            return 2;
+        }
+    }
+    collision::TriangleMesh meshes[2];
+    const std::filesystem::path paths[2] = {options.mesh_a, options.mesh_b};
+    for (int i = 0; i < 2; ++i) {
+        engine::MeshImportOutput imported = engine::importMesh(paths[i], 1.0);
+        if (!imported.ok) {
+            err << paths[i].string() << ": " << imported.error << "\n";
+            return 2;
+        }
+        meshes[i] = std::move(imported.mesh);
+    }
+
+    std::vector<Row> rows;
+    for (const std::string_view name : names) {
+        Row row;
+        row.bv = name;
+        const auto b0 = Clock::now();
+        const std::unique_ptr<collision::MeshBvh> a = collision::buildMeshBvh(name, meshes[0]);
+        const std::unique_ptr<collision::MeshBvh> b = collision::buildMeshBvh(name, meshes[1]);
+        row.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - b0).count();
+        row.nodes = a->nodeCount() + b->nodeCount();
+        row.colliding = a->testOverlap(*b, pose_b, &row.first);
+        row.pairs = a->intersect(*b, pose_b, &row.all);
+        row.first_us = 1e6 * timePerCall([&] { (void)a->testOverlap(*b, pose_b); });
+        row.all_us = 1e6 * timePerCall([&] { (void)a->intersect(*b, pose_b); });
+        rows.push_back(std::move(row));
+    }
+    bool agree = true;
+    for (const Row& r : rows) {
+        agree = agree && r.pairs == rows.front().pairs && r.colliding == !r.pairs.empty();
+    }
+
+    if (options.json) {
+        nlohmann::json j;
+        j["mesh_a"] = {{"path", paths[0].string()}, {"triangles", meshes[0].triangles.size()}};
+        j["mesh_b"] = {{"path", paths[1].string()}, {"triangles", meshes[1].triangles.size()}};
+        const auto& q = pose_b.orientation;
+        j["pose_b"] = {pose_b.position.x(),
+                       pose_b.position.y(),
+                       pose_b.position.z(),
+                       q.w(),
+                       q.x(),
+                       q.y(),
+                       q.z()};
+        j["volumes_agree"] = agree;
+        nlohmann::json results = nlohmann::json::array();
+        for (const Row& r : rows) {
+            results.push_back({
+                {"bv", std::string(r.bv)},
+                {"colliding", r.colliding},
+                {"triangle_pairs", r.pairs.size()},
+                {"nodes", r.nodes},
+                {"build_ms", r.build_ms},
+                {"first_contact",
+                 {{"bv_tests", r.first.bv_tests},
+                  {"triangle_tests", r.first.triangle_tests},
+                  {"time_us", r.first_us}}},
+                {"all_pairs",
+                 {{"bv_tests", r.all.bv_tests},
+                  {"triangle_tests", r.all.triangle_tests},
+                  {"time_us", r.all_us}}},
+            });
+        }
+        j["results"] = results;
+        out << j.dump(2) << "\n";
+    } else {
+        out << "A: " << paths[0].string() << " (" << meshes[0].triangles.size()
+            << " triangles)  B: " << paths[1].string() << " (" << meshes[1].triangles.size()
+            << " triangles)\n";
+        out << std::left << std::setw(8) << "bv" << std::right << std::setw(10) << "answer"
+            << std::setw(8) << "pairs" << std::setw(10) << "first Nv" << std::setw(10) << "first Np"
+            << std::setw(10) << "all Nv" << std::setw(10) << "all Np" << std::setw(11) << "build ms"
+            << std::setw(11) << "first us" << std::setw(11) << "all us"
+            << "\n";
+        out << std::fixed;
+        for (const Row& r : rows) {
+            out << std::left << std::setw(8) << r.bv << std::right << std::setw(10)
+                << (r.colliding ? "colliding" : "apart") << std::setw(8) << r.pairs.size()
+                << std::setw(10) << r.first.bv_tests << std::setw(10) << r.first.triangle_tests
+                << std::setw(10) << r.all.bv_tests << std::setw(10) << r.all.triangle_tests
+                << std::setprecision(2) << std::setw(11) << r.build_ms << std::setw(11)
+                << r.first_us << std::setw(11) << r.all_us << "\n";
+        }
+        out << "(Nv: BV tests, Np: triangle tests; build: both trees)\n";
+    }
+    if (!agree) {
+        err << "error: the volume types disagree on the triangle pairs (a BVH bug)\n";
+        return 1;
+    }
+    return 0;
+}
+
+}  // namespace app

@@ -1,0 +1,31 @@
+// app/query_command.h -- `cdlab query`: two meshes, B at a pose in A's frame, every BVH volume
+// type side by side (answer, triangle pairs, BV and triangle tests, build and query time).
+#pragma once
+
+#include <filesystem>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "collision/math.h"
+
+namespace app {
+
+struct QueryOptions {
+    std::filesystem::path mesh_a;
+    std::filesystem::path mesh_b;
+    std::string bv = "all";  ///< a BVH volume name (collision::bvhVolumeNames()) or "all"
+    std::string pose_b;      ///< "x,y,z,qw,qx,qy,qz" (B's frame in A's); empty: identity
+    bool json = false;       ///< machine-readable output on `out`
+};
+
+/// Parses "x,y,z,qw,qx,qy,qz" into a pose (quaternion normalised). Returns nothing and sets
+/// `error` for a wrong count, a non-number, a non-finite value or a zero quaternion.
+std::optional<collision::Pose> parsePose(std::string_view text, std::string* error);
+
+/// Exit codes: 0 success, 1 the volume types disagree on the pair list (a bug: reported),
+/// 2 bad input (flag, unreadable or empty mesh).
+int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err);
+
+}  // namespace app

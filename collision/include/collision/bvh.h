@@ -1,0 +1,197 @@
+// collision/bvh.h -- bounding-volume hierarchies over a triangle mesh (narrow phase of mesh pairs).
+// One generic tree, Bvh<BV>, templated on the node volume; the volume types form one type list
+// (BvhVolumeTypes) so the tree, the lookup by name and the typed tests all pick up a new volume.
+// Queries run one tandem traversal of two trees under the relative pose of B in A's frame.
+#pragma once
+
+#include <array>
+#include <compare>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <tuple>
+#include <vector>
+
+#include "collision/bounding_volumes.h"
+#include "collision/math.h"
+#include "collision/shape.h"
+
+namespace collision {
+
+/// Discrete-orientation polytope with K/2 fixed slab directions (Klosowski et al. 1998), in the
+/// mesh's local frame. Directions (unnormalised, integer components): k=6 the three axes; k=14
+/// adds the 4 cube diagonals; k=18 adds the 6 face diagonals; k=26 has all 13.
+/// Slab i is { p : min[i] <= dot(direction(i), p) <= max[i] }.
+template <int K>
+struct Kdop {
+    static_assert(K == 6 || K == 14 || K == 18 || K == 26, "k-DOP: k must be 6, 14, 18 or 26");
+    static constexpr int kSlabs = K / 2;
+    std::array<Real, K / 2> min{};
+    std::array<Real, K / 2> max{};
+};
+
+/// Rectangle swept sphere (Larsen, Gottschalk, Lin, Manocha 2000): the points within `radius` of
+/// the rectangle { center + s axes.col(0) + t axes.col(1) : |s| <= half_lengths[0],
+/// |t| <= half_lengths[1] }. axes is orthonormal and right-handed; col(2) is the normal.
+struct Rss {
+    Vec3 center = Vec3::Zero();
+    Mat3 axes = Mat3::Identity();
+    std::array<Real, 2> half_lengths{0, 0};
+    Real radius = 0;
+};
+
+/// Every node-volume type of the generic BVH, in display order. Append here (plus a BvName
+/// specialisation and the traits in collision/src/bvh_volumes.h) to add a volume type.
+using BvhVolumeTypes =
+    std::tuple<BoundingSphere, Aabb, Obb, Kdop<6>, Kdop<14>, Kdop<18>, Kdop<26>, Rss>;
+
+/// The name of a volume type, as the CLI and scene files spell it.
+template <class BV>
+struct BvName;
+template <>
+struct BvName<BoundingSphere> {
+    static constexpr std::string_view value = "sphere";
+};
+template <>
+struct BvName<Aabb> {
+    static constexpr std::string_view value = "aabb";
+};
+template <>
+struct BvName<Obb> {
+    static constexpr std::string_view value = "obb";
+};
+template <>
+struct BvName<Kdop<6>> {
+    static constexpr std::string_view value = "kdop6";
+};
+template <>
+struct BvName<Kdop<14>> {
+    static constexpr std::string_view value = "kdop14";
+};
+template <>
+struct BvName<Kdop<18>> {
+    static constexpr std::string_view value = "kdop18";
+};
+template <>
+struct BvName<Kdop<26>> {
+    static constexpr std::string_view value = "kdop26";
+};
+template <>
+struct BvName<Rss> {
+    static constexpr std::string_view value = "rss";
+};
+
+/// How the top-down build splits a node's triangles (along the longest axis of the bounding box
+/// of their centroids).
+enum class BvhSplit : std::uint8_t {
+    Median,  ///< half the triangles on each side (balanced tree, depth ceil(log2 n))
+    Mean,    ///< at the mean centroid coordinate; falls back to the median if one side is empty
+};
+
+struct BvhBuildOptions {
+    BvhSplit split = BvhSplit::Median;
+    int max_leaf_triangles = 1;  ///< a node with at most this many triangles is a leaf (>= 1)
+};
+
+/// One intersecting pair: triangle `a` of mesh A and triangle `b` of mesh B (indices into the
+/// meshes' `triangles`). Ordered by (a, b).
+struct TrianglePair {
+    std::int32_t a = 0;
+    std::int32_t b = 0;
+    auto operator<=>(const TrianglePair&) const = default;
+};
+
+/// Cost counters of one query (the Nv and Np of F = Nv Cv + Np Cp).
+struct BvhQueryStats {
+    std::int64_t bv_tests = 0;        ///< Nv: node-pair overlap tests
+    std::int64_t triangle_tests = 0;  ///< Np: exact triangle-triangle tests
+};
+
+/// A bounding-volume tree over the triangles of one mesh, in the mesh's local frame. Immutable
+/// after construction; rigid motion needs no rebuild (queries take the relative pose).
+/// Every node volume contains all corners of its triangles (validate() checks it).
+template <class BV>
+class Bvh {
+public:
+    struct Node {
+        BV volume;
+        Real cost = 0;            ///< volume of `volume` (tightness; picks the node to descend)
+        std::int32_t right = -1;  ///< internal: right child (left child is this index + 1)
+        std::int32_t first = 0;   ///< leaf: first triangle in leaf order
+        std::int32_t count = 0;   ///< leaf: number of triangles (> 0); 0 for internal nodes
+        bool isLeaf() const { return count > 0; }
+    };
+
+    Bvh() = default;
+    /// Top-down build. Cost O(n log n) for box-like volumes (expected, with Welzl for spheres).
+    /// An empty mesh gives an empty tree (every query: no contact). Triangle indices must be
+    /// valid vertex indices (asserted).
+    explicit Bvh(const TriangleMesh& mesh, const BvhBuildOptions& options = {});
+
+    const std::vector<Node>& nodes() const { return nodes_; }
+    std::int32_t triangleCount() const { return static_cast<std::int32_t>(ids_.size()); }
+    /// Corners of the triangle at leaf-order position `i` (copies of the mesh's vertices).
+    const std::array<Vec3, 3>& leafTriangle(std::int32_t i) const { return corners_[i]; }
+    /// Mesh index of the triangle at leaf-order position `i`.
+    std::int32_t leafTriangleId(std::int32_t i) const { return ids_[i]; }
+    /// Length scale of the mesh: largest |coordinate| plus the root extent (sets tolerances).
+    Real scale() const { return scale_; }
+    /// Longest root-to-leaf path (a single leaf has depth 1; empty tree 0). Computed at build.
+    int depth() const { return depth_; }
+    /// Whole-tree check: child ranges partition their parent, every triangle is in one leaf, and
+    /// every node volume contains its triangles' corners (to a tolerance relative to the mesh
+    /// scale). On failure returns false and, if `error` is given, says what failed.
+    bool validate(std::string* error = nullptr) const;
+
+private:
+    std::vector<Node> nodes_;
+    std::vector<std::array<Vec3, 3>> corners_;  // leaf order
+    std::vector<std::int32_t> ids_;             // leaf order -> mesh triangle index
+    Real scale_ = 0;
+    int depth_ = 0;
+};
+
+/// Does any triangle of `a` touch or cross any triangle of `b`, B placed by `b_in_a` (B's frame
+/// in A's frame)? Exact for the triangle corners as transformed (R v + t, in Real); the volume
+/// tests are conservative. Stops at the first intersecting pair. `stats` may be null.
+template <class BV>
+bool testBvhBvh(const Bvh<BV>& a, const Bvh<BV>& b, const Pose& b_in_a,
+                BvhQueryStats* stats = nullptr);
+
+/// Every intersecting triangle pair (touching counts), sorted by (a, b), no duplicates: the same
+/// list as intersectMeshMeshBruteForce for the same meshes and pose. `stats` may be null.
+template <class BV>
+std::vector<TrianglePair> intersectBvhBvh(const Bvh<BV>& a, const Bvh<BV>& b, const Pose& b_in_a,
+                                          BvhQueryStats* stats = nullptr);
+
+/// The brute-force reference: every triangle pair (after an exact per-triangle AABB reject) with
+/// the same exact triangle test and the same vertex transform. O(n_a n_b).
+std::vector<TrianglePair> intersectMeshMeshBruteForce(const TriangleMesh& a, const TriangleMesh& b,
+                                                      const Pose& b_in_a,
+                                                      BvhQueryStats* stats = nullptr);
+
+/// A Bvh of a volume type chosen at run time by name (CLI, scenes, benchmarks).
+class MeshBvh {
+public:
+    virtual ~MeshBvh() = default;
+    virtual std::string_view volumeName() const = 0;
+    virtual std::int32_t nodeCount() const = 0;
+    virtual int depth() const = 0;
+    virtual bool validate(std::string* error = nullptr) const = 0;
+    /// testBvhBvh with `b`, which must hold the same volume type (asserted; false if not).
+    virtual bool testOverlap(const MeshBvh& b, const Pose& b_in_a,
+                             BvhQueryStats* stats = nullptr) const = 0;
+    /// intersectBvhBvh with `b`, which must hold the same volume type (asserted; empty if not).
+    virtual std::vector<TrianglePair> intersect(const MeshBvh& b, const Pose& b_in_a,
+                                                BvhQueryStats* stats = nullptr) const = 0;
+};
+
+/// The names of BvhVolumeTypes, in order: sphere, aabb, obb, kdop6, kdop14, kdop18, kdop26, rss.
+const std::vector<std::string_view>& bvhVolumeNames();
+
+/// Builds the tree of the named volume type; nullptr for an unknown name.
+std::unique_ptr<MeshBvh> buildMeshBvh(std::string_view volume_name, const TriangleMesh& mesh,
+                                      const BvhBuildOptions& options = {});
+
+}  // namespace collision

@@ -1,0 +1,415 @@
+// collision/src/bvh_tree.cpp -- the generic BVH: top-down build, validate, and the one tandem
+// traversal behind every query; the brute-force reference; lookup of a volume type by name.
+// Invariants: nodes are in depth-first order (left child = parent + 1), each leaf owns a
+// contiguous range of the leaf-ordered triangles and the leaves partition them; every query moves
+// B's volumes and triangle corners into A's frame with one BvhTransform (the brute force uses the
+// same one), so every implementation tests bit-identical triangles; pair lists are sorted by
+// (a, b) and free of duplicates, so any two implementations compare with ==.
+#include <algorithm>
+#include <limits>
+#include <numeric>
+#include <sstream>
+
+#include "bvh_volumes.h"
+#include "collision/assert.h"
+#include "collision/bvh.h"
+#include "triangle_triangle.h"
+
+namespace collision {
+
+namespace {
+
+// Relative tolerance of validate()'s containment check (the fits add 16-48 ulps).
+constexpr Real kValidateSlack = Real(1024) * kEpsilon;
+
+template <class BV>
+struct Builder {
+    const BvhBuildOptions& options;
+    std::vector<typename Bvh<BV>::Node>& nodes;
+    const std::vector<std::array<Vec3, 3>>& corners;  // by mesh triangle index
+    const std::vector<Vec3>& centroids;               // by mesh triangle index
+    std::vector<std::int32_t>& ids;                   // leaf order -> mesh index, permuted here
+    std::vector<Vec3> scratch;                        // reused: no allocation per node
+
+    // Builds the subtree over leaf-order range [first, first + count); returns its node index.
+    std::int32_t build(std::int32_t first, std::int32_t count) {
+        const auto index = static_cast<std::int32_t>(nodes.size());
+        nodes.emplace_back();
+        scratch.clear();
+        for (std::int32_t i = first; i < first + count; ++i) {
+            const auto id = static_cast<std::size_t>(ids[static_cast<std::size_t>(i)]);
+            for (const Vec3& p : corners[id]) scratch.push_back(p);
+        }
+        {
+            auto& node = nodes[static_cast<std::size_t>(index)];
+            node.volume = BvTraits<BV>::fit(scratch);
+            node.cost = BvTraits<BV>::cost(node.volume);
+        }
+        if (count <= options.max_leaf_triangles) {
+            auto& node = nodes[static_cast<std::size_t>(index)];
+            node.first = first;
+            node.count = count;
+            return index;
+        }
+        const std::int32_t split = partition(first, count);
+        build(first, split - first);
+        const std::int32_t right = build(split, first + count - split);
+        nodes[static_cast<std::size_t>(index)].right = right;
+        return index;
+    }
+
+    // Splits along the longest axis of the centroids' bounding box; returns the first index of
+    // the right half (strictly inside the range).
+    std::int32_t partition(std::int32_t first, std::int32_t count) {
+        const auto begin = ids.begin() + first;
+        const auto end = begin + count;
+        auto centroid = [&](std::int32_t id) -> const Vec3& {
+            return centroids[static_cast<std::size_t>(id)];
+        };
+        Vec3 lo = centroid(*begin);
+        Vec3 hi = lo;
+        Vec3 sum = Vec3::Zero();
+        for (auto it = begin; it != end; ++it) {
+            lo = lo.cwiseMin(centroid(*it));
+            hi = hi.cwiseMax(centroid(*it));
+            sum += centroid(*it);
+        }
+        int axis = 0;
+        (hi - lo).maxCoeff(&axis);
+        auto key = [&](std::int32_t id) { return centroid(id)[axis]; };
+        if (options.split == BvhSplit::Mean) {
+            const Real mean = sum[axis] / Real(count);
+            const auto it =
+                std::partition(begin, end, [&](std::int32_t id) { return key(id) < mean; });
+            const auto left = static_cast<std::int32_t>(it - begin);
+            if (left > 0 && left < count) return first + left;
+        }
+        // Median; ties broken by triangle index so the build is deterministic.
+        const std::int32_t mid = count / 2;
+        std::nth_element(begin, begin + mid, end, [&](std::int32_t i, std::int32_t j) {
+            return key(i) < key(j) || (key(i) == key(j) && i < j);
+        });
+        return first + mid;
+    }
+};
+
+// The tandem traversal (Gottschalk 1996 §5): pop a node pair, test the volumes, and at two leaves
+// test their triangles; otherwise descend the node with the larger volume (a leaf never
+// descends). kFirstOnly stops at the first intersecting triangle pair.
+template <class BV, bool kFirstOnly>
+bool traverse(const Bvh<BV>& a, const Bvh<BV>& b, const Pose& b_in_a, BvhQueryStats* stats,
+              std::vector<TrianglePair>* pairs) {
+    const auto& na = a.nodes();
+    const auto& nb = b.nodes();
+    if (na.empty() || nb.empty()) return false;
+    const BvhTransform x = makeBvhTransform(b_in_a, a.scale(), b.scale());
+    std::int64_t bv_tests = 0;
+    std::int64_t tri_tests = 0;
+    bool found = false;
+    // Depth-first with an explicit stack; its size is bounded by depth(a) + depth(b) + 1.
+    std::vector<std::pair<std::int32_t, std::int32_t>> stack;
+    stack.reserve(static_cast<std::size_t>(2 * (a.depth() + b.depth()) + 4));
+    stack.emplace_back(0, 0);
+    while (!stack.empty()) {
+        const auto [ia, ib] = stack.back();
+        stack.pop_back();
+        const auto& node_a = na[static_cast<std::size_t>(ia)];
+        const auto& node_b = nb[static_cast<std::size_t>(ib)];
+        ++bv_tests;
+        if (!BvTraits<BV>::overlaps(node_a.volume, node_b.volume, x)) continue;
+        if (node_a.isLeaf() && node_b.isLeaf()) {
+            for (std::int32_t j = node_b.first; j < node_b.first + node_b.count; ++j) {
+                const auto& tb = b.leafTriangle(j);
+                const Vec3 p2 = x.apply(tb[0]);
+                const Vec3 q2 = x.apply(tb[1]);
+                const Vec3 r2 = x.apply(tb[2]);
+                for (std::int32_t i = node_a.first; i < node_a.first + node_a.count; ++i) {
+                    const auto& ta = a.leafTriangle(i);
+                    ++tri_tests;
+                    if (!testTriangleTriangle(ta[0], ta[1], ta[2], p2, q2, r2)) continue;
+                    found = true;
+                    if constexpr (kFirstOnly) {
+                        stack.clear();
+                        break;
+                    } else {
+                        pairs->push_back({a.leafTriangleId(i), b.leafTriangleId(j)});
+                    }
+                }
+                if (kFirstOnly && found) break;
+            }
+            continue;
+        }
+        const bool descend_a = node_b.isLeaf() || (!node_a.isLeaf() && node_a.cost >= node_b.cost);
+        if (descend_a) {
+            stack.emplace_back(node_a.right, ib);
+            stack.emplace_back(ia + 1, ib);
+        } else {
+            stack.emplace_back(ia, node_b.right);
+            stack.emplace_back(ia, ib + 1);
+        }
+    }
+    if (stats) {
+        stats->bv_tests += bv_tests;
+        stats->triangle_tests += tri_tests;
+    }
+    if (pairs) std::sort(pairs->begin(), pairs->end());  // each triangle is in one leaf: unique
+    return found;
+}
+
+template <class BV>
+class MeshBvhOf final : public MeshBvh {
+public:
+    MeshBvhOf(const TriangleMesh& mesh, const BvhBuildOptions& options) : tree_(mesh, options) {}
+    std::string_view volumeName() const override { return BvName<BV>::value; }
+    std::int32_t nodeCount() const override {
+        return static_cast<std::int32_t>(tree_.nodes().size());
+    }
+    int depth() const override { return tree_.depth(); }
+    bool validate(std::string* error) const override { return tree_.validate(error); }
+    bool testOverlap(const MeshBvh& b, const Pose& b_in_a, BvhQueryStats* stats) const override {
+        const auto* other = dynamic_cast<const MeshBvhOf<BV>*>(&b);
+        CDLAB_ASSERT(other != nullptr, "BVH query between different volume types");
+        return other != nullptr && testBvhBvh(tree_, other->tree_, b_in_a, stats);
+    }
+    std::vector<TrianglePair> intersect(const MeshBvh& b, const Pose& b_in_a,
+                                        BvhQueryStats* stats) const override {
+        const auto* other = dynamic_cast<const MeshBvhOf<BV>*>(&b);
+        CDLAB_ASSERT(other != nullptr, "BVH query between different volume types");
+        if (other == nullptr) return {};
+        return intersectBvhBvh(tree_, other->tree_, b_in_a, stats);
+    }
+
+private:
+    Bvh<BV> tree_;
+};
+
+}  // namespace
+
+template <class BV>
+int measureDepth(const std::vector<typename Bvh<BV>::Node>& nodes);
+
+template <class BV>
+Bvh<BV>::Bvh(const TriangleMesh& mesh, const BvhBuildOptions& options) {
+    CDLAB_ASSERT(options.max_leaf_triangles >= 1, "leaves need at least one triangle");
+    const std::size_t n = mesh.triangles.size();
+    if (n == 0) return;
+    corners_.resize(n);
+    ids_.resize(n);
+    std::vector<Vec3> centroids(n);
+    Vec3 lo = Vec3::Constant(std::numeric_limits<Real>::infinity());
+    Vec3 hi = -lo;
+    for (std::size_t i = 0; i < n; ++i) {
+        for (int k = 0; k < 3; ++k) {
+            const auto v = mesh.triangles[i][static_cast<std::size_t>(k)];
+            CDLAB_ASSERT(v >= 0 && static_cast<std::size_t>(v) < mesh.vertices.size(),
+                         "triangle index out of range");
+            corners_[i][static_cast<std::size_t>(k)] = mesh.vertices[static_cast<std::size_t>(v)];
+            lo = lo.cwiseMin(corners_[i][static_cast<std::size_t>(k)]);
+            hi = hi.cwiseMax(corners_[i][static_cast<std::size_t>(k)]);
+        }
+        ids_[i] = static_cast<std::int32_t>(i);
+        centroids[i] = (corners_[i][0] + corners_[i][1] + corners_[i][2]) / Real(3);
+    }
+    scale_ = (hi - lo).maxCoeff() + std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff());
+    BvhBuildOptions opts = options;
+    opts.max_leaf_triangles = std::max(1, opts.max_leaf_triangles);
+    nodes_.reserve(2 * n);
+    Builder<BV> builder{opts, nodes_, corners_, centroids, ids_, {}};
+    builder.build(0, static_cast<std::int32_t>(n));
+    // Corners into leaf order, so a leaf's triangles are contiguous in memory.
+    std::vector<std::array<Vec3, 3>> by_mesh = std::move(corners_);
+    corners_.resize(n);
+    for (std::size_t k = 0; k < n; ++k) corners_[k] = by_mesh[static_cast<std::size_t>(ids_[k])];
+    depth_ = measureDepth<BV>(nodes_);
+}
+
+template <class BV>
+int measureDepth(const std::vector<typename Bvh<BV>::Node>& nodes) {
+    using Node = typename Bvh<BV>::Node;
+    if (nodes.empty()) return 0;
+    int best = 0;
+    std::vector<std::pair<std::int32_t, int>> stack{{0, 1}};
+    while (!stack.empty()) {
+        const auto [i, d] = stack.back();
+        stack.pop_back();
+        best = std::max(best, d);
+        const Node& node = nodes[static_cast<std::size_t>(i)];
+        if (!node.isLeaf()) {
+            stack.emplace_back(i + 1, d + 1);
+            stack.emplace_back(node.right, d + 1);
+        }
+    }
+    return best;
+}
+
+template <class BV>
+bool Bvh<BV>::validate(std::string* error) const {
+    auto fail = [&](const std::string& what) {
+        if (error) *error = what;
+        return false;
+    };
+    if (nodes_.empty()) {
+        return ids_.empty() ? true : fail("triangles without nodes");
+    }
+    const Real tol = kValidateSlack * scale_;
+    std::vector<int> seen(ids_.size(), 0);
+    // Each stack entry: node, and the range [first, last) it must cover.
+    struct Item {
+        std::int32_t node;
+        std::int32_t first;
+        std::int32_t last;
+    };
+    std::vector<Item> stack{{0, 0, static_cast<std::int32_t>(ids_.size())}};
+    std::size_t visited = 0;
+    while (!stack.empty()) {
+        const Item it = stack.back();
+        stack.pop_back();
+        if (it.node < 0 || static_cast<std::size_t>(it.node) >= nodes_.size()) {
+            return fail("child index out of range");
+        }
+        ++visited;
+        const Node& node = nodes_[static_cast<std::size_t>(it.node)];
+        for (std::int32_t i = it.first; i < it.last; ++i) {
+            for (const Vec3& p : corners_[static_cast<std::size_t>(i)]) {
+                if (!BvTraits<BV>::contains(node.volume, p, tol)) {
+                    std::ostringstream msg;
+                    msg << "node " << it.node << " does not contain a corner of triangle "
+                        << ids_[static_cast<std::size_t>(i)];
+                    return fail(msg.str());
+                }
+            }
+        }
+        if (node.isLeaf()) {
+            if (node.first != it.first || node.first + node.count != it.last) {
+                return fail("leaf range does not match its parent's split");
+            }
+            for (std::int32_t i = it.first; i < it.last; ++i) ++seen[static_cast<std::size_t>(i)];
+            continue;
+        }
+        // The right child's subtree starts where the left one's range ends: find it from the
+        // left subtree's leaves (depth-first order).
+        const std::int32_t left = it.node + 1;
+        const std::int32_t right = node.right;
+        if (right <= left || static_cast<std::size_t>(right) >= nodes_.size()) {
+            return fail("internal node with bad children");
+        }
+        std::int32_t split = -1;
+        for (std::int32_t k = right - 1; k >= left; --k) {  // last leaf before `right`
+            if (nodes_[static_cast<std::size_t>(k)].isLeaf()) {
+                split = nodes_[static_cast<std::size_t>(k)].first +
+                        nodes_[static_cast<std::size_t>(k)].count;
+                break;
+            }
+        }
+        if (split <= it.first || split >= it.last) return fail("empty child range");
+        stack.push_back({left, it.first, split});
+        stack.push_back({right, split, it.last});
+    }
+    if (visited != nodes_.size()) return fail("unreachable nodes");
+    for (std::size_t i = 0; i < seen.size(); ++i) {
+        if (seen[i] != 1) return fail("a triangle is not in exactly one leaf");
+    }
+    std::vector<std::int32_t> sorted = ids_;
+    std::sort(sorted.begin(), sorted.end());
+    for (std::size_t i = 0; i < sorted.size(); ++i) {
+        if (sorted[i] != static_cast<std::int32_t>(i))
+            return fail("triangle ids not a permutation");
+    }
+    return true;
+}
+
+template <class BV>
+bool testBvhBvh(const Bvh<BV>& a, const Bvh<BV>& b, const Pose& b_in_a, BvhQueryStats* stats) {
+    return traverse<BV, true>(a, b, b_in_a, stats, nullptr);
+}
+
+template <class BV>
+std::vector<TrianglePair> intersectBvhBvh(const Bvh<BV>& a, const Bvh<BV>& b, const Pose& b_in_a,
+                                          BvhQueryStats* stats) {
+    std::vector<TrianglePair> pairs;
+    traverse<BV, false>(a, b, b_in_a, stats, &pairs);
+    return pairs;
+}
+
+std::vector<TrianglePair> intersectMeshMeshBruteForce(const TriangleMesh& a, const TriangleMesh& b,
+                                                      const Pose& b_in_a, BvhQueryStats* stats) {
+    // The same transform as the BVH queries (scales do not matter: only `apply` is used).
+    const BvhTransform x = makeBvhTransform(b_in_a, 0, 0);
+    struct Tri {
+        Vec3 p, q, r, lo, hi;
+    };
+    auto make = [](const Vec3& p, const Vec3& q, const Vec3& r) {
+        return Tri{p, q, r, p.cwiseMin(q).cwiseMin(r), p.cwiseMax(q).cwiseMax(r)};
+    };
+    std::vector<Tri> ta;
+    std::vector<Tri> tb;
+    for (const auto& t : a.triangles) {
+        ta.push_back(make(a.vertices[static_cast<std::size_t>(t[0])],
+                          a.vertices[static_cast<std::size_t>(t[1])],
+                          a.vertices[static_cast<std::size_t>(t[2])]));
+    }
+    for (const auto& t : b.triangles) {
+        tb.push_back(make(x.apply(b.vertices[static_cast<std::size_t>(t[0])]),
+                          x.apply(b.vertices[static_cast<std::size_t>(t[1])]),
+                          x.apply(b.vertices[static_cast<std::size_t>(t[2])])));
+    }
+    std::vector<TrianglePair> pairs;
+    std::int64_t tests = 0;
+    for (std::size_t i = 0; i < ta.size(); ++i) {
+        for (std::size_t j = 0; j < tb.size(); ++j) {
+            // Disjoint exact (unrounded) boxes of the same coordinates: the triangles are apart.
+            if ((ta[i].lo.array() > tb[j].hi.array()).any() ||
+                (tb[j].lo.array() > ta[i].hi.array()).any()) {
+                continue;
+            }
+            ++tests;
+            if (testTriangleTriangle(ta[i].p, ta[i].q, ta[i].r, tb[j].p, tb[j].q, tb[j].r)) {
+                pairs.push_back({static_cast<std::int32_t>(i), static_cast<std::int32_t>(j)});
+            }
+        }
+    }
+    if (stats) stats->triangle_tests += tests;
+    return pairs;  // generated in (a, b) order: sorted and unique
+}
+
+const std::vector<std::string_view>& bvhVolumeNames() {
+    static const std::vector<std::string_view> names = [] {
+        std::vector<std::string_view> out;
+        std::apply([&](auto... bv) { (out.push_back(BvName<decltype(bv)>::value), ...); },
+                   BvhVolumeTypes{});
+        return out;
+    }();
+    return names;
+}
+
+std::unique_ptr<MeshBvh> buildMeshBvh(std::string_view volume_name, const TriangleMesh& mesh,
+                                      const BvhBuildOptions& options) {
+    std::unique_ptr<MeshBvh> out;
+    std::apply(
+        [&](auto... bv) {
+            ((BvName<decltype(bv)>::value == volume_name && !out
+                  ? (void)(out = std::make_unique<MeshBvhOf<decltype(bv)>>(mesh, options))
+                  : (void)0),
+             ...);
+        },
+        BvhVolumeTypes{});
+    return out;
+}
+
+// Explicit instantiation for every type of BvhVolumeTypes (registration is explicit).
+#define CDLAB_BVH_INSTANTIATE(BV)                                                              \
+    template class Bvh<BV>;                                                                    \
+    template bool testBvhBvh<BV>(const Bvh<BV>&, const Bvh<BV>&, const Pose&, BvhQueryStats*); \
+    template std::vector<TrianglePair> intersectBvhBvh<BV>(const Bvh<BV>&, const Bvh<BV>&,     \
+                                                           const Pose&, BvhQueryStats*);
+CDLAB_BVH_INSTANTIATE(BoundingSphere)
+CDLAB_BVH_INSTANTIATE(Aabb)
+CDLAB_BVH_INSTANTIATE(Obb)
+CDLAB_BVH_INSTANTIATE(Kdop<6>)
+CDLAB_BVH_INSTANTIATE(Kdop<14>)
+CDLAB_BVH_INSTANTIATE(Kdop<18>)
+CDLAB_BVH_INSTANTIATE(Kdop<26>)
+CDLAB_BVH_INSTANTIATE(Rss)
+#undef CDLAB_BVH_INSTANTIATE
+
+}  // namespace collision

@@ -1,0 +1,260 @@
+// collision/src/bvh_volumes.h -- the traits of every BVH node volume (private to collision):
+// fit from triangle corners, overlap under the relative pose of B in A's frame, containment
+// (for validate), and cost (the volume, used for tightness and to pick the node to descend).
+// Overlap tests are conservative: they may report overlap for volumes that are a tolerance apart,
+// never separation for volumes that share a point.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "collision/bvh.h"
+#include "collision/math.h"
+
+namespace collision {
+
+/// Relative slack of the overlap tests, times the scene scale: covers the rounding of moving a
+/// volume into A's frame and of the projections, so rounding never separates touching volumes.
+inline constexpr Real kBvhOverlapSlack = Real(256) * kEpsilon;
+
+/// The 13 k-DOP directions (unnormalised): axes, cube diagonals, face diagonals.
+inline constexpr int kKdopDirectionCount = 13;
+inline constexpr std::array<std::array<int, 3>, kKdopDirectionCount> kKdopDirections = {{
+    {1, 0, 0},
+    {0, 1, 0},
+    {0, 0, 1},  // k = 6
+    {1, 1, 1},
+    {1, 1, -1},
+    {1, -1, 1},
+    {-1, 1, 1},  // + cube diagonals (14, 26)
+    {1, 1, 0},
+    {1, 0, 1},
+    {0, 1, 1},
+    {1, -1, 0},
+    {1, 0, -1},
+    {0, 1, -1},  // + edges (18, 26)
+}};
+
+/// Index into kKdopDirections of slab `i` of a Kdop<K>.
+template <int K>
+constexpr int kdopDirectionIndex(int i) {
+    if constexpr (K == 18) return i < 3 ? i : i + 4;  // axes then the 6 face diagonals
+    return i;                                         // 6, 14, 26 take a prefix
+}
+
+inline Vec3 kdopDirection(int index) {
+    const auto& d = kKdopDirections[static_cast<std::size_t>(index)];
+    return Vec3(Real(d[0]), Real(d[1]), Real(d[2]));
+}
+
+/// The relative pose of B in A's frame as the traversal uses it, with per-query precomputation:
+/// p_a = r p_b + t. Built once per query (never per node pair).
+struct BvhTransform {
+    Mat3 r = Mat3::Identity();
+    Vec3 t = Vec3::Zero();
+    bool identity = true;  ///< r is exactly the identity: same-orientation fast paths
+    Real tol = 0;          ///< absolute overlap slack (kBvhOverlapSlack times the scene scale)
+    // k-DOP support: for each direction n, r^T n and n.t (A's slabs against B's box), and r n and
+    // (r n).t (B's slabs against A's box, in B's frame).
+    std::array<Vec3, kKdopDirectionCount> rt_dir;
+    std::array<Real, kKdopDirectionCount> dir_dot_t;
+    std::array<Vec3, kKdopDirectionCount> r_dir;
+    std::array<Real, kKdopDirectionCount> r_dir_dot_t;
+
+    /// A point of B's frame in A's frame. The one transform used by both the BVH queries and the
+    /// brute-force reference, so both test bit-identical triangles.
+    Vec3 apply(const Vec3& p) const { return r * p + t; }
+};
+
+/// `scale_a`, `scale_b`: the meshes' length scales (Bvh::scale()).
+BvhTransform makeBvhTransform(const Pose& b_in_a, Real scale_a, Real scale_b);
+
+/// Separating-axis test of two boxes (Gottschalk, Lin, Manocha 1996 §4; RTCD 4.4.1) in A's box
+/// frame: `a`, `b` half extents, `rot` B's axes in A's box frame, `t` B's centre there. With
+/// kSwept, both boxes are additionally swept by spheres of total radius `radius_sum` (RSS): on
+/// every axis L the projection grows by radius_sum |L|. Fifteen axes only: for swept volumes this
+/// is conservative (the rounded edges are treated as the enclosing box edges).
+template <bool kSwept>
+inline bool testSat15(const Vec3& a, const Mat3& rot, const Vec3& t, const Vec3& b, Real tol,
+                      Real radius_sum) {
+    // |R| + eps keeps near-parallel edge pairs (cross product ~ 0) from false separations.
+    const Mat3 abs_rot = rot.cwiseAbs().array() + Real(16) * kEpsilon;
+    const Real face_slack = tol + (kSwept ? radius_sum : Real(0));
+    for (int i = 0; i < 3; ++i) {
+        if (std::abs(t[i]) > a[i] + abs_rot.row(i).dot(b) + face_slack) return false;
+    }
+    for (int j = 0; j < 3; ++j) {
+        if (std::abs(t.dot(rot.col(j))) > abs_rot.col(j).dot(a) + b[j] + face_slack) return false;
+    }
+    for (int i = 0; i < 3; ++i) {
+        const int i1 = (i + 1) % 3;
+        const int i2 = (i + 2) % 3;
+        for (int j = 0; j < 3; ++j) {
+            const int j1 = (j + 1) % 3;
+            const int j2 = (j + 2) % 3;
+            Real slack = tol;
+            if constexpr (kSwept) {
+                // |A_i x B_j| = |e_i x rot.col(j)| = sqrt(R_i1j^2 + R_i2j^2). Not sqrt(1 - R_ij^2):
+                // that rounds to 0 for near-parallel axes and falsely separates (found on a cube
+                // whose node axes were 1.7e-7 off the grid).
+                slack +=
+                    radius_sum * (std::sqrt(rot(i1, j) * rot(i1, j) + rot(i2, j) * rot(i2, j)) +
+                                  Real(16) * kEpsilon);
+            }
+            const Real ra = a[i1] * abs_rot(i2, j) + a[i2] * abs_rot(i1, j);
+            const Real rb = b[j1] * abs_rot(i, j2) + b[j2] * abs_rot(i, j1);
+            const Real dist = std::abs(t[i2] * rot(i1, j) - t[i1] * rot(i2, j));
+            if (dist > ra + rb + slack) return false;
+        }
+    }
+    return true;
+}
+
+template <class BV>
+struct BvTraits;
+
+// ---- Sphere: smallest enclosing sphere (Welzl), exact test. ----
+template <>
+struct BvTraits<BoundingSphere> {
+    static BoundingSphere fit(const std::vector<Vec3>& corners);
+    static bool overlaps(const BoundingSphere& a, const BoundingSphere& b, const BvhTransform& x) {
+        const Real r = a.radius + b.radius + x.tol;
+        return (x.apply(b.center) - a.center).squaredNorm() <= r * r;
+    }
+    static bool contains(const BoundingSphere& s, const Vec3& p, Real tol) {
+        return (p - s.center).norm() <= s.radius + tol;
+    }
+    static Real cost(const BoundingSphere& s) {
+        return Real(4) / Real(3) * std::numbers::pi_v<Real> * s.radius * s.radius * s.radius;
+    }
+};
+
+// ---- AABB in the mesh frame. Under a rotation B's box is an OBB in A's frame: the exact 15-axis
+// box test (no enclosing-box growth); with identical orientations the 3-axis interval test. ----
+template <>
+struct BvTraits<Aabb> {
+    static Aabb fit(const std::vector<Vec3>& corners);
+    static bool overlaps(const Aabb& a, const Aabb& b, const BvhTransform& x) {
+        if (x.identity) {
+            const Vec3 lo = b.min + x.t;
+            const Vec3 hi = b.max + x.t;
+            return (lo.array() <= a.max.array() + x.tol).all() &&
+                   (a.min.array() <= hi.array() + x.tol).all();
+        }
+        const Vec3 ha = (a.max - a.min) * Real(0.5);
+        const Vec3 hb = (b.max - b.min) * Real(0.5);
+        const Vec3 t = x.apply((b.min + b.max) * Real(0.5)) - (a.min + a.max) * Real(0.5);
+        return testSat15<false>(ha, x.r, t, hb, x.tol, 0);
+    }
+    static bool contains(const Aabb& box, const Vec3& p, Real tol) {
+        return (p.array() >= box.min.array() - tol).all() &&
+               (p.array() <= box.max.array() + tol).all();
+    }
+    static Real cost(const Aabb& box) { return box.extents().prod(); }
+};
+
+// ---- OBB (Gottschalk's OBBTree): area-weighted covariance of the node's triangles. ----
+template <>
+struct BvTraits<Obb> {
+    static Obb fit(const std::vector<Vec3>& corners);
+    static bool overlaps(const Obb& a, const Obb& b, const BvhTransform& x) {
+        const Mat3 rot = a.axes.transpose() * (x.r * b.axes);
+        const Vec3 t = a.axes.transpose() * (x.apply(b.center) - a.center);
+        return testSat15<false>(a.half_extents, rot, t, b.half_extents, x.tol, 0);
+    }
+    static bool contains(const Obb& box, const Vec3& p, Real tol) {
+        const Vec3 local = box.axes.transpose() * (p - box.center);
+        return (local.cwiseAbs().array() <= box.half_extents.array() + tol).all();
+    }
+    static Real cost(const Obb& box) { return Real(8) * box.half_extents.prod(); }
+};
+
+// ---- k-DOP. Same orientation: exact slab-against-slab test. Under a rotation the slab
+// directions no longer match, so the test is conservative: A's slabs against B's box (its first
+// three slabs, an OBB in A's frame), then B's slabs against A's box in B's frame. Each slab is a
+// true separating plane of the two sets, so a rejection is always right. ----
+template <int K>
+struct BvTraits<Kdop<K>> {
+    static Kdop<K> fit(const std::vector<Vec3>& corners);
+    static bool overlaps(const Kdop<K>& a, const Kdop<K>& b, const BvhTransform& x) {
+        constexpr int n = Kdop<K>::kSlabs;
+        if (x.identity) {
+            for (int i = 0; i < n; ++i) {
+                const Real d = x.dir_dot_t[static_cast<std::size_t>(kdopDirectionIndex<K>(i))];
+                if (b.min[i] + d > a.max[i] + x.tol || b.max[i] + d < a.min[i] - x.tol) {
+                    return false;
+                }
+            }
+            return true;
+        }
+        const Vec3 cb((b.min[0] + b.max[0]) * Real(0.5), (b.min[1] + b.max[1]) * Real(0.5),
+                      (b.min[2] + b.max[2]) * Real(0.5));
+        const Vec3 hb((b.max[0] - b.min[0]) * Real(0.5), (b.max[1] - b.min[1]) * Real(0.5),
+                      (b.max[2] - b.min[2]) * Real(0.5));
+        const Vec3 ca((a.min[0] + a.max[0]) * Real(0.5), (a.min[1] + a.max[1]) * Real(0.5),
+                      (a.min[2] + a.max[2]) * Real(0.5));
+        const Vec3 ha((a.max[0] - a.min[0]) * Real(0.5), (a.max[1] - a.min[1]) * Real(0.5),
+                      (a.max[2] - a.min[2]) * Real(0.5));
+        for (int i = 0; i < n; ++i) {
+            const auto k = static_cast<std::size_t>(kdopDirectionIndex<K>(i));
+            // n.(r cb + t) and the box's half projection sum_j |n.r_j| hb_j = |r^T n|.hb.
+            const Real centre = x.rt_dir[k].dot(cb) + x.dir_dot_t[k];
+            const Real radius = x.rt_dir[k].cwiseAbs().dot(hb);
+            if (centre - radius > a.max[i] + x.tol || centre + radius < a.min[i] - x.tol) {
+                return false;
+            }
+        }
+        for (int i = 0; i < n; ++i) {
+            const auto k = static_cast<std::size_t>(kdopDirectionIndex<K>(i));
+            // A's box in B's frame: centre r^T (ca - t); m.(r^T (ca - t)) = (r m).ca - (r m).t.
+            const Real centre = x.r_dir[k].dot(ca) - x.r_dir_dot_t[k];
+            const Real radius = x.r_dir[k].cwiseAbs().dot(ha);
+            if (centre - radius > b.max[i] + x.tol || centre + radius < b.min[i] - x.tol) {
+                return false;
+            }
+        }
+        return true;
+    }
+    static bool contains(const Kdop<K>& d, const Vec3& p, Real tol) {
+        for (int i = 0; i < Kdop<K>::kSlabs; ++i) {
+            const Real s = kdopDirection(kdopDirectionIndex<K>(i)).dot(p);
+            if (s < d.min[i] - tol || s > d.max[i] + tol) return false;
+        }
+        return true;
+    }
+    static Real cost(const Kdop<K>& d) {
+        // The volume of the axis slabs (an upper bound of the k-DOP's volume).
+        return (d.max[0] - d.min[0]) * (d.max[1] - d.min[1]) * (d.max[2] - d.min[2]);
+    }
+};
+
+// ---- RSS (Larsen et al. 2000): rectangle in the plane of the two largest principal axes. ----
+template <>
+struct BvTraits<Rss> {
+    static Rss fit(const std::vector<Vec3>& corners);
+    static bool overlaps(const Rss& a, const Rss& b, const BvhTransform& x) {
+        const Mat3 rot = a.axes.transpose() * (x.r * b.axes);
+        const Vec3 t = a.axes.transpose() * (x.apply(b.center) - a.center);
+        const Vec3 ha(a.half_lengths[0], a.half_lengths[1], 0);
+        const Vec3 hb(b.half_lengths[0], b.half_lengths[1], 0);
+        return testSat15<true>(ha, rot, t, hb, x.tol, a.radius + b.radius);
+    }
+    static bool contains(const Rss& s, const Vec3& p, Real tol) {
+        const Vec3 local = s.axes.transpose() * (p - s.center);
+        const Real dx = std::max(Real(0), std::abs(local.x()) - s.half_lengths[0]);
+        const Real dy = std::max(Real(0), std::abs(local.y()) - s.half_lengths[1]);
+        return std::sqrt(dx * dx + dy * dy + local.z() * local.z()) <= s.radius + tol;
+    }
+    static Real cost(const Rss& s) {
+        // Box part + four half-cylinders along the edges + the sphere at the corners.
+        const Real pi = std::numbers::pi_v<Real>;
+        const Real lx = 2 * s.half_lengths[0];
+        const Real ly = 2 * s.half_lengths[1];
+        const Real r = s.radius;
+        return lx * ly * 2 * r + (lx + ly) * pi * r * r + Real(4) / Real(3) * pi * r * r * r;
+    }
+};
+
+}  // namespace collision

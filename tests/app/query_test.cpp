@@ -1,0 +1,106 @@
+// End-to-end: `cdlab query` answers for every BVH volume type side by side, agrees across types,
+// writes JSON on request, and rejects bad flags and unreadable meshes with exit code 2.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "query_command.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct QueryResult {
+    int exit_code = -1;
+    std::string out;
+    std::string err;
+};
+
+std::string readAll(const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+}
+
+QueryResult runQueryCli(const std::string& args) {
+    const fs::path dir = fs::temp_directory_path() / ("cdlab_query_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const fs::path out = dir / "stdout.txt";
+    const fs::path err = dir / "stderr.txt";
+    const std::string cmd = std::string("cd ") + CDLAB_SOURCE_DIR + " && " + CDLAB_BINARY +
+                            " query " + args + " > " + out.string() + " 2> " + err.string() +
+                            " < /dev/null";
+    const int status = std::system(cmd.c_str());
+    QueryResult r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = readAll(out);
+    r.err = readAll(err);
+    fs::remove_all(dir);
+    return r;
+}
+
+TEST(Query, JsonHasEveryVolumeTypeAndTheyAgree) {
+    // The torus against itself shifted along x by a quarter of its size: the tubes cross.
+    const QueryResult r =
+        runQueryCli("assets/torus.obj assets/torus.obj --pose-b 0.5,0,0.1,1,0,0,0 --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_TRUE(j["volumes_agree"].get<bool>());
+    ASSERT_EQ(j["results"].size(), 8u);
+    const std::size_t pairs = j["results"][0]["triangle_pairs"].get<std::size_t>();
+    EXPECT_GT(pairs, 0u);
+    for (const auto& row : j["results"]) {
+        EXPECT_TRUE(row["colliding"].get<bool>()) << row["bv"];
+        EXPECT_EQ(row["triangle_pairs"].get<std::size_t>(), pairs) << row["bv"];
+        EXPECT_GT(row["all_pairs"]["bv_tests"].get<std::int64_t>(), 0);
+        EXPECT_GE(row["all_pairs"]["triangle_tests"].get<std::int64_t>(),
+                  static_cast<std::int64_t>(pairs));
+        EXPECT_LE(row["first_contact"]["triangle_tests"].get<std::int64_t>(),
+                  row["all_pairs"]["triangle_tests"].get<std::int64_t>());
+    }
+    EXPECT_EQ(j["results"][7]["bv"], "rss");
+}
+
+TEST(Query, FarApartIsNotCollidingAndTableIsPrinted) {
+    const QueryResult r = runQueryCli(
+        "assets/torus.obj assets/crystal.obj --bv obb "
+        "--pose-b 100,0,0,0.7071,0.7071,0,0");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("obb"), std::string::npos);
+    EXPECT_NE(r.out.find("apart"), std::string::npos);
+    EXPECT_EQ(r.out.find("colliding"), std::string::npos);
+}
+
+TEST(Query, BadInputExitsTwoWithAMessage) {
+    QueryResult r = runQueryCli("assets/torus.obj assets/torus.obj --bv lss");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("--bv: unknown volume 'lss'"), std::string::npos) << r.err;
+    r = runQueryCli("assets/torus.obj assets/torus.obj --pose-b 1,2,3");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("--pose-b: expected 7"), std::string::npos) << r.err;
+    r = runQueryCli("assets/torus.obj no/such/mesh.obj");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("no/such/mesh.obj"), std::string::npos) << r.err;
+}
+
+TEST(Query, ParsePose) {
+    std::string error;
+    const auto pose = app::parsePose("1, 2, 3, 2, 0, 0, 0", &error);
+    ASSERT_TRUE(pose.has_value()) << error;
+    EXPECT_EQ(pose->position, collision::Vec3(1, 2, 3));
+    EXPECT_DOUBLE_EQ(pose->orientation.w(), 1.0);  // normalised
+    EXPECT_FALSE(app::parsePose("1,2,3,0,0,0,0", &error).has_value());
+    EXPECT_NE(error.find("zero"), std::string::npos);
+    EXPECT_FALSE(app::parsePose("1,2,x,1,0,0,0", &error).has_value());
+    EXPECT_FALSE(app::parsePose("1,2,inf,1,0,0,0", &error).has_value());
+}
+
+}  // namespace

@@ -1,0 +1,326 @@
+// tests/collision/bvh_test.cpp -- the generic mesh BVH for every volume type: differential
+// against the brute-force triangle-pair reference (random, touching and coplanar poses),
+// containment of every fitted volume (validate), metamorphic translation and scaling, and the
+// lookup by name.
+#include "collision/bvh.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "test_random.h"
+
+namespace {
+
+using collision::Aabb;
+using collision::Bvh;
+using collision::BvhBuildOptions;
+using collision::BvhQueryStats;
+using collision::BvhSplit;
+using collision::BvhVolumeTypes;
+using collision::BvName;
+using collision::Pose;
+using collision::Quat;
+using collision::Real;
+using collision::TriangleMesh;
+using collision::TrianglePair;
+using collision::Vec3;
+
+// A torus around local z: `nu` segments around the ring, `nv` around the tube, 2 nu nv triangles.
+TriangleMesh makeTorus(Real ring, Real tube, int nu, int nv) {
+    TriangleMesh m;
+    for (int i = 0; i < nu; ++i) {
+        const Real u = 2 * std::numbers::pi_v<Real> * i / nu;
+        for (int j = 0; j < nv; ++j) {
+            const Real v = 2 * std::numbers::pi_v<Real> * j / nv;
+            const Real w = ring + tube * std::cos(v);
+            m.vertices.emplace_back(w * std::cos(u), w * std::sin(u), tube * std::sin(v));
+        }
+    }
+    auto id = [&](int i, int j) { return static_cast<std::int32_t>((i % nu) * nv + (j % nv)); };
+    for (int i = 0; i < nu; ++i) {
+        for (int j = 0; j < nv; ++j) {
+            m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+            m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+        }
+    }
+    return m;
+}
+
+// The cube [-1, 1]^3, each face an n x n grid of squares split in two triangles. With n a power of
+// two every coordinate is exact, so translated copies touch exactly.
+TriangleMesh makeGridCube(int n) {
+    TriangleMesh m;
+    for (int axis = 0; axis < 3; ++axis) {
+        for (int side = -1; side <= 1; side += 2) {
+            const int u_axis = (axis + 1) % 3;
+            const int v_axis = (axis + 2) % 3;
+            const auto base = static_cast<std::int32_t>(m.vertices.size());
+            for (int i = 0; i <= n; ++i) {
+                for (int j = 0; j <= n; ++j) {
+                    Vec3 p;
+                    p[axis] = side;
+                    p[u_axis] = -1 + Real(2) * i / n;
+                    p[v_axis] = -1 + Real(2) * j / n;
+                    m.vertices.push_back(p);
+                }
+            }
+            auto id = [&](int i, int j) {
+                return base + static_cast<std::int32_t>(i * (n + 1) + j);
+            };
+            for (int i = 0; i < n; ++i) {
+                for (int j = 0; j < n; ++j) {
+                    m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+                    m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+                }
+            }
+        }
+    }
+    return m;
+}
+
+TriangleMesh transformed(const TriangleMesh& m, Real scale, const Vec3& offset) {
+    TriangleMesh out = m;
+    for (Vec3& v : out.vertices) v = v * scale + offset;
+    return out;
+}
+
+// The relative pose that puts B' = s B + d where A' = s A + d puts B: x'(s v + d) = s x(v) + d.
+Pose scaledPose(const Pose& x, Real scale, const Vec3& offset) {
+    return Pose{x.position * scale + offset - (x.orientation * offset), x.orientation};
+}
+
+std::vector<Pose> randomPoses(std::uint64_t seed, int count, Real range) {
+    cdlab_test::Rng rng(seed);
+    std::vector<Pose> poses;
+    for (int i = 0; i < count; ++i) poses.push_back(Pose{rng.vec(-range, range), rng.rotation()});
+    return poses;
+}
+
+// Small tori for the brute-force comparison (1536 and 1200 triangles).
+const TriangleMesh& torusA() {
+    static const TriangleMesh m = makeTorus(1.0, 0.35, 48, 16);
+    return m;
+}
+const TriangleMesh& torusB() {
+    static const TriangleMesh m = makeTorus(0.8, 0.3, 40, 15);
+    return m;
+}
+const std::vector<Pose>& differentialPoses() {
+    static const std::vector<Pose> poses = randomPoses(4242, 16, 2.0);
+    return poses;
+}
+// Brute-force answers, computed once and shared by every volume type.
+const std::vector<TrianglePair>& bruteAnswer(std::size_t pose) {
+    static std::map<std::size_t, std::vector<TrianglePair>> cache;
+    auto it = cache.find(pose);
+    if (it == cache.end()) {
+        it = cache
+                 .emplace(pose, collision::intersectMeshMeshBruteForce(torusA(), torusB(),
+                                                                       differentialPoses()[pose]))
+                 .first;
+    }
+    return it->second;
+}
+
+template <class T>
+struct TupleToTypes;
+template <class... Ts>
+struct TupleToTypes<std::tuple<Ts...>> {
+    using type = ::testing::Types<Ts...>;
+};
+struct VolumeName {
+    template <class BV>
+    static std::string GetName(int) {
+        return std::string(BvName<BV>::value);
+    }
+};
+
+template <class BV>
+class BvhTyped : public ::testing::Test {};
+TYPED_TEST_SUITE(BvhTyped, TupleToTypes<BvhVolumeTypes>::type, VolumeName);
+
+TYPED_TEST(BvhTyped, EveryFittedVolumeContainsItsTriangles) {
+    for (const BvhSplit split : {BvhSplit::Median, BvhSplit::Mean}) {
+        for (const int leaf : {1, 4}) {
+            const BvhBuildOptions options{split, leaf};
+            for (const TriangleMesh* mesh : {&torusA(), &torusB()}) {
+                const Bvh<TypeParam> tree(*mesh, options);
+                std::string error;
+                EXPECT_TRUE(tree.validate(&error)) << error;
+                EXPECT_EQ(tree.triangleCount(), static_cast<int>(mesh->triangles.size()));
+                if (leaf == 1) {
+                    EXPECT_EQ(tree.nodes().size(), 2 * mesh->triangles.size() - 1);
+                }
+            }
+        }
+    }
+    // Far from the origin and at extreme scales the fits must still contain their corners.
+    for (const Real scale : {Real(1e-4), Real(1), Real(1e4)}) {
+        const Bvh<TypeParam> tree(transformed(torusB(), scale, Vec3(1e6, -1e6, 1e6)));
+        std::string error;
+        EXPECT_TRUE(tree.validate(&error)) << "scale " << scale << ": " << error;
+    }
+    const Bvh<TypeParam> median(torusA());
+    EXPECT_EQ(median.depth(), 12);  // ceil(log2 1536) + 1
+}
+
+TYPED_TEST(BvhTyped, AllPairsMatchBruteForceAtRandomPoses) {
+    const Bvh<TypeParam> a(torusA());
+    const Bvh<TypeParam> b(torusB());
+    int colliding = 0;
+    for (std::size_t k = 0; k < differentialPoses().size(); ++k) {
+        const Pose& pose = differentialPoses()[k];
+        BvhQueryStats all;
+        BvhQueryStats first;
+        const std::vector<TrianglePair> pairs = collision::intersectBvhBvh(a, b, pose, &all);
+        const bool hit = collision::testBvhBvh(a, b, pose, &first);
+        EXPECT_EQ(pairs, bruteAnswer(k)) << "pose " << k;
+        EXPECT_EQ(hit, !pairs.empty()) << "pose " << k;
+        EXPECT_LE(first.triangle_tests, all.triangle_tests);
+        EXPECT_GT(all.bv_tests, 0);
+        colliding += hit ? 1 : 0;
+    }
+    // Both outcomes must occur, or the test could not fail.
+    EXPECT_GE(colliding, 4);
+    EXPECT_LE(colliding, 12);
+}
+
+TYPED_TEST(BvhTyped, MeanSplitAndFatLeavesGiveTheSameAnswer) {
+    const Bvh<TypeParam> a(torusA(), BvhBuildOptions{BvhSplit::Mean, 4});
+    const Bvh<TypeParam> b(torusB(), BvhBuildOptions{BvhSplit::Mean, 3});
+    for (std::size_t k = 0; k < 6; ++k) {
+        EXPECT_EQ(collision::intersectBvhBvh(a, b, differentialPoses()[k]), bruteAnswer(k));
+    }
+}
+
+// Touching and coplanar cases on an exactly representable cube (8 x 8 squares per face):
+//   identical pose: every triangle touches itself and its neighbours;
+//   +2 along x:     the faces x = 1 of A and x = -1 of B coincide (coplanar, face to face);
+//   +2, +1/8, +1/8: the same faces with the grids offset by half a cell (crossing edges);
+//   +2, +2, 0:      the cubes share only an edge line; +2, +2, +2: only a corner.
+TYPED_TEST(BvhTyped, TouchingAndCoplanarPosesMatchBruteForce) {
+    const TriangleMesh cube = makeGridCube(8);
+    const Bvh<TypeParam> tree(cube);
+    const Quat quarter_turn(std::cos(std::numbers::pi_v<Real> / 4),
+                            std::sin(std::numbers::pi_v<Real> / 4), 0, 0);
+    const std::vector<Pose> poses = {
+        Pose{},
+        Pose{Vec3(2, 0, 0), Quat::Identity()},
+        Pose{Vec3(2, 0.125, 0.125), Quat::Identity()},
+        Pose{Vec3(2, 2, 0), Quat::Identity()},
+        Pose{Vec3(2, 2, 2), Quat::Identity()},
+        Pose{Vec3(2, 0, 0), quarter_turn},             // rotated: touching up to the rounding of R
+        Pose{Vec3(2 + 1e-9, 0, 0), Quat::Identity()},  // a hair apart
+    };
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+        const auto brute = collision::intersectMeshMeshBruteForce(cube, cube, poses[k]);
+        EXPECT_EQ(collision::intersectBvhBvh(tree, tree, poses[k]), brute) << "pose " << k;
+        EXPECT_EQ(collision::testBvhBvh(tree, tree, poses[k]), !brute.empty()) << "pose " << k;
+        if (k <= 4) {
+            EXPECT_FALSE(brute.empty()) << "pose " << k;
+        }
+        if (k == 6) {
+            EXPECT_TRUE(brute.empty());
+        }
+    }
+    // Two copies of a torus at the identical pose.
+    const Bvh<TypeParam> torus(torusB());
+    EXPECT_EQ(collision::intersectBvhBvh(torus, torus, Pose{}),
+              collision::intersectMeshMeshBruteForce(torusB(), torusB(), Pose{}));
+}
+
+// Metamorphic: move both meshes 1e6 away and scale them by 1e-4 and 1e4. The BVH must still
+// equal brute force on the moved scene exactly, and (these poses being generic, with no contact
+// within rounding of touching) give the original pair list.
+TYPED_TEST(BvhTyped, TranslatedAndScaledScenesGiveTheSameAnswer) {
+    const TriangleMesh small_a = makeTorus(1.0, 0.35, 24, 12);
+    const TriangleMesh small_b = makeTorus(0.8, 0.3, 20, 10);
+    const std::vector<Pose> poses = randomPoses(99, 4, 1.2);
+    for (const Real scale : {Real(1), Real(1e-4), Real(1e4)}) {
+        const Vec3 offset = Vec3(1e6, -2e6, 0.5e6) * scale;
+        const TriangleMesh ma = transformed(small_a, scale, offset);
+        const TriangleMesh mb = transformed(small_b, scale, offset);
+        const Bvh<TypeParam> a(ma);
+        const Bvh<TypeParam> b(mb);
+        for (const Pose& pose : poses) {
+            const Pose moved = scaledPose(pose, scale, offset);
+            const auto pairs = collision::intersectBvhBvh(a, b, moved);
+            EXPECT_EQ(pairs, collision::intersectMeshMeshBruteForce(ma, mb, moved))
+                << "scale " << scale;
+            EXPECT_EQ(pairs, collision::intersectMeshMeshBruteForce(small_a, small_b, pose))
+                << "scale " << scale;
+        }
+    }
+}
+
+// 10k-triangle tori: brute force would be 1e8 tests, so every volume type is checked against the
+// AABB tree instead (itself checked against brute force above).
+TYPED_TEST(BvhTyped, LargeToriMatchTheAabbTree) {
+    static const TriangleMesh big_a = makeTorus(1.0, 0.35, 100, 50);
+    static const TriangleMesh big_b = makeTorus(0.9, 0.3, 100, 50);
+    static const Bvh<Aabb> ref_a(big_a);
+    static const Bvh<Aabb> ref_b(big_b);
+    ASSERT_EQ(big_a.triangles.size(), 10000u);
+    const Bvh<TypeParam> a(big_a);
+    const Bvh<TypeParam> b(big_b);
+    EXPECT_TRUE(a.validate());
+    int colliding = 0;
+    for (const Pose& pose : randomPoses(7, 6, 1.5)) {
+        const auto expected = collision::intersectBvhBvh(ref_a, ref_b, pose);
+        EXPECT_EQ(collision::intersectBvhBvh(a, b, pose), expected);
+        EXPECT_EQ(collision::testBvhBvh(a, b, pose), !expected.empty());
+        colliding += expected.empty() ? 0 : 1;
+    }
+    EXPECT_GE(colliding, 2);
+}
+
+TEST(Bvh, LookupByNameCoversTheTypeList) {
+    const std::vector<std::string_view> expected = {"sphere", "aabb",   "obb",    "kdop6",
+                                                    "kdop14", "kdop18", "kdop26", "rss"};
+    EXPECT_EQ(collision::bvhVolumeNames(), expected);
+    EXPECT_EQ(collision::buildMeshBvh("lss?", torusA()), nullptr);
+    const Pose pose = differentialPoses()[0];
+    for (const std::string_view name : collision::bvhVolumeNames()) {
+        const auto a = collision::buildMeshBvh(name, torusA());
+        const auto b = collision::buildMeshBvh(name, torusB());
+        ASSERT_NE(a, nullptr) << name;
+        EXPECT_EQ(a->volumeName(), name);
+        EXPECT_EQ(a->nodeCount(), 2 * 1536 - 1);
+        EXPECT_TRUE(a->validate());
+        BvhQueryStats stats;
+        EXPECT_EQ(a->intersect(*b, pose, &stats), bruteAnswer(0)) << name;
+        EXPECT_EQ(a->testOverlap(*b, pose), !bruteAnswer(0).empty()) << name;
+        EXPECT_GT(stats.bv_tests, 0);
+    }
+}
+
+TEST(Bvh, EmptyMeshHasNoContacts) {
+    const TriangleMesh empty;
+    const Bvh<Aabb> e(empty);
+    const Bvh<Aabb> t(torusA());
+    EXPECT_TRUE(e.validate());
+    EXPECT_EQ(e.depth(), 0);
+    EXPECT_FALSE(collision::testBvhBvh(e, t, Pose{}));
+    EXPECT_TRUE(collision::intersectBvhBvh(t, e, Pose{}).empty());
+}
+
+// The BVH prunes: on a colliding pose it tests under 1 % of the triangle pairs.
+TEST(Bvh, CountersShowPruning) {
+    const Bvh<collision::Obb> a(torusA());
+    const Bvh<collision::Obb> b(torusB());
+    BvhQueryStats bvh;
+    std::size_t k = 0;
+    while (k < differentialPoses().size() && bruteAnswer(k).empty()) ++k;
+    ASSERT_LT(k, differentialPoses().size());
+    collision::intersectBvhBvh(a, b, differentialPoses()[k], &bvh);
+    EXPECT_LT(bvh.triangle_tests * 100, static_cast<std::int64_t>(1536 * 1200));
+    EXPECT_GE(bvh.triangle_tests, static_cast<std::int64_t>(bruteAnswer(k).size()));
+}
+
+}  // namespace
