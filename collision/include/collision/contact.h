@@ -1,0 +1,69 @@
+// collision/contact.h -- the full convex query: state, separation distance or penetration depth,
+// unit normal, witness points and witness features, and (for contact response) a contact
+// manifold of up to four points. The engine's impulse solver reads the manifold; `cdlab query`
+// and the tests read the witnesses.
+//
+// INTERFACE AGREED BEFORE IMPLEMENTATION (issue 4 narrow phase, issue 5 response): the
+// declarations below are the contract; collision/src/contact.cpp implements them.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "collision/math.h"
+#include "collision/narrow_phase.h"
+#include "collision/shape.h"
+
+namespace collision {
+
+/// Which part of a shape a witness point lies on. Indices refer to the shape's own numbering:
+/// box vertices 0..7 (bit k of the index set = +half_extents[k]), box edges 0..11, box faces
+/// 0..5 (2k = -axis k, 2k+1 = +axis k); hull vertices/faces index ConvexPolytope::vertices/faces
+/// (hull edges: the index of the face whose edge it is times 3 plus the edge within the face);
+/// capsule: Vertex 0/1 = bottom/top cap centre's spherical cap, Edge 0 = the cylinder; sphere:
+/// Face 0. `index < 0` when unknown.
+enum class FeatureType : std::uint8_t { Vertex, Edge, Face, Unknown };
+
+struct Feature {
+    FeatureType type = FeatureType::Unknown;
+    std::int32_t index = -1;
+};
+
+/// One point of a contact manifold, world frame.
+struct ManifoldPoint {
+    Vec3 point_a = Vec3::Zero();  ///< on A's surface
+    Vec3 point_b = Vec3::Zero();  ///< on B's surface
+    Real depth = 0;               ///< >= 0 penetration along the normal (0 when touching)
+};
+
+struct ContactOutput {
+    ContactState state = ContactState::Failed;
+    /// Separated: the distance (> touching tolerance). Touching/Penetrating: minus the
+    /// penetration depth (<= 0). Failed: 0.
+    Real signed_distance = 0;
+    /// Unit, world frame, pointing from A towards B: moving B by -signed_distance * normal
+    /// (penetrating) separates the shapes; for separated shapes (point_b - point_a) / distance.
+    /// Zero only when Failed.
+    Vec3 normal = Vec3::Zero();
+    /// Witness points, world frame: the closest points (Separated) or the deepest points of each
+    /// shape inside the other along the normal (Touching/Penetrating).
+    Vec3 point_a = Vec3::Zero();
+    Vec3 point_b = Vec3::Zero();
+    Feature feature_a;
+    Feature feature_b;
+    /// Contact points for response, only when Touching/Penetrating: one for round shapes, up to
+    /// four for face contacts (box-box: clipped incident face, RTCD 5.x / Gottschalk SAT axes).
+    std::array<ManifoldPoint, 4> manifold{};
+    std::int32_t manifold_size = 0;
+    std::int32_t iterations = 0;  ///< GJK + EPA iterations, when they ran
+};
+
+/// Full convex query of `a` at `pose_a` against `b` at `pose_b`. Convex shapes only (a Mesh
+/// is treated as its convex hull here; triangle-level mesh contact goes through the BVH).
+/// Guarantees: never NaN, never hangs (iteration caps -> Failed); the same touching convention
+/// as `collide` (narrow_phase.h: |signed distance| <= kTouchRelativeTolerance * scale is
+/// Touching), and `contact(a, b).state == collide(a, b).state`; swapping A and B mirrors the
+/// answer (normal negated, points and features swapped).
+ContactOutput contact(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b);
+
+}  // namespace collision
