@@ -1,6 +1,6 @@
 // collision/src/broad_phase_hgrid.cpp -- hierarchical grid of sorted columns, rebuilt each frame.
 // Completeness and uniqueness, same level: members' extents are <= the column width w (cells
-// are s_top / 2^k, widened by 2^-20 so rounding of floor((v - o) / w) cannot split two values
+// are s_top / 8^k, widened by 2^-20 so rounding of floor((v - o) / w) cannot split two values
 // less than a cell apart by two columns); so overlapping a, b sit in columns at most one apart in
 // y and in z. Sweeping column C against each of its 3 x 3 neighbours D, a finds exactly the
 // members of D greater than itself in (min x, id) whose min x <= a's max x -- among them every
@@ -241,7 +241,7 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     level_count_ = 0;
     if (table_.count() == 0) return;
 
-    // Levels: cells s_top / 2^k, down to the smallest extent (at most kMaxLevels).
+    // Levels: cells s_top / 8^k, down to the smallest extent (at most kMaxLevels).
     Real largest = 0;
     for (ProxyId id = 0; id < table_.capacity(); ++id) {
         if (table_.contains(id)) largest = std::max(largest, table_.aabb(id).extents().maxCoeff());
@@ -256,15 +256,15 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
         if (e > 0) {
             int exponent = 0;
             std::frexp(top / e, &exponent);  // top / e in [2^(exponent-1), 2^exponent)
-            k = std::clamp(exponent - 1, 0, kMaxLevels - 1);
-            while (k > 0 && std::ldexp(top, -k) < e) --k;  // guard rounding: cell >= extent
+            k = std::clamp((exponent - 1) / kLevelBits, 0, kMaxLevels - 1);
+            while (k > 0 && std::ldexp(top, -kLevelBits * k) < e) --k;  // guard: cell >= extent
         }
         members_[k].push_back(id);
         finest = std::max(finest, k);
     }
     level_count_ = finest + 1;
     for (int k = 0; k < level_count_; ++k) {
-        levels_[k].cell = std::ldexp(top, -k);
+        levels_[k].cell = std::ldexp(top, -kLevelBits * k);
         levels_[k].count = 0;
         if (!members_[k].empty()) buildLevel(levels_[k], members_[k]);
     }
