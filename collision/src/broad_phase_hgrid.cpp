@@ -2,10 +2,8 @@
 // Completeness and uniqueness, same level: members' extents are <= the column width w (cells
 // are s_top / 8^k, widened by 2^-20 so rounding of floor((v - o) / w) cannot split two values
 // less than a cell apart by two columns); so overlapping a, b sit in columns at most one apart in
-// y and in z. Sweeping column C against each of its 3 x 3 neighbours D, a finds exactly the
-// members of D greater than itself in (min x, id) whose min x <= a's max x -- among them every
-// overlapping one, since min_b.x <= max_a.x. The smaller of the two finds the pair; the larger
-// skips it. Across levels: a at a finer level scans, in each coarser level j, the columns
+// y and in z. Each pair of such columns is swept once (sweepLevel), and the box of the pair
+// that comes first in min x finds the other. Across levels: a at a finer level scans, in each coarser level j, the columns
 // within that level's largest extent E_j of its box and the min-x window [min_a.x - E_j,
 // max_a.x], widened by a few ulps; a pair across levels is found only from its finer member.
 #include "broad_phase_hgrid.h"
@@ -151,46 +149,65 @@ void HierarchicalGrid::buildLevel(Level& level, const std::vector<ProxyId>& memb
     level.start[0] = 0;
 }
 
+namespace {
+
+// The boxes of `from` in [q, end) whose min x lies within `a`'s x interval overlap `a` in x
+// (their min x >= a's, by the sweep order); emit those that also overlap in y and z.
+inline void scanForward(const HierarchicalGrid::PackedBox& a, ProxyId a_id,
+                        const HierarchicalGrid::PackedBox* box, const ProxyId* ids,
+                        std::uint32_t q, std::uint32_t end, int id_shift,
+                        std::vector<std::uint64_t>& keys, std::int64_t& tests) {
+    for (; q < end && box[q].min_x <= a.max_x; ++q) {
+        ++tests;
+        const HierarchicalGrid::PackedBox& b = box[q];
+        const bool hit = (b.min_y <= a.max_y) & (a.min_y <= b.max_y) & (b.min_z <= a.max_z) &
+                         (a.min_z <= b.max_z);
+        if (hit) {
+            const ProxyId b_id = ids[q];
+            const ProxyId lo = std::min(a_id, b_id);
+            const ProxyId hi = std::max(a_id, b_id);
+            keys.push_back((std::uint64_t(lo) << id_shift) | std::uint64_t(hi));
+        }
+    }
+}
+
+}  // namespace
+
 void HierarchicalGrid::sweepLevel(const Level& lv, BroadPhaseCounters& counters) {
+    // Each unordered pair of columns at most one apart is visited once: a column with itself
+    // (one sorted list swept forward), then with its four "forward" neighbours (+y; -y+z; +z;
+    // +y+z) by merging the two sorted lists: whichever box comes first in min x (ties: the
+    // column's own) scans the other list forward, so a pair is met exactly once, from the
+    // box that starts first (Baraff 1992 sort and sweep, two lists at a time).
     const PackedBox* const box = lv.box.data();
     const ProxyId* const ids = lv.id.data();
     const std::uint32_t* const start = lv.start.data();
     std::int64_t tests = 0;  // a local, so the pushes below cannot force it through memory
+    constexpr std::array<std::array<int, 2>, 4> kForward{{{1, 0}, {-1, 1}, {0, 1}, {1, 1}}};
     for (std::int64_t cz = 0; cz < lv.nz; ++cz) {
         for (std::int64_t cy = 0; cy < lv.ny; ++cy) {
             const std::int64_t c = cz * lv.ny + cy;
             const std::uint32_t c0 = start[c];
             const std::uint32_t c1 = start[c + 1];
             if (c0 == c1) continue;
-            for (std::int64_t dz = std::max<std::int64_t>(cz - 1, 0);
-                 dz <= std::min(cz + 1, lv.nz - 1); ++dz) {
-                for (std::int64_t dy = std::max<std::int64_t>(cy - 1, 0);
-                     dy <= std::min(cy + 1, lv.ny - 1); ++dy) {
-                    const std::int64_t d = dz * lv.ny + dy;
-                    const std::uint32_t d1 = start[d + 1];
-                    std::uint32_t p = start[d];
-                    for (std::uint32_t i = c0; i < c1 && p < d1; ++i) {
-                        const PackedBox& a = box[i];
-                        const ProxyId a_id = ids[i];
-                        // Skip members of D not greater than a in (min x, id).
-                        while (p < d1 && (box[p].min_x < a.min_x ||
-                                          (box[p].min_x == a.min_x && ids[p] <= a_id))) {
-                            ++p;
-                        }
-                        for (std::uint32_t q = p; q < d1 && box[q].min_x <= a.max_x; ++q) {
-                            ++tests;
-                            const PackedBox& b = box[q];
-                            // x overlaps already: a.min_x <= b.min_x <= a.max_x.
-                            const bool hit = (b.min_y <= a.max_y) & (a.min_y <= b.max_y) &
-                                             (b.min_z <= a.max_z) & (a.min_z <= b.max_z);
-                            if (hit) {
-                                const ProxyId b_id = ids[q];
-                                const ProxyId lo = std::min(a_id, b_id);
-                                const ProxyId hi = std::max(a_id, b_id);
-                                keys_.push_back((std::uint64_t(lo) << id_shift_) |
-                                                std::uint64_t(hi));
-                            }
-                        }
+            for (std::uint32_t i = c0; i < c1; ++i) {
+                scanForward(box[i], ids[i], box, ids, i + 1, c1, id_shift_, keys_, tests);
+            }
+            for (const auto& [oy, oz] : kForward) {
+                const std::int64_t dy = cy + oy;
+                const std::int64_t dz = cz + oz;
+                if (dy < 0 || dy >= lv.ny || dz >= lv.nz) continue;
+                const std::int64_t d = dz * lv.ny + dy;
+                std::uint32_t i = c0;
+                std::uint32_t j = start[d];
+                const std::uint32_t d1 = start[d + 1];
+                while (i < c1 && j < d1) {
+                    if (box[i].min_x <= box[j].min_x) {
+                        scanForward(box[i], ids[i], box, ids, j, d1, id_shift_, keys_, tests);
+                        ++i;
+                    } else {
+                        scanForward(box[j], ids[j], box, ids, i, c1, id_shift_, keys_, tests);
+                        ++j;
                     }
                 }
             }
