@@ -16,71 +16,13 @@
 #include <sstream>
 
 #include "collision/debug_draw.h"
+#include "radix_sort.h"
 
 namespace collision {
 
-namespace {
-
-constexpr int kDigitBits = 11;
-constexpr std::size_t kBuckets = std::size_t(1) << kDigitBits;
-
-// Order-preserving map of a coordinate to an unsigned integer (-0 and +0 map alike).
-template <typename T>
-std::uint64_t orderedBits(T v) {
-    if (v == 0) v = 0;
-    using U = std::conditional_t<sizeof(T) == 8, std::uint64_t, std::uint32_t>;
-    constexpr int kTop = int(sizeof(T)) * 8 - 1;
-    const U b = std::bit_cast<U>(v);
-    return (b >> kTop) ? U(~b) : U(b | (U(1) << kTop));
-}
-
-// LSD radix sort of 64-bit keys, 11 bits per pass, skipping digits that are all equal; stable.
-void radixSortKeys(std::vector<std::uint64_t>& keys, std::vector<std::uint64_t>& scratch,
-                   int bits) {
-    scratch.resize(keys.size());
-    std::array<std::uint32_t, kBuckets> count;
-    for (int shift = 0; shift < bits; shift += kDigitBits) {
-        count.fill(0);
-        for (std::uint64_t k : keys) ++count[(k >> shift) & (kBuckets - 1)];
-        if (count[(keys[0] >> shift) & (kBuckets - 1)] == keys.size()) continue;
-        std::uint32_t sum = 0;
-        for (std::uint32_t& c : count) {
-            const std::uint32_t here = c;
-            c = sum;
-            sum += here;
-        }
-        for (std::uint64_t k : keys) scratch[count[(k >> shift) & (kBuckets - 1)]++] = k;
-        keys.swap(scratch);
-    }
-}
-
-// Stable LSD radix sort of `order` (indices) by key[index].
-void radixSortIndices(std::vector<std::uint32_t>& order, std::vector<std::uint32_t>& scratch,
-                      const std::vector<std::uint64_t>& key) {
-    scratch.resize(order.size());
-    std::array<std::uint32_t, kBuckets> count;
-    for (int shift = 0; shift < 64; shift += kDigitBits) {
-        count.fill(0);
-        for (std::uint32_t i : order) ++count[(key[i] >> shift) & (kBuckets - 1)];
-        if (count[(key[order[0]] >> shift) & (kBuckets - 1)] == order.size()) continue;
-        std::uint32_t sum = 0;
-        for (std::uint32_t& c : count) {
-            const std::uint32_t here = c;
-            c = sum;
-            sum += here;
-        }
-        for (std::uint32_t i : order) scratch[count[(key[i] >> shift) & (kBuckets - 1)]++] = i;
-        order.swap(scratch);
-    }
-}
-
-int bitsFor(std::uint64_t n) {
-    int b = 1;
-    while ((std::uint64_t(1) << b) < n) ++b;
-    return b;
-}
-
-}  // namespace
+using radix::bitsFor;
+using radix::orderedBits;
+using radix::radixSortIndices;
 
 std::int64_t HierarchicalGrid::column(const Level& level, int axis, Real v) const {
     const Real origin = axis == 1 ? level.origin_y : level.origin_z;
@@ -302,17 +244,7 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
         }
     }
     // (a, b) order: one radix sort of the packed keys.
-    if (keys_.size() > 64) {
-        radixSortKeys(keys_, scratch_, 2 * id_shift_);
-    } else {
-        std::sort(keys_.begin(), keys_.end());
-    }
-    pairs.resize(keys_.size());
-    const std::uint64_t mask = (std::uint64_t(1) << id_shift_) - 1;
-    for (std::size_t i = 0; i < keys_.size(); ++i) {
-        pairs[i] = ProxyPair{static_cast<ProxyId>(keys_[i] >> id_shift_),
-                             static_cast<ProxyId>(keys_[i] & mask)};
-    }
+    radix::keysToSortedPairs(keys_, scratch_, id_shift_, pairs);
     counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
 }
 

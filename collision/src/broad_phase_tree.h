@@ -1,6 +1,8 @@
 // collision/src/broad_phase_tree.h -- dynamic AABB tree with fattened leaves.
 #pragma once
 
+#include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "collision/broad_phase.h"
@@ -13,8 +15,8 @@ namespace collision {
 /// Leaves hold AABBs fattened by a margin proportional to the box's size, so a proxy that moves
 /// a little is not touched at all; one that leaves its fat box is removed and re-inserted.
 /// Insertion descends by the surface-area heuristic (the sibling that least increases the total
-/// area of the ancestors), then AVL-style rotations keep the tree balanced. Pairs: each proxy
-/// queries the tree with its exact AABB and keeps partners of higher id, tested exactly.
+/// area of the ancestors), then surface-area rotations keep siblings close. Pairs: one
+/// traversal of the tree against itself, leaves tested on their exact AABBs.
 class DynamicAabbTree : public BroadPhase {
 public:
     std::string_view name() const override { return "tree"; }
@@ -54,7 +56,9 @@ private:
     int root_ = kNull;
     int free_list_ = kNull;
     std::int64_t moved_ = 0;
-    std::vector<int> stack_;
+    std::vector<std::pair<int, int>> pair_stack_;
+    std::vector<std::uint64_t> keys_;
+    std::vector<std::uint64_t> scratch_;
 };
 
 }  // namespace collision
