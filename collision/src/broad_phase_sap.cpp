@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "collision/debug_draw.h"
+#include "radix_sort.h"
 
 namespace collision {
 
@@ -113,13 +114,11 @@ void SweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters&
         refreshValues();
         for (int axis = 0; axis < 3; ++axis) insertionSort(axis, counters);
     }
-    pairs.clear();
-    pairs.reserve(pairs_.size());
-    for (std::uint64_t k : pairs_) {
-        pairs.push_back(ProxyPair{static_cast<ProxyId>(k >> 32),
-                                  static_cast<ProxyId>(k & 0xFFFFFFFFu)});
-    }
-    std::sort(pairs.begin(), pairs.end());
+    // (a, b) order: repack the keys into 2 x (bits of the largest id) and radix sort them.
+    const int shift = radix::bitsFor(static_cast<std::uint64_t>(table_.capacity()));
+    keys_.clear();
+    pairs_.forEach([&](std::uint64_t k) { keys_.push_back(((k >> 32) << shift) | (k & 0xFFFFFFFFu)); });
+    radix::keysToSortedPairs(keys_, scratch_, shift, pairs);
     counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
 }
 
@@ -158,7 +157,7 @@ std::string SweepAndPrune::validate() const {
             }
         }
     }
-    for (std::uint64_t k : pairs_) {
+    pairs_.forEach([&](std::uint64_t k) {
         const ProxyId a = static_cast<ProxyId>(k >> 32);
         const ProxyId b = static_cast<ProxyId>(k & 0xFFFFFFFFu);
         if (!table_.contains(a) || !table_.contains(b)) {
@@ -166,7 +165,7 @@ std::string SweepAndPrune::validate() const {
         } else if (!table_.aabb(a).overlaps(table_.aabb(b))) {
             out << "pair (" << a << "," << b << ") does not overlap; ";
         }
-    }
+    });
     return out.str();
 }
 

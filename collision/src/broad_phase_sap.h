@@ -3,10 +3,10 @@
 
 #include <array>
 #include <cstdint>
-#include <unordered_set>
 #include <vector>
 
 #include "collision/broad_phase.h"
+#include "pair_set.h"
 #include "proxy_table.h"
 
 namespace collision {
@@ -48,7 +48,9 @@ private:
 
     ProxyTable table_;
     std::array<std::vector<Endpoint>, 3> axes_;
-    std::unordered_set<std::uint64_t> pairs_;
+    PairSet pairs_;
+    std::vector<std::uint64_t> keys_;
+    std::vector<std::uint64_t> scratch_;
     std::vector<ProxyId> active_;
     bool dirty_ = true;
     std::int64_t moved_ = 0;
