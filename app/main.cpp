@@ -7,6 +7,7 @@
 #include "collision/broad_phase.h"
 #include "query_command.h"
 #include "run_command.h"
+#include "sweep_command.h"
 
 int main(int argc, char** argv) {
     CLI::App cli{"cdlab -- collision-detection lab: run rigid-body scenes headless and render "
@@ -60,6 +61,34 @@ int main(int argc, char** argv) {
                           "B's pose in A's frame: x,y,z,qw,qx,qy,qz (default identity)");
     query_cmd->add_flag("--json", query.json, "machine-readable output");
     // END query subcommand
+    app::SweepOptions sweep;
+    std::string sweep_out;
+    double sweep_duration = 0;
+    CLI::App* sweep_cmd = cli.add_subcommand(
+        "sweep", "run one scene under every combination of choices; measure cost and accuracy "
+                 "against a fine reference run; write results.csv, report.md and charts");
+    sweep_cmd->add_option("scene", sweep.scene, "scene file (YAML)")->required();
+    sweep_cmd
+        ->add_option("--vary", sweep.vary,
+                     "KEY=V1,V2,... (repeatable): a dotted scene key and its values, e.g. "
+                     "broadphase=sap,hgrid or world.time_step=0.01,0.002")
+        ->expected(1)
+        ->take_all();
+    sweep_cmd
+        ->add_option("--reference", sweep.reference,
+                     "KEY=VALUE override for the reference run (repeatable)")
+        ->expected(1)
+        ->take_all();
+    sweep_cmd
+        ->add_option("--reference-refine", sweep.reference_refine,
+                     "the reference's time step is the scene's divided by this")
+        ->capture_default_str();
+    sweep_cmd->add_option("--duration", sweep_duration,
+                          "simulated seconds per run (default: the scene's frames)");
+    sweep_cmd->add_option("--out", sweep_out, "output directory (default out/sweep_<scene>)");
+    bool sweep_no_timing = false;
+    sweep_cmd->add_flag("--no-report-timing", sweep_no_timing,
+                        "leave wall-clock times out of report.md so it is bit-identical");
     // BEGIN bench subcommand (registered by app/bench_*.cpp)
     CLI::App* bench_cmd = cli.add_subcommand("bench", "performance benchmarks");
     bench_cmd->require_subcommand(1);
@@ -117,6 +146,12 @@ int main(int argc, char** argv) {
         run.hud_timing = !no_timing;
         run.progress = !quiet;
         return app::runScene(run, std::cout, std::cerr);
+    }
+    if (sweep_cmd->parsed()) {
+        if (!sweep_out.empty()) sweep.out_dir = sweep_out;
+        if (sweep_cmd->count("--duration") > 0) sweep.duration = sweep_duration;
+        sweep.report_timing = !sweep_no_timing;
+        return app::runSweep(sweep, std::cout, std::cerr);
     }
     // BEGIN ccd dispatch
     // END ccd dispatch

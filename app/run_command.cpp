@@ -16,6 +16,7 @@
 
 #include "engine/scene.h"
 #include "broadphase_check.h"
+#include "output_files.h"
 #include "pause_dump.h"
 #include "render/image.h"
 #include "render/renderer.h"
@@ -30,36 +31,6 @@ constexpr int kExitOk = 0;
 constexpr int kExitFailure = 1;
 constexpr int kExitBadInput = 2;
 constexpr int kExitCheckFailed = 3;
-
-void writeTextAtomically(const fs::path& file, const std::string& text) {
-    const fs::path partial = fs::path(file.string() + ".partial");
-    {
-        std::ofstream f(partial, std::ios::binary | std::ios::trunc);
-        if (!f) throw render::RenderError("cannot write " + partial.string());
-        f << text;
-        f.flush();
-        if (!f) throw render::RenderError("cannot write " + partial.string());
-    }
-    std::error_code ec;
-    fs::rename(partial, file, ec);
-    if (ec) throw render::RenderError("cannot rename " + partial.string() + ": " + ec.message());
-}
-
-// Creates the output directory and proves it writable before any simulation work is done.
-void prepareOutputDir(const fs::path& dir) {
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec || !fs::is_directory(dir)) {
-        throw render::RenderError("cannot create output directory " + dir.string() +
-                                  (ec ? ": " + ec.message() : ""));
-    }
-    const fs::path probe = dir / ".cdlab-write-test";
-    {
-        std::ofstream f(probe);
-        if (!f) throw render::RenderError("output directory " + dir.string() + " is not writable");
-    }
-    fs::remove(probe, ec);
-}
 
 class ProgressBar {
 public:

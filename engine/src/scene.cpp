@@ -12,6 +12,7 @@
 #include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <initializer_list>
@@ -92,6 +93,7 @@ public:
         : file_(std::move(display_name)), base_dir_(std::move(base_dir)) {}
 
     Scene parse(const std::string& text);
+    void setOverrides(std::vector<SceneOverride> overrides) { overrides_ = std::move(overrides); }
 
 private:
     [[noreturn]] void fail(const YAML::Mark& mark, const std::string& path,
@@ -127,8 +129,11 @@ private:
     std::vector<Body> repeatBody(const Body& base, const Entry& entry, const std::string& path,
                                  const Scene& scene, Place&& place) const;
 
+    void applyOverrides(YAML::Node& root) const;
+
     std::string file_;
     fs::path base_dir_;
+    std::vector<SceneOverride> overrides_;
     std::map<std::pair<std::string, Real>, std::shared_ptr<const MeshImportOutput>> import_cache_;
     std::map<std::tuple<std::string, Real, int>, PreparedShape> mesh_cache_;
 };
@@ -750,6 +755,7 @@ Scene SceneParser::parse(const std::string& text) {
     } catch (const YAML::Exception& e) {
         fail(e.mark, "malformed YAML", e.msg);
     }
+    applyOverrides(root);
     Scene scene;
     scene.name = fs::path(file_).stem().string();
     if (!root.IsMap()) {
@@ -786,24 +792,93 @@ Scene SceneParser::parse(const std::string& text) {
     return scene;
 }
 
+void SceneParser::applyOverrides(YAML::Node& root) const {
+    for (const SceneOverride& o : overrides_) {
+        const std::string where = "override " + o.key + "=" + o.value;
+        std::vector<std::string> parts;
+        for (std::size_t from = 0;;) {
+            const std::size_t dot = o.key.find('.', from);
+            parts.push_back(o.key.substr(from, dot == std::string::npos ? dot : dot - from));
+            if (dot == std::string::npos) break;
+            from = dot + 1;
+        }
+        for (const std::string& p : parts) {
+            if (p.empty()) fail(YAML::Mark::null_mark(), where, "empty key in the path");
+        }
+        YAML::Node value;
+        try {
+            value = YAML::Load(o.value);
+        } catch (const YAML::Exception& e) {
+            fail(YAML::Mark::null_mark(), where, "malformed YAML value: " + e.msg);
+        }
+        if (!root.IsDefined() || root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
+        // Node::reset rebinds; plain assignment between nodes would overwrite the content.
+        YAML::Node node;
+        node.reset(root);
+        for (std::size_t i = 0; i < parts.size(); ++i) {
+            const std::string& p = parts[i];
+            const bool last = i + 1 == parts.size();
+            if (node.IsSequence()) {
+                const bool digits = std::all_of(p.begin(), p.end(),
+                                                [](char c) { return c >= '0' && c <= '9'; });
+                const std::size_t index = digits && p.size() < 9 ? std::stoul(p) : node.size();
+                if (index >= node.size()) {
+                    fail(node, where,
+                         "'" + p + "' is not an index of this list of " +
+                             std::to_string(node.size()));
+                }
+                if (last) {
+                    node[index] = value;
+                } else {
+                    YAML::Node child = node[index];
+                    node.reset(child);
+                }
+            } else if (node.IsMap() || node.IsNull()) {
+                if (last) {
+                    node[p] = value;
+                } else {
+                    YAML::Node child = node[p];
+                    if (!child.IsDefined() || child.IsNull()) {
+                        node[p] = YAML::Node(YAML::NodeType::Map);
+                        child = node[p];
+                    }
+                    node.reset(child);
+                }
+            } else {
+                fail(node, where, "'" + p + "' is below a value, not a mapping or list");
+            }
+        }
+    }
+}
+
 }  // namespace
 
-Scene parseScene(const std::string& yaml_text, const std::string& display_name,
-                 const std::filesystem::path& base_dir) {
-    SceneParser parser(display_name, base_dir);
+namespace {
+
+// Runs the parser; any failure that escaped its key still names a position.
+Scene runParser(SceneParser& parser, const std::string& text, const std::string& display_name) {
     try {
-        return parser.parse(yaml_text);
+        return parser.parse(text);
     } catch (const SceneError&) {
         throw;
     } catch (const YAML::Exception& e) {
-        // Safety net: any yaml-cpp failure not caught at its key still names a position.
         throw SceneError(formatMessage(display_name, e.mark, "scene", e.msg));
     } catch (const std::exception& e) {
         throw SceneError(formatMessage(display_name, YAML::Mark::null_mark(), "scene", e.what()));
     }
 }
 
-Scene loadScene(const std::filesystem::path& file) {
+}  // namespace
+
+Scene parseScene(const std::string& yaml_text, const std::string& display_name,
+                 const std::filesystem::path& base_dir) {
+    SceneParser parser(display_name, base_dir);
+    return runParser(parser, yaml_text, display_name);
+}
+
+Scene loadScene(const std::filesystem::path& file) { return loadScene(file, {}); }
+
+Scene loadScene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides) {
     std::error_code ec;
     if (!fs::is_regular_file(file, ec)) {
         throw SceneError(file.string() + ":1:1: scene: cannot open the file (" +
@@ -817,7 +892,9 @@ Scene loadScene(const std::filesystem::path& file) {
     }
     fs::path base = file.parent_path();
     if (base.empty()) base = ".";
-    return parseScene(text.str(), file.string(), base);
+    SceneParser parser(file.string(), base);
+    parser.setOverrides(overrides);
+    return runParser(parser, text.str(), file.string());
 }
 
 World makeWorld(const Scene& scene) {

@@ -62,6 +62,19 @@ Scene loadScene(const std::filesystem::path& file);
 Scene parseScene(const std::string& yaml_text, const std::string& display_name,
                  const std::filesystem::path& base_dir);
 
+/// A value put at a dotted key path of the scene document before it is validated, as
+/// `cdlab sweep --vary` does: `{"world.time_step", "0.01"}`, `{"bodies.3.radius", "0.5"}`
+/// (numbers index lists). The value is YAML text, so it is checked exactly like the file's own
+/// values; missing maps on the path are created; a path through a scalar is an error.
+struct SceneOverride {
+    std::string key;
+    std::string value;
+};
+
+/// loadScene with `overrides` applied, in order, to the document before validation. Errors
+/// about an overridden value carry its key path (their line:col is that of the value text).
+Scene loadScene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides);
+
 /// Builds a World holding the scene's bodies, with volumes and pairs already detected.
 World makeWorld(const Scene& scene);
 

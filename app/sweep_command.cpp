@@ -1,0 +1,467 @@
+// app/sweep_command.cpp -- `cdlab sweep` (see sweep_command.h).
+// Every run simulates the same interval; accuracy is judged against one reference run of the
+// same scene with a finer time step. Contacts are compared pair by pair through their first
+// contact time: a pair the reference confirms and a run never does is missed; a pair both
+// confirm contributes |t_run - t_ref| to the first-contact error (resolution: the larger of the
+// two time steps). Everything but the wall-clock times is deterministic.
+#include "sweep_command.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <ostream>
+#include <sstream>
+#include <utility>
+
+#include "output_files.h"
+#include "render/chart.h"
+#include "render/image.h"
+
+namespace app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kExitOk = 0;
+constexpr int kExitFailure = 1;
+constexpr int kExitBadInput = 2;
+
+using PairKey = std::pair<collision::ProxyId, collision::ProxyId>;
+using FirstContacts = std::map<PairKey, double>;
+
+std::string trim(const std::string& s) {
+    const std::size_t a = s.find_first_not_of(" \t");
+    if (a == std::string::npos) return "";
+    const std::size_t b = s.find_last_not_of(" \t");
+    return s.substr(a, b - a + 1);
+}
+
+std::string labelOf(const std::vector<engine::SceneOverride>& overrides) {
+    std::string label;
+    for (const engine::SceneOverride& o : overrides) {
+        if (!label.empty()) label += ' ';
+        label += o.key + "=" + o.value;
+    }
+    return label.empty() ? "scene as written" : label;
+}
+
+// Total mechanical energy: kinetic (translation + rotation) and gravity's potential.
+double totalEnergy(const engine::World& world, double& scale) {
+    const engine::Vec3 g = world.settings().gravity;
+    double e = 0;
+    scale = 0;
+    for (const engine::Body& b : world.bodies()) {
+        const double kinetic = b.kineticEnergy();
+        const double potential = -b.mass * g.dot(b.position);
+        e += kinetic + potential;
+        scale += std::abs(kinetic) + std::abs(potential);
+    }
+    return e;
+}
+
+SweepRun measure(const engine::Scene& scene, double duration, FirstContacts& first) {
+    SweepRun run;
+    engine::World world = engine::makeWorld(scene);
+    run.time_step = scene.world.time_step;
+    run.steps = std::max<std::int64_t>(1, std::llround(duration / run.time_step));
+
+    auto record = [&first, &world]() {
+        for (const collision::ProxyPair& p : world.collidingPairs()) {
+            first.try_emplace(PairKey{p.a, p.b}, double(world.time()));
+        }
+    };
+    record();
+    double energy_scale = 0;
+    const double e0 = totalEnergy(world, energy_scale);
+    std::vector<double> l0;
+    for (const engine::Body& b : world.bodies()) l0.push_back(b.angular_momentum.norm());
+
+    for (std::int64_t s = 0; s < run.steps; ++s) {
+        world.step();
+        const engine::StepStats& st = world.lastStats();
+        run.ms_integrate += 1e3 * st.integrate_s;
+        run.ms_volumes += 1e3 * st.volumes_s;
+        run.ms_broad += 1e3 * st.broad_phase_s;
+        run.ms_narrow += 1e3 * st.narrow_phase_s;
+        run.ms_step += 1e3 * st.total_s;
+        run.flagged += double(world.flaggedPairs().size());
+        run.confirmed += double(world.collidingPairs().size());
+        run.bv_tests += double(st.broad.volume_tests);
+        run.narrow_tests += double(st.narrow_tests);
+        run.triangle_tests += double(st.triangle_tests);
+        record();
+        double scale_now = 0;
+        const double e = totalEnergy(world, scale_now);
+        if (energy_scale > 0) {
+            run.max_energy_drift = std::max(run.max_energy_drift, std::abs(e - e0) / energy_scale);
+        }
+        const auto bodies = world.bodies();
+        for (std::size_t i = 0; i < bodies.size(); ++i) {
+            if (l0[i] <= 0) continue;
+            const double drift = std::abs(bodies[i].angular_momentum.norm() - l0[i]) / l0[i];
+            run.max_angular_momentum_drift = std::max(run.max_angular_momentum_drift, drift);
+        }
+    }
+    const double n = double(run.steps);
+    for (double* v : {&run.ms_integrate, &run.ms_volumes, &run.ms_broad, &run.ms_narrow,
+                      &run.ms_step, &run.flagged, &run.confirmed, &run.bv_tests,
+                      &run.narrow_tests, &run.triangle_tests}) {
+        *v /= n;
+    }
+    run.broad_false_positives = run.flagged - run.confirmed;
+    run.ms_per_simulated_s = run.ms_step / run.time_step;
+    run.pairs_confirmed_total = static_cast<std::int64_t>(first.size());
+    run.state_hash = world.stateHash();
+    return run;
+}
+
+void compareWithReference(SweepRun& run, const FirstContacts& mine, const FirstContacts& ref) {
+    double sum = 0;
+    std::int64_t common = 0;
+    for (const auto& [pair, t_ref] : ref) {
+        const auto it = mine.find(pair);
+        if (it == mine.end()) {
+            ++run.missed_pairs;
+            continue;
+        }
+        const double err = std::abs(it->second - t_ref);
+        run.max_first_contact_error = std::max(run.max_first_contact_error, err);
+        sum += err;
+        ++common;
+    }
+    for (const auto& entry : mine) {
+        if (ref.count(entry.first) == 0) ++run.extra_pairs;
+    }
+    run.mean_first_contact_error = common > 0 ? sum / double(common) : 0;
+}
+
+std::string fmt(double v, const char* spec = "%.4g") {
+    char text[48];
+    std::snprintf(text, sizeof text, spec, v);
+    return text;
+}
+
+std::string csvField(const std::string& s) {
+    if (s.find_first_of(",\"\n") == std::string::npos) return s;
+    std::string q = "\"";
+    for (char c : s) {
+        if (c == '"') q += '"';
+        q += c;
+    }
+    return q + "\"";
+}
+
+std::string csvTable(const std::vector<SweepRun>& runs) {
+    std::ostringstream csv;
+    csv << "run,time_step,steps,ms_integrate,ms_volumes,ms_broad,ms_narrow,ms_step,"
+           "ms_per_simulated_s,flagged,confirmed,broad_false_positives,bv_tests,narrow_tests,"
+           "triangle_tests,pairs_confirmed_total,missed_pairs,extra_pairs,"
+           "max_first_contact_error_s,mean_first_contact_error_s,max_energy_drift,"
+           "max_angular_momentum_drift,state_hash\n";
+    for (const SweepRun& r : runs) {
+        csv << csvField(r.label) << ',' << fmt(r.time_step, "%.17g") << ',' << r.steps;
+        for (double v : {r.ms_integrate, r.ms_volumes, r.ms_broad, r.ms_narrow, r.ms_step,
+                         r.ms_per_simulated_s, r.flagged, r.confirmed, r.broad_false_positives,
+                         r.bv_tests, r.narrow_tests, r.triangle_tests}) {
+            csv << ',' << fmt(v, "%.6g");
+        }
+        csv << ',' << r.pairs_confirmed_total << ',' << r.missed_pairs << ',' << r.extra_pairs;
+        for (double v : {r.max_first_contact_error, r.mean_first_contact_error,
+                         r.max_energy_drift, r.max_angular_momentum_drift}) {
+            csv << ',' << fmt(v, "%.6g");
+        }
+        csv << ',' << r.state_hash << '\n';
+    }
+    return csv.str();
+}
+
+struct Chart {
+    std::string file;
+    std::string title;
+    double SweepRun::*field;
+    bool log_scale;
+    bool timing;
+};
+
+const std::vector<Chart>& charts() {
+    static const std::vector<Chart> kCharts{
+        {"cost.png", "wall-clock ms per simulated second (lower is cheaper)",
+         &SweepRun::ms_per_simulated_s, false, true},
+        {"broad_false_positives.png", "broad-phase false positives per step (flagged - confirmed)",
+         &SweepRun::broad_false_positives, false, false},
+        {"bv_tests.png", "bounding-volume tests per step (Nv)", &SweepRun::bv_tests, false,
+         false},
+        {"first_contact_error.png", "max first-contact time error vs reference (s)",
+         &SweepRun::max_first_contact_error, false, false},
+        {"energy_drift.png", "max relative energy drift (log scale)", &SweepRun::max_energy_drift,
+         true, false},
+    };
+    return kCharts;
+}
+
+std::string markdownReport(const SweepOptions& options, const engine::Scene& base,
+                           double duration, const std::vector<SweepRun>& runs,
+                           const SweepRun& reference) {
+    std::ostringstream md;
+    md << "# Sweep of `" << options.scene.filename().string() << "`\n\n";
+    md << "- " << base.bodies.size() << " bodies, " << fmt(duration) << " s simulated per run, "
+       << "broad phase `" << base.world.broad_phase << "` unless varied.\n";
+    md << "- Reference: time step " << fmt(reference.time_step) << " s (" << reference.steps
+       << " steps)" << (options.reference.empty() ? "" : ", " + reference.label) << "; it confirmed "
+       << reference.pairs_confirmed_total << " distinct pairs.\n";
+    md << "- A pair is *missed* when the reference confirms it and the run never does; "
+          "*extra* the other way round. First-contact error compares the first step at which "
+          "each common pair is confirmed (resolution: the larger time step).\n";
+    md << "- Energy drift: max over steps of |E - E0| / (sum of |kinetic| + |potential| terms at "
+          "t = 0); |L| drift: max over bodies and steps of the relative change of a body's "
+          "angular momentum.\n";
+    if (options.report_timing) {
+        md << "- Times are wall-clock, this machine, this build; they vary from run to run "
+              "(results.csv keeps every stage).\n";
+    }
+    md << "\n| run | dt (s) | steps |";
+    if (options.report_timing) md << " ms/step | ms per sim. s |";
+    md << " flagged/step | confirmed/step | BP false pos./step | Nv/step | Np/step | missed | "
+          "extra | max TOI err (s) | energy drift | abs L drift |\n|---|---|---|";
+    if (options.report_timing) md << "---|---|";
+    md << "---|---|---|---|---|---|---|---|---|---|\n";
+    auto row = [&](const SweepRun& r) {
+        md << "| " << r.label << " | " << fmt(r.time_step) << " | " << r.steps << " |";
+        if (options.report_timing) {
+            md << ' ' << fmt(r.ms_step, "%.3f") << " | " << fmt(r.ms_per_simulated_s, "%.1f")
+               << " |";
+        }
+        md << ' ' << fmt(r.flagged, "%.2f") << " | " << fmt(r.confirmed, "%.2f") << " | "
+           << fmt(r.broad_false_positives, "%.2f") << " | " << fmt(r.bv_tests, "%.0f") << " | "
+           << fmt(r.triangle_tests, "%.0f") << " | " << r.missed_pairs << " | " << r.extra_pairs
+           << " | " << fmt(r.max_first_contact_error, "%.3g") << " | "
+           << fmt(r.max_energy_drift, "%.2e") << " | "
+           << fmt(r.max_angular_momentum_drift, "%.2e") << " |\n";
+    };
+    for (const SweepRun& r : runs) row(r);
+    SweepRun ref_row = reference;
+    ref_row.label = "reference";
+    row(ref_row);
+    md << '\n';
+    for (const Chart& c : charts()) {
+        if (c.timing && !options.report_timing) continue;
+        md << "![" << c.title << "](" << c.file << ")\n\n";
+    }
+
+    // The reading: which choice buys what, from the numbers above.
+    md << "## Reading\n\n";
+    const SweepRun* accurate = nullptr;
+    for (const SweepRun& r : runs) {
+        if (r.missed_pairs != 0 || r.extra_pairs != 0) continue;
+        if (accurate == nullptr ||
+            (options.report_timing ? r.ms_per_simulated_s < accurate->ms_per_simulated_s
+                                   : r.bv_tests < accurate->bv_tests)) {
+            accurate = &r;
+        }
+    }
+    if (accurate != nullptr) {
+        md << "- " << (options.report_timing ? "Cheapest" : "Fewest BV tests among the")
+           << " runs that confirm exactly the reference's pairs: **" << accurate->label << "**";
+        if (options.report_timing) md << " (" << fmt(accurate->ms_per_simulated_s, "%.1f")
+                                      << " ms per simulated second)";
+        md << ".\n";
+    } else {
+        md << "- No run confirms exactly the reference's pairs: every choice here trades "
+              "contacts for speed; see the missed and extra columns.\n";
+    }
+    const auto tightest = std::min_element(runs.begin(), runs.end(), [](auto& a, auto& b) {
+        return a.broad_false_positives < b.broad_false_positives;
+    });
+    const auto loosest = std::max_element(runs.begin(), runs.end(), [](auto& a, auto& b) {
+        return a.broad_false_positives < b.broad_false_positives;
+    });
+    if (tightest != runs.end() && tightest != loosest) {
+        md << "- Tightest broad phase: **" << tightest->label << "** ("
+           << fmt(tightest->broad_false_positives, "%.2f")
+           << " false positives per step) against **" << loosest->label << "** ("
+           << fmt(loosest->broad_false_positives, "%.2f") << "): every false positive costs a "
+           << "narrow-phase test.\n";
+    }
+    std::int64_t worst_missed = 0;
+    const SweepRun* worst = nullptr;
+    for (const SweepRun& r : runs) {
+        if (r.missed_pairs > worst_missed) {
+            worst_missed = r.missed_pairs;
+            worst = &r;
+        }
+    }
+    if (worst != nullptr) {
+        md << "- Most contacts missed: **" << worst->label << "**, " << worst->missed_pairs
+           << " of the reference's " << reference.pairs_confirmed_total
+           << " pairs never confirmed (tunnelling between steps, or contacts shorter than a "
+              "step).\n";
+    }
+    return md.str();
+}
+
+}  // namespace
+
+bool parseVary(const std::string& text, std::string& key, std::vector<std::string>& values,
+               std::string& error) {
+    const std::size_t eq = text.find('=');
+    if (eq == std::string::npos || eq == 0) {
+        error = "'" + text + "': expected KEY=V1,V2,...";
+        return false;
+    }
+    key = trim(text.substr(0, eq));
+    values.clear();
+    int depth = 0;
+    std::string current;
+    for (std::size_t i = eq + 1; i <= text.size(); ++i) {
+        const char c = i < text.size() ? text[i] : ',';
+        if (c == '[' || c == '{') ++depth;
+        if (c == ']' || c == '}') --depth;
+        if (c == ',' && depth <= 0) {
+            current = trim(current);
+            if (current.empty()) {
+                error = "'" + text + "': empty value";
+                return false;
+            }
+            values.push_back(current);
+            current.clear();
+        } else {
+            current += c;
+        }
+    }
+    if (depth != 0) {
+        error = "'" + text + "': unbalanced brackets";
+        return false;
+    }
+    if (key.empty() || key.find_first_of(" \t") != std::string::npos) {
+        error = "'" + text + "': bad key '" + key + "'";
+        return false;
+    }
+    return true;
+}
+
+int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) {
+    // The axes of the sweep.
+    std::vector<std::pair<std::string, std::vector<std::string>>> axes;
+    for (const std::string& v : options.vary) {
+        std::string key, error;
+        std::vector<std::string> values;
+        if (!parseVary(v, key, values, error)) {
+            err << "--vary " << error << "\n";
+            return kExitBadInput;
+        }
+        axes.emplace_back(key, values);
+    }
+    std::vector<engine::SceneOverride> reference_overrides;
+    for (const std::string& v : options.reference) {
+        std::string key, error;
+        std::vector<std::string> values;
+        if (!parseVary(v, key, values, error) || values.size() != 1) {
+            err << "--reference " << (error.empty() ? "'" + v + "': expected KEY=VALUE" : error)
+                << "\n";
+            return kExitBadInput;
+        }
+        reference_overrides.push_back({key, values[0]});
+    }
+    if (!(options.reference_refine >= 1) || !std::isfinite(options.reference_refine)) {
+        err << "--reference-refine: must be a finite number >= 1\n";
+        return kExitBadInput;
+    }
+    if (options.duration && !(*options.duration > 0 && std::isfinite(*options.duration))) {
+        err << "--duration: must be a finite number > 0\n";
+        return kExitBadInput;
+    }
+
+    // Every combination is loaded (and so validated) before anything runs.
+    std::vector<std::vector<engine::SceneOverride>> combos{{}};
+    for (const auto& [key, values] : axes) {
+        std::vector<std::vector<engine::SceneOverride>> next;
+        for (const auto& c : combos) {
+            for (const std::string& v : values) {
+                next.push_back(c);
+                next.back().push_back({key, v});
+            }
+        }
+        combos = std::move(next);
+    }
+    engine::Scene base;
+    std::vector<engine::Scene> scenes;
+    try {
+        base = engine::loadScene(options.scene);
+    } catch (const engine::SceneError& e) {
+        err << e.what() << "\n";
+        return kExitBadInput;
+    }
+    for (const auto& c : combos) {
+        try {
+            scenes.push_back(engine::loadScene(options.scene, c));
+        } catch (const engine::SceneError& e) {
+            err << "sweep run '" << labelOf(c) << "': " << e.what() << "\n";
+            return kExitBadInput;
+        }
+    }
+    const double duration =
+        options.duration ? *options.duration
+                         : double(std::max(base.frames - 1, 1)) * base.steps_per_frame *
+                               base.world.time_step;
+    engine::Scene reference_scene;
+    try {
+        std::vector<engine::SceneOverride> ref = {
+            {"world.time_step", fmt(base.world.time_step / options.reference_refine, "%.17g")}};
+        ref.insert(ref.end(), reference_overrides.begin(), reference_overrides.end());
+        reference_scene = engine::loadScene(options.scene, ref);
+    } catch (const engine::SceneError& e) {
+        err << "sweep reference: " << e.what() << "\n";
+        return kExitBadInput;
+    }
+
+    const fs::path out_dir = options.out_dir.empty()
+                                 ? fs::path("out") / ("sweep_" + base.name)
+                                 : options.out_dir;
+    try {
+        prepareOutputDir(out_dir);
+        for (const char* f : {"results.csv", "report.md"}) fs::remove(out_dir / f);
+        for (const Chart& c : charts()) fs::remove(out_dir / c.file);
+
+        FirstContacts reference_contacts;
+        SweepRun reference = measure(reference_scene, duration, reference_contacts);
+        reference.label = labelOf(reference_overrides);
+        out << "reference: dt " << fmt(reference.time_step) << " s, " << reference.steps
+            << " steps, " << reference.pairs_confirmed_total << " pairs confirmed\n";
+        std::vector<SweepRun> runs;
+        for (std::size_t i = 0; i < scenes.size(); ++i) {
+            FirstContacts contacts;
+            SweepRun run = measure(scenes[i], duration, contacts);
+            run.overrides = combos[i];
+            run.label = labelOf(combos[i]);
+            compareWithReference(run, contacts, reference_contacts);
+            out << "[" << i + 1 << "/" << scenes.size() << "] " << run.label << ": "
+                << run.steps << " steps, " << fmt(run.ms_step, "%.3f") << " ms/step, "
+                << fmt(run.broad_false_positives, "%.2f") << " broad false positives/step, "
+                << run.missed_pairs << " missed, " << run.extra_pairs << " extra\n";
+            runs.push_back(std::move(run));
+        }
+
+        for (const Chart& c : charts()) {
+            if (c.timing && !options.report_timing) continue;
+            render::BarChart chart;
+            chart.title = c.title;
+            chart.log_scale = c.log_scale;
+            for (const SweepRun& r : runs) chart.bars.push_back({r.label, r.*(c.field), false});
+            chart.bars.push_back({"reference", reference.*(c.field), true});
+            render::writePng(out_dir / c.file, render::drawBarChart(chart));
+        }
+        writeTextAtomically(out_dir / "results.csv", csvTable(runs));
+        writeTextAtomically(out_dir / "report.md",
+                            markdownReport(options, base, duration, runs, reference));
+        out << "wrote " << (out_dir / "report.md").string() << ", "
+            << (out_dir / "results.csv").string() << " and charts\n";
+    } catch (const std::exception& e) {
+        err << "error: " << e.what() << "\n";
+        return kExitFailure;
+    }
+    return kExitOk;
+}
+
+}  // namespace app
