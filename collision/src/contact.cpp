@@ -370,7 +370,7 @@ void generic(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx&
     if (g.state == GjkState::Separated && g.distance > kNormalRelative * ctx.scale) {
         core_a = g.point_a;
         core_b = g.point_b;
-        out.normal = (core_b - core_a) / g.distance;
+        out.normal = (core_b - core_a).normalized();  // length ~ distance > 0, checked above
         out.signed_distance = g.distance - radii;
     } else if (g.state == GjkState::Failed) {
         out.state = ContactState::Failed;
@@ -387,7 +387,13 @@ void generic(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx&
             // Tiny gap and no EPA answer: GJK's direction is the best there is.
             core_a = g.point_a;
             core_b = g.point_b;
-            out.normal = (core_b - core_a) / g.distance;
+            const Vec3 diff = core_b - core_a;
+            const Real len = diff.norm();
+            if (!(len > 0)) {
+                out.state = ContactState::Failed;
+                return;
+            }
+            out.normal = diff / len;
             out.signed_distance = g.distance - radii;
         } else {
             out.state = ContactState::Failed;

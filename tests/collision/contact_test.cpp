@@ -36,7 +36,7 @@ using collision::Vec3;
 
 Pose at(const Vec3& p, const Quat& q = Quat::Identity()) { return Pose{p, q}; }
 
-[[maybe_unused]] Quat axisAngle(Real angle, const Vec3& axis) {
+Quat axisAngle(Real angle, const Vec3& axis) {
     return Quat(Eigen::AngleAxis<Real>(angle, axis.normalized()));
 }
 
@@ -340,6 +340,318 @@ TEST(Contact, CapsuleCapsuleMatchesReference) {
         mix.add(out);
     }
     mix.expectBalanced("capsule-capsule");
+}
+
+// A random convex hull: points on an ellipsoid-ish cloud (fixed seed).
+Shape randomHull(cdlab_test::Rng& rng, Real size) {
+    std::vector<Vec3> points;
+    for (int i = 0; i < 24; ++i) {
+        Vec3 p = rng.vec(-1, 1);
+        if (p.norm() < 1e-3) p = Vec3::UnitX();
+        points.push_back(size * p.normalized().cwiseProduct(Vec3(1, 0.7, 0.5)));
+    }
+    return Shape::convexHull(hullOf(points));
+}
+
+std::vector<Shape> shapeZoo(cdlab_test::Rng& rng) {
+    std::vector<Shape> zoo;
+    zoo.push_back(Shape::sphere(0.6));
+    zoo.push_back(Shape::box(Vec3(0.8, 0.5, 0.3)));
+    zoo.push_back(Shape::capsule(0.3, 0.6));
+    zoo.push_back(randomHull(rng, 0.9));
+    zoo.push_back(Shape::sphere(0.25));
+    zoo.push_back(Shape::box(Vec3(0.2, 1.0, 0.6)));
+    zoo.push_back(Shape::capsule(0.15, 1.0));
+    zoo.push_back(randomHull(rng, 0.5));
+    return zoo;
+}
+
+// Every convex pair type: state equals collide(), exact mirror, witness invariants; and the
+// random poses hit both outcomes for every pair.
+TEST(Contact, EveryConvexPairAgreesWithCollideAndMirrors) {
+    cdlab_test::Rng rng(6);
+    const std::vector<Shape> zoo = shapeZoo(rng);
+    for (std::size_t i = 0; i < zoo.size(); ++i) {
+        for (std::size_t j = 0; j < zoo.size(); ++j) {
+            Mix mix;
+            for (int n = 0; n < 400; ++n) {
+                const Real reach = boundingRadius(zoo[i]) + boundingRadius(zoo[j]);
+                const Pose pa = at(rng.vec(-1, 1), rng.rotation());
+                const Vec3 dir = rng.rotation() * Vec3::UnitX();
+                const Pose pb = at(pa.position + rng.uniform(0.1, 1.2) * reach * dir, rng.rotation());
+                const ContactOutput out = contact(zoo[i], pa, zoo[j], pb);
+                ASSERT_EQ(out.state, collide(zoo[i], pa, zoo[j], pb).state) << i << " " << j << " " << n;
+                expectConsistent(zoo[i], pa, zoo[j], pb, out, 1e-9, "zoo", n);
+                expectMirror(out, contact(zoo[j], pb, zoo[i], pa), n);
+                mix.add(out);
+            }
+            EXPECT_GT(mix.colliding, 40) << i << " " << j;
+            EXPECT_LT(mix.colliding, 360) << i << " " << j;
+        }
+    }
+}
+
+// Near-touching poses: B is moved along a random direction to within a few tolerances of
+// contact, where rounding decides; the state must still be collide()'s.
+TEST(Contact, NearTouchingStateAgreesWithCollide) {
+    cdlab_test::Rng rng(7);
+    const std::vector<Shape> zoo = shapeZoo(rng);
+    int touching = 0;
+    for (std::size_t i = 0; i < zoo.size(); ++i) {
+        for (std::size_t j = 0; j < zoo.size(); ++j) {
+            for (int n = 0; n < 100; ++n) {
+                const Pose pa = at(rng.vec(-1, 1), rng.rotation());
+                Pose pb = at(pa.position + rng.vec(-1.4, 1.4), rng.rotation());
+                const ContactOutput first = contact(zoo[i], pa, zoo[j], pb);
+                if (first.state == ContactState::Failed) continue;
+                // Move B so the signed distance becomes a few tolerances around zero.
+                const Real scale = std::max(boundingRadius(zoo[i]), boundingRadius(zoo[j]));
+                const Real tol = collision::kTouchRelativeTolerance * scale;
+                pb.position -= (first.signed_distance - rng.uniform(-3, 3) * tol) * first.normal;
+                const ContactOutput out = contact(zoo[i], pa, zoo[j], pb);
+                ASSERT_EQ(out.state, collide(zoo[i], pa, zoo[j], pb).state) << i << " " << j << " " << n;
+                ASSERT_TRUE(out.normal.allFinite());
+                expectMirror(out, contact(zoo[j], pb, zoo[i], pa), n);
+                if (out.state == ContactState::Touching) ++touching;
+            }
+        }
+    }
+    EXPECT_GT(touching, 500);
+}
+
+TEST(Contact, SphereSphereExactTouchingAndCoincidentCentres) {
+    const Shape a = Shape::sphere(1);
+    const Shape b = Shape::sphere(0.5);
+    const ContactOutput touch = contact(a, at(Vec3(0, 0, 0)), b, at(Vec3(0, 1.5, 0)));
+    EXPECT_EQ(touch.state, ContactState::Touching);
+    EXPECT_EQ(touch.signed_distance, 0);
+    EXPECT_EQ(touch.normal, Vec3(0, 1, 0));
+    EXPECT_EQ(touch.manifold_size, 1);
+    EXPECT_EQ(touch.manifold[0].depth, 0);
+    // Coincident centres: no direction; the documented normal is the canonically first shape's
+    // local +x (here A: same type, lower key), depth the sum of the radii.
+    const Pose pa = at(Vec3(1, 2, 3), axisAngle(0.5, Vec3(0, 0, 1)));
+    const Pose pb = at(Vec3(1, 2, 3), axisAngle(1.0, Vec3(1, 1, 0)));
+    const ContactOutput out = contact(a, pa, b, pb);
+    EXPECT_EQ(out.state, ContactState::Penetrating);
+    EXPECT_DOUBLE_EQ(out.signed_distance, -1.5);
+    ASSERT_TRUE(out.normal.allFinite());
+    EXPECT_NEAR(out.normal.norm(), 1, 1e-15);
+    expectMirror(out, contact(b, pb, a, pa), 0);
+    expectConsistent(a, pa, b, pb, out, 1e-12, "coincident", 0);
+    // Deterministic: the same call twice gives bit-identical output.
+    const ContactOutput again = contact(a, pa, b, pb);
+    EXPECT_EQ(again.normal, out.normal);
+    EXPECT_EQ(again.point_a, out.point_a);
+}
+
+TEST(Contact, DegenerateConfigurationsGiveFiniteNormals) {
+    // Sphere centre on a capsule axis, crossing capsule axes, parallel coincident capsules,
+    // sphere centre at a box centre, coincident boxes and hulls.
+    cdlab_test::Rng rng(8);
+    const Shape hull = randomHull(rng, 0.7);
+    struct Case {
+        Shape a;
+        Pose pa;
+        Shape b;
+        Pose pb;
+    };
+    const std::vector<Case> cases{
+        {Shape::sphere(0.3), at(Vec3(0, 0.2, 0)), Shape::capsule(0.2, 1), at(Vec3::Zero())},
+        {Shape::capsule(0.2, 1), at(Vec3::Zero()), Shape::capsule(0.3, 1),
+         at(Vec3::Zero(), axisAngle(M_PI / 2, Vec3::UnitZ()))},
+        {Shape::capsule(0.2, 1), at(Vec3(1, 1, 1)), Shape::capsule(0.3, 0.5), at(Vec3(1, 1, 1))},
+        {Shape::sphere(0.3), at(Vec3(5, 5, 5)), Shape::box(Vec3(1, 1, 1)), at(Vec3(5, 5, 5))},
+        {Shape::box(Vec3(1, 2, 3)), at(Vec3::Zero()), Shape::box(Vec3(1, 2, 3)), at(Vec3::Zero())},
+        {hull, at(Vec3::Zero()), hull, at(Vec3::Zero())},
+        {Shape::sphere(0.3), at(Vec3::Zero()), hull, at(Vec3::Zero())},
+        {Shape::capsule(0.3, 0.2), at(Vec3::Zero()), Shape::box(Vec3(1, 1, 1)), at(Vec3::Zero())},
+    };
+    for (std::size_t n = 0; n < cases.size(); ++n) {
+        const Case& c = cases[n];
+        const ContactOutput out = contact(c.a, c.pa, c.b, c.pb);
+        ASSERT_EQ(out.state, ContactState::Penetrating) << n;
+        ASSERT_EQ(out.state, collide(c.a, c.pa, c.b, c.pb).state) << n;
+        expectConsistent(c.a, c.pa, c.b, c.pb, out, 1e-9, "degenerate", static_cast<int>(n));
+        // Identical inputs (same shape, same pose) make contact(a, b) and contact(b, a) the
+        // same call: no mirror is possible there.
+        const bool identical = c.a.type == c.b.type && c.a.hull == c.b.hull &&
+                               c.a.half_extents == c.b.half_extents && c.pa.position == c.pb.position;
+        if (!identical) expectMirror(out, contact(c.b, c.pb, c.a, c.pa), static_cast<int>(n));
+    }
+    // Crossing capsule axes: depth is the sum of the radii along the common perpendicular.
+    const ContactOutput cross = contact(cases[1].a, cases[1].pa, cases[1].b, cases[1].pb);
+    EXPECT_NEAR(cross.signed_distance, -0.5, 1e-15);
+    EXPECT_NEAR(std::abs(cross.normal.z()), 1, 1e-15);
+    // Sphere at the centre of a unit cube: leaves through a face, depth 1 + r.
+    const ContactOutput centred = contact(cases[3].a, cases[3].pa, cases[3].b, cases[3].pb);
+    EXPECT_NEAR(centred.signed_distance, -1.3, 1e-15);
+    EXPECT_EQ(centred.feature_b.type, FeatureType::Face);
+}
+
+TEST(Contact, NonFiniteInputFails) {
+    const Shape a = Shape::sphere(1);
+    const ContactOutput out =
+        contact(a, at(Vec3(std::nan(""), 0, 0)), Shape::box(Vec3(1, 1, 1)), at(Vec3::Zero()));
+    EXPECT_EQ(out.state, ContactState::Failed);
+    EXPECT_EQ(out.normal, Vec3::Zero());
+    EXPECT_EQ(out.signed_distance, 0);
+}
+
+// Box witness features: a sphere over a vertex, an edge and a face of a box, outside and inside.
+TEST(Contact, BoxFeaturesForVertexEdgeFace) {
+    const Shape box = Shape::box(Vec3(1, 2, 3));
+    const Shape sphere = Shape::sphere(0.5);
+    const Pose pb = at(Vec3(10, -20, 30), axisAngle(0.3, Vec3(1, 2, 3)));
+    auto sphereAt = [&](const Vec3& local) { return at(pb.apply(local)); };
+    // Vertex +x -y +z = bits 0 and 2 -> index 5.
+    ContactOutput out = contact(box, pb, sphere, sphereAt(Vec3(1.3, -2.3, 3.3)));
+    EXPECT_EQ(out.feature_a.type, FeatureType::Vertex);
+    EXPECT_EQ(out.feature_a.index, 5);
+    EXPECT_EQ(out.feature_b.type, FeatureType::Face);
+    // Edge along y at x = -1, z = +3: 4 * 1 + bit_x(0) + 2 * bit_z(1) = 6.
+    out = contact(box, pb, sphere, sphereAt(Vec3(-1.3, 0.5, 3.3)));
+    EXPECT_EQ(out.feature_a.type, FeatureType::Edge);
+    EXPECT_EQ(out.feature_a.index, 6);
+    // Face -y (index 2), touching from outside, and the same face from just inside.
+    out = contact(box, pb, sphere, sphereAt(Vec3(0.2, -2.4, 1)));
+    EXPECT_EQ(out.feature_a.type, FeatureType::Face);
+    EXPECT_EQ(out.feature_a.index, 2);
+    EXPECT_EQ(out.state, ContactState::Penetrating);
+    out = contact(box, pb, sphere, sphereAt(Vec3(0.2, -1.9, 1)));
+    EXPECT_EQ(out.feature_a.type, FeatureType::Face);
+    EXPECT_EQ(out.feature_a.index, 2);
+    // Box-box: B's vertex pushed into A's +z face; crossed edges.
+    const Shape cube = Shape::box(Vec3(1, 1, 1));
+    const Pose corner_down =
+        at(Vec3(0.1, -0.2, 1 + std::sqrt(Real(3)) - 0.05),
+           Quat::FromTwoVectors(Vec3(1, 1, 1).normalized(), Vec3(0, 0, 1)));
+    out = contact(cube, at(Vec3::Zero()), cube, corner_down);
+    EXPECT_EQ(out.state, ContactState::Penetrating);
+    EXPECT_NEAR(out.signed_distance, -0.05, 1e-12);
+    EXPECT_EQ(out.feature_a.type, FeatureType::Face);
+    EXPECT_EQ(out.feature_a.index, 5);
+    EXPECT_EQ(out.feature_b.type, FeatureType::Vertex);
+    EXPECT_EQ(out.manifold_size, 1);
+    // Edges: A's top edge along x (y = z = +1, edge index 4*0 + 1 + 2 = 3) against B's edge along
+    // B's local z at x = y = -h (index 4*2 + 0 + 0 = 8), turned to run along (0, -1, 1) with the
+    // edge's outward bisector pointing down (0, -1, -1): they cross at depth 0.01 along (0,1,1).
+    const Real r2 = std::sqrt(Real(2));
+    const Vec3 u_img = Vec3(0, -1, -1) / r2;  // image of local (-1, -1, 0) / sqrt 2
+    const Vec3 z_img = Vec3(0, -1, 1) / r2;
+    const Vec3 v_img = z_img.cross(u_img);    // image of local (1, -1, 0) / sqrt 2
+    collision::Mat3 rot;
+    rot.col(0) = (v_img - u_img) / r2;
+    rot.col(1) = -(u_img + v_img) / r2;
+    rot.col(2) = z_img;
+    const Real h = 0.5;
+    const Real pen = 0.01;
+    const Shape small = Shape::box(Vec3(h, h, h));
+    const Pose crossed = at(Vec3(0, 1, 1) + h * Vec3(0, 1, 1) - pen * Vec3(0, 1, 1) / r2, Quat(rot));
+    out = contact(cube, at(Vec3::Zero()), small, crossed);
+    ASSERT_EQ(out.state, ContactState::Penetrating);
+    EXPECT_NEAR(out.signed_distance, -pen, 1e-12);
+    EXPECT_LE((out.normal - Vec3(0, 1, 1) / r2).norm(), 1e-12);
+    EXPECT_EQ(out.feature_a.type, FeatureType::Edge);
+    EXPECT_EQ(out.feature_a.index, 3);
+    EXPECT_EQ(out.feature_b.type, FeatureType::Edge);
+    EXPECT_EQ(out.feature_b.index, 8);
+    EXPECT_EQ(out.manifold_size, 1);
+    expectConsistent(cube, at(Vec3::Zero()), small, crossed, out, 1e-12, "crossed", 0);
+}
+
+// A box resting flat on a bigger box: four manifold points at the contact depth, at the small
+// box's bottom corners; touching exactly gives four points at depth zero.
+TEST(Contact, BoxRestingOnBoxGivesFourPoints) {
+    const Shape ground = Shape::box(Vec3(5, 5, 0.5));
+    const Shape crate = Shape::box(Vec3(0.5, 0.7, 0.4));
+    const Quat yaw = axisAngle(0.3, Vec3::UnitZ());
+    for (const Real depth : {Real(0), Real(0.01), Real(0.2)}) {
+        const Pose pg = at(Vec3(3, -2, 1));
+        const Pose pc = at(Vec3(3.2, -1.9, 1 + 0.5 + 0.4 - depth), yaw);
+        const ContactOutput out = contact(ground, pg, crate, pc);
+        ASSERT_EQ(out.manifold_size, 4) << depth;
+        EXPECT_EQ(out.state, depth == 0 ? ContactState::Touching : ContactState::Penetrating);
+        EXPECT_NEAR(out.signed_distance, -depth, 1e-12);
+        EXPECT_NEAR(out.normal.z(), 1, 1e-12);
+        for (int i = 0; i < 4; ++i) {
+            const auto& m = out.manifold[static_cast<std::size_t>(i)];
+            EXPECT_NEAR(m.depth, depth, 1e-12);
+            EXPECT_NEAR(m.point_a.z(), 1.5, 1e-12);
+            // At one of the crate's bottom corners.
+            const Vec3 local = pc.applyInverse(m.point_b);
+            EXPECT_NEAR(local.cwiseAbs().x(), 0.5, 1e-12);
+            EXPECT_NEAR(local.cwiseAbs().y(), 0.7, 1e-12);
+            EXPECT_NEAR(local.z(), -0.4, 1e-12);
+        }
+        expectConsistent(ground, pg, crate, pc, out, 1e-12, "resting", 0);
+        expectMirror(out, contact(crate, pc, ground, pg), 0);
+    }
+    // Overhanging the edge: clipped to the ground's face, still four points inside it.
+    const Pose pg = at(Vec3::Zero());
+    const Pose pc = at(Vec3(4.8, 0, 0.5 + 0.4 - 0.05));
+    const ContactOutput out = contact(ground, pg, crate, pc);
+    ASSERT_EQ(out.manifold_size, 4);
+    for (int i = 0; i < 4; ++i) {
+        EXPECT_LE(out.manifold[static_cast<std::size_t>(i)].point_a.x(), 5 + 1e-12);
+        EXPECT_NEAR(out.manifold[static_cast<std::size_t>(i)].depth, 0.05, 1e-12);
+    }
+}
+
+// Metamorphic: translating both shapes by 1e6 and scaling the whole scene by 1e-4 and 1e4
+// changes the answer only by rounding relative to the size (and to the offset for points).
+TEST(Contact, TranslationAndScaleInvariance) {
+    cdlab_test::Rng rng(9);
+    for (const Real s : {Real(1e-4), Real(1e4)}) {
+        for (const Vec3& offset : {Vec3(0, 0, 0), Vec3(1e6, -1e6, 1e6)}) {
+            cdlab_test::Rng shapes(10);
+            const std::vector<Shape> zoo = shapeZoo(shapes);
+            cdlab_test::Rng shapes_again(10);
+            std::vector<Shape> scaled = shapeZoo(shapes_again);
+            for (Shape& sh : scaled) {
+                sh.radius *= s;
+                sh.half_height *= s;
+                sh.half_extents *= s;
+                if (sh.hull) {
+                    ConvexPolytope p = *sh.hull;
+                    for (Vec3& v : p.vertices) v *= s;
+                    sh.hull = std::make_shared<const ConvexPolytope>(p);
+                }
+            }
+            for (std::size_t i = 0; i < zoo.size(); ++i) {
+                for (std::size_t j = 0; j < zoo.size(); ++j) {
+                    for (int n = 0; n < 60; ++n) {
+                        const Pose pa = at(rng.vec(-1, 1), rng.rotation());
+                        const Pose pb = at(pa.position + rng.vec(-1.4, 1.4), rng.rotation());
+                        const ContactOutput ref = contact(zoo[i], pa, zoo[j], pb);
+                        const Pose qa = at(s * pa.position + offset, pa.orientation);
+                        const Pose qb = at(s * pb.position + offset, pb.orientation);
+                        const ContactOutput out = contact(scaled[i], qa, scaled[j], qb);
+                        // Near the touching band rounding may flip the state; elsewhere equal.
+                        const Real scale = std::max(boundingRadius(zoo[i]), boundingRadius(zoo[j]));
+                        if (std::abs(ref.signed_distance) > 1e-6 * scale) {
+                            ASSERT_EQ(out.state, ref.state) << i << " " << j << " " << n;
+                        }
+                        // Absolute rounding of coordinates near 1e6 is ~1e6 eps = 2e-10, relative
+                        // to a size s: allow 1e-9 relative plus that.
+                        const Real tol = 1e-9 * scale + 64 * collision::kEpsilon * offset.norm() / s;
+                        ASSERT_NEAR(out.signed_distance / s, ref.signed_distance, tol)
+                            << i << " " << j << " " << n << " s=" << s;
+                        if (std::abs(ref.signed_distance) > 1e-6 * scale &&
+                            ref.feature_a.type != FeatureType::Unknown) {
+                            // Unique normal except at ties; compare where the depth is clear.
+                            ASSERT_LE((out.normal - ref.normal).norm(), 1e-6 + tol)
+                                << i << " " << j << " " << n << " s=" << s;
+                        }
+                        ASSERT_LE(((out.point_a - offset) / s - ref.point_a).norm(),
+                                  1e-6 * scale + tol)
+                            << i << " " << j << " " << n << " s=" << s;
+                        expectConsistent(scaled[i], qa, scaled[j], qb, out, 1e-9, "scaled", n);
+                    }
+                }
+            }
+        }
+    }
 }
 
 }  // namespace
