@@ -4,6 +4,7 @@
 
 #include "bench_broadphase.h"
 #include "bench_ccd.h"
+#include "bench_convex.h"
 #include "collision/broad_phase.h"
 #include "query_command.h"
 #include "run_command.h"
@@ -128,6 +129,21 @@ int main(int argc, char** argv) {
     bench_ccd_cmd->add_option("--method", bench_ccd.method, "conservative, naive or all")
         ->check(CLI::IsMember({"conservative", "naive", "all"}))
         ->capture_default_str();
+    app::BenchConvexOptions bench_convex;
+    std::string bench_convex_json;
+    CLI::App* bench_convex_cmd = bench_cmd->add_subcommand(
+        "convex", "convex contact queries (GJK, EPA, SAT, closed forms) beside Bullet's GJK/EPA: "
+                  "us/query, answers compared");
+    bench_convex_cmd->add_option("--queries", bench_convex.queries, "random pairs per workload")
+        ->capture_default_str();
+    bench_convex_cmd->add_option("--passes", bench_convex.passes, "timed passes (fastest kept)")
+        ->capture_default_str();
+    bench_convex_cmd->add_option("--seed", bench_convex.seed, "pose seed")->capture_default_str();
+    bench_convex_cmd
+        ->add_option("--tolerance", bench_convex.tolerance,
+                     "relative answer tolerance for counting disagreements")
+        ->capture_default_str();
+    bench_convex_cmd->add_option("--json", bench_convex_json, "also write the rows as JSON to FILE");
     // END bench subcommand
 
     try {
@@ -168,6 +184,10 @@ int main(int argc, char** argv) {
         for (const std::string& d : bench_ccd_dirs) bench_ccd.dirs.emplace_back(d);
         if (!bench_ccd_json.empty()) bench_ccd.json = bench_ccd_json;
         return app::runBenchCcd(bench_ccd, std::cout, std::cerr);
+    }
+    if (bench_convex_cmd->parsed()) {
+        if (!bench_convex_json.empty()) bench_convex.json = bench_convex_json;
+        return app::runBenchConvex(bench_convex, std::cout, std::cerr);
     }
     // END bench dispatch
     return 2;
