@@ -108,7 +108,7 @@ MovingBoxes::MovingBoxes(WorkloadKind kind, int n, std::uint64_t seed) : kind_(k
         const double pairs = static_cast<double>(reference.count(*this).pairs);
         const double ratio = std::max(pairs, 1.0) / target;
         if (std::abs(ratio - 1) < 0.01) break;
-        side_ = std::max(side_ * std::cbrt(ratio), 4 * largest);
+        side_ = std::max<double>(side_ * std::cbrt(ratio), 4 * largest);
     }
     place();
 }

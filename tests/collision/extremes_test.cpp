@@ -57,7 +57,7 @@ struct Sized {
 std::array<Sized, 4> shapesOfSize(Real s) {
     return {{{"sphere", Shape::sphere(s), s},
              {"box", Shape::box(Vec3(s, 0.5 * s, 2 * s)), s},
-             {"capsule", Shape::capsule(0.5 * s, s), 0.5 * s},
+             {"capsule", Shape::capsule(Real(0.5) * s, s), Real(0.5) * s},
              {"hull", cubeHull(s), s}}};
 }
 
