@@ -47,6 +47,16 @@ int main(int argc, char** argv) {
     run_cmd->add_option("--stats", stats, "write per-frame counters and stage times to FILE.csv");
     bool quiet = false;
     run_cmd->add_flag("--quiet", quiet, "no progress bar");
+    std::vector<std::string> run_set;
+    run_cmd
+        ->add_option("--set", run_set,
+                     "KEY=VALUE: replace a scene value before validation, KEY a dotted path "
+                     "(world.time_step, bodies.2.radius); repeatable")
+        ->expected(1)
+        ->take_all();
+    std::string run_trace;
+    run_cmd->add_option("--trace", run_trace,
+                        "write every frame's body poses and confirmed pairs to FILE (JSON lines)");
 
     // BEGIN ccd subcommand
     // END ccd subcommand
@@ -87,6 +97,10 @@ int main(int argc, char** argv) {
     sweep_cmd->add_option("--duration", sweep_duration,
                           "simulated seconds per run (default: the scene's frames)");
     sweep_cmd->add_option("--out", sweep_out, "output directory (default out/sweep_<scene>)");
+    std::string sweep_float;
+    sweep_cmd->add_option("--float-binary", sweep_float,
+                          "a cdlab built with -DCDLAB_USE_FLOAT=ON: compare every run's frames "
+                          "with it (float_vs_double.csv, a report section)");
     bool sweep_no_timing = false;
     sweep_cmd->add_flag("--no-report-timing", sweep_no_timing,
                         "leave wall-clock times out of report.md so it is bit-identical");
@@ -159,6 +173,15 @@ int main(int argc, char** argv) {
         if (run_cmd->count("--frames") > 0) run.frames = frames;
         if (!broad_phase.empty()) run.broad_phase = broad_phase;
         if (!stats.empty()) run.stats_csv = stats;
+        for (const std::string& kv : run_set) {
+            const std::size_t eq = kv.find('=');
+            if (eq == std::string::npos || eq == 0) {
+                std::cerr << "--set '" << kv << "': expected KEY=VALUE\n";
+                return 2;
+            }
+            run.overrides.push_back({kv.substr(0, eq), kv.substr(eq + 1)});
+        }
+        if (!run_trace.empty()) run.trace = run_trace;
         run.hud_timing = !no_timing;
         run.progress = !quiet;
         return app::runScene(run, std::cout, std::cerr);
@@ -167,6 +190,7 @@ int main(int argc, char** argv) {
         if (!sweep_out.empty()) sweep.out_dir = sweep_out;
         if (sweep_cmd->count("--duration") > 0) sweep.duration = sweep_duration;
         sweep.report_timing = !sweep_no_timing;
+        if (!sweep_float.empty()) sweep.float_binary = sweep_float;
         return app::runSweep(sweep, std::cout, std::cerr);
     }
     // BEGIN ccd dispatch

@@ -92,6 +92,28 @@ std::string statsRow(int frame, const engine::World& world, const FrameStats& f)
     return line;
 }
 
+// One frame of a trace (see RunOptions::trace), numbers with every digit of a double so
+// builds can be compared to the last bit of the narrower one.
+std::string traceLine(int frame, const engine::World& world) {
+    nlohmann::json line;
+    line["frame"] = frame;
+    line["time"] = double(world.time());
+    nlohmann::json positions = nlohmann::json::array();
+    nlohmann::json orientations = nlohmann::json::array();
+    for (const engine::Body& b : world.bodies()) {
+        positions.push_back({double(b.position.x()), double(b.position.y()),
+                             double(b.position.z())});
+        const engine::Quat& q = b.orientation;
+        orientations.push_back({double(q.w()), double(q.x()), double(q.y()), double(q.z())});
+    }
+    line["positions"] = std::move(positions);
+    line["orientations_wxyz"] = std::move(orientations);
+    nlohmann::json pairs = nlohmann::json::array();
+    for (const collision::ProxyPair& p : world.collidingPairs()) pairs.push_back({p.a, p.b});
+    line["colliding_pairs"] = std::move(pairs);
+    return line.dump() + "\n";
+}
+
 std::string frameName(int frame) {
     char name[32];
     std::snprintf(name, sizeof name, "frame_%05d.png", frame);
@@ -104,7 +126,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
     // 1. Everything that can be wrong with the input is found before any output is written.
     engine::Scene scene;
     try {
-        scene = engine::loadScene(options.scene);
+        scene = engine::loadScene(options.scene, options.overrides);
     } catch (const engine::SceneError& e) {
         err << e.what() << "\n";
         return kExitBadInput;
@@ -148,6 +170,9 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         if (options.stats_csv && options.stats_csv->has_parent_path()) {
             prepareOutputDir(options.stats_csv->parent_path());
         }
+        if (options.trace && options.trace->has_parent_path()) {
+            prepareOutputDir(options.trace->parent_path());
+        }
         std::error_code ec;
         fs::remove(out_dir / "summary.json", ec);
 
@@ -170,6 +195,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         }
         std::string stats_text;
         if (options.stats_csv) stats_text = kStatsHeader;
+        std::string trace_text;
         ProgressBar progress(options.progress && ::isatty(STDERR_FILENO), scene.frames);
         std::int64_t flagged_total = 0;
         std::int64_t colliding_total = 0;
@@ -197,6 +223,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
                 }
             }
             if (options.stats_csv) stats_text += statsRow(frame, world, frame_stats);
+            if (options.trace) trace_text += traceLine(frame, world);
             flagged_total += static_cast<std::int64_t>(world.flaggedPairs().size());
             colliding_total += static_cast<std::int64_t>(world.collidingPairs().size());
             frame_options.hud_text =
@@ -217,6 +244,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         }
         if (video) video->finish();
         if (options.stats_csv) writeTextAtomically(*options.stats_csv, stats_text);
+        if (options.trace) writeTextAtomically(*options.trace, trace_text);
 
         nlohmann::ordered_json summary;
         summary["scene"] = options.scene.string();

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "engine/scene.h"
+
 namespace app {
 
 struct RunOptions {
@@ -23,6 +25,11 @@ struct RunOptions {
     bool draw_structure = false;              ///< draw the broad phase's own structure
     bool check_broad_phase = false;           ///< compare every step with the brute reference
     std::optional<std::filesystem::path> stats_csv;  ///< one row of counters per frame
+    /// Scene values replaced before validation (`--set world.time_step=0.01`).
+    std::vector<engine::SceneOverride> overrides;
+    /// One JSON line per frame: time, every body's position and orientation, confirmed pairs
+    /// (`cdlab sweep --float-binary` compares a float build's trace with the double one's).
+    std::optional<std::filesystem::path> trace;
 };
 
 /// Exit codes: 0 success, 1 output or runtime failure, 2 bad input (scene, flags),

@@ -6,10 +6,14 @@
 // two time steps). Everything but the wall-clock times is deterministic.
 #include "sweep_command.h"
 
+#include <sys/wait.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <ostream>
 #include <sstream>
 #include <utility>
@@ -17,6 +21,7 @@
 #include "output_files.h"
 #include "render/chart.h"
 #include "render/image.h"
+#include "run_command.h"
 
 namespace app {
 
@@ -29,6 +34,15 @@ constexpr int kExitFailure = 1;
 constexpr int kExitBadInput = 2;
 
 using PairKey = std::pair<collision::ProxyId, collision::ProxyId>;
+struct Vec3Like {
+    double x, y, z;
+};
+
+// One combination's float-against-double comparison (sweep --float-binary).
+struct FloatRun {
+    TraceComparison comparison;
+    std::string label;
+};
 using FirstContacts = std::map<PairKey, double>;
 
 std::string trim(const std::string& s) {
@@ -105,9 +119,9 @@ SweepRun measure(const engine::Scene& scene, double duration, FirstContacts& fir
         }
     }
     const double n = double(run.steps);
-    for (double* v : {&run.ms_integrate, &run.ms_volumes, &run.ms_broad, &run.ms_narrow,
-                      &run.ms_step, &run.flagged, &run.confirmed, &run.bv_tests,
-                      &run.narrow_tests, &run.triangle_tests}) {
+    for (double* v :
+         {&run.ms_integrate, &run.ms_volumes, &run.ms_broad, &run.ms_narrow, &run.ms_step,
+          &run.flagged, &run.confirmed, &run.bv_tests, &run.narrow_tests, &run.triangle_tests}) {
         *v /= n;
     }
     run.broad_false_positives = run.flagged - run.confirmed;
@@ -168,8 +182,8 @@ std::string csvTable(const std::vector<SweepRun>& runs) {
             csv << ',' << fmt(v, "%.6g");
         }
         csv << ',' << r.pairs_confirmed_total << ',' << r.missed_pairs << ',' << r.extra_pairs;
-        for (double v : {r.max_first_contact_error, r.mean_first_contact_error,
-                         r.max_energy_drift, r.max_angular_momentum_drift}) {
+        for (double v : {r.max_first_contact_error, r.mean_first_contact_error, r.max_energy_drift,
+                         r.max_angular_momentum_drift}) {
             csv << ',' << fmt(v, "%.6g");
         }
         csv << ',' << r.state_hash << '\n';
@@ -191,8 +205,7 @@ const std::vector<Chart>& charts() {
          &SweepRun::ms_per_simulated_s, false, true},
         {"broad_false_positives.png", "broad-phase false positives per step (flagged - confirmed)",
          &SweepRun::broad_false_positives, false, false},
-        {"bv_tests.png", "bounding-volume tests per step (Nv)", &SweepRun::bv_tests, false,
-         false},
+        {"bv_tests.png", "bounding-volume tests per step (Nv)", &SweepRun::bv_tests, false, false},
         {"first_contact_error.png", "max first-contact time error vs reference (s)",
          &SweepRun::max_first_contact_error, false, false},
         {"energy_drift.png", "max relative energy drift (log scale)", &SweepRun::max_energy_drift,
@@ -201,16 +214,45 @@ const std::vector<Chart>& charts() {
     return kCharts;
 }
 
-std::string markdownReport(const SweepOptions& options, const engine::Scene& base,
-                           double duration, const std::vector<SweepRun>& runs,
-                           const SweepRun& reference) {
+std::string floatSection(const std::vector<FloatRun>& floats, double scene_size) {
+    std::ostringstream md;
+    md << "## Float against double\n\n"
+          "Each run above repeated by the float build (`CDLAB_USE_FLOAT=ON`) over the scene's own "
+          "frames and compared frame by frame with the double build: the first frame whose "
+          "confirmed pairs differ, how many frames differ, and how far bodies drift apart "
+          "(scene size = bounds diagonal, "
+       << fmt(scene_size) << " m).\n\n"
+       << "| run | frames | first frame pairs differ | frames with different pairs | max position "
+          "deviation (m) | relative to scene | final deviation (m) | max orientation "
+          "deviation (rad) |\n|---|---|---|---|---|---|---|---|\n";
+    for (const FloatRun& f : floats) {
+        const TraceComparison& c = f.comparison;
+        if (!c.error.empty()) {
+            md << "| " << f.label << " | " << c.error << " | | | | | | |\n";
+            continue;
+        }
+        md << "| " << f.label << " | " << c.frames << " | "
+           << (c.first_pair_difference < 0 ? std::string("none")
+                                           : std::to_string(c.first_pair_difference))
+           << " | " << c.pair_frames_differing << " | " << fmt(c.max_position_deviation, "%.3g")
+           << " | " << fmt(c.max_position_deviation / scene_size, "%.2e") << " | "
+           << fmt(c.final_position_deviation, "%.3g") << " | "
+           << fmt(c.max_orientation_deviation, "%.3g") << " |\n";
+    }
+    md << "\n![float against double: max position deviation](float_deviation.png)\n\n";
+    return md.str();
+}
+
+std::string markdownReport(const SweepOptions& options, const engine::Scene& base, double duration,
+                           const std::vector<SweepRun>& runs, const SweepRun& reference,
+                           const std::vector<FloatRun>& floats) {
     std::ostringstream md;
     md << "# Sweep of `" << options.scene.filename().string() << "`\n\n";
     md << "- " << base.bodies.size() << " bodies, " << fmt(duration) << " s simulated per run, "
        << "broad phase `" << base.world.broad_phase << "` unless varied.\n";
     md << "- Reference: time step " << fmt(reference.time_step) << " s (" << reference.steps
-       << " steps)" << (options.reference.empty() ? "" : ", " + reference.label) << "; it confirmed "
-       << reference.pairs_confirmed_total << " distinct pairs.\n";
+       << " steps)" << (options.reference.empty() ? "" : ", " + reference.label)
+       << "; it confirmed " << reference.pairs_confirmed_total << " distinct pairs.\n";
     md << "- A pair is *missed* when the reference confirms it and the run never does; "
           "*extra* the other way round. First-contact error compares the first step at which "
           "each common pair is confirmed (resolution: the larger time step).\n";
@@ -237,8 +279,8 @@ std::string markdownReport(const SweepOptions& options, const engine::Scene& bas
            << fmt(r.broad_false_positives, "%.2f") << " | " << fmt(r.bv_tests, "%.0f") << " | "
            << fmt(r.triangle_tests, "%.0f") << " | " << r.missed_pairs << " | " << r.extra_pairs
            << " | " << fmt(r.max_first_contact_error, "%.3g") << " | "
-           << fmt(r.max_energy_drift, "%.2e") << " | "
-           << fmt(r.max_angular_momentum_drift, "%.2e") << " |\n";
+           << fmt(r.max_energy_drift, "%.2e") << " | " << fmt(r.max_angular_momentum_drift, "%.2e")
+           << " |\n";
     };
     for (const SweepRun& r : runs) row(r);
     SweepRun ref_row = reference;
@@ -250,6 +292,9 @@ std::string markdownReport(const SweepOptions& options, const engine::Scene& bas
         md << "![" << c.title << "](" << c.file << ")\n\n";
     }
 
+    if (!floats.empty()) {
+        md << floatSection(floats, (base.world.bounds.max - base.world.bounds.min).norm());
+    }
     // The reading: which choice buys what, from the numbers above.
     md << "## Reading\n\n";
     const SweepRun* accurate = nullptr;
@@ -264,8 +309,8 @@ std::string markdownReport(const SweepOptions& options, const engine::Scene& bas
     if (accurate != nullptr) {
         md << "- " << (options.report_timing ? "Cheapest" : "Fewest BV tests among the")
            << " runs that confirm exactly the reference's pairs: **" << accurate->label << "**";
-        if (options.report_timing) md << " (" << fmt(accurate->ms_per_simulated_s, "%.1f")
-                                      << " ms per simulated second)";
+        if (options.report_timing)
+            md << " (" << fmt(accurate->ms_per_simulated_s, "%.1f") << " ms per simulated second)";
         md << ".\n";
     } else {
         md << "- No run confirms exactly the reference's pairs: every choice here trades "
@@ -292,6 +337,14 @@ std::string markdownReport(const SweepOptions& options, const engine::Scene& bas
             worst = &r;
         }
     }
+    for (const FloatRun& f : floats) {
+        if (f.comparison.error.empty() && f.comparison.first_pair_difference >= 0) {
+            md << "- Float changes the answers of **" << f.label << "** from frame "
+               << f.comparison.first_pair_difference << " on ("
+               << f.comparison.pair_frames_differing << " of " << f.comparison.frames
+               << " frames).\n";
+        }
+    }
     if (worst != nullptr) {
         md << "- Most contacts missed: **" << worst->label << "**, " << worst->missed_pairs
            << " of the reference's " << reference.pairs_confirmed_total
@@ -301,7 +354,113 @@ std::string markdownReport(const SweepOptions& options, const engine::Scene& bas
     return md.str();
 }
 
+// Single-quoted for /bin/sh: every character literal, ' written as '\''.
+std::string shellQuote(const std::string& s) {
+    std::string q = "'";
+    for (char c : s) {
+        if (c == '\'') {
+            q += "'\\''";
+        } else {
+            q += c;
+        }
+    }
+    return q + "'";
+}
+
+// Runs one combination through this (double) build in-process and through the float build as a
+// child process, both writing traces, and compares them.
+FloatRun compareFloat(const SweepOptions& options, const std::vector<engine::SceneOverride>& c,
+                      const fs::path& dir, std::size_t index) {
+    const std::string stem = "run" + std::to_string(index);
+    RunOptions run;
+    run.scene = options.scene;
+    run.overrides = c;
+    run.no_video = true;
+    run.no_frames = true;
+    run.progress = false;
+    run.out_dir = dir / (stem + "_double");
+    run.trace = dir / (stem + "_double.jsonl");
+    std::ostringstream run_out, run_err;
+    FloatRun result;
+    result.label = labelOf(c);
+    if (runScene(run, run_out, run_err) != 0) {
+        result.comparison.error = "double run failed: " + run_err.str();
+        return result;
+    }
+    const fs::path float_trace = dir / (stem + "_float.jsonl");
+    std::string cmd = shellQuote(options.float_binary->string()) + " run " +
+                      shellQuote(options.scene.string()) + " --no-frames --no-video --quiet" +
+                      " --out " + shellQuote((dir / (stem + "_float")).string()) + " --trace " +
+                      shellQuote(float_trace.string());
+    for (const engine::SceneOverride& o : c) cmd += " --set " + shellQuote(o.key + "=" + o.value);
+    cmd += " > " + shellQuote((dir / (stem + "_float.log")).string()) + " 2>&1";
+    const int status = std::system(cmd.c_str());
+    if (!(WIFEXITED(status) && WEXITSTATUS(status) == 0)) {
+        result.comparison.error =
+            "the float build failed (see " + (dir / (stem + "_float.log")).string() + ")";
+        return result;
+    }
+    result.comparison = compareTraces(*run.trace, float_trace);
+    return result;
+}
+
 }  // namespace
+
+TraceComparison compareTraces(const fs::path& a, const fs::path& b) {
+    TraceComparison out;
+    std::ifstream fa(a), fb(b);
+    if (!fa || !fb) {
+        out.error = "cannot read " + (fa ? b : a).string();
+        return out;
+    }
+    std::string la, lb;
+    try {
+        while (std::getline(fa, la) && std::getline(fb, lb)) {
+            const nlohmann::json ja = nlohmann::json::parse(la);
+            const nlohmann::json jb = nlohmann::json::parse(lb);
+            const auto& pa = ja.at("positions");
+            const auto& pb = jb.at("positions");
+            const auto& qa = ja.at("orientations_wxyz");
+            const auto& qb = jb.at("orientations_wxyz");
+            if (pa.size() != pb.size() || qa.size() != pa.size() || qb.size() != pb.size()) {
+                out.error = "different body counts at frame " + std::to_string(out.frames);
+                return out;
+            }
+            double frame_max = 0;
+            for (std::size_t i = 0; i < pa.size(); ++i) {
+                const Vec3Like d{pa[i][0].get<double>() - pb[i][0].get<double>(),
+                                 pa[i][1].get<double>() - pb[i][1].get<double>(),
+                                 pa[i][2].get<double>() - pb[i][2].get<double>()};
+                frame_max = std::max(frame_max, std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z));
+                // Rotation angle between unit quaternions, 4 atan2(|a - b|, |a + b|) with b's
+                // sign matched to a's (|a -+ b| = 2 sin, 2 cos of a quarter of the angle): accurate
+                // near 0, where 2 acos(a.b) loses half the digits.
+                double dot = 0;
+                for (int k = 0; k < 4; ++k) dot += qa[i][k].get<double>() * qb[i][k].get<double>();
+                const double sign = dot < 0 ? -1 : 1;
+                double diff2 = 0, sum2 = 0;
+                for (int k = 0; k < 4; ++k) {
+                    const double x = qa[i][k].get<double>();
+                    const double y = sign * qb[i][k].get<double>();
+                    diff2 += (x - y) * (x - y);
+                    sum2 += (x + y) * (x + y);
+                }
+                const double angle = 4 * std::atan2(std::sqrt(diff2), std::sqrt(sum2));
+                out.max_orientation_deviation = std::max(out.max_orientation_deviation, angle);
+            }
+            out.max_position_deviation = std::max(out.max_position_deviation, frame_max);
+            out.final_position_deviation = frame_max;
+            if (ja.at("colliding_pairs") != jb.at("colliding_pairs")) {
+                ++out.pair_frames_differing;
+                if (out.first_pair_difference < 0) out.first_pair_difference = out.frames;
+            }
+            ++out.frames;
+        }
+    } catch (const nlohmann::json::exception& e) {
+        out.error = std::string("malformed trace: ") + e.what();
+    }
+    return out;
+}
 
 bool parseVary(const std::string& text, std::string& key, std::vector<std::string>& values,
                std::string& error) {
@@ -373,6 +532,14 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
         return kExitBadInput;
     }
 
+    if (options.float_binary) {
+        std::error_code ec;
+        if (!fs::is_regular_file(*options.float_binary, ec)) {
+            err << "--float-binary " << options.float_binary->string()
+                << ": no such file (build one with cmake -DCDLAB_USE_FLOAT=ON)\n";
+            return kExitBadInput;
+        }
+    }
     // Every combination is loaded (and so validated) before anything runs.
     std::vector<std::vector<engine::SceneOverride>> combos{{}};
     for (const auto& [key, values] : axes) {
@@ -401,10 +568,9 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
             return kExitBadInput;
         }
     }
-    const double duration =
-        options.duration ? *options.duration
-                         : double(std::max(base.frames - 1, 1)) * base.steps_per_frame *
-                               base.world.time_step;
+    const double duration = options.duration ? *options.duration
+                                             : double(std::max(base.frames - 1, 1)) *
+                                                   base.steps_per_frame * base.world.time_step;
     engine::Scene reference_scene;
     try {
         std::vector<engine::SceneOverride> ref = {
@@ -416,12 +582,14 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
         return kExitBadInput;
     }
 
-    const fs::path out_dir = options.out_dir.empty()
-                                 ? fs::path("out") / ("sweep_" + base.name)
-                                 : options.out_dir;
+    const fs::path out_dir =
+        options.out_dir.empty() ? fs::path("out") / ("sweep_" + base.name) : options.out_dir;
     try {
         prepareOutputDir(out_dir);
-        for (const char* f : {"results.csv", "report.md"}) fs::remove(out_dir / f);
+        for (const char* f :
+             {"results.csv", "report.md", "float_vs_double.csv", "float_deviation.png"}) {
+            fs::remove(out_dir / f);
+        }
         for (const Chart& c : charts()) fs::remove(out_dir / c.file);
 
         FirstContacts reference_contacts;
@@ -436,8 +604,8 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
             run.overrides = combos[i];
             run.label = labelOf(combos[i]);
             compareWithReference(run, contacts, reference_contacts);
-            out << "[" << i + 1 << "/" << scenes.size() << "] " << run.label << ": "
-                << run.steps << " steps, " << fmt(run.ms_step, "%.3f") << " ms/step, "
+            out << "[" << i + 1 << "/" << scenes.size() << "] " << run.label << ": " << run.steps
+                << " steps, " << fmt(run.ms_step, "%.3f") << " ms/step, "
                 << fmt(run.broad_false_positives, "%.2f") << " broad false positives/step, "
                 << run.missed_pairs << " missed, " << run.extra_pairs << " extra\n";
             runs.push_back(std::move(run));
@@ -452,9 +620,40 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
             chart.bars.push_back({"reference", reference.*(c.field), true});
             render::writePng(out_dir / c.file, render::drawBarChart(chart));
         }
+        std::vector<FloatRun> floats;
+        if (options.float_binary) {
+            const fs::path traces = out_dir / "traces";
+            prepareOutputDir(traces);
+            std::string csv =
+                "run,frames,first_pair_difference,pair_frames_differing,max_position_deviation,"
+                "final_position_deviation,max_orientation_deviation,error\n";
+            render::BarChart chart;
+            chart.title = "float vs double: max position deviation (m, log scale)";
+            chart.log_scale = true;
+            for (std::size_t i = 0; i < combos.size(); ++i) {
+                floats.push_back(compareFloat(options, combos[i], traces, i));
+                const TraceComparison& c = floats.back().comparison;
+                out << "[float " << i + 1 << "/" << combos.size() << "] " << floats.back().label
+                    << ": "
+                    << (c.error.empty() ? "max deviation " + fmt(c.max_position_deviation) +
+                                              " m, pairs differ in " +
+                                              std::to_string(c.pair_frames_differing) + " frames"
+                                        : c.error)
+                    << "\n";
+                csv += csvField(floats.back().label) + "," + std::to_string(c.frames) + "," +
+                       std::to_string(c.first_pair_difference) + "," +
+                       std::to_string(c.pair_frames_differing) + "," +
+                       fmt(c.max_position_deviation, "%.6g") + "," +
+                       fmt(c.final_position_deviation, "%.6g") + "," +
+                       fmt(c.max_orientation_deviation, "%.6g") + "," + csvField(c.error) + "\n";
+                chart.bars.push_back({floats.back().label, c.max_position_deviation, false});
+            }
+            writeTextAtomically(out_dir / "float_vs_double.csv", csv);
+            render::writePng(out_dir / "float_deviation.png", render::drawBarChart(chart));
+        }
         writeTextAtomically(out_dir / "results.csv", csvTable(runs));
         writeTextAtomically(out_dir / "report.md",
-                            markdownReport(options, base, duration, runs, reference));
+                            markdownReport(options, base, duration, runs, reference, floats));
         out << "wrote " << (out_dir / "report.md").string() << ", "
             << (out_dir / "results.csv").string() << " and charts\n";
     } catch (const std::exception& e) {

@@ -28,6 +28,9 @@ struct SweepOptions {
     /// runs with different time steps cover the same interval.
     std::optional<double> duration;
     std::filesystem::path out_dir;  ///< default out/sweep_<scene stem>
+    /// A cdlab executable built with CDLAB_USE_FLOAT=ON: every combination is also run by it
+    /// (`cdlab run --set ... --trace`) and its frames compared with the double build's.
+    std::optional<std::filesystem::path> float_binary;
     /// Timings in report.md (off: the report is bit-identical from run to run; the CSV keeps
     /// them).
     bool report_timing = true;
@@ -42,21 +45,36 @@ struct SweepRun {
     std::int64_t steps = 0;
     double ms_integrate = 0, ms_volumes = 0, ms_broad = 0, ms_narrow = 0, ms_step = 0;
     double ms_per_simulated_s = 0;
-    double flagged = 0;            ///< broad-phase pairs per step
-    double confirmed = 0;          ///< narrow-phase confirmed pairs per step
-    double broad_false_positives = 0;  ///< flagged - confirmed, per step
-    double bv_tests = 0;           ///< broad-phase bounding-volume tests per step (Nv)
-    double narrow_tests = 0;       ///< narrow-phase pair tests per step
-    double triangle_tests = 0;     ///< triangle tests per step (Np)
+    double flagged = 0;                      ///< broad-phase pairs per step
+    double confirmed = 0;                    ///< narrow-phase confirmed pairs per step
+    double broad_false_positives = 0;        ///< flagged - confirmed, per step
+    double bv_tests = 0;                     ///< broad-phase bounding-volume tests per step (Nv)
+    double narrow_tests = 0;                 ///< narrow-phase pair tests per step
+    double triangle_tests = 0;               ///< triangle tests per step (Np)
     std::int64_t pairs_confirmed_total = 0;  ///< distinct pairs ever confirmed
-    std::int64_t missed_pairs = 0;   ///< confirmed in the reference, never in this run
-    std::int64_t extra_pairs = 0;    ///< confirmed in this run, never in the reference
-    double max_first_contact_error = 0;   ///< s, |first contact - reference's|, common pairs
-    double mean_first_contact_error = 0;  ///< s
-    double max_energy_drift = 0;     ///< max over steps |E - E0| / (sum of |energy terms| at 0)
+    std::int64_t missed_pairs = 0;           ///< confirmed in the reference, never in this run
+    std::int64_t extra_pairs = 0;            ///< confirmed in this run, never in the reference
+    double max_first_contact_error = 0;      ///< s, |first contact - reference's|, common pairs
+    double mean_first_contact_error = 0;     ///< s
+    double max_energy_drift = 0;  ///< max over steps |E - E0| / (sum of |energy terms| at 0)
     double max_angular_momentum_drift = 0;  ///< max over bodies and steps | |L| - |L0| | / |L0|
     std::uint64_t state_hash = 0;
 };
+
+/// How two traces of the same scene (`cdlab run --trace`) differ, frame by frame.
+struct TraceComparison {
+    int frames = 0;                        ///< frames present in both
+    int first_pair_difference = -1;        ///< first frame whose confirmed pairs differ; -1: none
+    int pair_frames_differing = 0;         ///< frames whose confirmed pair sets differ
+    double max_position_deviation = 0;     ///< m, over bodies and frames
+    double final_position_deviation = 0;   ///< m, last common frame
+    double max_orientation_deviation = 0;  ///< rad
+    std::string error;                     ///< non-empty: the traces could not be compared
+};
+
+/// Reads two trace files and compares them; `error` says why when they cannot be compared
+/// (unreadable, malformed, different body counts).
+TraceComparison compareTraces(const std::filesystem::path& a, const std::filesystem::path& b);
 
 /// Parses "KEY=V1,V2" (commas inside [] or {} do not split). Returns false with a message.
 bool parseVary(const std::string& text, std::string& key, std::vector<std::string>& values,

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -20,8 +21,8 @@ namespace fs = std::filesystem;
 const fs::path kScene = fs::path(CDLAB_SOURCE_DIR) / "tests/data/tunnel_small.yaml";
 
 fs::path tempDir(const std::string& name) {
-    const fs::path d = fs::temp_directory_path() /
-                       ("cdlab_sweep_" + name + "_" + std::to_string(::getpid()));
+    const fs::path d =
+        fs::temp_directory_path() / ("cdlab_sweep_" + name + "_" + std::to_string(::getpid()));
     fs::remove_all(d);
     return d;
 }
@@ -33,17 +34,35 @@ std::string slurp(const fs::path& p) {
     return s.str();
 }
 
-// results.csv as one map per row, column name -> text (labels here have no commas).
+// A CSV file as one map per row, column name -> text.
 std::vector<std::map<std::string, std::string>> readCsv(const fs::path& file) {
     std::ifstream f(file);
     std::string line;
     std::vector<std::string> header;
     std::vector<std::map<std::string, std::string>> rows;
     while (std::getline(f, line)) {
-        std::vector<std::string> cells;
-        std::stringstream ss(line);
-        std::string cell;
-        while (std::getline(ss, cell, ',')) cells.push_back(cell);
+        // RFC 4180 fields: quoted when they hold commas, "" for a quote inside.
+        std::vector<std::string> cells(1);
+        bool quoted = false;
+        for (std::size_t i = 0; i < line.size(); ++i) {
+            const char c = line[i];
+            if (quoted) {
+                if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+                    cells.back() += '"';
+                    ++i;
+                } else if (c == '"') {
+                    quoted = false;
+                } else {
+                    cells.back() += c;
+                }
+            } else if (c == '"') {
+                quoted = true;
+            } else if (c == ',') {
+                cells.emplace_back();
+            } else {
+                cells.back() += c;
+            }
+        }
         if (header.empty()) {
             header = cells;
             continue;
@@ -81,8 +100,8 @@ TEST(Sweep, TimeStepThatTunnelsMissesTheContactAndBroadPhasesAgree) {
         const auto& row = rows[i];
         const bool coarse = i % 2 == 0;
         const std::vector<std::string> methods{"brute", "sap", "hgrid", "tree"};
-        const std::string label = "broadphase=" + methods[i / 2] +
-                                  " world.time_step=" + (coarse ? "0.05" : "0.005");
+        const std::string label =
+            "broadphase=" + methods[i / 2] + " world.time_step=" + (coarse ? "0.05" : "0.005");
         EXPECT_EQ(row.at("run"), label);
         // 0.1 s simulated whatever the step: 2 or 20 steps.
         EXPECT_EQ(row.at("steps"), coarse ? "2" : "20");
@@ -166,6 +185,75 @@ TEST(Sweep, BadInputIsExitTwoWithTheKeyNamed) {
     // Nothing was written for a rejected sweep.
     EXPECT_FALSE(fs::exists(o.out_dir / "report.md"));
     fs::remove_all(o.out_dir);
+}
+
+TEST(Sweep, FloatComparisonAgainstTheSameBuildFindsNoDifference) {
+    // The plumbing of --float-binary (cdlab run --set ... --trace in a child process, values
+    // with spaces and brackets quoted for the shell) checked with this double build standing in
+    // for the float one: bit-identical runs, so every deviation is exactly zero.
+    app::SweepOptions o;
+    o.scene = kScene;
+    o.vary = {"world.time_step=0.01,0.005", "world.gravity=[0, -9.81, 0]"};
+    o.float_binary = fs::path(CDLAB_BINARY);
+    o.out_dir = tempDir("float");
+    const Outcome r = sweep(o);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto rows = readCsv(o.out_dir / "float_vs_double.csv");
+    ASSERT_EQ(rows.size(), 2u);
+    for (const auto& row : rows) {
+        EXPECT_EQ(row.at("frames"), "11");
+        EXPECT_EQ(row.at("first_pair_difference"), "-1");
+        EXPECT_EQ(row.at("max_position_deviation"), "0");
+        EXPECT_EQ(row.at("max_orientation_deviation"), "0");
+        EXPECT_EQ(row.count("error") ? row.at("error") : "", "");
+    }
+    EXPECT_NE(slurp(o.out_dir / "report.md").find("## Float against double"), std::string::npos);
+    fs::remove_all(o.out_dir);
+
+    o.float_binary = fs::path("/nonexistent/cdlab");
+    EXPECT_EQ(sweep(o).code, 2);
+}
+
+TEST(Sweep, CompareTracesFindsTheFirstDifferingFrameAndTheLargestDeviation) {
+    const fs::path dir = tempDir("traces");
+    fs::create_directories(dir);
+    auto write = [&](const std::string& name, const std::string& text) {
+        std::ofstream(dir / name) << text;
+        return dir / name;
+    };
+    const std::string f0 =
+        R"({"frame":0,"time":0,"positions":[[0,0,0],[1,0,0]],"orientations_wxyz":[[1,0,0,0],[1,0,0,0]],"colliding_pairs":[[0,1]]})"
+        "\n";
+    const std::string f1 =
+        R"({"frame":1,"time":0.1,"positions":[[0,0,0],[2,0,0]],"orientations_wxyz":[[1,0,0,0],[1,0,0,0]],"colliding_pairs":[]})"
+        "\n";
+    const std::string f1_moved =
+        R"({"frame":1,"time":0.1,"positions":[[0,0,0.5],[2,0,0]],"orientations_wxyz":[[1,0,0,0],[0,1,0,0]],"colliding_pairs":[[0,1]]})"
+        "\n";
+    const fs::path a = write("a.jsonl", f0 + f1);
+    const fs::path b = write("b.jsonl", f0 + f1_moved);
+    app::TraceComparison same = app::compareTraces(a, a);
+    EXPECT_EQ(same.error, "");
+    EXPECT_EQ(same.frames, 2);
+    EXPECT_EQ(same.first_pair_difference, -1);
+    EXPECT_EQ(same.max_position_deviation, 0);
+    app::TraceComparison diff = app::compareTraces(a, b);
+    EXPECT_EQ(diff.error, "");
+    EXPECT_EQ(diff.first_pair_difference, 1);
+    EXPECT_EQ(diff.pair_frames_differing, 1);
+    EXPECT_DOUBLE_EQ(diff.max_position_deviation, 0.5);
+    EXPECT_DOUBLE_EQ(diff.final_position_deviation, 0.5);
+    EXPECT_NEAR(diff.max_orientation_deviation, M_PI, 1e-12);  // half a turn about x
+    const fs::path one_body = write(
+        "c.jsonl",
+        R"({"frame":0,"time":0,"positions":[[0,0,0]],"orientations_wxyz":[[1,0,0,0]],"colliding_pairs":[]})"
+        "\n");
+    EXPECT_NE(app::compareTraces(a, one_body).error.find("body counts"), std::string::npos);
+    EXPECT_NE(app::compareTraces(a, write("bad.jsonl", "{not json\n")).error.find("malformed"),
+              std::string::npos);
+    EXPECT_NE(app::compareTraces(a, dir / "missing.jsonl").error.find("cannot read"),
+              std::string::npos);
+    fs::remove_all(dir);
 }
 
 }  // namespace
