@@ -101,6 +101,8 @@ int main(int argc, char** argv) {
     sweep_cmd->add_option("--float-binary", sweep_float,
                           "a cdlab built with -DCDLAB_USE_FLOAT=ON: compare every run's frames "
                           "with it (float_vs_double.csv, a report section)");
+    sweep_cmd->add_flag("--keep-traces", sweep.keep_traces,
+                        "keep DIR/traces/ (both builds' frames) after the float comparison");
     bool sweep_no_timing = false;
     sweep_cmd->add_flag("--no-report-timing", sweep_no_timing,
                         "leave wall-clock times out of report.md so it is bit-identical");

@@ -649,6 +649,7 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
                 chart.bars.push_back({floats.back().label, c.max_position_deviation, false});
             }
             writeTextAtomically(out_dir / "float_vs_double.csv", csv);
+            if (!options.keep_traces) fs::remove_all(traces);
             render::writePng(out_dir / "float_deviation.png", render::drawBarChart(chart));
         }
         writeTextAtomically(out_dir / "results.csv", csvTable(runs));

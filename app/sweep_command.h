@@ -31,6 +31,9 @@ struct SweepOptions {
     /// A cdlab executable built with CDLAB_USE_FLOAT=ON: every combination is also run by it
     /// (`cdlab run --set ... --trace`) and its frames compared with the double build's.
     std::optional<std::filesystem::path> float_binary;
+    /// Keep DIR/traces/ (every frame of both builds, JSON lines); removed after comparing
+    /// otherwise, since it is large (about 1 MB per run of a few hundred frames).
+    bool keep_traces = false;
     /// Timings in report.md (off: the report is bit-identical from run to run; the CSV keeps
     /// them).
     bool report_timing = true;

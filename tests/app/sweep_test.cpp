@@ -208,6 +208,7 @@ TEST(Sweep, FloatComparisonAgainstTheSameBuildFindsNoDifference) {
         EXPECT_EQ(row.count("error") ? row.at("error") : "", "");
     }
     EXPECT_NE(slurp(o.out_dir / "report.md").find("## Float against double"), std::string::npos);
+    EXPECT_FALSE(fs::exists(o.out_dir / "traces"));  // removed unless --keep-traces
     fs::remove_all(o.out_dir);
 
     o.float_binary = fs::path("/nonexistent/cdlab");
