@@ -95,52 +95,36 @@ std::array<long, 3> countStateColors(const render::Image& image) {
     return counts;
 }
 
-// One extra broad phase fed the world's volumes, beside its brute-force reference.
+// Feeds a broad phase the world's volumes: inserts new proxies, moves the others.
+void feed(collision::BroadPhase& phase, std::size_t& inserted,
+          std::span<const collision::ProxyVolumes> volumes) {
+    for (std::size_t i = 0; i < volumes.size(); ++i) {
+        const auto id = static_cast<collision::ProxyId>(i);
+        if (i < inserted) {
+            phase.move(id, volumes[i]);
+        } else {
+            phase.insert(id, volumes[i]);
+        }
+    }
+    inserted = volumes.size();
+}
+
+// Brute-force references, one per volume type however many broad phases use it.
+struct Reference {
+    std::string name;
+    std::unique_ptr<collision::BroadPhase> phase;
+    std::vector<collision::ProxyPair> pairs;
+    std::size_t inserted = 0;
+};
+
+// One broad phase from `expect.broadphases`, fed the world's volumes beside its reference.
 struct ExtraBroadPhase {
     std::string name;
-    std::string reference_name;
+    std::size_t reference = 0;  // index into the references
     std::unique_ptr<collision::BroadPhase> phase;
-    std::unique_ptr<collision::BroadPhase> reference;
     std::vector<collision::ProxyPair> got;
-    std::vector<collision::ProxyPair> expected;
     std::size_t inserted = 0;
-    std::int64_t steps_checked = 0;
     std::string first_mismatch;  // empty while they agree
-
-    explicit ExtraBroadPhase(const std::string& n) : name(n) {
-        const collision::BroadPhaseEntry* entry = collision::findBroadPhase(n);
-        reference_name = std::string(entry->reference);
-        phase = entry->create();
-        reference = collision::findBroadPhase(entry->reference)->create();
-    }
-
-    void check(const engine::World& world, int frame, std::int64_t step) {
-        if (!first_mismatch.empty()) return;
-        const auto volumes = world.volumes();
-        for (std::size_t i = 0; i < volumes.size(); ++i) {
-            const auto id = static_cast<collision::ProxyId>(i);
-            if (i < inserted) {
-                phase->move(id, volumes[i]);
-                reference->move(id, volumes[i]);
-            } else {
-                phase->insert(id, volumes[i]);
-                reference->insert(id, volumes[i]);
-            }
-        }
-        inserted = volumes.size();
-        collision::BroadPhaseCounters ignored;
-        phase->findPairs(got, ignored);
-        reference->findPairs(expected, ignored);
-        ++steps_checked;
-        const std::string report =
-            describePairMismatch(name, reference_name, got, expected, world.bodies());
-        if (!report.empty()) {
-            std::string oneline = report;
-            std::replace(oneline.begin(), oneline.end(), '\n', ';');
-            first_mismatch = "differs at frame " + std::to_string(frame) + ", step " +
-                             std::to_string(step) + ": " + oneline;
-        }
-    }
 };
 
 struct PairTracker {
@@ -196,8 +180,7 @@ std::string formatDouble(double v) {
 
 }  // namespace
 
-std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames,
-                                 const fs::path& dump_dir) {
+std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames, const fs::path& dump_dir) {
     const engine::Expectations& ex = scene.expect;
     std::vector<CheckRow> rows;
     if (!ex.present) {
@@ -216,8 +199,25 @@ std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames,
     std::vector<double> max_displacement(n, 0.0);
     std::vector<double> max_rotation(n, 0.0);
 
+    std::vector<Reference> references;
     std::vector<ExtraBroadPhase> extra;
-    for (const std::string& name : ex.broad_phases) extra.emplace_back(name);
+    for (const std::string& name : ex.broad_phases) {
+        const collision::BroadPhaseEntry* entry = collision::findBroadPhase(name);
+        ExtraBroadPhase e;
+        e.name = name;
+        e.phase = entry->create();
+        e.reference = references.size();
+        for (std::size_t r = 0; r < references.size(); ++r) {
+            if (references[r].name == entry->reference) e.reference = r;
+        }
+        if (e.reference == references.size()) {
+            references.push_back({std::string(entry->reference),
+                                  collision::findBroadPhase(entry->reference)->create(),
+                                  {},
+                                  0});
+        }
+        extra.push_back(std::move(e));
+    }
     const double energy0 = totalEnergy(world);
     double max_drift = 0;
     int max_drift_frame = 0;
@@ -234,7 +234,23 @@ std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames,
     };
 
     auto observeStep = [&](int frame) {
-        for (ExtraBroadPhase& e : extra) e.check(world, frame, world.stepCount());
+        collision::BroadPhaseCounters ignored;
+        for (Reference& r : references) {
+            feed(*r.phase, r.inserted, world.volumes());
+            r.phase->findPairs(r.pairs, ignored);
+        }
+        for (ExtraBroadPhase& e : extra) {
+            if (!e.first_mismatch.empty()) continue;  // report the first mismatch only
+            feed(*e.phase, e.inserted, world.volumes());
+            e.phase->findPairs(e.got, ignored);
+            std::string report =
+                describePairMismatch(e.name, references[e.reference].name, e.got,
+                                     references[e.reference].pairs, world.bodies());
+            if (report.empty()) continue;
+            std::replace(report.begin(), report.end(), '\n', ';');
+            e.first_mismatch = "differs at frame " + std::to_string(frame) + ", step " +
+                               std::to_string(world.stepCount()) + ": " + report;
+        }
         if (ex.energy_drift_max) {
             const double drift = std::abs(totalEnergy(world) - energy0) /
                                  std::max(std::abs(energy0), kMinReferenceEnergy);
@@ -300,7 +316,8 @@ std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames,
 
     // Rows, in a fixed order.
     if (ex.min_bodies) {
-        CheckRow r{"at least " + std::to_string(*ex.min_bodies) + " bodies", n >= std::size_t(*ex.min_bodies), ""};
+        CheckRow r{"at least " + std::to_string(*ex.min_bodies) + " bodies",
+                   n >= std::size_t(*ex.min_bodies), ""};
         if (!r.pass) r.reason = "the scene has " + std::to_string(n) + " bodies";
         rows.push_back(r);
     }
@@ -313,9 +330,9 @@ std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames,
                 ++count;
             }
         }
-        CheckRow r{"at least " + std::to_string(*ex.min_moving_rotating) +
-                       " bodies moving and rotating",
-                   count >= *ex.min_moving_rotating, ""};
+        CheckRow r{
+            "at least " + std::to_string(*ex.min_moving_rotating) + " bodies moving and rotating",
+            count >= *ex.min_moving_rotating, ""};
         if (!r.pass) {
             r.reason = std::to_string(count) + " of " + std::to_string(n) +
                        " bodies both moved and rotated (> 1 degree) in " + std::to_string(frames) +
@@ -324,8 +341,9 @@ std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames,
         rows.push_back(r);
     }
     for (const ExtraBroadPhase& e : extra) {
-        CheckRow r{"broad phase " + e.name + " equals " + e.reference_name + " every step",
-                   e.first_mismatch.empty(), e.first_mismatch};
+        CheckRow r{
+            "broad phase " + e.name + " equals " + references[e.reference].name + " every step",
+            e.first_mismatch.empty(), e.first_mismatch};
         rows.push_back(r);
     }
     if (ex.energy_drift_max) {
@@ -333,8 +351,7 @@ std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames,
                    max_drift <= double(*ex.energy_drift_max), ""};
         if (!r.pass) {
             r.reason = "relative drift " + formatDouble(max_drift) + " at frame " +
-                       std::to_string(max_drift_frame) + " (E0 = " + formatDouble(energy0) +
-                       " J)";
+                       std::to_string(max_drift_frame) + " (E0 = " + formatDouble(energy0) + " J)";
         }
         rows.push_back(r);
     }
@@ -348,8 +365,9 @@ std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames,
         const PairTracker& t = pair_state[k];
         std::string what;
         if (p.colliding) what += *p.colliding ? "colliding" : "not colliding";
-        if (p.flagged) what += std::string(what.empty() ? "" : ", ") +
-                               (*p.flagged ? "flagged" : "not flagged");
+        if (p.flagged)
+            what +=
+                std::string(what.empty() ? "" : ", ") + (*p.flagged ? "flagged" : "not flagged");
         CheckRow r{"pair " + p.a_name + " / " + p.b_name + " " + what + " at " +
                        (p.every ? "every " : "some ") + frameText(p.frames),
                    false, ""};

@@ -23,7 +23,7 @@ struct CheckOptions {
 struct CheckRow {
     std::string expectation;  ///< e.g. "pair ball0-crate1 colliding in 10..20 (every)"
     bool pass = false;
-    std::string reason;       ///< why it failed (empty on pass); may carry a measured value
+    std::string reason;  ///< why it failed (empty on pass); may carry a measured value
 };
 
 /// Runs `scene` for `frames` frames (frame 0 = initial state) and grades every expectation.

@@ -7,8 +7,6 @@
 //
 //     a -->   gap 2.1 m   <-- b          c (still)
 //    (-1.55)             (1.55)        (0, 2.5, -2)
-#include "check_command.h"
-
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -17,6 +15,8 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+
+#include "check_command.h"
 
 namespace app {
 namespace {
@@ -34,8 +34,8 @@ const std::string kTwoSpheres =
     "  - {name: c, shape: sphere, radius: 0.5, position: [0, 2.5, -2]}\n";
 
 fs::path tempDir(const std::string& name) {
-    const fs::path d = fs::temp_directory_path() /
-                       ("cdlab_check_test_" + name + "_" + std::to_string(::getpid()));
+    const fs::path d =
+        fs::temp_directory_path() / ("cdlab_check_test_" + name + "_" + std::to_string(::getpid()));
     fs::remove_all(d);
     fs::create_directories(d);
     return d;
@@ -52,22 +52,23 @@ const CheckRow* findRow(const std::vector<CheckRow>& rows, const std::string& fr
 
 TEST(Check, ExpectationsThatHoldPass) {
     const fs::path dir = tempDir("pass");
-    const engine::Scene scene = parse(kTwoSpheres +
-                                      "expect:\n"
-                                      "  min_bodies: 3\n"
-                                      "  broadphases: [sap, sphere, grid]\n"
-                                      "  energy_drift_max: 0\n"
-                                      "  pause_dumps: [0, 15]\n"
-                                      "  pairs:\n"
-                                      "    - {a: a, b: b, frames: [0, 10], flagged: false}\n"
-                                      "    - {a: a, b: b, frames: [11, 20], colliding: true}\n"
-                                      "    - {a: b, b: a, frames: [21, 24], colliding: false}\n"
-                                      "    - {a: a, b: c, frames: [0, 24], flagged: false}\n"
-                                      "    - {a: a, b: b, frames: [0, 24], when: any, "
-                                      "colliding: true}\n"
-                                      "  colors:\n"
-                                      "    - {frame: 15, present: [red, green], absent: [yellow]}\n"
-                                      "    - {frame: 0, present: [green], absent: [red, yellow]}\n");
+    const engine::Scene scene =
+        parse(kTwoSpheres +
+              "expect:\n"
+              "  min_bodies: 3\n"
+              "  broadphases: [sap, sphere, grid]\n"
+              "  energy_drift_max: 0\n"
+              "  pause_dumps: [0, 15]\n"
+              "  pairs:\n"
+              "    - {a: a, b: b, frames: [0, 10], flagged: false}\n"
+              "    - {a: a, b: b, frames: [11, 20], colliding: true}\n"
+              "    - {a: b, b: a, frames: [21, 24], colliding: false}\n"
+              "    - {a: a, b: c, frames: [0, 24], flagged: false}\n"
+              "    - {a: a, b: b, frames: [0, 24], when: any, "
+              "colliding: true}\n"
+              "  colors:\n"
+              "    - {frame: 15, present: [red, green], absent: [yellow]}\n"
+              "    - {frame: 0, present: [green], absent: [red, yellow]}\n");
     const std::vector<CheckRow> rows = checkScene(scene, 25, dir);
     ASSERT_EQ(rows.size(), 14u);
     for (const CheckRow& r : rows) {
@@ -131,8 +132,9 @@ TEST(Check, ShortRunsAndMissingSectionsFail) {
 
 TEST(Check, SameSceneSameRows) {
     const fs::path dir = tempDir("det");
-    const engine::Scene scene = parse(kTwoSpheres + "expect:\n  energy_drift_max: 0\n"
-                                                    "  colors:\n    - {frame: 3, absent: [red]}\n");
+    const engine::Scene scene = parse(kTwoSpheres +
+                                      "expect:\n  energy_drift_max: 0\n"
+                                      "  colors:\n    - {frame: 3, absent: [red]}\n");
     const std::vector<CheckRow> a = checkScene(scene, 25, dir);
     const std::vector<CheckRow> b = checkScene(scene, 25, dir);
     ASSERT_EQ(a.size(), b.size());

@@ -37,8 +37,8 @@ const std::string kScene =
     "expect:\n";                                                          // 7
 
 TEST(SceneExpect, AbsentMeansNotPresent) {
-    const Scene s = parseScene(
-        "world: {bounds: {min: [-1, -1, -1], max: [1, 1, 1]}}\nbodies:\n", "x.yaml", ".");
+    const Scene s = parseScene("world: {bounds: {min: [-1, -1, -1], max: [1, 1, 1]}}\nbodies:\n",
+                               "x.yaml", ".");
     EXPECT_FALSE(s.expect.present);
     const Scene empty = parseScene(kScene, "x.yaml", ".");
     EXPECT_TRUE(empty.expect.present);
@@ -90,8 +90,8 @@ TEST(SceneExpect, ParsesEveryKey) {
 }
 
 TEST(SceneExpectErrors, UnknownKeysAtEveryLevel) {
-    EXPECT_SCENE_ERROR(kScene + "  min_body: 3\n", "8:3: expect.min_body: ",
-                       "unknown key 'min_body'");
+    EXPECT_SCENE_ERROR(kScene + "  min_body: 3\n",
+                       "8:3: expect.min_body: ", "unknown key 'min_body'");
     EXPECT_SCENE_ERROR(kScene + "  pairs:\n    - {a: a, b: b, frame: 1, colliding: true}\n",
                        "9:20: expect.pairs[0].frame: ", "unknown key 'frame'");
     EXPECT_SCENE_ERROR(kScene + "  colors:\n    - {frame: 1, colour: [red]}\n",
@@ -124,29 +124,29 @@ TEST(SceneExpectErrors, FramesOutsideTheRun) {
 }
 
 TEST(SceneExpectErrors, ValuesAndContradictions) {
-    EXPECT_SCENE_ERROR(kScene + "  broadphases: [sap, bogus]\n", "8:22: expect.broadphases[1]: ",
-                       "unknown broad phase 'bogus'");
-    EXPECT_SCENE_ERROR(kScene + "  energy_drift_max: -1\n", "8:21: expect.energy_drift_max: ",
-                       "must be >= 0");
-    EXPECT_SCENE_ERROR(kScene + "  energy_drift_max: .nan\n", "8:21: expect.energy_drift_max: ",
-                       "must be finite");
-    EXPECT_SCENE_ERROR(kScene + "  min_bodies: -2\n", "8:15: expect.min_bodies: ",
-                       "must be >= 0");
+    EXPECT_SCENE_ERROR(kScene + "  broadphases: [sap, bogus]\n",
+                       "8:22: expect.broadphases[1]: ", "unknown broad phase 'bogus'");
+    EXPECT_SCENE_ERROR(kScene + "  energy_drift_max: -1\n",
+                       "8:21: expect.energy_drift_max: ", "must be >= 0");
+    EXPECT_SCENE_ERROR(kScene + "  energy_drift_max: .nan\n",
+                       "8:21: expect.energy_drift_max: ", "must be finite");
+    EXPECT_SCENE_ERROR(kScene + "  min_bodies: -2\n", "8:15: expect.min_bodies: ", "must be >= 0");
     EXPECT_SCENE_ERROR(kScene + "  pairs:\n    - {a: a, b: b, frames: 1}\n",
                        "9:7: expect.pairs[0]: ", "needs 'colliding' or 'flagged'");
     EXPECT_SCENE_ERROR(kScene +
                            "  pairs:\n    - {a: a, b: b, frames: 1, colliding: true, "
                            "flagged: false}\n",
                        "9:57: expect.pairs[0].flagged: ", "can never hold");
-    EXPECT_SCENE_ERROR(kScene + "  pairs:\n    - {a: a, b: b, frames: 1, when: always, "
-                                "flagged: true}\n",
+    EXPECT_SCENE_ERROR(kScene +
+                           "  pairs:\n    - {a: a, b: b, frames: 1, when: always, "
+                           "flagged: true}\n",
                        "9:37: expect.pairs[0].when: ", "expected one of: every, any");
     EXPECT_SCENE_ERROR(kScene + "  colors:\n    - {frame: 1, present: [blue]}\n",
                        "9:28: expect.colors[0].present[0]: ", "unknown colour 'blue'");
     EXPECT_SCENE_ERROR(kScene + "  colors:\n    - {frame: 1, present: [red], absent: [red]}\n",
                        "9:7: expect.colors[0]: ", "both present and absent");
-    EXPECT_SCENE_ERROR(kScene + "  colors:\n    - {frame: 1}\n", "9:7: expect.colors[0]: ",
-                       "needs 'present' or 'absent'");
+    EXPECT_SCENE_ERROR(kScene + "  colors:\n    - {frame: 1}\n",
+                       "9:7: expect.colors[0]: ", "needs 'present' or 'absent'");
     EXPECT_SCENE_ERROR(kScene + "  colors:\n    - {frame: 1, present: [red], min_pixels: 0}\n",
                        "9:46: expect.colors[0].min_pixels: ", "must be >= 1");
     EXPECT_SCENE_ERROR(kScene + "  pairs: {a: a}\n", "8:10: expect.pairs: ", "expected a list");
