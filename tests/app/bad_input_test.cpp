@@ -127,7 +127,7 @@ std::vector<BadCase> badCases() {
          kHead + "  - {shape: mesh, file: nan.obj, position: [0, 0, 0]}\n",
          {{"nan.obj", obj_nan}},
          "4:19: bodies[0].file: ",
-         "nan.obj"},
+         "non-finite vertex in './nan.obj'"},
         {"ModelAssimpRejects",
          kHead + "  - {shape: hull, file: garbage.obj, position: [0, 0, 0]}\n",
          {{"garbage.obj", garbage}},
