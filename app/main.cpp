@@ -5,6 +5,7 @@
 #include "bench_broadphase.h"
 #include "bench_ccd.h"
 #include "check_command.h"
+#include "sweep_command.h"
 #include "collision/broad_phase.h"
 #include "query_command.h"
 #include "run_command.h"
@@ -61,6 +62,24 @@ int main(int argc, char** argv) {
     check_cmd->add_option("--out", check_out,
                           "keep pause dumps in DIR (default: a temporary folder, removed)");
     // END check subcommand
+    // BEGIN sweep subcommand
+    app::SweepOptions sweep;
+    std::string sweep_scene;
+    std::vector<std::string> sweep_vary;
+    std::string sweep_out;
+    int sweep_frames = 0;
+    CLI::App* sweep_cmd = cli.add_subcommand(
+        "sweep", "run one scene under every combination of settings: results.csv and report.md "
+                 "with time per frame and stage, flagged pairs, narrow-phase rejections, BV tests");
+    sweep_cmd->add_option("scene", sweep_scene, "scene file (YAML)")->required();
+    sweep_cmd
+        ->add_option("--vary", sweep_vary,
+                     "KEY=V1,V2,... (repeatable); KEY: broadphase, time_step, steps_per_frame")
+        ->expected(1)
+        ->take_all();
+    sweep_cmd->add_option("--out", sweep_out, "output directory")->required();
+    sweep_cmd->add_option("--frames", sweep_frames, "frames per run (overrides the scene)");
+    // END sweep subcommand
     // BEGIN ccd subcommand
     // END ccd subcommand
     // BEGIN query subcommand
@@ -141,6 +160,20 @@ int main(int argc, char** argv) {
         return app::runCheck(check, std::cout, std::cerr);
     }
     // END check dispatch
+    // BEGIN sweep dispatch
+    if (sweep_cmd->parsed()) {
+        sweep.scene = sweep_scene;
+        sweep.out_dir = sweep_out;
+        if (sweep_cmd->count("--frames") > 0) sweep.frames = sweep_frames;
+        try {
+            for (const std::string& v : sweep_vary) sweep.axes.push_back(app::parseSweepAxis(v));
+        } catch (const std::invalid_argument& e) {
+            std::cerr << e.what() << "\n";
+            return 2;
+        }
+        return app::runSweep(sweep, std::cout, std::cerr);
+    }
+    // END sweep dispatch
     // BEGIN ccd dispatch
     // END ccd dispatch
     // BEGIN query dispatch
