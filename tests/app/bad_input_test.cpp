@@ -56,6 +56,9 @@ struct BadCase {
     std::string fragment;
 };
 
+// gtest prints the case by name instead of its bytes.
+void PrintTo(const BadCase& c, std::ostream* os) { *os << c.name; }
+
 std::vector<BadCase> badCases() {
     const std::string obj_points = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
     const std::string obj_flat = "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n";
