@@ -131,7 +131,7 @@ private:
 
     std::string file_;
     fs::path base_dir_;
-    std::map<std::pair<std::string, Real>, std::shared_ptr<const MeshImportOutput>> import_cache_;
+    std::map<std::string, std::shared_ptr<const MeshImportOutput>> import_cache_;  // scale 1
     std::map<std::tuple<std::string, Real, int>, PreparedShape> mesh_cache_;
 };
 
@@ -393,18 +393,37 @@ const PreparedShape& SceneParser::prepareMeshShape(ShapeType type, const std::st
     const auto key = std::make_tuple(canonical.string(), scale, static_cast<int>(type));
     if (const auto it = mesh_cache_.find(key); it != mesh_cache_.end()) return it->second;
 
-    // Errors about the file are reported at the `file:` key. One import per (file, scale), shared
-    // by the hull and mesh bodies made from it.
-    auto import_it = import_cache_.find({canonical.string(), scale});
+    // Errors about the file are reported at the `file:` key. One import per file, at scale 1,
+    // shared by every hull and mesh body made from it: assimp is the slow part (under ASan one OBJ
+    // import costs about half a second, so a scene with many scales of one file took seconds).
+    auto import_it = import_cache_.find(canonical.string());
     if (import_it == import_cache_.end()) {
-        import_it =
-            import_cache_
-                .emplace(std::make_pair(canonical.string(), scale),
-                         std::make_shared<const MeshImportOutput>(importMesh(resolved, scale)))
-                .first;
+        import_it = import_cache_
+                        .emplace(canonical.string(),
+                                 std::make_shared<const MeshImportOutput>(importMesh(resolved, 1)))
+                        .first;
     }
-    const MeshImportOutput& imported = *import_it->second;
-    if (!imported.ok) fail(file_entry.key_node, path, imported.error);
+    // Scaling after the import gives importMesh(file, scale)'s mesh unless rounding at an extreme
+    // scale made a kept triangle degenerate (vertices merge, or the area vanishes) or the file
+    // only works at its scale (a failed import); then that scale is imported on its own, so the
+    // welding and degenerate-triangle rules and the error messages are importMesh's exactly.
+    MeshImportOutput imported = *import_it->second;
+    bool exact = imported.ok;
+    for (Vec3& v : imported.mesh.vertices) {
+        v *= scale;
+        exact = exact && v.allFinite();
+    }
+    for (const auto& t : imported.mesh.triangles) {
+        if (!exact) break;
+        const Vec3& a = imported.mesh.vertices[t[0]];
+        const Vec3& b = imported.mesh.vertices[t[1]];
+        const Vec3& c = imported.mesh.vertices[t[2]];
+        exact = a != b && b != c && a != c && (b - a).cross(c - a).squaredNorm() > 0;
+    }
+    if (!exact) {
+        imported = importMesh(resolved, scale);
+        if (!imported.ok) fail(file_entry.key_node, path, imported.error);
+    }
     const collision::ConvexHullOutput hull = collision::computeConvexHull(imported.mesh.vertices);
     if (!hull.ok) {
         fail(file_entry.key_node, path,

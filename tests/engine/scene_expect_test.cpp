@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <limits>
 #include <string>
 
+#include "engine/mesh_import.h"
 #include "engine/scene.h"
 
 namespace engine {
@@ -150,6 +152,42 @@ TEST(SceneExpectErrors, ValuesAndContradictions) {
     EXPECT_SCENE_ERROR(kScene + "  colors:\n    - {frame: 1, present: [red], min_pixels: 0}\n",
                        "9:46: expect.colors[0].min_pixels: ", "must be >= 1");
     EXPECT_SCENE_ERROR(kScene + "  pairs: {a: a}\n", "8:10: expect.pairs: ", "expected a list");
+}
+
+}  // namespace
+}  // namespace engine
+
+namespace engine {
+namespace {
+
+// Regression (found with the fuzz target): every scale of a mesh file used to be a separate
+// assimp import, about half a second each under ASan. Now a file is imported once and scaled;
+// the mesh must still be exactly importMesh(file, scale)'s, up to the re-centring translation.
+TEST(SceneMeshScale, ScaledAfterImportEqualsImportAtScale) {
+    const std::filesystem::path scenes = std::filesystem::path(CDLAB_SOURCE_DIR) / "scenes";
+    const Real scales[] = {Real(0.71), Real(0.65), Real(1e-3), Real(1e3), Real(0.62)};
+    std::string text = "world: {bounds: {min: [-10, -10, -10], max: [10, 10, 10]}}\nbodies:\n";
+    for (const Real s : scales) {
+        text += "  - {shape: mesh, file: ../assets/torus.obj, position: [0, 0, 0], scale: " +
+                std::to_string(s) + "}\n";
+    }
+    const Scene scene = parseScene(text, "t.yaml", scenes);
+    ASSERT_EQ(scene.bodies.size(), std::size(scales));
+    for (std::size_t i = 0; i < std::size(scales); ++i) {
+        const Real s = std::stod(std::to_string(scales[i]));  // the value the file states
+        const MeshImportOutput direct = importMesh(scenes / "../assets/torus.obj", s);
+        ASSERT_TRUE(direct.ok) << direct.error;
+        const collision::TriangleMesh& got = *scene.bodies[i].shape.mesh;
+        ASSERT_EQ(got.triangles, direct.mesh.triangles) << "scale " << s;
+        ASSERT_EQ(got.vertices.size(), direct.mesh.vertices.size());
+        const Vec3 offset = direct.mesh.vertices[0] - got.vertices[0];  // the centre of mass
+        for (std::size_t v = 0; v < got.vertices.size(); ++v) {
+            const Vec3 d = direct.mesh.vertices[v] - got.vertices[v];
+            // got = direct - com, rounded once: equal offsets up to one rounding of the size.
+            EXPECT_LE((d - offset).norm(), 8 * std::numeric_limits<Real>::epsilon() * 2 * s)
+                << "scale " << s << " vertex " << v;
+        }
+    }
 }
 
 }  // namespace
