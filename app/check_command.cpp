@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <memory>
@@ -357,7 +358,9 @@ std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames, const f
     }
     for (std::size_t k = 0; k < ex.pause_dumps.size(); ++k) {
         const int f = ex.pause_dumps[k];
-        const std::string problem = verifyPauseDump(dump_dir, f, scene);
+        const std::string problem = f >= frames
+                                        ? "the run has only " + std::to_string(frames) + " frames"
+                                        : verifyPauseDump(dump_dir, f, scene);
         rows.push_back({"pause dump at frame " + std::to_string(f), problem.empty(), problem});
     }
     for (std::size_t k = 0; k < ex.pairs.size(); ++k) {
