@@ -5,6 +5,7 @@
 #include "bench_broadphase.h"
 #include "bench_ccd.h"
 #include "bench_convex.h"
+#include "check_command.h"
 #include "collision/broad_phase.h"
 #include "query_command.h"
 #include "run_command.h"
@@ -58,6 +59,20 @@ int main(int argc, char** argv) {
     run_cmd->add_option("--trace", run_trace,
                         "write every frame's body poses and confirmed pairs to FILE (JSON lines)");
 
+    // BEGIN check subcommand
+    app::CheckOptions check;
+    std::vector<std::string> check_scenes;
+    int check_frames = 0;
+    std::string check_out;
+    CLI::App* check_cmd = cli.add_subcommand(
+        "check", "run scenes headless and grade them against their 'expect:' sections: a "
+                 "pass/fail table, exit 0 all pass, 1 any failure, 2 bad input");
+    check_cmd->add_option("scenes", check_scenes, "scene files (YAML)")->required();
+    check_cmd->add_option("--frames", check_frames,
+                          "frames to run (overrides expect.frames and the scene)");
+    check_cmd->add_option("--out", check_out,
+                          "keep pause dumps in DIR (default: a temporary folder, removed)");
+    // END check subcommand
     // BEGIN ccd subcommand
     // END ccd subcommand
     // BEGIN query subcommand
@@ -195,6 +210,14 @@ int main(int argc, char** argv) {
         if (!sweep_float.empty()) sweep.float_binary = sweep_float;
         return app::runSweep(sweep, std::cout, std::cerr);
     }
+    // BEGIN check dispatch
+    if (check_cmd->parsed()) {
+        for (const std::string& sc : check_scenes) check.scenes.emplace_back(sc);
+        if (check_cmd->count("--frames") > 0) check.frames = check_frames;
+        if (!check_out.empty()) check.out_dir = check_out;
+        return app::runCheck(check, std::cout, std::cerr);
+    }
+    // END check dispatch
     // BEGIN ccd dispatch
     // END ccd dispatch
     // BEGIN query dispatch

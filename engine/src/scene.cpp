@@ -125,6 +125,8 @@ private:
     std::vector<Body> parseBody(const YAML::Node& n, std::size_t index, const Scene& scene);
     const PreparedShape& prepareMeshShape(ShapeType type, const std::string& file, Real scale,
                                           const Entry& file_entry, const std::string& path);
+    /// `expect:` (after the bodies, whose names it refers to).
+    void parseExpect(const YAML::Node& n, Scene& scene) const;
     template <typename Place>
     std::vector<Body> repeatBody(const Body& base, const Entry& entry, const std::string& path,
                                  const Scene& scene, Place&& place) const;
@@ -134,7 +136,7 @@ private:
     std::string file_;
     fs::path base_dir_;
     std::vector<SceneOverride> overrides_;
-    std::map<std::pair<std::string, Real>, std::shared_ptr<const MeshImportOutput>> import_cache_;
+    std::map<std::string, std::shared_ptr<const MeshImportOutput>> import_cache_;  // scale 1
     std::map<std::tuple<std::string, Real, int>, PreparedShape> mesh_cache_;
 };
 
@@ -396,18 +398,37 @@ const PreparedShape& SceneParser::prepareMeshShape(ShapeType type, const std::st
     const auto key = std::make_tuple(canonical.string(), scale, static_cast<int>(type));
     if (const auto it = mesh_cache_.find(key); it != mesh_cache_.end()) return it->second;
 
-    // Errors about the file are reported at the `file:` key. One import per (file, scale), shared
-    // by the hull and mesh bodies made from it.
-    auto import_it = import_cache_.find({canonical.string(), scale});
+    // Errors about the file are reported at the `file:` key. One import per file, at scale 1,
+    // shared by every hull and mesh body made from it: assimp is the slow part (under ASan one OBJ
+    // import costs about half a second, so a scene with many scales of one file took seconds).
+    auto import_it = import_cache_.find(canonical.string());
     if (import_it == import_cache_.end()) {
-        import_it =
-            import_cache_
-                .emplace(std::make_pair(canonical.string(), scale),
-                         std::make_shared<const MeshImportOutput>(importMesh(resolved, scale)))
-                .first;
+        import_it = import_cache_
+                        .emplace(canonical.string(),
+                                 std::make_shared<const MeshImportOutput>(importMesh(resolved, 1)))
+                        .first;
     }
-    const MeshImportOutput& imported = *import_it->second;
-    if (!imported.ok) fail(file_entry.key_node, path, imported.error);
+    // Scaling after the import gives importMesh(file, scale)'s mesh unless rounding at an extreme
+    // scale made a kept triangle degenerate (vertices merge, or the area vanishes) or the file
+    // only works at its scale (a failed import); then that scale is imported on its own, so the
+    // welding and degenerate-triangle rules and the error messages are importMesh's exactly.
+    MeshImportOutput imported = *import_it->second;
+    bool exact = imported.ok;
+    for (Vec3& v : imported.mesh.vertices) {
+        v *= scale;
+        exact = exact && v.allFinite();
+    }
+    for (const auto& t : imported.mesh.triangles) {
+        if (!exact) break;
+        const Vec3& a = imported.mesh.vertices[t[0]];
+        const Vec3& b = imported.mesh.vertices[t[1]];
+        const Vec3& c = imported.mesh.vertices[t[2]];
+        exact = a != b && b != c && a != c && (b - a).cross(c - a).squaredNorm() > 0;
+    }
+    if (!exact) {
+        imported = importMesh(resolved, scale);
+        if (!imported.ok) fail(file_entry.key_node, path, imported.error);
+    }
     const collision::ConvexHullOutput hull = collision::computeConvexHull(imported.mesh.vertices);
     if (!hull.ok) {
         fail(file_entry.key_node, path,
@@ -744,6 +765,189 @@ std::vector<Body> SceneParser::repeatBody(const Body& base, const Entry& entry,
     return out;
 }
 
+// BEGIN expect (self-grading scenes)
+// `expect:` states outcomes `cdlab check` verifies. Everything that can be checked without
+// running is checked here: frames inside the run, body names that exist and are unique, broad
+// phase names in the registry, colour names, contradictory pair states.
+void SceneParser::parseExpect(const YAML::Node& n, Scene& scene) const {
+    const std::string path = "expect";
+    Expectations& ex = scene.expect;
+    ex.present = true;
+    if (n.IsNull()) return;  // "expect:" with nothing after it: nothing to check
+    const std::vector<Entry> es =
+        entries(n, path, {"frames", "min_bodies", "min_moving_rotating", "broadphases",
+                          "energy_drift_max", "pause_dumps", "pairs", "colors"});
+    // The run length first: every frame below must lie inside it.
+    if (const Entry* f = find(es, "frames")) {
+        const int v = readInt(f->value, childPath(path, "frames"));
+        if (v < 1) fail(f->value, childPath(path, "frames"), "must be >= 1");
+        ex.frames = v;
+    }
+    const int run_frames = ex.frames.value_or(scene.frames);
+    auto readFrame = [&](const YAML::Node& v, const std::string& p) {
+        const int f = readInt(v, p);
+        if (f < 0 || f >= run_frames) {
+            fail(v, p, "frame out of range (the check runs frames 0.." +
+                           std::to_string(run_frames - 1) + ")");
+        }
+        return f;
+    };
+    auto readFrames = [&](const YAML::Node& v, const std::string& p) {
+        FrameRange r;
+        if (v.IsSequence()) {
+            if (v.size() != 2) fail(v, p, "expected a frame or a range [first, last]");
+            r.first = readFrame(v[0], indexPath(p, 0));
+            r.last = readFrame(v[1], indexPath(p, 1));
+            if (r.last < r.first) fail(v[1], indexPath(p, 1), "must be >= the first frame");
+        } else {
+            r.first = r.last = readFrame(v, p);
+        }
+        return r;
+    };
+    auto readCount = [&](const YAML::Node& v, const std::string& p) {
+        const int c = readInt(v, p);
+        if (c < 0) fail(v, p, "must be >= 0");
+        return c;
+    };
+    auto readList = [&](const YAML::Node& v, const std::string& p) {
+        if (!v.IsSequence()) fail(v, p, "expected a list");
+        std::vector<YAML::Node> out;
+        for (std::size_t i = 0; i < v.size(); ++i) out.push_back(v[i]);
+        return out;
+    };
+    // Body names -> index; a name given to several bodies cannot be referred to.
+    std::map<std::string, std::vector<BodyId>> by_name;
+    for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+        by_name[scene.bodies[i].name].push_back(static_cast<BodyId>(i));
+    }
+    auto readBody = [&](const YAML::Node& v, const std::string& p) {
+        const std::string name = readString(v, p);
+        const auto it = by_name.find(name);
+        if (it == by_name.end()) fail(v, p, "no body is named '" + name + "'");
+        if (it->second.size() > 1) {
+            fail(v, p, "the name '" + name + "' is given to " +
+                           std::to_string(it->second.size()) + " bodies");
+        }
+        return it->second.front();
+    };
+    auto readState = [&](const YAML::Node& v, const std::string& p) {
+        const std::string c = readString(v, p);
+        if (c == "green") return BodyState::Apart;
+        if (c == "yellow") return BodyState::Flagged;
+        if (c == "red") return BodyState::Colliding;
+        fail(v, p, "unknown colour '" + c + "' (expected one of: green, yellow, red)");
+    };
+
+    for (const Entry& e : es) {
+        const std::string p = childPath(path, e.key);
+        if (e.key == "min_bodies") {
+            ex.min_bodies = readCount(e.value, p);
+        } else if (e.key == "min_moving_rotating") {
+            ex.min_moving_rotating = readCount(e.value, p);
+        } else if (e.key == "energy_drift_max") {
+            const Real d = readReal(e.value, p);
+            if (!(d >= 0)) fail(e.value, p, "must be >= 0 (relative drift)");
+            ex.energy_drift_max = d;
+        } else if (e.key == "broadphases") {
+            const std::vector<YAML::Node> list = readList(e.value, p);
+            for (std::size_t i = 0; i < list.size(); ++i) {
+                const std::string name = readString(list[i], indexPath(p, i));
+                if (collision::findBroadPhase(name) == nullptr) {
+                    fail(list[i], indexPath(p, i),
+                         "unknown broad phase '" + name +
+                             "' (expected one of: " + collision::broadPhaseNames() + ")");
+                }
+                ex.broad_phases.push_back(name);
+            }
+        } else if (e.key == "pause_dumps") {
+            const std::vector<YAML::Node> list = readList(e.value, p);
+            for (std::size_t i = 0; i < list.size(); ++i) {
+                ex.pause_dumps.push_back(readFrame(list[i], indexPath(p, i)));
+            }
+        } else if (e.key == "pairs") {
+            const std::vector<YAML::Node> list = readList(e.value, p);
+            for (std::size_t i = 0; i < list.size(); ++i) {
+                const std::string ip = indexPath(p, i);
+                const std::vector<Entry> pe =
+                    entries(list[i], ip, {"a", "b", "frames", "when", "colliding", "flagged"});
+                PairExpectation pair;
+                pair.line = list[i].Mark().line + 1;
+                pair.column = list[i].Mark().column + 1;
+                const Entry& a = require(pe, "a", list[i], ip);
+                const Entry& b = require(pe, "b", list[i], ip);
+                pair.a = readBody(a.value, childPath(ip, "a"));
+                pair.b = readBody(b.value, childPath(ip, "b"));
+                pair.a_name = a.value.Scalar();
+                pair.b_name = b.value.Scalar();
+                if (pair.a == pair.b) fail(b.value, childPath(ip, "b"), "must differ from 'a'");
+                pair.frames = readFrames(require(pe, "frames", list[i], ip).value,
+                                         childPath(ip, "frames"));
+                if (const Entry* w = find(pe, "when")) {
+                    const std::string when = readString(w->value, childPath(ip, "when"));
+                    if (when != "every" && when != "any") {
+                        fail(w->value, childPath(ip, "when"),
+                             "unknown '" + when + "' (expected one of: every, any)");
+                    }
+                    pair.every = when == "every";
+                }
+                if (const Entry* c = find(pe, "colliding")) {
+                    pair.colliding = readBool(c->value, childPath(ip, "colliding"));
+                }
+                if (const Entry* f = find(pe, "flagged")) {
+                    pair.flagged = readBool(f->value, childPath(ip, "flagged"));
+                }
+                if (!pair.colliding && !pair.flagged) {
+                    fail(list[i], ip, "needs 'colliding' or 'flagged' (or both)");
+                }
+                // Confirmed pairs are a subset of flagged pairs.
+                if (pair.colliding == true && pair.flagged == false) {
+                    fail(find(pe, "flagged")->value, childPath(ip, "flagged"),
+                         "a colliding pair is always flagged: 'colliding: true' with "
+                         "'flagged: false' can never hold");
+                }
+                ex.pairs.push_back(std::move(pair));
+            }
+        } else if (e.key == "colors") {
+            const std::vector<YAML::Node> list = readList(e.value, p);
+            for (std::size_t i = 0; i < list.size(); ++i) {
+                const std::string ip = indexPath(p, i);
+                const std::vector<Entry> ce =
+                    entries(list[i], ip, {"frame", "present", "absent", "min_pixels"});
+                ColorExpectation color;
+                color.line = list[i].Mark().line + 1;
+                color.column = list[i].Mark().column + 1;
+                color.frame =
+                    readFrame(require(ce, "frame", list[i], ip).value, childPath(ip, "frame"));
+                for (const Entry& c : ce) {
+                    const std::string cp = childPath(ip, c.key);
+                    if (c.key == "present" || c.key == "absent") {
+                        const std::vector<YAML::Node> names = readList(c.value, cp);
+                        for (std::size_t k = 0; k < names.size(); ++k) {
+                            const BodyState st = readState(names[k], indexPath(cp, k));
+                            (c.key == "present" ? color.present : color.absent).push_back(st);
+                        }
+                    } else if (c.key == "min_pixels") {
+                        color.min_pixels = readInt(c.value, cp);
+                        if (color.min_pixels < 1) fail(c.value, cp, "must be >= 1");
+                    }
+                }
+                for (const BodyState st : color.present) {
+                    for (const BodyState other : color.absent) {
+                        if (st == other) {
+                            fail(list[i], ip, "a colour cannot be both present and absent");
+                        }
+                    }
+                }
+                if (color.present.empty() && color.absent.empty()) {
+                    fail(list[i], ip, "needs 'present' or 'absent'");
+                }
+                ex.colors.push_back(std::move(color));
+            }
+        }
+    }
+}
+// END expect (self-grading scenes)
+
 Scene SceneParser::parse(const std::string& text) {
     YAML::Node root;
     try {
@@ -760,10 +964,11 @@ Scene SceneParser::parse(const std::string& text) {
     scene.name = fs::path(file_).stem().string();
     if (!root.IsMap()) {
         fail(root, "scene",
-             "expected a mapping with keys: world, broadphase, output, camera, draw, bodies");
+             "expected a mapping with keys: world, broadphase, output, camera, draw, bodies, "
+             "expect");
     }
-    const std::vector<Entry> es =
-        entries(root, "", {"world", "broadphase", "output", "camera", "draw", "bodies"});
+    const std::vector<Entry> es = entries(
+        root, "", {"world", "broadphase", "output", "camera", "draw", "bodies", "expect"});
     parseWorld(require(es, "world", root, "").value, scene);
     for (const Entry& e : es) {
         if (e.key == "broadphase") {
@@ -789,6 +994,7 @@ Scene SceneParser::parse(const std::string& text) {
             }
         }
     }
+    if (const Entry* e = find(es, "expect")) parseExpect(e->value, scene);
     return scene;
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -36,6 +37,52 @@ struct DrawSettings {
     bool structure = false;  ///< the broad phase's own structure (cells, intervals, nodes)
 };
 
+// BEGIN expect (self-grading scenes)
+/// A frame or an inclusive frame range [first, last] of a run (frame 0 is the initial state).
+struct FrameRange {
+    int first = 0;
+    int last = 0;
+};
+
+/// `expect.pairs[i]`: what must hold for one named pair of bodies over a frame range.
+struct PairExpectation {
+    BodyId a = 0;                  ///< body index; a != b
+    BodyId b = 0;
+    std::string a_name;            ///< as written in the scene, for reports
+    std::string b_name;
+    FrameRange frames;
+    bool every = true;             ///< true: at every frame of the range; false: at some frame
+    std::optional<bool> colliding; ///< confirmed by the narrow phase (or must not be)
+    std::optional<bool> flagged;   ///< flagged by the broad phase (or must not be)
+    int line = 0;                  ///< 1-based position of the entry in the scene file
+    int column = 0;
+};
+
+/// `expect.colors[i]`: a frame rendered without HUD, counting pixels of the state colours.
+struct ColorExpectation {
+    int frame = 0;
+    std::vector<BodyState> present;  ///< each needs at least min_pixels pixels of its colour
+    std::vector<BodyState> absent;   ///< each must have fewer than min_pixels pixels
+    int min_pixels = 20;
+    int line = 0;
+    int column = 0;
+};
+
+/// The optional top-level `expect:` section: outcomes `cdlab check` verifies. Frames are
+/// validated against `frames` (or the scene's frame count); body names must exist (unique).
+struct Expectations {
+    bool present = false;             ///< the scene has an `expect:` section
+    std::optional<int> frames;        ///< frames to run for the check (default: scene.frames)
+    std::optional<int> min_bodies;
+    std::optional<int> min_moving_rotating;  ///< bodies displaced and rotated by the last frame
+    std::vector<std::string> broad_phases;   ///< each must equal its brute reference every step
+    std::optional<Real> energy_drift_max;    ///< max |E(t) - E(0)| / |E(0)|, E kinetic+potential
+    std::vector<int> pause_dumps;            ///< frames whose pause PNG + JSON must be written
+    std::vector<PairExpectation> pairs;
+    std::vector<ColorExpectation> colors;
+};
+// END expect (self-grading scenes)
+
 struct Scene {
     std::string name;               ///< file stem
     WorldSettings world;
@@ -45,6 +92,7 @@ struct Scene {
     CameraSettings camera;
     DrawSettings draw;
     std::vector<Body> bodies;
+    Expectations expect;            ///< `expect:` (self-grading), empty when absent
 };
 
 /// A bad scene file. what() is "FILE:LINE:COL: key.path: what is wrong" (1-based line and column).

@@ -1,0 +1,232 @@
+// tests/app/check_test.cpp -- `cdlab check`: a scene whose expectations hold passes, one whose
+// expectations are wrong fails with the reason, bad input exits 2; and through the binary.
+//
+// The test scene: two unit-diameter spheres 3.1 m apart closing at 2 m/s along x, so they touch
+// at t = 1.05 s and pass through each other (no response) until t = 2.05 s; dt = 0.1 s, one step
+// per frame, so they collide in frames 11..20 and nowhere else. A third sphere stays far away.
+//
+//     a -->   gap 2.1 m   <-- b          c (still)
+//    (-1.55)             (1.55)        (0, 2.5, -2)
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "check_command.h"
+
+namespace app {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kTwoSpheres =
+    "world: {bounds: {min: [-4, -4, -4], max: [4, 4, 4]}, time_step: 0.1, frames: 25}\n"
+    "output: {width: 160, height: 120, fps: 10}\n"
+    "camera: {position: [0, 0, 12], look_at: [0, 0, 0]}\n"
+    "draw: {volumes: [aabb]}\n"
+    "bodies:\n"
+    "  - {name: a, shape: sphere, radius: 0.5, position: [-1.55, 0, 0], velocity: [1, 0, 0]}\n"
+    "  - {name: b, shape: sphere, radius: 0.5, position: [1.55, 0, 0], velocity: [-1, 0, 0]}\n"
+    "  - {name: c, shape: sphere, radius: 0.5, position: [0, 2.5, -2]}\n";
+
+fs::path tempDir(const std::string& name) {
+    const fs::path d =
+        fs::temp_directory_path() / ("cdlab_check_test_" + name + "_" + std::to_string(::getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
+engine::Scene parse(const std::string& text) { return engine::parseScene(text, "t.yaml", "."); }
+
+const CheckRow* findRow(const std::vector<CheckRow>& rows, const std::string& fragment) {
+    for (const CheckRow& r : rows) {
+        if (r.expectation.find(fragment) != std::string::npos) return &r;
+    }
+    return nullptr;
+}
+
+TEST(Check, ExpectationsThatHoldPass) {
+    const fs::path dir = tempDir("pass");
+    const engine::Scene scene =
+        parse(kTwoSpheres +
+              "expect:\n"
+              "  min_bodies: 3\n"
+              "  broadphases: [sap, sphere, grid]\n"
+              "  energy_drift_max: 0\n"
+              "  pause_dumps: [0, 15]\n"
+              "  pairs:\n"
+              "    - {a: a, b: b, frames: [0, 10], flagged: false}\n"
+              "    - {a: a, b: b, frames: [11, 20], colliding: true}\n"
+              "    - {a: b, b: a, frames: [21, 24], colliding: false}\n"
+              "    - {a: a, b: c, frames: [0, 24], flagged: false}\n"
+              "    - {a: a, b: b, frames: [0, 24], when: any, "
+              "colliding: true}\n"
+              "  colors:\n"
+              "    - {frame: 15, present: [red, green], absent: [yellow]}\n"
+              "    - {frame: 0, present: [green], absent: [red, yellow]}\n");
+    const std::vector<CheckRow> rows = checkScene(scene, 25, dir);
+    ASSERT_EQ(rows.size(), 14u);
+    for (const CheckRow& r : rows) {
+        EXPECT_TRUE(r.pass) << r.expectation << ": " << r.reason;
+        EXPECT_TRUE(r.reason.empty()) << r.reason;
+    }
+    EXPECT_TRUE(fs::exists(dir / "pause_0.png"));
+    EXPECT_TRUE(fs::exists(dir / "pause_15.json"));
+    fs::remove_all(dir);
+}
+
+TEST(Check, WrongExpectationsFailWithTheReason) {
+    const fs::path dir = tempDir("fail");
+    // Gravity makes semi-implicit Euler drift in energy; nothing rotates.
+    std::string text = kTwoSpheres;
+    text.replace(text.find("frames: 25}"), 11, "frames: 25, gravity: [0, -9.81, 0]}");
+    const engine::Scene scene = parse(text +
+                                      "expect:\n"
+                                      "  min_bodies: 4\n"
+                                      "  min_moving_rotating: 1\n"
+                                      "  energy_drift_max: 1e-12\n"
+                                      "  pairs:\n"
+                                      "    - {a: a, b: b, frames: [5, 12], colliding: true}\n"
+                                      "    - {a: a, b: c, frames: [0, 24], when: any, "
+                                      "flagged: true}\n"
+                                      "  colors:\n"
+                                      "    - {frame: 0, present: [red]}\n");
+    const std::vector<CheckRow> rows = checkScene(scene, 25, dir);
+    ASSERT_EQ(rows.size(), 6u);
+    for (const CheckRow& r : rows) EXPECT_FALSE(r.pass) << r.expectation;
+    EXPECT_EQ(findRow(rows, "at least 4 bodies")->reason, "the scene has 3 bodies");
+    EXPECT_EQ(findRow(rows, "moving and rotating")->reason,
+              "0 of 3 bodies both moved and rotated (> 1 degree) in 25 frames");
+    EXPECT_EQ(findRow(rows, "energy")->reason.rfind("relative drift ", 0), 0u)
+        << findRow(rows, "energy")->reason;
+    EXPECT_EQ(findRow(rows, "pair a / b colliding")->reason, "does not hold at frame 5");
+    EXPECT_EQ(findRow(rows, "pair a / c")->reason, "holds at no frame of the range");
+    const std::string colour = findRow(rows, "colours red")->reason;
+    EXPECT_EQ(colour, "red: 0 pixels, need 20");
+    fs::remove_all(dir);
+}
+
+TEST(Check, ShortRunsAndMissingSectionsFail) {
+    const fs::path dir = tempDir("short");
+    std::vector<CheckRow> rows = checkScene(parse(kTwoSpheres), 25, dir);
+    ASSERT_EQ(rows.size(), 1u);
+    EXPECT_FALSE(rows[0].pass);
+    EXPECT_EQ(rows[0].reason, "the scene has no 'expect:' section");
+
+    rows = checkScene(parse(kTwoSpheres + "expect:\n  pairs:\n"
+                                          "    - {a: a, b: b, frames: [11, 20], colliding: true}\n"
+                                          "  colors:\n    - {frame: 15, present: [red]}\n"
+                                          "  pause_dumps: [14]\n"),
+                      12, dir);
+    ASSERT_EQ(rows.size(), 3u);
+    for (const CheckRow& r : rows) {
+        EXPECT_FALSE(r.pass) << r.expectation;
+        EXPECT_EQ(r.reason, "the run has only 12 frames") << r.expectation;
+    }
+    fs::remove_all(dir);
+}
+
+TEST(Check, SameSceneSameRows) {
+    const fs::path dir = tempDir("det");
+    const engine::Scene scene = parse(kTwoSpheres +
+                                      "expect:\n  energy_drift_max: 0\n"
+                                      "  colors:\n    - {frame: 3, absent: [red]}\n");
+    const std::vector<CheckRow> a = checkScene(scene, 25, dir);
+    const std::vector<CheckRow> b = checkScene(scene, 25, dir);
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        EXPECT_EQ(a[i].expectation, b[i].expectation);
+        EXPECT_EQ(a[i].pass, b[i].pass);
+        EXPECT_EQ(a[i].reason, b[i].reason);
+    }
+    fs::remove_all(dir);
+}
+
+// --- through the binary ---
+
+struct Result {
+    int exit_code = -1;
+    std::string out;
+    std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+}
+
+Result runCdlab(const std::string& args, const fs::path& work) {
+    const fs::path out = work / "stdout.txt";
+    const fs::path err = work / "stderr.txt";
+    const std::string cmd = std::string("cd ") + CDLAB_SOURCE_DIR + " && " + CDLAB_BINARY + " " +
+                            args + " > " + out.string() + " 2> " + err.string() + " < /dev/null";
+    const int status = std::system(cmd.c_str());
+    Result r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+}
+
+TEST(CheckCli, ExitCodesAndTable) {
+    const fs::path work = tempDir("cli");
+    const fs::path good = work / "good.yaml";
+    const fs::path bad = work / "wrong.yaml";
+    const fs::path broken = work / "broken.yaml";
+    std::ofstream(good) << kTwoSpheres
+                        << "expect:\n  pairs:\n"
+                           "    - {a: a, b: b, frames: [11, 20], colliding: true}\n";
+    std::ofstream(bad) << kTwoSpheres
+                       << "expect:\n  pairs:\n"
+                          "    - {a: a, b: b, frames: [9, 20], colliding: true}\n";
+    std::ofstream(broken) << kTwoSpheres << "expect:\n  pairs:\n"
+                          << "    - {a: a, b: zz, frames: 1, colliding: true}\n";
+
+    Result r = runCdlab("check " + good.string(), work);
+    EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+    EXPECT_NE(r.out.find("pair a / b colliding at every frames 11..20  pass"), std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("1 scene, 1 expectations, 0 failed"), std::string::npos) << r.out;
+
+    r = runCdlab("check " + good.string() + " " + bad.string(), work);
+    EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+    EXPECT_NE(r.out.find("FAIL    does not hold at frame 9"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("2 scenes, 2 expectations, 1 failed"), std::string::npos) << r.out;
+
+    // A shorter run than the expectations need is a failure, not bad input.
+    r = runCdlab("check --frames 5 " + good.string(), work);
+    EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+    EXPECT_NE(r.out.find("the run has only 5 frames"), std::string::npos) << r.out;
+
+    // Bad input: nothing runs, the precise message, exit 2.
+    r = runCdlab("check " + good.string() + " " + broken.string(), work);
+    EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+    EXPECT_NE(r.err.find("broken.yaml:11:17: expect.pairs[0].b: no body is named 'zz'"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(r.out, "");
+    r = runCdlab("check --frames 0 " + good.string(), work);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("--frames: must be >= 1"), std::string::npos) << r.err;
+    r = runCdlab("check", work);
+    EXPECT_EQ(r.exit_code, 2);
+
+    // --out keeps the pause dumps.
+    const fs::path dumps = work / "dumps";
+    std::ofstream(good, std::ios::app) << "  pause_dumps: [2]\n";
+    r = runCdlab("check --out " + dumps.string() + " " + good.string(), work);
+    EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+    EXPECT_TRUE(fs::exists(dumps / "0_good" / "pause_2.png"));
+    EXPECT_TRUE(fs::exists(dumps / "0_good" / "pause_2.json"));
+    fs::remove_all(work);
+}
+
+}  // namespace
+}  // namespace app
