@@ -95,22 +95,22 @@ struct Builder {
 
 // The tandem traversal (Gottschalk 1996 §5): pop a node pair, test the volumes, and at two leaves
 // test their triangles; otherwise descend the node with the larger volume (a leaf never
-// descends). kFirstOnly stops at the first intersecting triangle pair.
-template <class BV, bool kFirstOnly>
-bool traverse(const Bvh<BV>& a, const Bvh<BV>& b, const Pose& b_in_a, BvhQueryStats* stats,
-              std::vector<TrianglePair>* pairs) {
+// descends). Every intersecting triangle pair goes to on_pair(i, j, ta, tb) (leaf-order indices,
+// corners in A's frame), which returns true to stop. Returns true when stopped.
+template <class BV, class OnPair>
+bool traverse(const Bvh<BV>& a, const Bvh<BV>& b, const BvhTransform& x, BvhQueryStats* stats,
+              OnPair&& on_pair) {
     const auto& na = a.nodes();
     const auto& nb = b.nodes();
     if (na.empty() || nb.empty()) return false;
-    const BvhTransform x = makeBvhTransform(b_in_a, a.scale(), b.scale());
     std::int64_t bv_tests = 0;
     std::int64_t tri_tests = 0;
-    bool found = false;
+    bool stopped = false;
     // Depth-first with an explicit stack; its size is bounded by depth(a) + depth(b) + 1.
     std::vector<std::pair<std::int32_t, std::int32_t>> stack;
     stack.reserve(static_cast<std::size_t>(2 * (a.depth() + b.depth()) + 4));
     stack.emplace_back(0, 0);
-    while (!stack.empty()) {
+    while (!stack.empty() && !stopped) {
         const auto [ia, ib] = stack.back();
         stack.pop_back();
         const auto& node_a = na[static_cast<std::size_t>(ia)];
@@ -118,24 +118,20 @@ bool traverse(const Bvh<BV>& a, const Bvh<BV>& b, const Pose& b_in_a, BvhQuerySt
         ++bv_tests;
         if (!BvTraits<BV>::overlaps(node_a.volume, node_b.volume, x)) continue;
         if (node_a.isLeaf() && node_b.isLeaf()) {
-            for (std::int32_t j = node_b.first; j < node_b.first + node_b.count; ++j) {
+            for (std::int32_t j = node_b.first; j < node_b.first + node_b.count && !stopped; ++j) {
                 const auto& tb = b.leafTriangle(j);
-                const Vec3 p2 = x.apply(tb[0]);
-                const Vec3 q2 = x.apply(tb[1]);
-                const Vec3 r2 = x.apply(tb[2]);
+                const std::array<Vec3, 3> moved{x.apply(tb[0]), x.apply(tb[1]), x.apply(tb[2])};
                 for (std::int32_t i = node_a.first; i < node_a.first + node_a.count; ++i) {
                     const auto& ta = a.leafTriangle(i);
                     ++tri_tests;
-                    if (!testTriangleTriangle(ta[0], ta[1], ta[2], p2, q2, r2)) continue;
-                    found = true;
-                    if constexpr (kFirstOnly) {
-                        stack.clear();
+                    if (!testTriangleTriangle(ta[0], ta[1], ta[2], moved[0], moved[1], moved[2])) {
+                        continue;
+                    }
+                    if (on_pair(i, j, ta, moved)) {
+                        stopped = true;
                         break;
-                    } else {
-                        pairs->push_back({a.leafTriangleId(i), b.leafTriangleId(j)});
                     }
                 }
-                if (kFirstOnly && found) break;
             }
             continue;
         }
@@ -152,8 +148,64 @@ bool traverse(const Bvh<BV>& a, const Bvh<BV>& b, const Pose& b_in_a, BvhQuerySt
         stats->bv_tests += bv_tests;
         stats->triangle_tests += tri_tests;
     }
-    if (pairs) std::sort(pairs->begin(), pairs->end());  // each triangle is in one leaf: unique
-    return found;
+    return stopped;
+}
+
+// The tree-against-one-volume traversal: every leaf triangle whose node volumes all overlap
+// `volume` (in B's frame, placed by x) goes to on_triangle(i, corners) (leaf order), which returns
+// true to stop. Returns true when stopped.
+template <class BV, class OnTriangle>
+bool traverseVolume(const Bvh<BV>& a, const BV& volume, const BvhTransform& x,
+                    BvhQueryStats* stats, OnTriangle&& on_triangle) {
+    const auto& na = a.nodes();
+    if (na.empty()) return false;
+    std::int64_t bv_tests = 0;
+    bool stopped = false;
+    std::vector<std::int32_t> stack;
+    stack.reserve(static_cast<std::size_t>(a.depth() + 2));
+    stack.push_back(0);
+    while (!stack.empty() && !stopped) {
+        const std::int32_t ia = stack.back();
+        stack.pop_back();
+        const auto& node = na[static_cast<std::size_t>(ia)];
+        ++bv_tests;
+        if (!BvTraits<BV>::overlaps(node.volume, volume, x)) continue;
+        if (node.isLeaf()) {
+            for (std::int32_t i = node.first; i < node.first + node.count; ++i) {
+                if (on_triangle(i, a.leafTriangle(i))) {
+                    stopped = true;
+                    break;
+                }
+            }
+            continue;
+        }
+        stack.push_back(node.right);
+        stack.push_back(ia + 1);
+    }
+    if (stats) stats->bv_tests += bv_tests;
+    return stopped;
+}
+
+// The closed surface of the box [lo, hi] as 12 triangles (36 corners): the fits that weight by
+// triangle area (OBB, RSS) see a box, not a point cloud.
+std::vector<Vec3> boxSurfaceCorners(const Vec3& lo, const Vec3& hi) {
+    auto corner = [&](int bits) {
+        return Vec3((bits & 1) ? hi.x() : lo.x(), (bits & 2) ? hi.y() : lo.y(),
+                    (bits & 4) ? hi.z() : lo.z());
+    };
+    std::vector<Vec3> out;
+    out.reserve(36);
+    for (int axis = 0; axis < 3; ++axis) {
+        const int u = 1 << ((axis + 1) % 3);
+        const int v = 1 << ((axis + 2) % 3);
+        for (int side = 0; side < 2; ++side) {
+            const int base = side ? (1 << axis) : 0;
+            for (const int bits : {base, base | u, base | u | v, base, base | u | v, base | v}) {
+                out.push_back(corner(bits));
+            }
+        }
+    }
+    return out;
 }
 
 template <class BV>
@@ -177,6 +229,38 @@ public:
         CDLAB_ASSERT(other != nullptr, "BVH query between different volume types");
         if (other == nullptr) return {};
         return intersectBvhBvh(tree_, other->tree_, b_in_a, stats);
+    }
+    std::int32_t triangleCount() const override { return tree_.triangleCount(); }
+    bool sameVolumeType(const MeshBvh& b) const override {
+        return dynamic_cast<const MeshBvhOf<BV>*>(&b) != nullptr;
+    }
+    bool visitIntersecting(const MeshBvh& b, const Mat3& rotation, const Vec3& translation,
+                           TrianglePairVisitor& visitor, BvhQueryStats* stats) const override {
+        const auto* other = dynamic_cast<const MeshBvhOf<BV>*>(&b);
+        CDLAB_ASSERT(other != nullptr, "BVH query between different volume types");
+        if (other == nullptr) return false;
+        const Bvh<BV>& tb = other->tree_;
+        const BvhTransform x = makeBvhTransform(rotation, translation, tree_.scale(), tb.scale());
+        return traverse(tree_, tb, x, stats,
+                        [&](std::int32_t i, std::int32_t j, const std::array<Vec3, 3>& ta,
+                            const std::array<Vec3, 3>& moved) {
+                            return visitor.visit(tree_.leafTriangleId(i), ta,
+                                                 tb.leafTriangleId(j), moved);
+                        });
+    }
+    bool visitNearBox(const Vec3& box_min, const Vec3& box_max, const Mat3& rotation,
+                      const Vec3& translation, TriangleVisitor& visitor,
+                      BvhQueryStats* stats) const override {
+        if (tree_.nodes().empty()) return false;
+        const Real box_scale =
+            (box_max - box_min).maxCoeff() +
+            std::max(box_min.cwiseAbs().maxCoeff(), box_max.cwiseAbs().maxCoeff());
+        const BV volume = BvTraits<BV>::fit(boxSurfaceCorners(box_min, box_max));
+        const BvhTransform x = makeBvhTransform(rotation, translation, tree_.scale(), box_scale);
+        return traverseVolume(tree_, volume, x, stats,
+                              [&](std::int32_t i, const std::array<Vec3, 3>& corners) {
+                                  return visitor.visit(tree_.leafTriangleId(i), corners);
+                              });
     }
 
 private:
@@ -320,14 +404,24 @@ bool Bvh<BV>::validate(std::string* error) const {
 
 template <class BV>
 bool testBvhBvh(const Bvh<BV>& a, const Bvh<BV>& b, const Pose& b_in_a, BvhQueryStats* stats) {
-    return traverse<BV, true>(a, b, b_in_a, stats, nullptr);
+    const BvhTransform x = makeBvhTransform(b_in_a, a.scale(), b.scale());
+    return traverse(a, b, x, stats,
+                    [](std::int32_t, std::int32_t, const std::array<Vec3, 3>&,
+                       const std::array<Vec3, 3>&) { return true; });
 }
 
 template <class BV>
 std::vector<TrianglePair> intersectBvhBvh(const Bvh<BV>& a, const Bvh<BV>& b, const Pose& b_in_a,
                                           BvhQueryStats* stats) {
     std::vector<TrianglePair> pairs;
-    traverse<BV, false>(a, b, b_in_a, stats, &pairs);
+    const BvhTransform x = makeBvhTransform(b_in_a, a.scale(), b.scale());
+    traverse(a, b, x, stats,
+             [&](std::int32_t i, std::int32_t j, const std::array<Vec3, 3>&,
+                 const std::array<Vec3, 3>&) {
+                 pairs.push_back({a.leafTriangleId(i), b.leafTriangleId(j)});
+                 return false;
+             });
+    std::sort(pairs.begin(), pairs.end());  // each triangle is in one leaf: unique
     return pairs;
 }
 

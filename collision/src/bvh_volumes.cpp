@@ -90,9 +90,14 @@ Mat3 principalAxes(const std::vector<Vec3>& corners) {
 }  // namespace
 
 BvhTransform makeBvhTransform(const Pose& b_in_a, Real scale_a, Real scale_b) {
+    return makeBvhTransform(b_in_a.rotation(), b_in_a.position, scale_a, scale_b);
+}
+
+BvhTransform makeBvhTransform(const Mat3& rotation, const Vec3& translation, Real scale_a,
+                              Real scale_b) {
     BvhTransform x;
-    x.r = b_in_a.rotation();
-    x.t = b_in_a.position;
+    x.r = rotation;
+    x.t = translation;
     x.identity = x.r == Mat3::Identity();
     x.tol = kBvhOverlapSlack * (scale_a + scale_b + x.t.cwiseAbs().maxCoeff());
     for (int k = 0; k < kKdopDirectionCount; ++k) {

@@ -70,6 +70,9 @@ struct BvhTransform {
 
 /// `scale_a`, `scale_b`: the meshes' length scales (Bvh::scale()).
 BvhTransform makeBvhTransform(const Pose& b_in_a, Real scale_a, Real scale_b);
+/// The same from a rotation matrix (orthonormal) and a translation: p_a = rotation p_b + t.
+BvhTransform makeBvhTransform(const Mat3& rotation, const Vec3& translation, Real scale_a,
+                              Real scale_b);
 
 /// Separating-axis test of two boxes (Gottschalk, Lin, Manocha 1996 §4; RTCD 4.4.1) in A's box
 /// frame: `a`, `b` half extents, `rot` B's axes in A's box frame, `t` B's centre there. With

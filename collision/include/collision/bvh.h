@@ -171,7 +171,26 @@ std::vector<TrianglePair> intersectMeshMeshBruteForce(const TriangleMesh& a, con
                                                       const Pose& b_in_a,
                                                       BvhQueryStats* stats = nullptr);
 
-/// A Bvh of a volume type chosen at run time by name (CLI, scenes, benchmarks).
+/// Receives the intersecting triangle pairs of MeshBvh::visitIntersecting, all corners in A's
+/// frame (B's moved by the query transform).
+class TrianglePairVisitor {
+public:
+    virtual ~TrianglePairVisitor() = default;
+    /// Triangle `a` of mesh A (mesh index, corners `ta`) touches or crosses triangle `b` of mesh B
+    /// (corners `tb`). Return true to stop the traversal.
+    virtual bool visit(std::int32_t a, const std::array<Vec3, 3>& ta, std::int32_t b,
+                       const std::array<Vec3, 3>& tb) = 0;
+};
+
+/// Receives the candidate triangles of MeshBvh::visitNearBox, corners in the mesh's frame.
+class TriangleVisitor {
+public:
+    virtual ~TriangleVisitor() = default;
+    /// Triangle `id` (mesh index) whose leaf volume overlaps the box. Return true to stop.
+    virtual bool visit(std::int32_t id, const std::array<Vec3, 3>& corners) = 0;
+};
+
+/// A Bvh of a volume type chosen at run time by name (CLI, scenes, benchmarks, mesh shapes).
 class MeshBvh {
 public:
     virtual ~MeshBvh() = default;
@@ -185,7 +204,32 @@ public:
     /// intersectBvhBvh with `b`, which must hold the same volume type (asserted; empty if not).
     virtual std::vector<TrianglePair> intersect(const MeshBvh& b, const Pose& b_in_a,
                                                 BvhQueryStats* stats = nullptr) const = 0;
+    /// Number of triangles of the mesh the tree was built from.
+    virtual std::int32_t triangleCount() const = 0;
+    /// True when `b` holds the same volume type (the tandem queries need it).
+    virtual bool sameVolumeType(const MeshBvh& b) const = 0;
+    /// The tandem traversal with a visitor: every intersecting triangle pair (exact triangle test,
+    /// touching counts) goes to `visitor` until it returns true. B is placed by p_a = rotation p_b
+    /// + translation (`rotation` orthonormal), the form the narrow phase holds; B's corners are
+    /// moved with exactly that expression. `b` must hold the same volume type (asserted; nothing
+    /// visited if not). Returns true when the visitor stopped the traversal.
+    virtual bool visitIntersecting(const MeshBvh& b, const Mat3& rotation, const Vec3& translation,
+                                   TrianglePairVisitor& visitor,
+                                   BvhQueryStats* stats = nullptr) const = 0;
+    /// The tree-against-volume traversal: the box [box_min, box_max] of a frame B placed by
+    /// p_a = rotation p_b + translation gets a volume of this tree's type fitted around it (in
+    /// B's frame), and every leaf triangle whose node volumes all overlap it goes to `visitor`
+    /// until it returns true. Conservative: every triangle that meets the box is visited (the
+    /// volume tests have a slack relative to the scale); others may be. Returns true when the
+    /// visitor stopped the traversal. stats->bv_tests counts the node tests.
+    virtual bool visitNearBox(const Vec3& box_min, const Vec3& box_max, const Mat3& rotation,
+                              const Vec3& translation, TriangleVisitor& visitor,
+                              BvhQueryStats* stats = nullptr) const = 0;
 };
+
+/// The volume type mesh shapes use unless a scene chooses another (`world.mesh_bvh`): the fastest
+/// in `cdlab bench narrowphase` on the two-tori workload.
+inline constexpr std::string_view kDefaultMeshBvh = "obb";
 
 /// The names of BvhVolumeTypes, in order: sphere, aabb, obb, kdop6, kdop14, kdop18, kdop26, rss.
 const std::vector<std::string_view>& bvhVolumeNames();
