@@ -16,7 +16,7 @@ struct BenchNarrowphaseOptions {
     int triangles = 10000;  ///< per torus (rounded to 2 nu nv with nu = 2 nv); >= 32
     bool large = false;     ///< 100k-triangle tori (overrides `triangles`)
     int poses = 32;         ///< even, >= 2: half colliding, half not
-    int reps = 3;           ///< repetitions per pose; the fastest counts (the machine is shared)
+    int reps = 3;  ///< repetitions per pose (and of the build, at most 3); the fastest counts
     std::uint64_t seed = 7;
     /// Method names (cdlab volume names, "fcl-obbrss", ...); empty: all.
     std::vector<std::string> methods;

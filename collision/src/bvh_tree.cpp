@@ -9,6 +9,7 @@
 #include <limits>
 #include <numeric>
 #include <sstream>
+#include <type_traits>
 
 #include "bvh_volumes.h"
 #include "collision/assert.h"
@@ -29,6 +30,7 @@ struct Builder {
     const std::vector<std::array<Vec3, 3>>& corners;  // by mesh triangle index
     const std::vector<Vec3>& centroids;               // by mesh triangle index
     std::vector<std::int32_t>& ids;                   // leaf order -> mesh index, permuted here
+    const std::vector<TriangleMoments>& moments;      // by mesh triangle index (oriented BVs)
     std::vector<Vec3> scratch;                        // reused: no allocation per node
 
     // Builds the subtree over leaf-order range [first, first + count); returns its node index.
@@ -42,7 +44,7 @@ struct Builder {
         }
         {
             auto& node = nodes[static_cast<std::size_t>(index)];
-            node.volume = BvTraits<BV>::fit(scratch);
+            node.volume = fitNode(first, count);
             node.cost = BvTraits<BV>::cost(node.volume);
         }
         if (count <= options.max_leaf_triangles) {
@@ -56,6 +58,30 @@ struct Builder {
         const std::int32_t right = build(split, first + count - split);
         nodes[static_cast<std::size_t>(index)].right = right;
         return index;
+    }
+
+    // The node volume over `scratch` (the corners of leaf-order range [first, first + count)).
+    // Oriented volumes take their axes from per-triangle moments summed over the range (one
+    // pass of additions instead of the covariance from corners), and a one-triangle leaf the
+    // triangle's own frame (a flat, tight box); the extents are measured from the corners either
+    // way, so every volume contains its triangles whatever the axes.
+    BV fitNode(std::int32_t first, std::int32_t count) {
+        if constexpr (std::is_same_v<BV, Obb> || std::is_same_v<BV, Rss>) {
+            Mat3 axes;
+            if (count == 1 && triangleAxes(scratch[0], scratch[1], scratch[2], &axes)) {
+                return BvTraits<BV>::fitWithAxes(scratch, axes);
+            }
+            TriangleMoments sum;
+            for (std::int32_t i = first; i < first + count; ++i) {
+                sum.add(moments[static_cast<std::size_t>(ids[static_cast<std::size_t>(i)])]);
+            }
+            if (!momentAxes(sum, &axes)) axes = principalAxes(scratch);
+            return BvTraits<BV>::fitWithAxes(scratch, axes);
+        } else {
+            (void)first;
+            (void)count;
+            return BvTraits<BV>::fit(scratch);
+        }
     }
 
     // Splits along the longest axis of the centroids' bounding box; returns the first index of
@@ -298,7 +324,16 @@ Bvh<BV>::Bvh(const TriangleMesh& mesh, const BvhBuildOptions& options) {
     BvhBuildOptions opts = options;
     opts.max_leaf_triangles = std::max(1, opts.max_leaf_triangles);
     nodes_.reserve(2 * n);
-    Builder<BV> builder{opts, nodes_, corners_, centroids, ids_, {}};
+    std::vector<TriangleMoments> moments;
+    if constexpr (std::is_same_v<BV, Obb> || std::is_same_v<BV, Rss>) {
+        // About the centre of the mesh's box, so the sums stay small far from the origin.
+        const Vec3 origin = (lo + hi) * Real(0.5);
+        moments.resize(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            moments[i] = triangleMoments(corners_[i][0], corners_[i][1], corners_[i][2], origin);
+        }
+    }
+    Builder<BV> builder{opts, nodes_, corners_, centroids, ids_, moments, {}};
     builder.build(0, static_cast<std::int32_t>(n));
     // Corners into leaf order, so a leaf's triangles are contiguous in memory.
     std::vector<std::array<Vec3, 3>> by_mesh = std::move(corners_);

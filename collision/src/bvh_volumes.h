@@ -115,6 +115,31 @@ inline bool testSat15(const Vec3& a, const Mat3& rot, const Vec3& t, const Vec3&
     return true;
 }
 
+/// Area-weighted moments of triangles about a fixed origin (Gottschalk 1996 §3): additive, so a
+/// node's moments are the sum of its triangles'.
+struct TriangleMoments {
+    Real area = 0;
+    Vec3 first = Vec3::Zero();   ///< sum of area * centroid
+    Mat3 second = Mat3::Zero();  ///< sum of area/12 (9 m m^T + p p^T + q q^T + r r^T)
+    void add(const TriangleMoments& o) {
+        area += o.area;
+        first += o.first;
+        second += o.second;
+    }
+};
+TriangleMoments triangleMoments(const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& origin);
+/// Principal axes of summed moments (largest variance first, right-handed); false for zero area.
+/// Cancellation far from `origin` only loosens the fit: extents are measured along the axes.
+bool momentAxes(const TriangleMoments& m, Mat3* axes);
+/// Principal axes of triangles given as consecutive corner triples (covariance of the corners
+/// when their total area is zero).
+Mat3 principalAxes(const std::vector<Vec3>& corners);
+/// Eigenvectors of a covariance, largest first, as a right-handed orthonormal frame.
+Mat3 axesOfCovariance(const Mat3& cov);
+/// The tight frame of one triangle: its longest edge, the in-plane perpendicular, the normal.
+/// False for a sliver whose normal is lost in rounding.
+bool triangleAxes(const Vec3& p, const Vec3& q, const Vec3& r, Mat3* axes);
+
 template <class BV>
 struct BvTraits;
 
@@ -162,6 +187,8 @@ struct BvTraits<Aabb> {
 template <>
 struct BvTraits<Obb> {
     static Obb fit(const std::vector<Vec3>& corners);
+    /// The box along given orthonormal axes: exact projections plus slack.
+    static Obb fitWithAxes(const std::vector<Vec3>& corners, const Mat3& axes);
     static bool overlaps(const Obb& a, const Obb& b, const BvhTransform& x) {
         const Mat3 rot = a.axes.transpose() * (x.r * b.axes);
         const Vec3 t = a.axes.transpose() * (x.apply(b.center) - a.center);
@@ -237,6 +264,8 @@ struct BvTraits<Kdop<K>> {
 template <>
 struct BvTraits<Rss> {
     static Rss fit(const std::vector<Vec3>& corners);
+    /// The RSS whose rectangle spans axes.col(0), axes.col(1) (orthonormal, right-handed).
+    static Rss fitWithAxes(const std::vector<Vec3>& corners, const Mat3& axes);
     static bool overlaps(const Rss& a, const Rss& b, const BvhTransform& x) {
         const Mat3 rot = a.axes.transpose() * (x.r * b.axes);
         const Vec3 t = a.axes.transpose() * (x.apply(b.center) - a.center);
