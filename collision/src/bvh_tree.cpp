@@ -501,6 +501,67 @@ std::vector<TrianglePair> intersectMeshMeshBruteForce(const TriangleMesh& a, con
     return pairs;  // generated in (a, b) order: sorted and unique
 }
 
+std::vector<TrianglePair> intersectMeshMeshSweep(const TriangleMesh& a, const TriangleMesh& b,
+                                                 const Pose& b_in_a, BvhQueryStats* stats) {
+    // The brute force's triangles and boxes (same transform, same expressions), but B's boxes
+    // sorted by min.x: for A's triangle i only B's boxes with min.x in
+    // [lo_i.x - widest B box, hi_i.x] can overlap, and those are tested with the brute force's
+    // exact comparisons, so the candidate set and the answer are the brute force's.
+    const BvhTransform x = makeBvhTransform(b_in_a, 0, 0);
+    struct Tri {
+        Vec3 p, q, r, lo, hi;
+        std::int32_t id;
+    };
+    auto make = [](const Vec3& p, const Vec3& q, const Vec3& r, std::size_t id) {
+        return Tri{p, q, r, p.cwiseMin(q).cwiseMin(r), p.cwiseMax(q).cwiseMax(r),
+                   static_cast<std::int32_t>(id)};
+    };
+    std::vector<Tri> ta;
+    std::vector<Tri> tb;
+    ta.reserve(a.triangles.size());
+    tb.reserve(b.triangles.size());
+    for (std::size_t i = 0; i < a.triangles.size(); ++i) {
+        const auto& t = a.triangles[i];
+        ta.push_back(make(a.vertices[static_cast<std::size_t>(t[0])],
+                          a.vertices[static_cast<std::size_t>(t[1])],
+                          a.vertices[static_cast<std::size_t>(t[2])], i));
+    }
+    Real widest = 0;
+    for (std::size_t j = 0; j < b.triangles.size(); ++j) {
+        const auto& t = b.triangles[j];
+        tb.push_back(make(x.apply(b.vertices[static_cast<std::size_t>(t[0])]),
+                          x.apply(b.vertices[static_cast<std::size_t>(t[1])]),
+                          x.apply(b.vertices[static_cast<std::size_t>(t[2])]), j));
+        widest = std::max(widest, tb.back().hi.x() - tb.back().lo.x());
+    }
+    std::sort(tb.begin(), tb.end(), [](const Tri& u, const Tri& v) {
+        return u.lo.x() < v.lo.x() || (u.lo.x() == v.lo.x() && u.id < v.id);
+    });
+    std::vector<TrianglePair> pairs;
+    std::int64_t tests = 0;
+    for (const Tri& ti : ta) {
+        // Every box with lo.x >= ti.lo.x - widest, moved down by a rounding margin (only widens
+        // the scan: the exact box test below decides).
+        const Real from =
+            ti.lo.x() - widest - Real(4) * kEpsilon * (std::abs(ti.lo.x()) + widest);
+        auto it = std::lower_bound(tb.begin(), tb.end(), from,
+                                   [](const Tri& u, Real v) { return u.lo.x() < v; });
+        for (; it != tb.end() && it->lo.x() <= ti.hi.x(); ++it) {
+            const Tri& tj = *it;
+            if ((ti.lo.array() > tj.hi.array()).any() || (tj.lo.array() > ti.hi.array()).any()) {
+                continue;
+            }
+            ++tests;
+            if (testTriangleTriangle(ti.p, ti.q, ti.r, tj.p, tj.q, tj.r)) {
+                pairs.push_back({ti.id, tj.id});
+            }
+        }
+    }
+    if (stats) stats->triangle_tests += tests;
+    std::sort(pairs.begin(), pairs.end());
+    return pairs;
+}
+
 const std::vector<std::string_view>& bvhVolumeNames() {
     static const std::vector<std::string_view> names = [] {
         std::vector<std::string_view> out;

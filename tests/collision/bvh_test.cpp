@@ -300,6 +300,29 @@ TEST(Bvh, LookupByNameCoversTheTypeList) {
     }
 }
 
+TEST(Bvh, SweepReferenceEqualsBruteForce) {
+    // Random poses of the tori, and grid cubes touching face to face, edge to edge and corner to
+    // corner (exact coordinates): the sweep returns the brute force's list, with as many tests.
+    int non_empty = 0;
+    for (std::size_t i = 0; i < differentialPoses().size(); ++i) {
+        BvhQueryStats brute_stats;
+        BvhQueryStats sweep_stats;
+        const Pose& p = differentialPoses()[i];
+        const auto brute = collision::intersectMeshMeshBruteForce(torusA(), torusB(), p, &brute_stats);
+        EXPECT_EQ(collision::intersectMeshMeshSweep(torusA(), torusB(), p, &sweep_stats), brute);
+        EXPECT_EQ(sweep_stats.triangle_tests, brute_stats.triangle_tests);
+        non_empty += !brute.empty();
+    }
+    EXPECT_GT(non_empty, 3);
+    const TriangleMesh cube = makeGridCube(4);
+    for (const Vec3& d : {Vec3(2, 0, 0), Vec3(2, 2, 0), Vec3(2, 2, 2), Vec3(0, -2, 0.5)}) {
+        const Pose p{d, Quat::Identity()};
+        const auto brute = collision::intersectMeshMeshBruteForce(cube, cube, p);
+        EXPECT_FALSE(brute.empty());
+        EXPECT_EQ(collision::intersectMeshMeshSweep(cube, cube, p), brute);
+    }
+}
+
 TEST(Bvh, EmptyMeshHasNoContacts) {
     const TriangleMesh empty;
     const Bvh<Aabb> e(empty);
