@@ -257,6 +257,7 @@ public:
         return intersectBvhBvh(tree_, other->tree_, b_in_a, stats);
     }
     std::int32_t triangleCount() const override { return tree_.triangleCount(); }
+    std::int32_t refit(const TriangleMesh& mesh) override { return tree_.refit(mesh); }
     bool sameVolumeType(const MeshBvh& b) const override {
         return dynamic_cast<const MeshBvhOf<BV>*>(&b) != nullptr;
     }
@@ -359,6 +360,47 @@ int measureDepth(const std::vector<typename Bvh<BV>::Node>& nodes) {
         }
     }
     return best;
+}
+
+template <class BV>
+std::int32_t Bvh<BV>::refit(const TriangleMesh& mesh) {
+    CDLAB_ASSERT(mesh.triangles.size() == ids_.size(), "refit with another mesh");
+    if (mesh.triangles.size() != ids_.size() || nodes_.empty()) return 0;
+    Vec3 lo = Vec3::Constant(std::numeric_limits<Real>::infinity());
+    Vec3 hi = -lo;
+    for (std::size_t k = 0; k < ids_.size(); ++k) {
+        const auto& tri = mesh.triangles[static_cast<std::size_t>(ids_[k])];
+        for (std::size_t c = 0; c < 3; ++c) {
+            CDLAB_ASSERT(tri[c] >= 0 && static_cast<std::size_t>(tri[c]) < mesh.vertices.size(),
+                         "triangle index out of range");
+            corners_[k][c] = mesh.vertices[static_cast<std::size_t>(tri[c])];
+            lo = lo.cwiseMin(corners_[k][c]);
+            hi = hi.cwiseMax(corners_[k][c]);
+        }
+    }
+    scale_ = (hi - lo).maxCoeff() + std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff());
+    // Ranges bottom-up: children come after their parent in depth-first order, so a reverse
+    // sweep sees both children of a node before the node.
+    std::vector<std::int32_t> first(nodes_.size());
+    std::vector<std::int32_t> last(nodes_.size());
+    std::vector<Vec3> scratch;
+    for (std::size_t k = nodes_.size(); k-- > 0;) {
+        Node& node = nodes_[k];
+        if (node.isLeaf()) {
+            first[k] = node.first;
+            last[k] = node.first + node.count;
+        } else {
+            first[k] = first[k + 1];
+            last[k] = last[static_cast<std::size_t>(node.right)];
+        }
+        scratch.clear();
+        for (std::int32_t i = first[k]; i < last[k]; ++i) {
+            for (const Vec3& p : corners_[static_cast<std::size_t>(i)]) scratch.push_back(p);
+        }
+        node.volume = BvTraits<BV>::fit(scratch);
+        node.cost = BvTraits<BV>::cost(node.volume);
+    }
+    return static_cast<std::int32_t>(nodes_.size());
 }
 
 template <class BV>

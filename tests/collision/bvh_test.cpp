@@ -191,6 +191,49 @@ TYPED_TEST(BvhTyped, AllPairsMatchBruteForceAtRandomPoses) {
     EXPECT_LE(colliding, 12);
 }
 
+// A deformed torus A: radial waves and a twist about z, large enough to move triangles by more
+// than their leaves' sizes.
+TriangleMesh deformedTorusA() {
+    TriangleMesh m = torusA();
+    for (Vec3& v : m.vertices) {
+        const Real angle = std::atan2(v.y(), v.x());
+        const Real k = 1 + Real(0.25) * std::sin(3 * angle);
+        const Real twist = Real(0.4) * v.z();
+        const Vec3 w(v.x() * k, v.y() * k, v.z() * (1 + Real(0.5) * std::cos(2 * angle)));
+        v = Vec3(w.x() * std::cos(twist) - w.y() * std::sin(twist),
+                 w.x() * std::sin(twist) + w.y() * std::cos(twist), w.z());
+    }
+    return m;
+}
+
+TYPED_TEST(BvhTyped, RefitGivesTheRebuildsAnswers) {
+    const TriangleMesh deformed = deformedTorusA();
+    Bvh<TypeParam> refitted(torusA());
+    EXPECT_EQ(refitted.refit(deformed), static_cast<std::int32_t>(refitted.nodes().size()));
+    std::string error;
+    EXPECT_TRUE(refitted.validate(&error)) << error;  // every volume contains the moved triangles
+    const Bvh<TypeParam> rebuilt(deformed);
+    const Bvh<TypeParam> b(torusB());
+    int changed = 0;
+    for (std::size_t k = 0; k < differentialPoses().size(); ++k) {
+        const Pose& pose = differentialPoses()[k];
+        const std::vector<TrianglePair> expected =
+            collision::intersectMeshMeshBruteForce(deformed, torusB(), pose);
+        EXPECT_EQ(collision::intersectBvhBvh(refitted, b, pose), expected) << "pose " << k;
+        EXPECT_EQ(collision::intersectBvhBvh(rebuilt, b, pose), expected) << "pose " << k;
+        EXPECT_EQ(collision::testBvhBvh(refitted, b, pose), !expected.empty()) << "pose " << k;
+        changed += expected != bruteAnswer(k);
+    }
+    // The deformation changes most answers, so a refit that did nothing would fail above.
+    EXPECT_GE(changed, 5);
+    // Through the run-time interface too.
+    auto tree = collision::buildMeshBvh(BvName<TypeParam>::value, torusA());
+    EXPECT_GT(tree->refit(deformed), 0);
+    const auto tree_b = collision::buildMeshBvh(BvName<TypeParam>::value, torusB());
+    EXPECT_EQ(tree->intersect(*tree_b, differentialPoses()[0]),
+              collision::intersectMeshMeshBruteForce(deformed, torusB(), differentialPoses()[0]));
+}
+
 TYPED_TEST(BvhTyped, MeanSplitAndFatLeavesGiveTheSameAnswer) {
     const Bvh<TypeParam> a(torusA(), BvhBuildOptions{BvhSplit::Mean, 4});
     const Bvh<TypeParam> b(torusB(), BvhBuildOptions{BvhSplit::Mean, 3});

@@ -143,6 +143,12 @@ public:
     /// every node volume contains its triangles' corners (to a tolerance relative to the mesh
     /// scale). On failure returns false and, if `error` is given, says what failed.
     bool validate(std::string* error = nullptr) const;
+    /// Refit for a deforming mesh: takes the vertex positions of `mesh` (the triangles the tree
+    /// was built from, same order; asserted, and nothing done when the count differs), moves
+    /// every triangle and refits every node volume to its triangles, keeping the tree's
+    /// structure. O(n log n); queries then answer for the deformed mesh (exact triangle tests;
+    /// the volumes may be looser than a rebuild's). Returns the nodes updated (Nu).
+    std::int32_t refit(const TriangleMesh& mesh);
 
 private:
     std::vector<Node> nodes_;
@@ -213,6 +219,9 @@ public:
                                                 BvhQueryStats* stats = nullptr) const = 0;
     /// Number of triangles of the mesh the tree was built from.
     virtual std::int32_t triangleCount() const = 0;
+    /// Bvh::refit (a deforming mesh): returns the nodes updated. Not for a tree shared by shapes
+    /// that other threads query.
+    virtual std::int32_t refit(const TriangleMesh& mesh) = 0;
     /// True when `b` holds the same volume type (the tandem queries need it).
     virtual bool sameVolumeType(const MeshBvh& b) const = 0;
     /// The tandem traversal with a visitor: every intersecting triangle pair (exact triangle test,
