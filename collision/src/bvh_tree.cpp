@@ -258,6 +258,9 @@ public:
     }
     std::int32_t triangleCount() const override { return tree_.triangleCount(); }
     std::int32_t refit(const TriangleMesh& mesh) override { return tree_.refit(mesh); }
+    std::vector<TrianglePair> intersectSelf(BvhQueryStats* stats) const override {
+        return collision::intersectSelf(tree_, stats);
+    }
     bool sameVolumeType(const MeshBvh& b) const override {
         return dynamic_cast<const MeshBvhOf<BV>*>(&b) != nullptr;
     }
@@ -306,6 +309,7 @@ Bvh<BV>::Bvh(const TriangleMesh& mesh, const BvhBuildOptions& options) {
     if (n == 0) return;
     corners_.resize(n);
     ids_.resize(n);
+    vertex_ids_.resize(n);
     std::vector<Vec3> centroids(n);
     Vec3 lo = Vec3::Constant(std::numeric_limits<Real>::infinity());
     Vec3 hi = -lo;
@@ -339,7 +343,10 @@ Bvh<BV>::Bvh(const TriangleMesh& mesh, const BvhBuildOptions& options) {
     // Corners into leaf order, so a leaf's triangles are contiguous in memory.
     std::vector<std::array<Vec3, 3>> by_mesh = std::move(corners_);
     corners_.resize(n);
-    for (std::size_t k = 0; k < n; ++k) corners_[k] = by_mesh[static_cast<std::size_t>(ids_[k])];
+    for (std::size_t k = 0; k < n; ++k) {
+        corners_[k] = by_mesh[static_cast<std::size_t>(ids_[k])];
+        vertex_ids_[k] = mesh.triangles[static_cast<std::size_t>(ids_[k])];
+    }
     depth_ = measureDepth<BV>(nodes_);
 }
 
@@ -502,6 +509,119 @@ std::vector<TrianglePair> intersectBvhBvh(const Bvh<BV>& a, const Bvh<BV>& b, co
     return pairs;
 }
 
+namespace {
+
+bool shareVertex(const std::array<std::int32_t, 3>& u, const std::array<std::int32_t, 3>& v) {
+    for (const std::int32_t i : u) {
+        if (i == v[0] || i == v[1] || i == v[2]) return true;
+    }
+    return false;
+}
+
+}  // namespace
+
+template <class BV>
+std::vector<TrianglePair> intersectSelf(const Bvh<BV>& tree, BvhQueryStats* stats) {
+    std::vector<TrianglePair> pairs;
+    const auto& nodes = tree.nodes();
+    if (nodes.empty()) return pairs;
+    // Same frame on both sides: the identity transform, and the corners as stored (the brute
+    // force tests the same coordinates).
+    const BvhTransform x = makeBvhTransform(Mat3::Identity(), Vec3::Zero(), tree.scale(),
+                                            tree.scale());
+    std::int64_t bv_tests = 0;
+    std::int64_t tri_tests = 0;
+    auto testLeafTriangles = [&](std::int32_t i, std::int32_t j) {
+        if (shareVertex(tree.leafTriangleVertices(i), tree.leafTriangleVertices(j))) return;
+        const auto& ta = tree.leafTriangle(i);
+        const auto& tb = tree.leafTriangle(j);
+        ++tri_tests;
+        if (testTriangleTriangle(ta[0], ta[1], ta[2], tb[0], tb[1], tb[2])) {
+            const std::int32_t a = tree.leafTriangleId(i);
+            const std::int32_t b = tree.leafTriangleId(j);
+            pairs.push_back({std::min(a, b), std::max(a, b)});
+        }
+    };
+    // A pair (n, n) stands for the pairs inside subtree n: its children's inner pairs and the
+    // pairs across them. Distinct subtrees are disjoint, so every triangle pair is seen once.
+    std::vector<std::pair<std::int32_t, std::int32_t>> stack{{0, 0}};
+    while (!stack.empty()) {
+        const auto [ia, ib] = stack.back();
+        stack.pop_back();
+        const auto& na = nodes[static_cast<std::size_t>(ia)];
+        const auto& nb = nodes[static_cast<std::size_t>(ib)];
+        if (ia == ib) {
+            if (na.isLeaf()) {
+                for (std::int32_t i = na.first; i < na.first + na.count; ++i) {
+                    for (std::int32_t j = i + 1; j < na.first + na.count; ++j) {
+                        testLeafTriangles(i, j);
+                    }
+                }
+            } else {
+                stack.emplace_back(ia + 1, na.right);
+                stack.emplace_back(na.right, na.right);
+                stack.emplace_back(ia + 1, ia + 1);
+            }
+            continue;
+        }
+        ++bv_tests;
+        if (!BvTraits<BV>::overlaps(na.volume, nb.volume, x)) continue;
+        if (na.isLeaf() && nb.isLeaf()) {
+            for (std::int32_t i = na.first; i < na.first + na.count; ++i) {
+                for (std::int32_t j = nb.first; j < nb.first + nb.count; ++j) {
+                    testLeafTriangles(i, j);
+                }
+            }
+            continue;
+        }
+        const bool descend_a = nb.isLeaf() || (!na.isLeaf() && na.cost >= nb.cost);
+        if (descend_a) {
+            stack.emplace_back(na.right, ib);
+            stack.emplace_back(ia + 1, ib);
+        } else {
+            stack.emplace_back(ia, nb.right);
+            stack.emplace_back(ia, ib + 1);
+        }
+    }
+    if (stats) {
+        stats->bv_tests += bv_tests;
+        stats->triangle_tests += tri_tests;
+    }
+    std::sort(pairs.begin(), pairs.end());
+    return pairs;
+}
+
+std::vector<TrianglePair> intersectSelfBruteForce(const TriangleMesh& mesh, BvhQueryStats* stats) {
+    std::vector<TrianglePair> pairs;
+    std::int64_t tests = 0;
+    const std::size_t n = mesh.triangles.size();
+    auto corner = [&](std::size_t t, int k) -> const Vec3& {
+        return mesh.vertices[static_cast<std::size_t>(mesh.triangles[t][static_cast<std::size_t>(k)])];
+    };
+    std::vector<Vec3> lo(n);
+    std::vector<Vec3> hi(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        lo[i] = corner(i, 0).cwiseMin(corner(i, 1)).cwiseMin(corner(i, 2));
+        hi[i] = corner(i, 0).cwiseMax(corner(i, 1)).cwiseMax(corner(i, 2));
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t j = i + 1; j < n; ++j) {
+            // Disjoint exact boxes of the same coordinates: the triangles are apart.
+            if ((lo[i].array() > hi[j].array()).any() || (lo[j].array() > hi[i].array()).any()) {
+                continue;
+            }
+            if (shareVertex(mesh.triangles[i], mesh.triangles[j])) continue;
+            ++tests;
+            if (testTriangleTriangle(corner(i, 0), corner(i, 1), corner(i, 2), corner(j, 0),
+                                     corner(j, 1), corner(j, 2))) {
+                pairs.push_back({static_cast<std::int32_t>(i), static_cast<std::int32_t>(j)});
+            }
+        }
+    }
+    if (stats) stats->triangle_tests += tests;
+    return pairs;  // generated in (a, b) order
+}
+
 std::vector<TrianglePair> intersectMeshMeshBruteForce(const TriangleMesh& a, const TriangleMesh& b,
                                                       const Pose& b_in_a, BvhQueryStats* stats) {
     // The same transform as the BVH queries (scales do not matter: only `apply` is used).
@@ -633,7 +753,8 @@ std::unique_ptr<MeshBvh> buildMeshBvh(std::string_view volume_name, const Triang
     template class Bvh<BV>;                                                                    \
     template bool testBvhBvh<BV>(const Bvh<BV>&, const Bvh<BV>&, const Pose&, BvhQueryStats*); \
     template std::vector<TrianglePair> intersectBvhBvh<BV>(const Bvh<BV>&, const Bvh<BV>&,     \
-                                                           const Pose&, BvhQueryStats*);
+                                                           const Pose&, BvhQueryStats*);       \
+    template std::vector<TrianglePair> intersectSelf<BV>(const Bvh<BV>&, BvhQueryStats*);
 CDLAB_BVH_INSTANTIATE(BoundingSphere)
 CDLAB_BVH_INSTANTIATE(Aabb)
 CDLAB_BVH_INSTANTIATE(Obb)

@@ -234,6 +234,64 @@ TYPED_TEST(BvhTyped, RefitGivesTheRebuildsAnswers) {
               collision::intersectMeshMeshBruteForce(deformed, torusB(), differentialPoses()[0]));
 }
 
+// One mesh made of torus A and torus B placed by `pose`: its self-intersections are the pairs
+// between the two parts (plus none inside a torus, whose neighbours share vertices).
+TriangleMesh unionMesh(const Pose& pose) {
+    TriangleMesh m = torusA();
+    const auto offset = static_cast<std::int32_t>(m.vertices.size());
+    for (const Vec3& v : torusB().vertices) m.vertices.push_back(pose.apply(v));
+    for (const auto& t : torusB().triangles) {
+        m.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+    }
+    return m;
+}
+
+// Brute-force self pairs of unionMesh(pose k), computed once for every volume type.
+const std::vector<TrianglePair>& bruteSelfAnswer(std::size_t k) {
+    static std::map<std::size_t, std::vector<TrianglePair>> cache;
+    auto it = cache.find(k);
+    if (it == cache.end()) {
+        it = cache
+                 .emplace(k, collision::intersectSelfBruteForce(unionMesh(differentialPoses()[k])))
+                 .first;
+    }
+    return it->second;
+}
+
+TYPED_TEST(BvhTyped, SelfCollisionMatchesBruteForce) {
+    int non_empty = 0;
+    for (std::size_t k = 0; k < 6; ++k) {
+        const TriangleMesh mesh = unionMesh(differentialPoses()[k]);
+        const Bvh<TypeParam> tree(mesh);
+        BvhQueryStats stats;
+        const std::vector<TrianglePair>& brute = bruteSelfAnswer(k);
+        EXPECT_EQ(collision::intersectSelf(tree, &stats), brute) << "pose " << k;
+        EXPECT_GT(stats.bv_tests, 0);
+        non_empty += !brute.empty();
+        // Fat leaves hold adjacent triangles together: still excluded.
+        const Bvh<TypeParam> fat(mesh, BvhBuildOptions{BvhSplit::Mean, 4});
+        EXPECT_EQ(collision::intersectSelf(fat), brute) << "pose " << k;
+    }
+    EXPECT_GE(non_empty, 2);
+    EXPECT_LE(non_empty, 5);
+    // A closed torus alone: every touching pair is adjacent (shares a vertex).
+    EXPECT_TRUE(collision::intersectSelfBruteForce(torusA()).empty());
+    EXPECT_TRUE(collision::intersectSelf(Bvh<TypeParam>(torusA())).empty());
+    // A grid cube with a copy of one face's triangle pushed through the cube: it crosses the
+    // faces it passes through, and the pairs come out as the brute force's.
+    TriangleMesh cube = makeGridCube(2);
+    const auto base = static_cast<std::int32_t>(cube.vertices.size());
+    cube.vertices.push_back(Vec3(-1.5, 0.1, 0.2));
+    cube.vertices.push_back(Vec3(1.5, 0.3, -0.1));
+    cube.vertices.push_back(Vec3(0.2, 1.5, 0.3));
+    cube.triangles.push_back({base, base + 1, base + 2});
+    const auto brute = collision::intersectSelfBruteForce(cube);
+    EXPECT_FALSE(brute.empty());
+    EXPECT_EQ(collision::intersectSelf(Bvh<TypeParam>(cube)), brute);
+    auto runtime = collision::buildMeshBvh(BvName<TypeParam>::value, cube);
+    EXPECT_EQ(runtime->intersectSelf(), brute);
+}
+
 TYPED_TEST(BvhTyped, MeanSplitAndFatLeavesGiveTheSameAnswer) {
     const Bvh<TypeParam> a(torusA(), BvhBuildOptions{BvhSplit::Mean, 4});
     const Bvh<TypeParam> b(torusB(), BvhBuildOptions{BvhSplit::Mean, 3});

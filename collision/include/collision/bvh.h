@@ -135,6 +135,10 @@ public:
     const std::array<Vec3, 3>& leafTriangle(std::int32_t i) const { return corners_[i]; }
     /// Mesh index of the triangle at leaf-order position `i`.
     std::int32_t leafTriangleId(std::int32_t i) const { return ids_[i]; }
+    /// Mesh vertex indices of the triangle at leaf-order position `i` (adjacency for self tests).
+    const std::array<std::int32_t, 3>& leafTriangleVertices(std::int32_t i) const {
+        return vertex_ids_[i];
+    }
     /// Length scale of the mesh: largest |coordinate| plus the root extent (sets tolerances).
     Real scale() const { return scale_; }
     /// Longest root-to-leaf path (a single leaf has depth 1; empty tree 0). Computed at build.
@@ -154,6 +158,7 @@ private:
     std::vector<Node> nodes_;
     std::vector<std::array<Vec3, 3>> corners_;  // leaf order
     std::vector<std::int32_t> ids_;             // leaf order -> mesh triangle index
+    std::vector<std::array<std::int32_t, 3>> vertex_ids_;  // leaf order: the mesh's indices
     Real scale_ = 0;
     int depth_ = 0;
 };
@@ -170,6 +175,17 @@ bool testBvhBvh(const Bvh<BV>& a, const Bvh<BV>& b, const Pose& b_in_a,
 template <class BV>
 std::vector<TrianglePair> intersectBvhBvh(const Bvh<BV>& a, const Bvh<BV>& b, const Pose& b_in_a,
                                           BvhQueryStats* stats = nullptr);
+
+/// Self-collision of one mesh: every pair of its triangles that touch or cross, except adjacent
+/// ones (sharing a vertex index; coincident vertices with different indices do not count as
+/// shared), as (a, b) with a < b, sorted, no duplicates. One traversal of the tree against
+/// itself that visits each pair of subtrees once. `stats` may be null.
+template <class BV>
+std::vector<TrianglePair> intersectSelf(const Bvh<BV>& tree, BvhQueryStats* stats = nullptr);
+
+/// The reference for intersectSelf: every non-adjacent pair (a < b) with the same exact test.
+std::vector<TrianglePair> intersectSelfBruteForce(const TriangleMesh& mesh,
+                                                  BvhQueryStats* stats = nullptr);
 
 /// The brute-force reference: every triangle pair (after an exact per-triangle AABB reject) with
 /// the same exact triangle test and the same vertex transform. O(n_a n_b).
@@ -219,6 +235,8 @@ public:
                                                 BvhQueryStats* stats = nullptr) const = 0;
     /// Number of triangles of the mesh the tree was built from.
     virtual std::int32_t triangleCount() const = 0;
+    /// intersectSelf on this tree.
+    virtual std::vector<TrianglePair> intersectSelf(BvhQueryStats* stats = nullptr) const = 0;
     /// Bvh::refit (a deforming mesh): returns the nodes updated. Not for a tree shared by shapes
     /// that other threads query.
     virtual std::int32_t refit(const TriangleMesh& mesh) = 0;
