@@ -14,6 +14,7 @@
 #include "bvh_volumes.h"
 #include "collision/assert.h"
 #include "collision/bvh.h"
+#include "triangle_distance.h"
 #include "triangle_triangle.h"
 
 namespace collision {
@@ -258,6 +259,17 @@ public:
     }
     std::int32_t triangleCount() const override { return tree_.triangleCount(); }
     std::int32_t refit(const TriangleMesh& mesh) override { return tree_.refit(mesh); }
+    MeshDistance distance(const MeshBvh& b, const Pose& b_in_a,
+                          BvhQueryStats* stats) const override {
+        const auto* other = dynamic_cast<const MeshBvhOf<BV>*>(&b);
+        CDLAB_ASSERT(other != nullptr, "BVH query between different volume types");
+        if (other == nullptr) {
+            MeshDistance none;
+            none.distance = std::numeric_limits<Real>::infinity();
+            return none;
+        }
+        return distanceBvhBvh(tree_, other->tree_, b_in_a, stats);
+    }
     std::vector<TrianglePair> intersectSelf(BvhQueryStats* stats) const override {
         return collision::intersectSelf(tree_, stats);
     }
@@ -511,6 +523,165 @@ std::vector<TrianglePair> intersectBvhBvh(const Bvh<BV>& a, const Bvh<BV>& b, co
 
 namespace {
 
+// Every node volume seen as a box (centre, orthonormal axes, half extents) swept by a radius:
+// what the distance lower bound needs. Each view contains the volume.
+struct BoxView {
+    Vec3 center = Vec3::Zero();
+    Mat3 axes = Mat3::Identity();
+    Vec3 half = Vec3::Zero();
+    Real radius = 0;
+};
+BoxView boxView(const BoundingSphere& s) { return {s.center, Mat3::Identity(), Vec3::Zero(), s.radius}; }
+BoxView boxView(const Aabb& b) {
+    return {(b.min + b.max) * Real(0.5), Mat3::Identity(), (b.max - b.min) * Real(0.5), 0};
+}
+BoxView boxView(const Obb& b) { return {b.center, b.axes, b.half_extents, 0}; }
+template <int K>
+BoxView boxView(const Kdop<K>& d) {
+    // The first three slabs are the axes: the k-DOP's bounding box.
+    const Vec3 lo(d.min[0], d.min[1], d.min[2]);
+    const Vec3 hi(d.max[0], d.max[1], d.max[2]);
+    return {(lo + hi) * Real(0.5), Mat3::Identity(), (hi - lo) * Real(0.5), 0};
+}
+BoxView boxView(const Rss& s) {
+    return {s.center, s.axes, Vec3(s.half_lengths[0], s.half_lengths[1], 0), s.radius};
+}
+
+// A lower bound on the distance between two volumes (B's moved by x): the largest gap of their
+// projections on a unit axis (projection onto a unit axis shortens no distance) over A's axes,
+// B's axes and the line of centres, minus the rounding slack x.tol. May be negative.
+template <class BV>
+Real distanceLowerBound(const BV& va, const BV& vb, const BvhTransform& x) {
+    const BoxView a = boxView(va);
+    BoxView b = boxView(vb);
+    b.center = x.apply(b.center);
+    b.axes = x.r * b.axes;
+    const Vec3 d = b.center - a.center;
+    auto gap = [&](const Vec3& unit) {
+        return std::abs(unit.dot(d)) - (a.axes.transpose() * unit).cwiseAbs().dot(a.half) -
+               (b.axes.transpose() * unit).cwiseAbs().dot(b.half) - a.radius - b.radius;
+    };
+    Real best = -std::numeric_limits<Real>::infinity();
+    for (int i = 0; i < 3; ++i) {
+        best = std::max(best, gap(a.axes.col(i)));
+        best = std::max(best, gap(b.axes.col(i)));
+    }
+    const Real len = d.norm();
+    if (len > 0) best = std::max(best, gap(d / len));
+    return best - x.tol;
+}
+
+}  // namespace
+
+template <class BV>
+MeshDistance distanceBvhBvh(const Bvh<BV>& a, const Bvh<BV>& b, const Pose& b_in_a,
+                            BvhQueryStats* stats) {
+    MeshDistance out;
+    out.distance = std::numeric_limits<Real>::infinity();
+    const auto& na = a.nodes();
+    const auto& nb = b.nodes();
+    if (na.empty() || nb.empty()) return out;
+    const BvhTransform x = makeBvhTransform(b_in_a, a.scale(), b.scale());
+    std::int64_t bv_tests = 1;
+    std::int64_t tri_tests = 0;
+    struct Item {
+        std::int32_t ia;
+        std::int32_t ib;
+        Real bound;
+    };
+    std::vector<Item> stack{{0, 0, distanceLowerBound(na[0].volume, nb[0].volume, x)}};
+    while (!stack.empty() && out.distance > 0) {
+        const Item it = stack.back();
+        stack.pop_back();
+        if (it.bound > out.distance) continue;
+        const auto& node_a = na[static_cast<std::size_t>(it.ia)];
+        const auto& node_b = nb[static_cast<std::size_t>(it.ib)];
+        if (node_a.isLeaf() && node_b.isLeaf()) {
+            for (std::int32_t j = node_b.first; j < node_b.first + node_b.count; ++j) {
+                const auto& tb = b.leafTriangle(j);
+                const Vec3 p2 = x.apply(tb[0]);
+                const Vec3 q2 = x.apply(tb[1]);
+                const Vec3 r2 = x.apply(tb[2]);
+                for (std::int32_t i = node_a.first; i < node_a.first + node_a.count; ++i) {
+                    const auto& ta = a.leafTriangle(i);
+                    ++tri_tests;
+                    const TriangleDistance td =
+                        distanceTriangleTriangle(ta[0], ta[1], ta[2], p2, q2, r2);
+                    if (td.distance < out.distance) {
+                        out.distance = td.distance;
+                        out.a = a.leafTriangleId(i);
+                        out.b = b.leafTriangleId(j);
+                        out.point_on_a = td.point_on_1;
+                        out.point_on_b = td.point_on_2;
+                    }
+                }
+            }
+            continue;
+        }
+        const bool descend_a =
+            node_b.isLeaf() || (!node_a.isLeaf() && node_a.cost >= node_b.cost);
+        Item first{it.ia, it.ib, 0};
+        Item second{it.ia, it.ib, 0};
+        if (descend_a) {
+            first.ia = it.ia + 1;
+            second.ia = node_a.right;
+        } else {
+            first.ib = it.ib + 1;
+            second.ib = node_b.right;
+        }
+        first.bound = distanceLowerBound(na[static_cast<std::size_t>(first.ia)].volume,
+                                         nb[static_cast<std::size_t>(first.ib)].volume, x);
+        second.bound = distanceLowerBound(na[static_cast<std::size_t>(second.ia)].volume,
+                                          nb[static_cast<std::size_t>(second.ib)].volume, x);
+        bv_tests += 2;
+        // The nearer pair is popped first, so the best distance shrinks early.
+        if (first.bound < second.bound) std::swap(first, second);
+        if (first.bound <= out.distance) stack.push_back(first);
+        if (second.bound <= out.distance) stack.push_back(second);
+    }
+    if (stats) {
+        stats->bv_tests += bv_tests;
+        stats->triangle_tests += tri_tests;
+    }
+    return out;
+}
+
+MeshDistance distanceMeshMeshBruteForce(const TriangleMesh& a, const TriangleMesh& b,
+                                        const Pose& b_in_a, BvhQueryStats* stats) {
+    const BvhTransform x = makeBvhTransform(b_in_a, 0, 0);  // the BVH query's transform
+    MeshDistance out;
+    out.distance = std::numeric_limits<Real>::infinity();
+    std::vector<std::array<Vec3, 3>> moved(b.triangles.size());
+    for (std::size_t j = 0; j < b.triangles.size(); ++j) {
+        for (std::size_t k = 0; k < 3; ++k) {
+            moved[j][k] = x.apply(b.vertices[static_cast<std::size_t>(b.triangles[j][k])]);
+        }
+    }
+    std::int64_t tests = 0;
+    for (std::size_t i = 0; i < a.triangles.size(); ++i) {
+        const auto& t = a.triangles[i];
+        const Vec3& p1 = a.vertices[static_cast<std::size_t>(t[0])];
+        const Vec3& q1 = a.vertices[static_cast<std::size_t>(t[1])];
+        const Vec3& r1 = a.vertices[static_cast<std::size_t>(t[2])];
+        for (std::size_t j = 0; j < moved.size(); ++j) {
+            ++tests;
+            const TriangleDistance td =
+                distanceTriangleTriangle(p1, q1, r1, moved[j][0], moved[j][1], moved[j][2]);
+            if (td.distance < out.distance) {
+                out.distance = td.distance;
+                out.a = static_cast<std::int32_t>(i);
+                out.b = static_cast<std::int32_t>(j);
+                out.point_on_a = td.point_on_1;
+                out.point_on_b = td.point_on_2;
+            }
+        }
+    }
+    if (stats) stats->triangle_tests += tests;
+    return out;
+}
+
+namespace {
+
 bool shareVertex(const std::array<std::int32_t, 3>& u, const std::array<std::int32_t, 3>& v) {
     for (const std::int32_t i : u) {
         if (i == v[0] || i == v[1] || i == v[2]) return true;
@@ -754,7 +925,9 @@ std::unique_ptr<MeshBvh> buildMeshBvh(std::string_view volume_name, const Triang
     template bool testBvhBvh<BV>(const Bvh<BV>&, const Bvh<BV>&, const Pose&, BvhQueryStats*); \
     template std::vector<TrianglePair> intersectBvhBvh<BV>(const Bvh<BV>&, const Bvh<BV>&,     \
                                                            const Pose&, BvhQueryStats*);       \
-    template std::vector<TrianglePair> intersectSelf<BV>(const Bvh<BV>&, BvhQueryStats*);
+    template std::vector<TrianglePair> intersectSelf<BV>(const Bvh<BV>&, BvhQueryStats*);      \
+    template MeshDistance distanceBvhBvh<BV>(const Bvh<BV>&, const Bvh<BV>&, const Pose&,      \
+                                             BvhQueryStats*);
 CDLAB_BVH_INSTANTIATE(BoundingSphere)
 CDLAB_BVH_INSTANTIATE(Aabb)
 CDLAB_BVH_INSTANTIATE(Obb)

@@ -292,6 +292,93 @@ TYPED_TEST(BvhTyped, SelfCollisionMatchesBruteForce) {
     EXPECT_EQ(runtime->intersectSelf(), brute);
 }
 
+// Small tori for the distance brute force (256 and 196 triangles).
+const TriangleMesh& smallTorusA() {
+    static const TriangleMesh m = makeTorus(1.0, 0.35, 16, 8);
+    return m;
+}
+const TriangleMesh& smallTorusB() {
+    static const TriangleMesh m = makeTorus(0.8, 0.3, 14, 7);
+    return m;
+}
+const std::vector<Pose>& distancePoses() {
+    static const std::vector<Pose> poses = randomPoses(777, 12, 3.0);
+    return poses;
+}
+
+// The brute force once per (scale, pose), shared by every volume type.
+const collision::MeshDistance& bruteDistance(Real scale, std::size_t pose_index,
+                                             const TriangleMesh& a, const TriangleMesh& b,
+                                             const Pose& pose) {
+    static std::map<std::pair<Real, std::size_t>, collision::MeshDistance> cache;
+    const auto key = std::make_pair(scale, pose_index);
+    auto it = cache.find(key);
+    if (it == cache.end()) {
+        it = cache.emplace(key, collision::distanceMeshMeshBruteForce(a, b, pose)).first;
+    }
+    return it->second;
+}
+
+TYPED_TEST(BvhTyped, DistanceMatchesBruteForceWithWitnesses) {
+    int separated = 0;
+    int touching = 0;
+    for (const Real scale : {Real(1), Real(1e-4), Real(1e4)}) {
+        const Vec3 offset = scale == 1 ? Vec3(Vec3::Zero()) : Vec3(Vec3(1e6, -1e6, 1e6) * scale);
+        const TriangleMesh ma = transformed(smallTorusA(), scale, offset);
+        const TriangleMesh mb = transformed(smallTorusB(), scale, offset);
+        const Bvh<TypeParam> a(ma);
+        const Bvh<TypeParam> b(mb);
+        const Real tol = Real(1e-9) * scale;  // relative to the meshes' size
+        for (const Pose& p0 : distancePoses()) {
+            const Pose pose = scaledPose(p0, scale, offset);
+            BvhQueryStats stats;
+            const collision::MeshDistance fast = collision::distanceBvhBvh(a, b, pose, &stats);
+            const collision::MeshDistance& brute = bruteDistance(
+                scale, static_cast<std::size_t>(&p0 - &distancePoses()[0]), ma, mb, pose);
+            ASSERT_GE(fast.a, 0);
+            ASSERT_GE(fast.b, 0);
+            EXPECT_NEAR(fast.distance, brute.distance, tol);
+            // The witnesses are points of the witness triangles, as far apart as reported.
+            EXPECT_NEAR((fast.point_on_a - fast.point_on_b).norm(), fast.distance, tol);
+            const auto& ta = ma.triangles[static_cast<std::size_t>(fast.a)];
+            const auto& tb = mb.triangles[static_cast<std::size_t>(fast.b)];
+            std::array<Vec3, 3> corners_b;
+            for (std::size_t k = 0; k < 3; ++k) {
+                corners_b[k] = pose.orientation * mb.vertices[static_cast<std::size_t>(tb[k])] +
+                               pose.position;
+            }
+            const Vec3 na = (ma.vertices[ta[1]] - ma.vertices[ta[0]])
+                                .cross(ma.vertices[ta[2]] - ma.vertices[ta[0]])
+                                .normalized();
+            const Vec3 nb = (corners_b[1] - corners_b[0]).cross(corners_b[2] - corners_b[0])
+                                .normalized();
+            EXPECT_NEAR(na.dot(fast.point_on_a - ma.vertices[ta[0]]), 0, tol);
+            EXPECT_NEAR(nb.dot(fast.point_on_b - corners_b[0]), 0, tol);
+            if (brute.distance > 0) {
+                ++separated;
+                EXPECT_GT(stats.bv_tests, 0);
+            } else {
+                ++touching;
+            }
+        }
+    }
+    EXPECT_GE(separated, 9);
+    EXPECT_GE(touching, 9);
+    // Closed form: grid cubes a gap g apart along x; witnesses on the facing faces.
+    const TriangleMesh cube = makeGridCube(2);
+    const Bvh<TypeParam> tree(cube);
+    for (const Real g : {Real(0.25), Real(1e-3), Real(0)}) {
+        const collision::MeshDistance d =
+            collision::distanceBvhBvh(tree, tree, Pose{Vec3(2 + g, 0.3, -0.2), Quat::Identity()});
+        EXPECT_NEAR(d.distance, g, 1e-12);
+        EXPECT_NEAR(d.point_on_a.x(), 1, 1e-12);
+        EXPECT_NEAR(d.point_on_b.x(), 1 + g, 1e-12);
+    }
+    auto runtime = collision::buildMeshBvh(BvName<TypeParam>::value, cube);
+    EXPECT_NEAR(runtime->distance(*runtime, Pose{Vec3(0, 2.5, 0), Quat::Identity()}).distance,
+                0.5, 1e-12);
+}
+
 TYPED_TEST(BvhTyped, MeanSplitAndFatLeavesGiveTheSameAnswer) {
     const Bvh<TypeParam> a(torusA(), BvhBuildOptions{BvhSplit::Mean, 4});
     const Bvh<TypeParam> b(torusB(), BvhBuildOptions{BvhSplit::Mean, 3});

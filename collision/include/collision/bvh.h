@@ -6,6 +6,7 @@
 
 #include <array>
 #include <compare>
+#include <limits>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -176,6 +177,30 @@ template <class BV>
 std::vector<TrianglePair> intersectBvhBvh(const Bvh<BV>& a, const Bvh<BV>& b, const Pose& b_in_a,
                                           BvhQueryStats* stats = nullptr);
 
+/// Distance between two meshes with witnesses: the closest triangle pair and its closest points.
+struct MeshDistance {
+    Real distance = 0;         ///< >= 0; 0 when the meshes touch or cross; +inf for an empty mesh
+    std::int32_t a = -1;       ///< witness triangle of A (mesh index), -1 for an empty mesh
+    std::int32_t b = -1;       ///< witness triangle of B
+    Vec3 point_on_a = Vec3::Zero();  ///< closest point on triangle a, in A's frame
+    Vec3 point_on_b = Vec3::Zero();  ///< closest point on triangle b, in A's frame
+};
+
+/// Smallest distance between the surfaces of `a` and `b` (B placed by `b_in_a`), by a
+/// depth-first traversal that visits the nearer child pair first and skips node pairs whose
+/// volume-distance lower bound exceeds the best distance found. Approximate to the rounding of
+/// the triangle closest points (relative to the meshes' scale); the same value as
+/// distanceMeshMeshBruteForce up to that rounding (a tie may pick another witness pair).
+/// Stops at 0 (touching or crossing). stats: bv_tests = lower bounds, triangle_tests = triangle
+/// distances. `stats` may be null.
+template <class BV>
+MeshDistance distanceBvhBvh(const Bvh<BV>& a, const Bvh<BV>& b, const Pose& b_in_a,
+                            BvhQueryStats* stats = nullptr);
+
+/// The reference: the minimum over every triangle pair (ties: the first pair in (a, b) order).
+MeshDistance distanceMeshMeshBruteForce(const TriangleMesh& a, const TriangleMesh& b,
+                                        const Pose& b_in_a, BvhQueryStats* stats = nullptr);
+
 /// Self-collision of one mesh: every pair of its triangles that touch or cross, except adjacent
 /// ones (sharing a vertex index; coincident vertices with different indices do not count as
 /// shared), as (a, b) with a < b, sorted, no duplicates. One traversal of the tree against
@@ -235,6 +260,9 @@ public:
                                                 BvhQueryStats* stats = nullptr) const = 0;
     /// Number of triangles of the mesh the tree was built from.
     virtual std::int32_t triangleCount() const = 0;
+    /// distanceBvhBvh with `b`, which must hold the same volume type (asserted; +inf if not).
+    virtual MeshDistance distance(const MeshBvh& b, const Pose& b_in_a,
+                                  BvhQueryStats* stats = nullptr) const = 0;
     /// intersectSelf on this tree.
     virtual std::vector<TrianglePair> intersectSelf(BvhQueryStats* stats = nullptr) const = 0;
     /// Bvh::refit (a deforming mesh): returns the nodes updated. Not for a tree shared by shapes
