@@ -6,10 +6,13 @@
 // same one), so every implementation tests bit-identical triangles; pair lists are sorted by
 // (a, b) and free of duplicates, so any two implementations compare with ==.
 #include <algorithm>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <sstream>
+#include <queue>
 #include <type_traits>
+#include <unordered_map>
 
 #include "bvh_volumes.h"
 #include "collision/assert.h"
@@ -32,6 +35,9 @@ struct Builder {
     const std::vector<Vec3>& centroids;               // by mesh triangle index
     std::vector<std::int32_t>& ids;                   // leaf order -> mesh index, permuted here
     const std::vector<TriangleMoments>& moments;      // by mesh triangle index (oriented BVs)
+    // Bottom-up builds: the split of each cluster's range (key first * (n + 1) + count), found
+    // by bottomUpSplits; null for top-down.
+    const std::unordered_map<std::int64_t, std::int32_t>* splits = nullptr;
     std::vector<Vec3> scratch;                        // reused: no allocation per node
 
     // Builds the subtree over leaf-order range [first, first + count); returns its node index.
@@ -54,7 +60,11 @@ struct Builder {
             node.count = count;
             return index;
         }
-        const std::int32_t split = partition(first, count);
+        const std::int32_t split =
+            splits ? splits->at(static_cast<std::int64_t>(first) *
+                                    static_cast<std::int64_t>(ids.size() + 1) +
+                                count)
+                   : partition(first, count);
         build(first, split - first);
         const std::int32_t right = build(split, first + count - split);
         nodes[static_cast<std::size_t>(index)].right = right;
@@ -119,6 +129,107 @@ struct Builder {
         return first + mid;
     }
 };
+
+// Spreads the low 10 bits of v to every third bit (Morton code, RTCD 7.3.5).
+std::uint32_t spreadBits(std::uint32_t v) {
+    v &= 0x3ffu;
+    v = (v | (v << 16)) & 0x030000ffu;
+    v = (v | (v << 8)) & 0x0300f00fu;
+    v = (v | (v << 4)) & 0x030c30c3u;
+    v = (v | (v << 2)) & 0x09249249u;
+    return v;
+}
+
+// The bottom-up build's clustering. Puts `ids` in Morton order of the centroids (ties by
+// triangle index: deterministic), then merges neighbouring clusters of that order greedily, the
+// pair with the smallest merged AABB surface area first (ties: the leftmost), until one is left.
+// Clusters are contiguous ranges of the order, so the result is a split per internal range.
+std::unordered_map<std::int64_t, std::int32_t> bottomUpSplits(
+    const std::vector<std::array<Vec3, 3>>& corners, const std::vector<Vec3>& centroids,
+    std::vector<std::int32_t>& ids) {
+    const std::size_t n = ids.size();
+    Vec3 lo = centroids[0];
+    Vec3 hi = centroids[0];
+    for (const Vec3& c : centroids) {
+        lo = lo.cwiseMin(c);
+        hi = hi.cwiseMax(c);
+    }
+    const Vec3 extent = (hi - lo).cwiseMax(Vec3::Constant(std::numeric_limits<Real>::min()));
+    std::vector<std::uint32_t> code(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 u = ((centroids[i] - lo).array() / extent.array()) * Real(1023);
+        code[i] = spreadBits(static_cast<std::uint32_t>(u.x())) |
+                  (spreadBits(static_cast<std::uint32_t>(u.y())) << 1) |
+                  (spreadBits(static_cast<std::uint32_t>(u.z())) << 2);
+    }
+    std::sort(ids.begin(), ids.end(), [&](std::int32_t a, std::int32_t b) {
+        const auto ca = code[static_cast<std::size_t>(a)];
+        const auto cb = code[static_cast<std::size_t>(b)];
+        return ca < cb || (ca == cb && a < b);
+    });
+    struct Cluster {
+        std::int32_t first;
+        std::int32_t count;
+        Vec3 lo;
+        Vec3 hi;
+        std::int32_t prev;
+        std::int32_t next;
+        bool alive;
+    };
+    std::vector<Cluster> clusters;
+    clusters.reserve(2 * n);
+    for (std::size_t k = 0; k < n; ++k) {
+        const auto& t = corners[static_cast<std::size_t>(ids[k])];
+        clusters.push_back({static_cast<std::int32_t>(k), 1, t[0].cwiseMin(t[1]).cwiseMin(t[2]),
+                            t[0].cwiseMax(t[1]).cwiseMax(t[2]), static_cast<std::int32_t>(k) - 1,
+                            k + 1 < n ? static_cast<std::int32_t>(k + 1) : -1, true});
+    }
+    auto area = [](const Vec3& l, const Vec3& h) {
+        const Vec3 e = h - l;
+        return e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
+    };
+    struct Candidate {
+        Real cost;
+        std::int32_t first;  // leftmost triangle: the tie-break
+        std::int32_t left;
+        std::int32_t right;
+        bool operator>(const Candidate& o) const {
+            return cost > o.cost || (cost == o.cost && first > o.first);
+        }
+    };
+    std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> queue;
+    auto push = [&](std::int32_t l, std::int32_t r) {
+        if (l < 0 || r < 0) return;
+        const Cluster& a = clusters[static_cast<std::size_t>(l)];
+        const Cluster& b = clusters[static_cast<std::size_t>(r)];
+        queue.push({area(a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)), a.first, l, r});
+    };
+    for (std::size_t k = 0; k + 1 < n; ++k) {
+        push(static_cast<std::int32_t>(k), static_cast<std::int32_t>(k + 1));
+    }
+    std::unordered_map<std::int64_t, std::int32_t> splits;
+    splits.reserve(n);
+    const auto key_base = static_cast<std::int64_t>(n + 1);
+    while (!queue.empty()) {
+        const Candidate c = queue.top();
+        queue.pop();
+        Cluster& a = clusters[static_cast<std::size_t>(c.left)];
+        Cluster& b = clusters[static_cast<std::size_t>(c.right)];
+        if (!a.alive || !b.alive || a.next != c.right) continue;  // stale entry
+        a.alive = false;
+        b.alive = false;
+        const auto id = static_cast<std::int32_t>(clusters.size());
+        const Cluster merged{a.first, a.count + b.count, a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi),
+                             a.prev, b.next, true};
+        splits[static_cast<std::int64_t>(merged.first) * key_base + merged.count] = b.first;
+        if (merged.prev >= 0) clusters[static_cast<std::size_t>(merged.prev)].next = id;
+        if (merged.next >= 0) clusters[static_cast<std::size_t>(merged.next)].prev = id;
+        clusters.push_back(merged);
+        push(merged.prev, id);
+        push(id, merged.next);
+    }
+    return splits;
+}
 
 // The tandem traversal (Gottschalk 1996 §5): pop a node pair, test the volumes, and at two leaves
 // test their triangles; otherwise descend the node with the larger volume (a leaf never
@@ -350,7 +461,10 @@ Bvh<BV>::Bvh(const TriangleMesh& mesh, const BvhBuildOptions& options) {
             moments[i] = triangleMoments(corners_[i][0], corners_[i][1], corners_[i][2], origin);
         }
     }
-    Builder<BV> builder{opts, nodes_, corners_, centroids, ids_, moments, {}};
+    std::unordered_map<std::int64_t, std::int32_t> splits;
+    if (opts.build == BvhBuild::BottomUp) splits = bottomUpSplits(corners_, centroids, ids_);
+    Builder<BV> builder{opts,    nodes_, corners_, centroids, ids_, moments,
+                        opts.build == BvhBuild::BottomUp ? &splits : nullptr, {}};
     builder.build(0, static_cast<std::int32_t>(n));
     // Corners into leaf order, so a leaf's triangles are contiguous in memory.
     std::vector<std::array<Vec3, 3>> by_mesh = std::move(corners_);

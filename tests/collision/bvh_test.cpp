@@ -379,6 +379,44 @@ TYPED_TEST(BvhTyped, DistanceMatchesBruteForceWithWitnesses) {
                 0.5, 1e-12);
 }
 
+TYPED_TEST(BvhTyped, BottomUpBuildGivesTheBruteForceAnswers) {
+    for (const int leaf : {1, 3}) {
+        const BvhBuildOptions options{BvhSplit::Median, leaf, collision::BvhBuild::BottomUp};
+        const Bvh<TypeParam> a(torusA(), options);
+        const Bvh<TypeParam> b(torusB(), options);
+        std::string error;
+        EXPECT_TRUE(a.validate(&error)) << error;
+        EXPECT_TRUE(b.validate(&error)) << error;
+        if (leaf == 1) {
+            EXPECT_EQ(a.nodes().size(), 2 * torusA().triangles.size() - 1);
+        }
+        // Not the top-down tree in disguise: another structure.
+        const Bvh<TypeParam> top(torusA(), BvhBuildOptions{BvhSplit::Median, leaf});
+        bool differs = top.nodes().size() != a.nodes().size();
+        for (std::size_t i = 0; !differs && i < a.nodes().size(); ++i) {
+            differs = top.nodes()[i].right != a.nodes()[i].right ||
+                      top.leafTriangleId(static_cast<std::int32_t>(i % torusA().triangles.size())) !=
+                          a.leafTriangleId(static_cast<std::int32_t>(i % torusA().triangles.size()));
+        }
+        EXPECT_TRUE(differs);
+        for (std::size_t k = 0; k < differentialPoses().size(); ++k) {
+            const Pose& pose = differentialPoses()[k];
+            EXPECT_EQ(collision::intersectBvhBvh(a, b, pose), bruteAnswer(k)) << "pose " << k;
+            EXPECT_EQ(collision::testBvhBvh(a, b, pose), !bruteAnswer(k).empty()) << "pose " << k;
+        }
+    }
+    // Deterministic: two builds give the same nodes.
+    const BvhBuildOptions options{BvhSplit::Median, 1, collision::BvhBuild::BottomUp};
+    const Bvh<TypeParam> x(torusB(), options);
+    const Bvh<TypeParam> y(torusB(), options);
+    ASSERT_EQ(x.nodes().size(), y.nodes().size());
+    for (std::size_t i = 0; i < x.nodes().size(); ++i) {
+        EXPECT_EQ(x.nodes()[i].right, y.nodes()[i].right);
+        EXPECT_EQ(x.nodes()[i].first, y.nodes()[i].first);
+        EXPECT_EQ(x.nodes()[i].cost, y.nodes()[i].cost);
+    }
+}
+
 TYPED_TEST(BvhTyped, MeanSplitAndFatLeavesGiveTheSameAnswer) {
     const Bvh<TypeParam> a(torusA(), BvhBuildOptions{BvhSplit::Mean, 4});
     const Bvh<TypeParam> b(torusB(), BvhBuildOptions{BvhSplit::Mean, 3});

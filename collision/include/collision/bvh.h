@@ -90,9 +90,18 @@ enum class BvhSplit : std::uint8_t {
     Mean,    ///< at the mean centroid coordinate; falls back to the median if one side is empty
 };
 
+/// How the tree is built.
+enum class BvhBuild : std::uint8_t {
+    TopDown,   ///< recursive splits (BvhSplit)
+    BottomUp,  ///< greedy agglomerative: triangles in Morton order of their centroids, then the
+               ///< neighbouring pair of clusters with the smallest merged box area merges first
+               ///< (RTCD 6.2.2; the Morton neighbourhood as in Walter et al. 2008)
+};
+
 struct BvhBuildOptions {
-    BvhSplit split = BvhSplit::Median;
+    BvhSplit split = BvhSplit::Median;  ///< top-down only
     int max_leaf_triangles = 1;  ///< a node with at most this many triangles is a leaf (>= 1)
+    BvhBuild build = BvhBuild::TopDown;
 };
 
 /// One intersecting pair: triangle `a` of mesh A and triangle `b` of mesh B (indices into the
