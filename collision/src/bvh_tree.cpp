@@ -248,13 +248,25 @@ bool traverse(const Bvh<BV>& a, const Bvh<BV>& b, const BvhTransform& x, BvhQuer
     std::vector<std::pair<std::int32_t, std::int32_t>> stack;
     stack.reserve(static_cast<std::size_t>(2 * (a.depth() + b.depth()) + 4));
     stack.emplace_back(0, 0);
+    // B's node volume moved into A's frame, kept while the traversal descends A under the same
+    // B node (the pair popped next after descending A has the same B node).
+    [[maybe_unused]] BV moved_b{};
+    [[maybe_unused]] std::int32_t moved_id = -1;
     while (!stack.empty() && !stopped) {
         const auto [ia, ib] = stack.back();
         stack.pop_back();
         const auto& node_a = na[static_cast<std::size_t>(ia)];
         const auto& node_b = nb[static_cast<std::size_t>(ib)];
         ++bv_tests;
-        if (!BvTraits<BV>::overlaps(node_a.volume, node_b.volume, x)) continue;
+        if constexpr (MovableVolume<BV>) {
+            if (ib != moved_id) {
+                moved_b = BvTraits<BV>::move(node_b.volume, x);
+                moved_id = ib;
+            }
+            if (!BvTraits<BV>::overlapsMoved(node_a.volume, moved_b, x)) continue;
+        } else {
+            if (!BvTraits<BV>::overlaps(node_a.volume, node_b.volume, x)) continue;
+        }
         if (node_a.isLeaf() && node_b.isLeaf()) {
             for (std::int32_t j = node_b.first; j < node_b.first + node_b.count && !stopped; ++j) {
                 const auto& tb = b.leafTriangle(j);
@@ -302,12 +314,18 @@ bool traverseVolume(const Bvh<BV>& a, const BV& volume, const BvhTransform& x,
     std::vector<std::int32_t> stack;
     stack.reserve(static_cast<std::size_t>(a.depth() + 2));
     stack.push_back(0);
+    [[maybe_unused]] BV moved{};
+    if constexpr (MovableVolume<BV>) moved = BvTraits<BV>::move(volume, x);
     while (!stack.empty() && !stopped) {
         const std::int32_t ia = stack.back();
         stack.pop_back();
         const auto& node = na[static_cast<std::size_t>(ia)];
         ++bv_tests;
-        if (!BvTraits<BV>::overlaps(node.volume, volume, x)) continue;
+        if constexpr (MovableVolume<BV>) {
+            if (!BvTraits<BV>::overlapsMoved(node.volume, moved, x)) continue;
+        } else {
+            if (!BvTraits<BV>::overlaps(node.volume, volume, x)) continue;
+        }
         if (node.isLeaf()) {
             for (std::int32_t i = node.first; i < node.first + node.count; ++i) {
                 if (on_triangle(i, a.leafTriangle(i))) {

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cmath>
+#include <concepts>
 #include <numbers>
 #include <vector>
 
@@ -143,6 +144,14 @@ bool triangleAxes(const Vec3& p, const Vec3& q, const Vec3& r, Mat3* axes);
 template <class BV>
 struct BvTraits;
 
+/// Volume types whose traits can move B's volume into A's frame once (move) and test against
+/// the moved copy (overlapsMoved); the traversals cache the moved copy of the current B node.
+template <class BV>
+concept MovableVolume = requires(const BV& v, const BvhTransform& x) {
+    { BvTraits<BV>::move(v, x) } -> std::same_as<BV>;
+    { BvTraits<BV>::overlapsMoved(v, v, x) } -> std::same_as<bool>;
+};
+
 // ---- Sphere: smallest enclosing sphere (Welzl), exact test. ----
 template <>
 struct BvTraits<BoundingSphere> {
@@ -190,9 +199,17 @@ struct BvTraits<Obb> {
     /// The box along given orthonormal axes: exact projections plus slack.
     static Obb fitWithAxes(const std::vector<Vec3>& corners, const Mat3& axes);
     static bool overlaps(const Obb& a, const Obb& b, const BvhTransform& x) {
-        const Mat3 rot = a.axes.transpose() * (x.r * b.axes);
-        const Vec3 t = a.axes.transpose() * (x.apply(b.center) - a.center);
-        return testSat15<false>(a.half_extents, rot, t, b.half_extents, x.tol, 0);
+        return overlapsMoved(a, move(b, x), x);
+    }
+    /// B's box in A's frame: computed once per B node while the traversal descends A under it.
+    static Obb move(const Obb& b, const BvhTransform& x) {
+        return Obb{x.apply(b.center), x.r * b.axes, b.half_extents};
+    }
+    /// overlaps() with B already moved (the same products in the same order: the same answer).
+    static bool overlapsMoved(const Obb& a, const Obb& moved, const BvhTransform& x) {
+        const Mat3 rot = a.axes.transpose() * moved.axes;
+        const Vec3 t = a.axes.transpose() * (moved.center - a.center);
+        return testSat15<false>(a.half_extents, rot, t, moved.half_extents, x.tol, 0);
     }
     static bool contains(const Obb& box, const Vec3& p, Real tol) {
         const Vec3 local = box.axes.transpose() * (p - box.center);
@@ -267,11 +284,19 @@ struct BvTraits<Rss> {
     /// The RSS whose rectangle spans axes.col(0), axes.col(1) (orthonormal, right-handed).
     static Rss fitWithAxes(const std::vector<Vec3>& corners, const Mat3& axes);
     static bool overlaps(const Rss& a, const Rss& b, const BvhTransform& x) {
-        const Mat3 rot = a.axes.transpose() * (x.r * b.axes);
-        const Vec3 t = a.axes.transpose() * (x.apply(b.center) - a.center);
+        return overlapsMoved(a, move(b, x), x);
+    }
+    /// B's volume in A's frame: computed once per B node while the traversal descends A under it.
+    static Rss move(const Rss& b, const BvhTransform& x) {
+        return Rss{x.apply(b.center), x.r * b.axes, b.half_lengths, b.radius};
+    }
+    /// overlaps() with B already moved (the same products in the same order: the same answer).
+    static bool overlapsMoved(const Rss& a, const Rss& moved, const BvhTransform& x) {
+        const Mat3 rot = a.axes.transpose() * moved.axes;
+        const Vec3 t = a.axes.transpose() * (moved.center - a.center);
         const Vec3 ha(a.half_lengths[0], a.half_lengths[1], 0);
-        const Vec3 hb(b.half_lengths[0], b.half_lengths[1], 0);
-        return testSat15<true>(ha, rot, t, hb, x.tol, a.radius + b.radius);
+        const Vec3 hb(moved.half_lengths[0], moved.half_lengths[1], 0);
+        return testSat15<true>(ha, rot, t, hb, x.tol, a.radius + moved.radius);
     }
     static bool contains(const Rss& s, const Vec3& p, Real tol) {
         const Vec3 local = s.axes.transpose() * (p - s.center);
