@@ -6,6 +6,7 @@
 #include "bench_ccd.h"
 #include "bench_convex.h"
 #include "check_command.h"
+#include "bench_narrowphase.h"
 #include "collision/broad_phase.h"
 #include "query_command.h"
 #include "run_command.h"
@@ -175,6 +176,25 @@ int main(int argc, char** argv) {
                      "relative answer tolerance for counting disagreements")
         ->capture_default_str();
     bench_convex_cmd->add_option("--json", bench_convex_json, "also write the rows as JSON to FILE");
+    app::BenchNarrowphaseOptions bench_np;
+    std::string bench_np_json;
+    CLI::App* bench_np_cmd = bench_cmd->add_subcommand(
+        "narrowphase", "mesh-mesh queries on two tori: every BVH volume type beside FCL's "
+                       "BVHModel types (build, first contact, all pairs, Nv, Np)");
+    bench_np_cmd->add_option("--triangles", bench_np.triangles, "triangles per torus")
+        ->capture_default_str();
+    bench_np_cmd->add_flag("--large", bench_np.large, "100k-triangle tori");
+    bench_np_cmd->add_option("--poses", bench_np.poses, "poses, even: half collide")
+        ->capture_default_str();
+    bench_np_cmd->add_option("--reps", bench_np.reps, "repetitions per pose (fastest counts)")
+        ->capture_default_str();
+    bench_np_cmd->add_option("--seed", bench_np.seed, "pose seed")->capture_default_str();
+    bench_np_cmd
+        ->add_option("--methods", bench_np.methods,
+                     "comma-separated (default all): volume names and fcl-obbrss, fcl-obb, "
+                     "fcl-rss, fcl-kios, fcl-aabb, fcl-kdop18")
+        ->delimiter(',');
+    bench_np_cmd->add_option("--json", bench_np_json, "also write the table as JSON to FILE");
     // END bench subcommand
 
     try {
@@ -237,6 +257,10 @@ int main(int argc, char** argv) {
     if (bench_convex_cmd->parsed()) {
         if (!bench_convex_json.empty()) bench_convex.json = bench_convex_json;
         return app::runBenchConvex(bench_convex, std::cout, std::cerr);
+    }
+    if (bench_np_cmd->parsed()) {
+        if (!bench_np_json.empty()) bench_np.json = bench_np_json;
+        return app::runBenchNarrowphase(bench_np, std::cout, std::cerr);
     }
     // END bench dispatch
     return 2;

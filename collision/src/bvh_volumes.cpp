@@ -6,6 +6,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -27,6 +28,35 @@ Real magnitude(const std::vector<Vec3>& pts) {
         hi = hi.cwiseMax(p);
     }
     return (hi - lo).maxCoeff() + std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff());
+}
+
+}  // namespace
+
+// Eigenvectors of a covariance matrix as a right-handed orthonormal frame, largest variance first.
+// A failed or degenerate solve gives the identity or any perpendicular completion: the fits
+// measure extents along whatever axes they get, so containment never depends on this.
+Mat3 axesOfCovariance(const Mat3& cov) {
+    Eigen::SelfAdjointEigenSolver<Mat3> solver;
+    solver.computeDirect(cov);
+    Mat3 axes = Mat3::Identity();
+    const Vec3 e0 = solver.eigenvectors().col(2);
+    const Vec3 e1 = solver.eigenvectors().col(1);
+    const Real n0 = e0.norm();
+    if (solver.info() == Eigen::Success && std::isfinite(n0) && n0 > Real(0.5)) {
+        // Gram-Schmidt so the axes are orthonormal to rounding whatever the solver returned.
+        axes.col(0) = e0 / n0;
+        Vec3 v1 = e1 - axes.col(0) * axes.col(0).dot(e1);
+        const Real n1 = v1.norm();
+        if (n1 > Real(0.5)) {
+            axes.col(1) = v1 / n1;
+        } else {
+            // Pick any unit vector perpendicular to col(0).
+            const Vec3 any = std::abs(axes(0, 0)) < Real(0.9) ? Vec3::UnitX() : Vec3::UnitY();
+            axes.col(1) = axes.col(0).cross(any).normalized();
+        }
+        axes.col(2) = axes.col(0).cross(axes.col(1));
+    }
+    return axes;
 }
 
 // Principal axes of the triangles (consecutive corner triples), area weighted (Gottschalk 1996
@@ -64,35 +94,63 @@ Mat3 principalAxes(const std::vector<Vec3>& corners) {
             cov += d * d.transpose();
         }
     }
-    Eigen::SelfAdjointEigenSolver<Mat3> solver;
-    solver.computeDirect(cov);
-    Mat3 axes = Mat3::Identity();
-    const Vec3 e0 = solver.eigenvectors().col(2);
-    const Vec3 e1 = solver.eigenvectors().col(1);
-    const Real n0 = e0.norm();
-    if (solver.info() == Eigen::Success && std::isfinite(n0) && n0 > Real(0.5)) {
-        // Gram-Schmidt so the axes are orthonormal to rounding whatever the solver returned.
-        axes.col(0) = e0 / n0;
-        Vec3 v1 = e1 - axes.col(0) * axes.col(0).dot(e1);
-        const Real n1 = v1.norm();
-        if (n1 > Real(0.5)) {
-            axes.col(1) = v1 / n1;
-        } else {
-            // Pick any unit vector perpendicular to col(0).
-            const Vec3 any = std::abs(axes(0, 0)) < Real(0.9) ? Vec3::UnitX() : Vec3::UnitY();
-            axes.col(1) = axes.col(0).cross(any).normalized();
-        }
-        axes.col(2) = axes.col(0).cross(axes.col(1));
-    }
-    return axes;
+    return axesOfCovariance(cov);
 }
 
-}  // namespace
+TriangleMoments triangleMoments(const Vec3& p0, const Vec3& q0, const Vec3& r0,
+                                const Vec3& origin) {
+    // The same sums as principalAxes, per triangle, so a node's moments are a sum over its
+    // triangles (computed once at build instead of once per node level).
+    const Vec3 p = p0 - origin;
+    const Vec3 q = q0 - origin;
+    const Vec3 r = r0 - origin;
+    TriangleMoments t;
+    t.area = Real(0.5) * (q - p).cross(r - p).norm();
+    const Vec3 m = (p + q + r) / Real(3);
+    t.first = t.area * m;
+    t.second = t.area / Real(12) *
+               (Real(9) * m * m.transpose() + p * p.transpose() + q * q.transpose() +
+                r * r.transpose());
+    return t;
+}
+
+bool momentAxes(const TriangleMoments& m, Mat3* axes) {
+    if (!(m.area > 0)) return false;
+    const Vec3 mu = m.first / m.area;
+    *axes = axesOfCovariance(m.second / m.area - mu * mu.transpose());
+    return true;
+}
+
+bool triangleAxes(const Vec3& p, const Vec3& q, const Vec3& r, Mat3* axes) {
+    const std::array<Vec3, 3> edges{q - p, r - q, p - r};
+    int longest = 0;
+    for (int k = 1; k < 3; ++k) {
+        if (edges[static_cast<std::size_t>(k)].squaredNorm() >
+            edges[static_cast<std::size_t>(longest)].squaredNorm()) {
+            longest = k;
+        }
+    }
+    const Vec3 n = (q - p).cross(r - p);
+    const Vec3& e = edges[static_cast<std::size_t>(longest)];
+    const Real n_len = n.norm();
+    const Real e_len = e.norm();
+    // A sliver whose normal is lost in rounding: let the caller use the covariance instead.
+    if (!(n_len > Real(16) * kEpsilon * e_len * e_len) || !(e_len > 0)) return false;
+    axes->col(0) = e / e_len;
+    axes->col(2) = n / n_len;
+    axes->col(1) = axes->col(2).cross(axes->col(0));
+    return true;
+}
 
 BvhTransform makeBvhTransform(const Pose& b_in_a, Real scale_a, Real scale_b) {
+    return makeBvhTransform(b_in_a.rotation(), b_in_a.position, scale_a, scale_b);
+}
+
+BvhTransform makeBvhTransform(const Mat3& rotation, const Vec3& translation, Real scale_a,
+                              Real scale_b) {
     BvhTransform x;
-    x.r = b_in_a.rotation();
-    x.t = b_in_a.position;
+    x.r = rotation;
+    x.t = translation;
     x.identity = x.r == Mat3::Identity();
     x.tol = kBvhOverlapSlack * (scale_a + scale_b + x.t.cwiseAbs().maxCoeff());
     for (int k = 0; k < kKdopDirectionCount; ++k) {
@@ -123,7 +181,11 @@ Aabb BvTraits<Aabb>::fit(const std::vector<Vec3>& corners) {
 
 Obb BvTraits<Obb>::fit(const std::vector<Vec3>& corners) {
     CDLAB_ASSERT(!corners.empty(), "fitting a volume to no points");
-    const Mat3 axes = principalAxes(corners);
+    return fitWithAxes(corners, principalAxes(corners));
+}
+
+Obb BvTraits<Obb>::fitWithAxes(const std::vector<Vec3>& corners, const Mat3& axes) {
+    CDLAB_ASSERT(!corners.empty(), "fitting a volume to no points");
     const Vec3 origin = corners[0];
     Vec3 lo = Vec3::Zero();
     Vec3 hi = Vec3::Zero();
@@ -169,11 +231,15 @@ template struct BvTraits<Kdop<26>>;
 
 Rss BvTraits<Rss>::fit(const std::vector<Vec3>& corners) {
     CDLAB_ASSERT(!corners.empty(), "fitting a volume to no points");
+    return fitWithAxes(corners, principalAxes(corners));
+}
+
+Rss BvTraits<Rss>::fitWithAxes(const std::vector<Vec3>& corners, const Mat3& axes) {
+    CDLAB_ASSERT(!corners.empty(), "fitting a volume to no points");
     // Larsen et al. 2000 §4: the rectangle spans the two largest principal axes; the radius is
     // half the thickness along the third. The rectangle is then shrunk as far as every point's
     // own slack sqrt(r^2 - dz^2) allows on each axis, and the radius re-measured exactly, so
     // points near the rounded corners are covered by construction.
-    const Mat3 axes = principalAxes(corners);
     const Vec3 origin = corners[0];
     std::vector<Vec3> local;
     local.reserve(corners.size());

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cmath>
+#include <concepts>
 #include <numbers>
 #include <vector>
 
@@ -70,6 +71,9 @@ struct BvhTransform {
 
 /// `scale_a`, `scale_b`: the meshes' length scales (Bvh::scale()).
 BvhTransform makeBvhTransform(const Pose& b_in_a, Real scale_a, Real scale_b);
+/// The same from a rotation matrix (orthonormal) and a translation: p_a = rotation p_b + t.
+BvhTransform makeBvhTransform(const Mat3& rotation, const Vec3& translation, Real scale_a,
+                              Real scale_b);
 
 /// Separating-axis test of two boxes (Gottschalk, Lin, Manocha 1996 §4; RTCD 4.4.1) in A's box
 /// frame: `a`, `b` half extents, `rot` B's axes in A's box frame, `t` B's centre there. With
@@ -112,8 +116,41 @@ inline bool testSat15(const Vec3& a, const Mat3& rot, const Vec3& t, const Vec3&
     return true;
 }
 
+/// Area-weighted moments of triangles about a fixed origin (Gottschalk 1996 §3): additive, so a
+/// node's moments are the sum of its triangles'.
+struct TriangleMoments {
+    Real area = 0;
+    Vec3 first = Vec3::Zero();   ///< sum of area * centroid
+    Mat3 second = Mat3::Zero();  ///< sum of area/12 (9 m m^T + p p^T + q q^T + r r^T)
+    void add(const TriangleMoments& o) {
+        area += o.area;
+        first += o.first;
+        second += o.second;
+    }
+};
+TriangleMoments triangleMoments(const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& origin);
+/// Principal axes of summed moments (largest variance first, right-handed); false for zero area.
+/// Cancellation far from `origin` only loosens the fit: extents are measured along the axes.
+bool momentAxes(const TriangleMoments& m, Mat3* axes);
+/// Principal axes of triangles given as consecutive corner triples (covariance of the corners
+/// when their total area is zero).
+Mat3 principalAxes(const std::vector<Vec3>& corners);
+/// Eigenvectors of a covariance, largest first, as a right-handed orthonormal frame.
+Mat3 axesOfCovariance(const Mat3& cov);
+/// The tight frame of one triangle: its longest edge, the in-plane perpendicular, the normal.
+/// False for a sliver whose normal is lost in rounding.
+bool triangleAxes(const Vec3& p, const Vec3& q, const Vec3& r, Mat3* axes);
+
 template <class BV>
 struct BvTraits;
+
+/// Volume types whose traits can move B's volume into A's frame once (move) and test against
+/// the moved copy (overlapsMoved); the traversals cache the moved copy of the current B node.
+template <class BV>
+concept MovableVolume = requires(const BV& v, const BvhTransform& x) {
+    { BvTraits<BV>::move(v, x) } -> std::same_as<BV>;
+    { BvTraits<BV>::overlapsMoved(v, v, x) } -> std::same_as<bool>;
+};
 
 // ---- Sphere: smallest enclosing sphere (Welzl), exact test. ----
 template <>
@@ -159,10 +196,20 @@ struct BvTraits<Aabb> {
 template <>
 struct BvTraits<Obb> {
     static Obb fit(const std::vector<Vec3>& corners);
+    /// The box along given orthonormal axes: exact projections plus slack.
+    static Obb fitWithAxes(const std::vector<Vec3>& corners, const Mat3& axes);
     static bool overlaps(const Obb& a, const Obb& b, const BvhTransform& x) {
-        const Mat3 rot = a.axes.transpose() * (x.r * b.axes);
-        const Vec3 t = a.axes.transpose() * (x.apply(b.center) - a.center);
-        return testSat15<false>(a.half_extents, rot, t, b.half_extents, x.tol, 0);
+        return overlapsMoved(a, move(b, x), x);
+    }
+    /// B's box in A's frame: computed once per B node while the traversal descends A under it.
+    static Obb move(const Obb& b, const BvhTransform& x) {
+        return Obb{x.apply(b.center), x.r * b.axes, b.half_extents};
+    }
+    /// overlaps() with B already moved (the same products in the same order: the same answer).
+    static bool overlapsMoved(const Obb& a, const Obb& moved, const BvhTransform& x) {
+        const Mat3 rot = a.axes.transpose() * moved.axes;
+        const Vec3 t = a.axes.transpose() * (moved.center - a.center);
+        return testSat15<false>(a.half_extents, rot, t, moved.half_extents, x.tol, 0);
     }
     static bool contains(const Obb& box, const Vec3& p, Real tol) {
         const Vec3 local = box.axes.transpose() * (p - box.center);
@@ -234,12 +281,22 @@ struct BvTraits<Kdop<K>> {
 template <>
 struct BvTraits<Rss> {
     static Rss fit(const std::vector<Vec3>& corners);
+    /// The RSS whose rectangle spans axes.col(0), axes.col(1) (orthonormal, right-handed).
+    static Rss fitWithAxes(const std::vector<Vec3>& corners, const Mat3& axes);
     static bool overlaps(const Rss& a, const Rss& b, const BvhTransform& x) {
-        const Mat3 rot = a.axes.transpose() * (x.r * b.axes);
-        const Vec3 t = a.axes.transpose() * (x.apply(b.center) - a.center);
+        return overlapsMoved(a, move(b, x), x);
+    }
+    /// B's volume in A's frame: computed once per B node while the traversal descends A under it.
+    static Rss move(const Rss& b, const BvhTransform& x) {
+        return Rss{x.apply(b.center), x.r * b.axes, b.half_lengths, b.radius};
+    }
+    /// overlaps() with B already moved (the same products in the same order: the same answer).
+    static bool overlapsMoved(const Rss& a, const Rss& moved, const BvhTransform& x) {
+        const Mat3 rot = a.axes.transpose() * moved.axes;
+        const Vec3 t = a.axes.transpose() * (moved.center - a.center);
         const Vec3 ha(a.half_lengths[0], a.half_lengths[1], 0);
-        const Vec3 hb(b.half_lengths[0], b.half_lengths[1], 0);
-        return testSat15<true>(ha, rot, t, hb, x.tol, a.radius + b.radius);
+        const Vec3 hb(moved.half_lengths[0], moved.half_lengths[1], 0);
+        return testSat15<true>(ha, rot, t, hb, x.tol, a.radius + moved.radius);
     }
     static bool contains(const Rss& s, const Vec3& p, Real tol) {
         const Vec3 local = s.axes.transpose() * (p - s.center);

@@ -1,7 +1,7 @@
 // collision/src/narrow_phase.cpp -- collide(): dispatch through a [ShapeType][ShapeType] table of
 // free functions (each pair written once; the swapped flag reorders the arguments), closed forms
-// for sphere/box/capsule pairs, GJK (gjk.h) for every other convex pair, triangle-level tests for
-// meshes.
+// for sphere/box/capsule pairs, GJK (gjk.h) for every other convex pair, and for meshes the shape's
+// hierarchy (bvh.h) down to triangle-level tests.
 // Invariants: every pair routine computes in the first shape's frame from one RelativePose built
 // by subtracting positions first; the touching tolerance is kTouchRelativeTolerance times the
 // larger bounding radius of the two shapes, and |signed distance| <= tolerance is Touching in
@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "collision/assert.h"
+#include "collision/bvh.h"
 #include "gjk.h"
 #include "triangle_triangle.h"
 
@@ -210,13 +211,59 @@ Box3 triangleBox(const Vec3& p, const Vec3& q, const Vec3& r) {
 
 // A triangle of the mesh against the convex shape: GJK on the triangle as a 3-point convex set.
 // A Penetrating triangle ends the scan; Touching ones do not, so the state (Penetrating over
-// Touching) does not depend on triangle order.
+// Touching) does not depend on triangle order, nor on which triangles the culling lets through
+// (culling only drops triangles farther than the tolerance from B).
+class MeshConvexScan final : public TriangleVisitor {
+public:
+    MeshConvexScan(const ConvexCore& core_b, const RelativePose& b_in_a, const PairContext& ctx,
+                   const Box3& box_b)
+        : core_b_(core_b), b_in_a_(b_in_a), ctx_(ctx), box_b_(box_b) {}
+    bool visit(std::int32_t, const std::array<Vec3, 3>& t) override {
+        if (!triangleBox(t[0], t[1], t[2]).overlaps(box_b_)) return false;
+        ++tests_;
+        const CollideOutput res = collideConvexCores(ConvexCore::triangle(t[0], t[1], t[2]), core_b_,
+                                                     b_in_a_, ctx_.tolerance, ctx_.scale);
+        iterations_ += res.iterations;
+        penetrating_ = res.state == ContactState::Penetrating;
+        touching_ = touching_ || res.state == ContactState::Touching;
+        failed_ = failed_ || res.state == ContactState::Failed;
+        return penetrating_;
+    }
+    CollideOutput result() const {
+        CollideOutput out;
+        out.state = penetrating_ ? ContactState::Penetrating
+                    : touching_  ? ContactState::Touching
+                    : failed_    ? ContactState::Failed
+                                 : ContactState::Separated;
+        out.triangle_tests = tests_;
+        out.iterations = iterations_;
+        return out;
+    }
+
+private:
+    const ConvexCore& core_b_;
+    const RelativePose& b_in_a_;
+    const PairContext& ctx_;
+    const Box3& box_b_;  // B's grown AABB in A's frame: the last cull before GJK
+    std::int32_t tests_ = 0;
+    std::int32_t iterations_ = 0;
+    bool penetrating_ = false;
+    bool touching_ = false;
+    bool failed_ = false;
+};
+
+// Mesh against convex. Only triangles whose box overlaps B's exact AABB in A's frame (from B's
+// support points along A's axes), grown by B's radius and the touching tolerance, reach GJK.
+// With a hierarchy, only the leaves whose node volumes overlap a volume fitted around B's own box
+// (support points along B's axes, grown the same way) are looked at; without one (the
+// brute-force reference) every triangle is. Both cullings keep every triangle within the
+// tolerance of B, so the state is the same.
 CollideOutput collideMeshConvex(const Shape& a, const Shape& b, const RelativePose& b_in_a,
                                 const PairContext& ctx) {
     CDLAB_ASSERT(a.mesh, "mesh shape without triangles");
     const TriangleMesh& mesh = *a.mesh;
     const ConvexCore core_b = ConvexCore::fromShape(b);
-    // B's exact AABB in A's frame from its support points along A's axes.
+    const Real grow = core_b.radius + ctx.tolerance;
     Box3 box_b;
     for (int k = 0; k < 3; ++k) {
         const Vec3 axis_in_b = b_in_a.rotation.row(k).transpose();
@@ -225,34 +272,29 @@ CollideOutput collideMeshConvex(const Shape& a, const Shape& b, const RelativePo
         box_b.min[k] = lo;
         box_b.max[k] = hi;
     }
-    box_b.inflate(core_b.radius + ctx.tolerance);
-
-    CollideOutput out;
-    out.state = ContactState::Separated;
-    bool touching = false;
-    bool failed = false;
-    for (const auto& tri : mesh.triangles) {
-        const Vec3& p = mesh.vertices[static_cast<std::size_t>(tri[0])];
-        const Vec3& q = mesh.vertices[static_cast<std::size_t>(tri[1])];
-        const Vec3& r = mesh.vertices[static_cast<std::size_t>(tri[2])];
-        if (!triangleBox(p, q, r).overlaps(box_b)) continue;
-        ++out.triangle_tests;
-        const CollideOutput res = collideConvexCores(ConvexCore::triangle(p, q, r), core_b, b_in_a,
-                                                     ctx.tolerance, ctx.scale);
-        out.iterations += res.iterations;
-        if (res.state == ContactState::Penetrating) {
-            out.state = ContactState::Penetrating;
-            return out;
+    box_b.inflate(grow);
+    MeshConvexScan scan(core_b, b_in_a, ctx, box_b);
+    if (a.bvh) {
+        Vec3 lo;
+        Vec3 hi;
+        for (int k = 0; k < 3; ++k) {
+            hi[k] = core_b.support(Vec3::Unit(k))[k] + grow;
+            lo[k] = core_b.support(-Vec3::Unit(k))[k] - grow;
         }
-        touching = touching || res.state == ContactState::Touching;
-        failed = failed || res.state == ContactState::Failed;
+        BvhQueryStats stats;
+        a.bvh->visitNearBox(lo, hi, b_in_a.rotation, b_in_a.position, scan, &stats);
+        CollideOutput out = scan.result();
+        out.bv_tests = stats.bv_tests;
+        return out;
     }
-    if (touching) {
-        out.state = ContactState::Touching;
-    } else if (failed) {
-        out.state = ContactState::Failed;
+    for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+        const auto& tri = mesh.triangles[i];
+        const std::array<Vec3, 3> t{mesh.vertices[static_cast<std::size_t>(tri[0])],
+                                    mesh.vertices[static_cast<std::size_t>(tri[1])],
+                                    mesh.vertices[static_cast<std::size_t>(tri[2])]};
+        if (scan.visit(static_cast<std::int32_t>(i), t)) break;
     }
-    return out;
+    return scan.result();
 }
 
 // Does triangle (p, q, r) have corners farther than `tolerance` on both sides of the plane of
@@ -270,12 +312,54 @@ bool straddles(const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& u, const
     return std::max({dp, dq, dr}) > tolerance && std::min({dp, dq, dr}) < -tolerance;
 }
 
-// Mesh-mesh: B's vertices go to A's frame once; each mesh's triangles are culled against the
-// other's (tolerance-inflated) AABB, and the survivors are tested pairwise with the exact
-// triangle-triangle test. Brute force over survivors; hierarchies come later.
+// Intersecting triangle pairs from the tandem traversal: a pair where each triangle straddles the
+// other's plane crosses (Penetrating, stop); any other intersecting pair touches. The state does
+// not depend on the order the pairs arrive in.
+class MeshMeshScan final : public TrianglePairVisitor {
+public:
+    explicit MeshMeshScan(Real tolerance) : tolerance_(tolerance) {}
+    bool visit(std::int32_t, const std::array<Vec3, 3>& ta, std::int32_t,
+               const std::array<Vec3, 3>& tb) override {
+        if (straddles(ta[0], ta[1], ta[2], tb[0], tb[1], tb[2], tolerance_) &&
+            straddles(tb[0], tb[1], tb[2], ta[0], ta[1], ta[2], tolerance_)) {
+            penetrating_ = true;
+            return true;
+        }
+        touching_ = true;
+        return false;
+    }
+    ContactState state() const {
+        return penetrating_ ? ContactState::Penetrating
+               : touching_  ? ContactState::Touching
+                            : ContactState::Separated;
+    }
+
+private:
+    Real tolerance_;
+    bool penetrating_ = false;
+    bool touching_ = false;
+};
+
+// Mesh-mesh. With hierarchies of one volume type: the tandem traversal under the relative pose
+// (no mesh is re-transformed; B's corners move to A's frame only at leaf pairs, with the same
+// expression as below). Otherwise (the brute-force reference): B's vertices go to A's frame once;
+// each mesh's triangles are culled against the other's (tolerance-inflated) AABB, and the
+// survivors are tested pairwise with the exact triangle-triangle test. Both give the same state:
+// the exact test decides, and both cullings are conservative.
 CollideOutput collideMeshMesh(const Shape& a, const Shape& b, const RelativePose& b_in_a,
                               const PairContext& ctx) {
     CDLAB_ASSERT(a.mesh && b.mesh, "mesh shape without triangles");
+    if (a.bvh && b.bvh && a.bvh->sameVolumeType(*b.bvh)) {
+        MeshMeshScan scan(ctx.tolerance);
+        BvhQueryStats stats;
+        a.bvh->visitIntersecting(*b.bvh, b_in_a.rotation, b_in_a.position, scan, &stats);
+        CollideOutput out;
+        out.state = scan.state();
+        out.triangle_tests = static_cast<std::int32_t>(
+            std::min<std::int64_t>(stats.triangle_tests, std::numeric_limits<std::int32_t>::max()));
+        out.bv_tests = stats.bv_tests;
+        return out;
+    }
     const TriangleMesh& mesh_a = *a.mesh;
     const TriangleMesh& mesh_b = *b.mesh;
     // Scratch reused across calls: no allocation per pair once warm.

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "collision/assert.h"
+#include "collision/bvh.h"
 
 namespace collision {
 
@@ -50,11 +51,22 @@ Shape Shape::convexHull(std::shared_ptr<const ConvexPolytope> hull) {
 
 Shape Shape::triangleMesh(std::shared_ptr<const TriangleMesh> mesh,
                           std::shared_ptr<const ConvexPolytope> hull) {
+    CDLAB_ASSERT(mesh, "mesh shape without triangles");
+    std::shared_ptr<const MeshBvh> bvh = buildMeshBvh(kDefaultMeshBvh, *mesh);
+    return triangleMesh(std::move(mesh), std::move(hull), std::move(bvh));
+}
+
+Shape Shape::triangleMesh(std::shared_ptr<const TriangleMesh> mesh,
+                          std::shared_ptr<const ConvexPolytope> hull,
+                          std::shared_ptr<const MeshBvh> bvh) {
     CDLAB_ASSERT(mesh && hull && !hull->vertices.empty(), "mesh needs its hull");
+    CDLAB_ASSERT(!bvh || bvh->triangleCount() == static_cast<std::int32_t>(mesh->triangles.size()),
+                 "the hierarchy was built from another mesh");
     Shape s;
     s.type = ShapeType::Mesh;
     s.mesh = std::move(mesh);
     s.hull = std::move(hull);
+    s.bvh = std::move(bvh);
     return s;
 }
 

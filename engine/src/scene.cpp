@@ -27,6 +27,7 @@
 #include <utility>
 
 #include "collision/broad_phase.h"
+#include "collision/bvh.h"
 #include "collision/convex_hull.h"
 #include "engine/mass_properties.h"
 #include "engine/mesh_import.h"
@@ -123,8 +124,10 @@ private:
     void parseDraw(const YAML::Node& n, Scene& scene) const;
     /// One body, or the `repeat.count` bodies a `repeat` entry generates.
     std::vector<Body> parseBody(const YAML::Node& n, std::size_t index, const Scene& scene);
+    /// `bvh_name`: the volume type of a mesh's hierarchy (validated by parseWorld).
     const PreparedShape& prepareMeshShape(ShapeType type, const std::string& file, Real scale,
-                                          const Entry& file_entry, const std::string& path);
+                                          const Entry& file_entry, const std::string& path,
+                                          const std::string& bvh_name);
     /// `expect:` (after the bodies, whose names it refers to).
     void parseExpect(const YAML::Node& n, Scene& scene) const;
     template <typename Place>
@@ -274,7 +277,8 @@ Vec3 SceneParser::readVec3(const YAML::Node& n, const std::string& path) const {
 void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
     const std::string path = "world";
     const std::vector<Entry> es =
-        entries(n, path, {"bounds", "gravity", "time_step", "steps_per_frame", "frames"});
+        entries(n, path,
+                {"bounds", "gravity", "time_step", "steps_per_frame", "frames", "mesh_bvh"});
     {
         const Entry& b = require(es, "bounds", n, path);
         const std::string bp = childPath(path, "bounds");
@@ -304,6 +308,18 @@ void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
         } else if (e.key == "frames") {
             scene.frames = readInt(e.value, p);
             if (scene.frames < 1) fail(e.value, p, "must be >= 1");
+        } else if (e.key == "mesh_bvh") {
+            const std::string name = readString(e.value, p);
+            const auto& names = collision::bvhVolumeNames();
+            if (std::find(names.begin(), names.end(), name) == names.end()) {
+                std::string list;
+                for (const std::string_view v : names) {
+                    list += (list.empty() ? "" : ", ") + std::string(v);
+                }
+                fail(e.value, p,
+                     "unknown bounding volume '" + name + "' (expected one of: " + list + ")");
+            }
+            scene.world.mesh_bvh = name;
         }
     }
 }
@@ -389,7 +405,8 @@ void SceneParser::parseDraw(const YAML::Node& n, Scene& scene) const {
 
 const PreparedShape& SceneParser::prepareMeshShape(ShapeType type, const std::string& file,
                                                    Real scale, const Entry& file_entry,
-                                                   const std::string& path) {
+                                                   const std::string& path,
+                                                   const std::string& bvh_name) {
     fs::path resolved = fs::path(file);
     if (resolved.is_relative()) resolved = base_dir_ / resolved;
     std::error_code ec;
@@ -440,7 +457,8 @@ const PreparedShape& SceneParser::prepareMeshShape(ShapeType type, const std::st
         type == ShapeType::ConvexHull
             ? Shape::convexHull(std::make_shared<const collision::ConvexPolytope>(hull.hull))
             : Shape::triangleMesh(std::make_shared<const collision::TriangleMesh>(imported.mesh),
-                                  std::make_shared<const collision::ConvexPolytope>(hull.hull));
+                                  std::make_shared<const collision::ConvexPolytope>(hull.hull),
+                                  nullptr);  // only for the mass properties: no hierarchy
     const MassPropertiesOutput mp = computeMassProperties(raw, 1);
     if (!mp.ok) fail(file_entry.key_node, path, "'" + resolved.string() + "': " + mp.error);
     const Vec3 com = mp.props.center_of_mass;
@@ -454,9 +472,14 @@ const PreparedShape& SceneParser::prepareMeshShape(ShapeType type, const std::st
     } else {
         collision::TriangleMesh centred_mesh = imported.mesh;
         for (Vec3& v : centred_mesh.vertices) v -= com;
+        // The hierarchy is built once here, in the body frame, and shared by every body made
+        // from this file (rigid motion needs no rebuild).
+        auto mesh = std::make_shared<const collision::TriangleMesh>(std::move(centred_mesh));
+        std::shared_ptr<const collision::MeshBvh> bvh = collision::buildMeshBvh(bvh_name, *mesh);
         prepared.shape = Shape::triangleMesh(
-            std::make_shared<const collision::TriangleMesh>(std::move(centred_mesh)),
-            std::make_shared<const collision::ConvexPolytope>(std::move(centred_hull)));
+            std::move(mesh),
+            std::make_shared<const collision::ConvexPolytope>(std::move(centred_hull)),
+            std::move(bvh));
     }
     return mesh_cache_.emplace(key, std::move(prepared)).first->second;
 }
@@ -617,8 +640,9 @@ std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
     const std::string mass_path = childPath(path, mass_at->key);
     const YAML::Node mass_node = mass_at->value;
     if (type == ShapeType::ConvexHull || type == ShapeType::Mesh) {
-        const PreparedShape& prepared = prepareMeshShape(type, file_entry->value.Scalar(), scale,
-                                                         *file_entry, childPath(path, "file"));
+        const PreparedShape& prepared =
+            prepareMeshShape(type, file_entry->value.Scalar(), scale, *file_entry,
+                             childPath(path, "file"), scene.world.mesh_bvh);
         shape = prepared.shape;
         unit = prepared.unit;
     } else {

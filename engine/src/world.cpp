@@ -139,12 +139,14 @@ void World::runCollisionPipeline() {
     colliding_.clear();
     stats_.narrow_tests = 0;
     stats_.triangle_tests = 0;
+    stats_.bv_tests = 0;
     for (const collision::ProxyPair& pair : flagged_) {
         const Body& a = bodies_[pair.a];
         const Body& b = bodies_[pair.b];
         const collision::CollideOutput out = collision::collide(a.shape, a.pose(), b.shape, b.pose());
         ++stats_.narrow_tests;
         stats_.triangle_tests += out.triangle_tests;
+        stats_.bv_tests += out.bv_tests;
         if (collision::isColliding(out.state)) colliding_.push_back(pair);
     }
     stats_.narrow_phase_s = secondsSince(t);

@@ -204,7 +204,7 @@ TEST(Cli, StatsCsvHasOneRowPerFrameAndCheckBroadphasePasses) {
     int rows = 0;
     std::string last;
     while (std::getline(lines, line)) {
-        EXPECT_EQ(std::count(line.begin(), line.end(), ','), 15) << line;
+        EXPECT_EQ(std::count(line.begin(), line.end(), ','), 16) << line;
         last = line;
         ++rows;
     }
@@ -214,7 +214,7 @@ TEST(Cli, StatsCsvHasOneRowPerFrameAndCheckBroadphasePasses) {
     std::vector<std::string> cells;
     std::stringstream row(last);
     for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
-    ASSERT_EQ(cells.size(), 16u);
+    ASSERT_EQ(cells.size(), 17u);
     EXPECT_EQ(cells[0], "5");
     EXPECT_EQ(cells[2], "hgrid");
     EXPECT_EQ(std::stoul(cells[4]), p["flagged_pairs"].size());

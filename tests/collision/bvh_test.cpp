@@ -191,6 +191,232 @@ TYPED_TEST(BvhTyped, AllPairsMatchBruteForceAtRandomPoses) {
     EXPECT_LE(colliding, 12);
 }
 
+// A deformed torus A: radial waves and a twist about z, large enough to move triangles by more
+// than their leaves' sizes.
+TriangleMesh deformedTorusA() {
+    TriangleMesh m = torusA();
+    for (Vec3& v : m.vertices) {
+        const Real angle = std::atan2(v.y(), v.x());
+        const Real k = 1 + Real(0.25) * std::sin(3 * angle);
+        const Real twist = Real(0.4) * v.z();
+        const Vec3 w(v.x() * k, v.y() * k, v.z() * (1 + Real(0.5) * std::cos(2 * angle)));
+        v = Vec3(w.x() * std::cos(twist) - w.y() * std::sin(twist),
+                 w.x() * std::sin(twist) + w.y() * std::cos(twist), w.z());
+    }
+    return m;
+}
+
+TYPED_TEST(BvhTyped, RefitGivesTheRebuildsAnswers) {
+    const TriangleMesh deformed = deformedTorusA();
+    Bvh<TypeParam> refitted(torusA());
+    EXPECT_EQ(refitted.refit(deformed), static_cast<std::int32_t>(refitted.nodes().size()));
+    std::string error;
+    EXPECT_TRUE(refitted.validate(&error)) << error;  // every volume contains the moved triangles
+    const Bvh<TypeParam> rebuilt(deformed);
+    const Bvh<TypeParam> b(torusB());
+    int changed = 0;
+    for (std::size_t k = 0; k < differentialPoses().size(); ++k) {
+        const Pose& pose = differentialPoses()[k];
+        const std::vector<TrianglePair> expected =
+            collision::intersectMeshMeshBruteForce(deformed, torusB(), pose);
+        EXPECT_EQ(collision::intersectBvhBvh(refitted, b, pose), expected) << "pose " << k;
+        EXPECT_EQ(collision::intersectBvhBvh(rebuilt, b, pose), expected) << "pose " << k;
+        EXPECT_EQ(collision::testBvhBvh(refitted, b, pose), !expected.empty()) << "pose " << k;
+        changed += expected != bruteAnswer(k);
+    }
+    // The deformation changes most answers, so a refit that did nothing would fail above.
+    EXPECT_GE(changed, 5);
+    // Through the run-time interface too.
+    auto tree = collision::buildMeshBvh(BvName<TypeParam>::value, torusA());
+    EXPECT_GT(tree->refit(deformed), 0);
+    const auto tree_b = collision::buildMeshBvh(BvName<TypeParam>::value, torusB());
+    EXPECT_EQ(tree->intersect(*tree_b, differentialPoses()[0]),
+              collision::intersectMeshMeshBruteForce(deformed, torusB(), differentialPoses()[0]));
+}
+
+// One mesh made of torus A and torus B placed by `pose`: its self-intersections are the pairs
+// between the two parts (plus none inside a torus, whose neighbours share vertices).
+TriangleMesh unionMesh(const Pose& pose) {
+    TriangleMesh m = torusA();
+    const auto offset = static_cast<std::int32_t>(m.vertices.size());
+    for (const Vec3& v : torusB().vertices) m.vertices.push_back(pose.apply(v));
+    for (const auto& t : torusB().triangles) {
+        m.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+    }
+    return m;
+}
+
+// Brute-force self pairs of unionMesh(pose k), computed once for every volume type.
+const std::vector<TrianglePair>& bruteSelfAnswer(std::size_t k) {
+    static std::map<std::size_t, std::vector<TrianglePair>> cache;
+    auto it = cache.find(k);
+    if (it == cache.end()) {
+        it = cache
+                 .emplace(k, collision::intersectSelfBruteForce(unionMesh(differentialPoses()[k])))
+                 .first;
+    }
+    return it->second;
+}
+
+TYPED_TEST(BvhTyped, SelfCollisionMatchesBruteForce) {
+    int non_empty = 0;
+    for (std::size_t k = 0; k < 6; ++k) {
+        const TriangleMesh mesh = unionMesh(differentialPoses()[k]);
+        const Bvh<TypeParam> tree(mesh);
+        BvhQueryStats stats;
+        const std::vector<TrianglePair>& brute = bruteSelfAnswer(k);
+        EXPECT_EQ(collision::intersectSelf(tree, &stats), brute) << "pose " << k;
+        EXPECT_GT(stats.bv_tests, 0);
+        non_empty += !brute.empty();
+        // Fat leaves hold adjacent triangles together: still excluded.
+        const Bvh<TypeParam> fat(mesh, BvhBuildOptions{BvhSplit::Mean, 4});
+        EXPECT_EQ(collision::intersectSelf(fat), brute) << "pose " << k;
+    }
+    EXPECT_GE(non_empty, 2);
+    EXPECT_LE(non_empty, 5);
+    // A closed torus alone: every touching pair is adjacent (shares a vertex).
+    EXPECT_TRUE(collision::intersectSelfBruteForce(torusA()).empty());
+    EXPECT_TRUE(collision::intersectSelf(Bvh<TypeParam>(torusA())).empty());
+    // A grid cube with a copy of one face's triangle pushed through the cube: it crosses the
+    // faces it passes through, and the pairs come out as the brute force's.
+    TriangleMesh cube = makeGridCube(2);
+    const auto base = static_cast<std::int32_t>(cube.vertices.size());
+    cube.vertices.push_back(Vec3(-1.5, 0.1, 0.2));
+    cube.vertices.push_back(Vec3(1.5, 0.3, -0.1));
+    cube.vertices.push_back(Vec3(0.2, 1.5, 0.3));
+    cube.triangles.push_back({base, base + 1, base + 2});
+    const auto brute = collision::intersectSelfBruteForce(cube);
+    EXPECT_FALSE(brute.empty());
+    EXPECT_EQ(collision::intersectSelf(Bvh<TypeParam>(cube)), brute);
+    auto runtime = collision::buildMeshBvh(BvName<TypeParam>::value, cube);
+    EXPECT_EQ(runtime->intersectSelf(), brute);
+}
+
+// Small tori for the distance brute force (256 and 196 triangles).
+const TriangleMesh& smallTorusA() {
+    static const TriangleMesh m = makeTorus(1.0, 0.35, 16, 8);
+    return m;
+}
+const TriangleMesh& smallTorusB() {
+    static const TriangleMesh m = makeTorus(0.8, 0.3, 14, 7);
+    return m;
+}
+const std::vector<Pose>& distancePoses() {
+    static const std::vector<Pose> poses = randomPoses(777, 12, 3.0);
+    return poses;
+}
+
+// The brute force once per (scale, pose), shared by every volume type.
+const collision::MeshDistance& bruteDistance(Real scale, std::size_t pose_index,
+                                             const TriangleMesh& a, const TriangleMesh& b,
+                                             const Pose& pose) {
+    static std::map<std::pair<Real, std::size_t>, collision::MeshDistance> cache;
+    const auto key = std::make_pair(scale, pose_index);
+    auto it = cache.find(key);
+    if (it == cache.end()) {
+        it = cache.emplace(key, collision::distanceMeshMeshBruteForce(a, b, pose)).first;
+    }
+    return it->second;
+}
+
+TYPED_TEST(BvhTyped, DistanceMatchesBruteForceWithWitnesses) {
+    int separated = 0;
+    int touching = 0;
+    for (const Real scale : {Real(1), Real(1e-4), Real(1e4)}) {
+        const Vec3 offset = scale == 1 ? Vec3(Vec3::Zero()) : Vec3(Vec3(1e6, -1e6, 1e6) * scale);
+        const TriangleMesh ma = transformed(smallTorusA(), scale, offset);
+        const TriangleMesh mb = transformed(smallTorusB(), scale, offset);
+        const Bvh<TypeParam> a(ma);
+        const Bvh<TypeParam> b(mb);
+        const Real tol = Real(1e-9) * scale;  // relative to the meshes' size
+        for (const Pose& p0 : distancePoses()) {
+            const Pose pose = scaledPose(p0, scale, offset);
+            BvhQueryStats stats;
+            const collision::MeshDistance fast = collision::distanceBvhBvh(a, b, pose, &stats);
+            const collision::MeshDistance& brute = bruteDistance(
+                scale, static_cast<std::size_t>(&p0 - &distancePoses()[0]), ma, mb, pose);
+            ASSERT_GE(fast.a, 0);
+            ASSERT_GE(fast.b, 0);
+            EXPECT_NEAR(fast.distance, brute.distance, tol);
+            // The witnesses are points of the witness triangles, as far apart as reported.
+            EXPECT_NEAR((fast.point_on_a - fast.point_on_b).norm(), fast.distance, tol);
+            const auto& ta = ma.triangles[static_cast<std::size_t>(fast.a)];
+            const auto& tb = mb.triangles[static_cast<std::size_t>(fast.b)];
+            std::array<Vec3, 3> corners_b;
+            for (std::size_t k = 0; k < 3; ++k) {
+                corners_b[k] = pose.orientation * mb.vertices[static_cast<std::size_t>(tb[k])] +
+                               pose.position;
+            }
+            const Vec3 na = (ma.vertices[ta[1]] - ma.vertices[ta[0]])
+                                .cross(ma.vertices[ta[2]] - ma.vertices[ta[0]])
+                                .normalized();
+            const Vec3 nb = (corners_b[1] - corners_b[0]).cross(corners_b[2] - corners_b[0])
+                                .normalized();
+            EXPECT_NEAR(na.dot(fast.point_on_a - ma.vertices[ta[0]]), 0, tol);
+            EXPECT_NEAR(nb.dot(fast.point_on_b - corners_b[0]), 0, tol);
+            if (brute.distance > 0) {
+                ++separated;
+                EXPECT_GT(stats.bv_tests, 0);
+            } else {
+                ++touching;
+            }
+        }
+    }
+    EXPECT_GE(separated, 9);
+    EXPECT_GE(touching, 9);
+    // Closed form: grid cubes a gap g apart along x; witnesses on the facing faces.
+    const TriangleMesh cube = makeGridCube(2);
+    const Bvh<TypeParam> tree(cube);
+    for (const Real g : {Real(0.25), Real(1e-3), Real(0)}) {
+        const collision::MeshDistance d =
+            collision::distanceBvhBvh(tree, tree, Pose{Vec3(2 + g, 0.3, -0.2), Quat::Identity()});
+        EXPECT_NEAR(d.distance, g, 1e-12);
+        EXPECT_NEAR(d.point_on_a.x(), 1, 1e-12);
+        EXPECT_NEAR(d.point_on_b.x(), 1 + g, 1e-12);
+    }
+    auto runtime = collision::buildMeshBvh(BvName<TypeParam>::value, cube);
+    EXPECT_NEAR(runtime->distance(*runtime, Pose{Vec3(0, 2.5, 0), Quat::Identity()}).distance,
+                0.5, 1e-12);
+}
+
+TYPED_TEST(BvhTyped, BottomUpBuildGivesTheBruteForceAnswers) {
+    for (const int leaf : {1, 3}) {
+        const BvhBuildOptions options{BvhSplit::Median, leaf, collision::BvhBuild::BottomUp};
+        const Bvh<TypeParam> a(torusA(), options);
+        const Bvh<TypeParam> b(torusB(), options);
+        std::string error;
+        EXPECT_TRUE(a.validate(&error)) << error;
+        EXPECT_TRUE(b.validate(&error)) << error;
+        if (leaf == 1) {
+            EXPECT_EQ(a.nodes().size(), 2 * torusA().triangles.size() - 1);
+        }
+        // Not the top-down tree in disguise: another structure.
+        const Bvh<TypeParam> top(torusA(), BvhBuildOptions{BvhSplit::Median, leaf});
+        bool differs = top.nodes().size() != a.nodes().size();
+        for (std::size_t i = 0; !differs && i < a.nodes().size(); ++i) {
+            differs = top.nodes()[i].right != a.nodes()[i].right ||
+                      top.leafTriangleId(static_cast<std::int32_t>(i % torusA().triangles.size())) !=
+                          a.leafTriangleId(static_cast<std::int32_t>(i % torusA().triangles.size()));
+        }
+        EXPECT_TRUE(differs);
+        for (std::size_t k = 0; k < differentialPoses().size(); ++k) {
+            const Pose& pose = differentialPoses()[k];
+            EXPECT_EQ(collision::intersectBvhBvh(a, b, pose), bruteAnswer(k)) << "pose " << k;
+            EXPECT_EQ(collision::testBvhBvh(a, b, pose), !bruteAnswer(k).empty()) << "pose " << k;
+        }
+    }
+    // Deterministic: two builds give the same nodes.
+    const BvhBuildOptions options{BvhSplit::Median, 1, collision::BvhBuild::BottomUp};
+    const Bvh<TypeParam> x(torusB(), options);
+    const Bvh<TypeParam> y(torusB(), options);
+    ASSERT_EQ(x.nodes().size(), y.nodes().size());
+    for (std::size_t i = 0; i < x.nodes().size(); ++i) {
+        EXPECT_EQ(x.nodes()[i].right, y.nodes()[i].right);
+        EXPECT_EQ(x.nodes()[i].first, y.nodes()[i].first);
+        EXPECT_EQ(x.nodes()[i].cost, y.nodes()[i].cost);
+    }
+}
+
 TYPED_TEST(BvhTyped, MeanSplitAndFatLeavesGiveTheSameAnswer) {
     const Bvh<TypeParam> a(torusA(), BvhBuildOptions{BvhSplit::Mean, 4});
     const Bvh<TypeParam> b(torusB(), BvhBuildOptions{BvhSplit::Mean, 3});
@@ -297,6 +523,29 @@ TEST(Bvh, LookupByNameCoversTheTypeList) {
         EXPECT_EQ(a->intersect(*b, pose, &stats), bruteAnswer(0)) << name;
         EXPECT_EQ(a->testOverlap(*b, pose), !bruteAnswer(0).empty()) << name;
         EXPECT_GT(stats.bv_tests, 0);
+    }
+}
+
+TEST(Bvh, SweepReferenceEqualsBruteForce) {
+    // Random poses of the tori, and grid cubes touching face to face, edge to edge and corner to
+    // corner (exact coordinates): the sweep returns the brute force's list, with as many tests.
+    int non_empty = 0;
+    for (std::size_t i = 0; i < differentialPoses().size(); ++i) {
+        BvhQueryStats brute_stats;
+        BvhQueryStats sweep_stats;
+        const Pose& p = differentialPoses()[i];
+        const auto brute = collision::intersectMeshMeshBruteForce(torusA(), torusB(), p, &brute_stats);
+        EXPECT_EQ(collision::intersectMeshMeshSweep(torusA(), torusB(), p, &sweep_stats), brute);
+        EXPECT_EQ(sweep_stats.triangle_tests, brute_stats.triangle_tests);
+        non_empty += !brute.empty();
+    }
+    EXPECT_GT(non_empty, 3);
+    const TriangleMesh cube = makeGridCube(4);
+    for (const Vec3& d : {Vec3(2, 0, 0), Vec3(2, 2, 0), Vec3(2, 2, 2), Vec3(0, -2, 0.5)}) {
+        const Pose p{d, Quat::Identity()};
+        const auto brute = collision::intersectMeshMeshBruteForce(cube, cube, p);
+        EXPECT_FALSE(brute.empty());
+        EXPECT_EQ(collision::intersectMeshMeshSweep(cube, cube, p), brute);
     }
 }
 

@@ -10,6 +10,8 @@
 #include <memory>
 #include <vector>
 
+#include "collision/bvh.h"
+
 // Private narrow-phase headers (collision/src is not on the test's include path).
 #include "gjk.h"
 #include "triangle_triangle.h"
@@ -320,6 +322,8 @@ Shape scaled(const Shape& s, Real k) {
         auto mesh = std::make_shared<TriangleMesh>(*s.mesh);
         for (Vec3& v : mesh->vertices) v *= k;
         out.mesh = mesh;
+        // The hierarchy belongs to the mesh it was built from: rebuild it for the scaled copy.
+        if (s.bvh) out.bvh = collision::buildMeshBvh(s.bvh->volumeName(), *mesh);
     }
     return out;
 }

@@ -10,6 +10,7 @@
 #include <numbers>
 #include <string>
 
+#include "collision/bvh.h"
 #include "engine/mass_properties.h"
 
 namespace engine {
@@ -311,6 +312,43 @@ TEST(SceneErrors, UnknownNamesListTheChoices) {
     EXPECT_SCENE_ERROR(withBody("  - shape: cone\n    position: [0, 0, 0]\n"),
                        "4:12: bodies[0].shape: ",
                        "unknown shape 'cone' (expected one of: sphere, box, capsule, hull, mesh)");
+}
+
+TEST(Scene, MeshBvhIsChosenByTheWorld) {
+    const std::string body = "  - shape: mesh\n    file: ../assets/torus.obj\n"
+                             "    position: [0, 0, 0]\n";
+    // Default: every mesh body carries the default hierarchy, built once and shared.
+    const Scene d = parse(withBody(body + body));
+    ASSERT_EQ(d.bodies.size(), 2u);
+    ASSERT_TRUE(d.bodies[0].shape.bvh);
+    EXPECT_EQ(d.bodies[0].shape.bvh->volumeName(), collision::kDefaultMeshBvh);
+    EXPECT_EQ(d.bodies[0].shape.bvh.get(), d.bodies[1].shape.bvh.get());
+    EXPECT_EQ(d.world.mesh_bvh, collision::kDefaultMeshBvh);
+    // The two coincident tori collide, found through the hierarchy: its counters reach StepStats.
+    const World w = makeWorld(d);
+    EXPECT_EQ(w.collidingPairs().size(), 1u);
+    EXPECT_GT(w.lastStats().bv_tests, 0);
+    EXPECT_GT(w.lastStats().triangle_tests, 0);
+    // Every volume type by name.
+    for (const std::string_view name : collision::bvhVolumeNames()) {
+        const Scene s = parse("world:\n  bounds: {min: [-10, -6, -10], max: [10, 6, 10]}\n"
+                              "  mesh_bvh: " + std::string(name) + "\nbodies:\n" + body);
+        ASSERT_EQ(s.bodies.size(), 1u);
+        ASSERT_TRUE(s.bodies[0].shape.bvh);
+        EXPECT_EQ(s.bodies[0].shape.bvh->volumeName(), name);
+        EXPECT_EQ(s.bodies[0].shape.bvh->triangleCount(),
+                  static_cast<std::int32_t>(s.bodies[0].shape.mesh->triangles.size()));
+        EXPECT_TRUE(s.bodies[0].shape.bvh->validate());
+    }
+}
+
+TEST(SceneErrors, UnknownMeshBvh) {
+    EXPECT_SCENE_ERROR("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  mesh_bvh: kdop7\n",
+                       "3:13: world.mesh_bvh: ",
+                       "unknown bounding volume 'kdop7' (expected one of: sphere, aabb, obb, "
+                       "kdop6, kdop14, kdop18, kdop26, rss)");
+    EXPECT_SCENE_ERROR("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  mesh_bvh: [obb]\n",
+                       "3:13: world.mesh_bvh: ", "expected a string");
 }
 
 TEST(SceneErrors, KeysThatDoNotApplyToTheShape) {

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <compare>
+#include <limits>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -89,9 +90,18 @@ enum class BvhSplit : std::uint8_t {
     Mean,    ///< at the mean centroid coordinate; falls back to the median if one side is empty
 };
 
+/// How the tree is built.
+enum class BvhBuild : std::uint8_t {
+    TopDown,   ///< recursive splits (BvhSplit)
+    BottomUp,  ///< greedy agglomerative: triangles in Morton order of their centroids, then the
+               ///< neighbouring pair of clusters with the smallest merged box area merges first
+               ///< (RTCD 6.2.2; the Morton neighbourhood as in Walter et al. 2008)
+};
+
 struct BvhBuildOptions {
-    BvhSplit split = BvhSplit::Median;
+    BvhSplit split = BvhSplit::Median;  ///< top-down only
     int max_leaf_triangles = 1;  ///< a node with at most this many triangles is a leaf (>= 1)
+    BvhBuild build = BvhBuild::TopDown;
 };
 
 /// One intersecting pair: triangle `a` of mesh A and triangle `b` of mesh B (indices into the
@@ -135,6 +145,10 @@ public:
     const std::array<Vec3, 3>& leafTriangle(std::int32_t i) const { return corners_[i]; }
     /// Mesh index of the triangle at leaf-order position `i`.
     std::int32_t leafTriangleId(std::int32_t i) const { return ids_[i]; }
+    /// Mesh vertex indices of the triangle at leaf-order position `i` (adjacency for self tests).
+    const std::array<std::int32_t, 3>& leafTriangleVertices(std::int32_t i) const {
+        return vertex_ids_[i];
+    }
     /// Length scale of the mesh: largest |coordinate| plus the root extent (sets tolerances).
     Real scale() const { return scale_; }
     /// Longest root-to-leaf path (a single leaf has depth 1; empty tree 0). Computed at build.
@@ -143,11 +157,18 @@ public:
     /// every node volume contains its triangles' corners (to a tolerance relative to the mesh
     /// scale). On failure returns false and, if `error` is given, says what failed.
     bool validate(std::string* error = nullptr) const;
+    /// Refit for a deforming mesh: takes the vertex positions of `mesh` (the triangles the tree
+    /// was built from, same order; asserted, and nothing done when the count differs), moves
+    /// every triangle and refits every node volume to its triangles, keeping the tree's
+    /// structure. O(n log n); queries then answer for the deformed mesh (exact triangle tests;
+    /// the volumes may be looser than a rebuild's). Returns the nodes updated (Nu).
+    std::int32_t refit(const TriangleMesh& mesh);
 
 private:
     std::vector<Node> nodes_;
     std::vector<std::array<Vec3, 3>> corners_;  // leaf order
     std::vector<std::int32_t> ids_;             // leaf order -> mesh triangle index
+    std::vector<std::array<std::int32_t, 3>> vertex_ids_;  // leaf order: the mesh's indices
     Real scale_ = 0;
     int depth_ = 0;
 };
@@ -165,13 +186,74 @@ template <class BV>
 std::vector<TrianglePair> intersectBvhBvh(const Bvh<BV>& a, const Bvh<BV>& b, const Pose& b_in_a,
                                           BvhQueryStats* stats = nullptr);
 
+/// Distance between two meshes with witnesses: the closest triangle pair and its closest points.
+struct MeshDistance {
+    Real distance = 0;         ///< >= 0; 0 when the meshes touch or cross; +inf for an empty mesh
+    std::int32_t a = -1;       ///< witness triangle of A (mesh index), -1 for an empty mesh
+    std::int32_t b = -1;       ///< witness triangle of B
+    Vec3 point_on_a = Vec3::Zero();  ///< closest point on triangle a, in A's frame
+    Vec3 point_on_b = Vec3::Zero();  ///< closest point on triangle b, in A's frame
+};
+
+/// Smallest distance between the surfaces of `a` and `b` (B placed by `b_in_a`), by a
+/// depth-first traversal that visits the nearer child pair first and skips node pairs whose
+/// volume-distance lower bound exceeds the best distance found. Approximate to the rounding of
+/// the triangle closest points (relative to the meshes' scale); the same value as
+/// distanceMeshMeshBruteForce up to that rounding (a tie may pick another witness pair).
+/// Stops at 0 (touching or crossing). stats: bv_tests = lower bounds, triangle_tests = triangle
+/// distances. `stats` may be null.
+template <class BV>
+MeshDistance distanceBvhBvh(const Bvh<BV>& a, const Bvh<BV>& b, const Pose& b_in_a,
+                            BvhQueryStats* stats = nullptr);
+
+/// The reference: the minimum over every triangle pair (ties: the first pair in (a, b) order).
+MeshDistance distanceMeshMeshBruteForce(const TriangleMesh& a, const TriangleMesh& b,
+                                        const Pose& b_in_a, BvhQueryStats* stats = nullptr);
+
+/// Self-collision of one mesh: every pair of its triangles that touch or cross, except adjacent
+/// ones (sharing a vertex index; coincident vertices with different indices do not count as
+/// shared), as (a, b) with a < b, sorted, no duplicates. One traversal of the tree against
+/// itself that visits each pair of subtrees once. `stats` may be null.
+template <class BV>
+std::vector<TrianglePair> intersectSelf(const Bvh<BV>& tree, BvhQueryStats* stats = nullptr);
+
+/// The reference for intersectSelf: every non-adjacent pair (a < b) with the same exact test.
+std::vector<TrianglePair> intersectSelfBruteForce(const TriangleMesh& mesh,
+                                                  BvhQueryStats* stats = nullptr);
+
 /// The brute-force reference: every triangle pair (after an exact per-triangle AABB reject) with
 /// the same exact triangle test and the same vertex transform. O(n_a n_b).
 std::vector<TrianglePair> intersectMeshMeshBruteForce(const TriangleMesh& a, const TriangleMesh& b,
                                                       const Pose& b_in_a,
                                                       BvhQueryStats* stats = nullptr);
 
-/// A Bvh of a volume type chosen at run time by name (CLI, scenes, benchmarks).
+/// The brute force's answer (same triangles, boxes and exact tests, same list) found faster: B's
+/// triangle boxes sorted along x, each triangle of A tested only against the boxes whose x range
+/// can overlap its own. For checking large meshes (benchmarks); O(n log n + candidates).
+std::vector<TrianglePair> intersectMeshMeshSweep(const TriangleMesh& a, const TriangleMesh& b,
+                                                 const Pose& b_in_a,
+                                                 BvhQueryStats* stats = nullptr);
+
+/// Receives the intersecting triangle pairs of MeshBvh::visitIntersecting, all corners in A's
+/// frame (B's moved by the query transform).
+class TrianglePairVisitor {
+public:
+    virtual ~TrianglePairVisitor() = default;
+    /// Triangle `a` of mesh A (mesh index, corners `ta`) touches or crosses triangle `b` of mesh B
+    /// (corners `tb`). Return true to stop the traversal.
+    virtual bool visit(std::int32_t a, const std::array<Vec3, 3>& ta, std::int32_t b,
+                       const std::array<Vec3, 3>& tb) = 0;
+};
+
+/// Receives the candidate triangles of MeshBvh::visitNearBox, corners in the mesh's frame.
+class TriangleVisitor {
+public:
+    virtual ~TriangleVisitor() = default;
+    /// Triangle `id` (mesh index) whose leaf volume overlaps the box. Return true to stop.
+    virtual bool visit(std::int32_t id, const std::array<Vec3, 3>& corners) = 0;
+};
+
+/// A Bvh of a volume type chosen at run time by name (CLI, scenes, benchmarks, mesh shapes).
 class MeshBvh {
 public:
     virtual ~MeshBvh() = default;
@@ -185,7 +267,40 @@ public:
     /// intersectBvhBvh with `b`, which must hold the same volume type (asserted; empty if not).
     virtual std::vector<TrianglePair> intersect(const MeshBvh& b, const Pose& b_in_a,
                                                 BvhQueryStats* stats = nullptr) const = 0;
+    /// Number of triangles of the mesh the tree was built from.
+    virtual std::int32_t triangleCount() const = 0;
+    /// distanceBvhBvh with `b`, which must hold the same volume type (asserted; +inf if not).
+    virtual MeshDistance distance(const MeshBvh& b, const Pose& b_in_a,
+                                  BvhQueryStats* stats = nullptr) const = 0;
+    /// intersectSelf on this tree.
+    virtual std::vector<TrianglePair> intersectSelf(BvhQueryStats* stats = nullptr) const = 0;
+    /// Bvh::refit (a deforming mesh): returns the nodes updated. Not for a tree shared by shapes
+    /// that other threads query.
+    virtual std::int32_t refit(const TriangleMesh& mesh) = 0;
+    /// True when `b` holds the same volume type (the tandem queries need it).
+    virtual bool sameVolumeType(const MeshBvh& b) const = 0;
+    /// The tandem traversal with a visitor: every intersecting triangle pair (exact triangle test,
+    /// touching counts) goes to `visitor` until it returns true. B is placed by p_a = rotation p_b
+    /// + translation (`rotation` orthonormal), the form the narrow phase holds; B's corners are
+    /// moved with exactly that expression. `b` must hold the same volume type (asserted; nothing
+    /// visited if not). Returns true when the visitor stopped the traversal.
+    virtual bool visitIntersecting(const MeshBvh& b, const Mat3& rotation, const Vec3& translation,
+                                   TrianglePairVisitor& visitor,
+                                   BvhQueryStats* stats = nullptr) const = 0;
+    /// The tree-against-volume traversal: the box [box_min, box_max] of a frame B placed by
+    /// p_a = rotation p_b + translation gets a volume of this tree's type fitted around it (in
+    /// B's frame), and every leaf triangle whose node volumes all overlap it goes to `visitor`
+    /// until it returns true. Conservative: every triangle that meets the box is visited (the
+    /// volume tests have a slack relative to the scale); others may be. Returns true when the
+    /// visitor stopped the traversal. stats->bv_tests counts the node tests.
+    virtual bool visitNearBox(const Vec3& box_min, const Vec3& box_max, const Mat3& rotation,
+                              const Vec3& translation, TriangleVisitor& visitor,
+                              BvhQueryStats* stats = nullptr) const = 0;
 };
+
+/// The volume type mesh shapes use unless a scene chooses another (`world.mesh_bvh`): the fastest
+/// in `cdlab bench narrowphase` on the two-tori workload.
+inline constexpr std::string_view kDefaultMeshBvh = "obb";
 
 /// The names of BvhVolumeTypes, in order: sphere, aabb, obb, kdop6, kdop14, kdop18, kdop26, rss.
 const std::vector<std::string_view>& bvhVolumeNames();

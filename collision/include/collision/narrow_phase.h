@@ -18,6 +18,7 @@ struct CollideOutput {
     ContactState state = ContactState::Failed;
     Real distance = 0;          ///< separation when Separated, else 0
     std::int32_t triangle_tests = 0;  ///< triangle-level tests made (meshes)
+    std::int64_t bv_tests = 0;        ///< hierarchy node tests made (meshes with a MeshBvh)
     std::int32_t iterations = 0;      ///< GJK iterations, when GJK ran
 };
 

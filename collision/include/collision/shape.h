@@ -20,6 +20,8 @@ inline constexpr int kShapeTypeCount = 5;
 std::string_view shapeTypeName(ShapeType type);
 
 /// An indexed triangle soup (counter-clockwise seen from outside when the mesh is closed).
+class MeshBvh;
+
 struct TriangleMesh {
     std::vector<Vec3> vertices;
     std::vector<std::array<std::int32_t, 3>> triangles;
@@ -40,15 +42,24 @@ struct Shape {
     Vec3 half_extents = Vec3::Zero();   ///< box
     std::shared_ptr<const ConvexPolytope> hull;  ///< hull: the shape; mesh: its convex hull
     std::shared_ptr<const TriangleMesh> mesh;    ///< mesh only
+    /// Mesh only: the hierarchy over `mesh`'s triangles, built once, shared and never changed
+    /// (queries take the relative pose). Null: the narrow phase tests triangles by brute force.
+    std::shared_ptr<const MeshBvh> bvh;
 
     static Shape sphere(Real radius);
     static Shape box(const Vec3& half_extents);
     /// A capsule along local y: the segment (0,-half_height,0)-(0,half_height,0) swept by radius.
     static Shape capsule(Real radius, Real half_height);
     static Shape convexHull(std::shared_ptr<const ConvexPolytope> hull);
-    /// `hull` must be the convex hull of `mesh`'s vertices.
+    /// `hull` must be the convex hull of `mesh`'s vertices. Builds the mesh's hierarchy with the
+    /// default volume type (kDefaultMeshBvh in bvh.h), O(n log n) in the triangle count.
     static Shape triangleMesh(std::shared_ptr<const TriangleMesh> mesh,
                               std::shared_ptr<const ConvexPolytope> hull);
+    /// The same with a hierarchy built beforehand from `mesh` (buildMeshBvh), or null for none
+    /// (the narrow phase then tests every triangle: the brute-force reference).
+    static Shape triangleMesh(std::shared_ptr<const TriangleMesh> mesh,
+                              std::shared_ptr<const ConvexPolytope> hull,
+                              std::shared_ptr<const MeshBvh> bvh);
 
     bool isConvex() const { return type != ShapeType::Mesh; }
 };

@@ -10,6 +10,7 @@
 
 #include "collision/bounding_volumes.h"
 #include "collision/broad_phase.h"
+#include "collision/bvh.h"
 #include "engine/body.h"
 
 namespace engine {
@@ -23,6 +24,9 @@ struct WorldSettings {
     Vec3 gravity = Vec3::Zero();   ///< m/s^2
     Real time_step = Real(1) / 60; ///< s, > 0
     std::string broad_phase = "sap";  ///< registry name
+    /// Node volume of mesh bodies' hierarchies (collision::bvhVolumeNames()); scene key
+    /// `world.mesh_bvh`. Read when mesh bodies are built (scene loading), not by the World.
+    std::string mesh_bvh{collision::kDefaultMeshBvh};
 };
 
 /// Wall-clock time per stage of the last step, in seconds, and the broad phase's counters.
@@ -34,7 +38,8 @@ struct StepStats {
     double total_s = 0;
     collision::BroadPhaseCounters broad;
     std::int64_t narrow_tests = 0;
-    std::int64_t triangle_tests = 0;
+    std::int64_t triangle_tests = 0;  ///< triangle-level tests of the narrow phase (meshes)
+    std::int64_t bv_tests = 0;        ///< mesh-hierarchy node tests of the narrow phase
 };
 
 class World {

@@ -1,0 +1,402 @@
+// app/bench_narrowphase.cpp -- `cdlab bench narrowphase`. Wiring and timing only: trees and queries
+// are collision/bvh.h; FCL (when CMake found it, CDLAB_HAVE_FCL) stays in this file.
+// Same inputs for every method: one torus mesh for A and B, B placed by the pose (A at the
+// identity). The reference answer per pose is cdlab's brute-force triangle loop
+// (intersectMeshMeshBruteForce; for --large its sweep form, the same list); cdlab methods must return its pair list exactly, FCL's boolean
+// and pair count are compared and mismatches reported (FCL's triangle test is not exact).
+#include "bench_narrowphase.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <ostream>
+#include <random>
+
+#include "collision/bvh.h"
+
+#ifdef CDLAB_HAVE_FCL
+#include <fcl/geometry/bvh/BVH_model.h>
+#include <fcl/math/bv/AABB.h>
+#include <fcl/math/bv/OBB.h>
+#include <fcl/math/bv/OBBRSS.h>
+#include <fcl/math/bv/RSS.h>
+#include <fcl/math/bv/kDOP.h>
+#include <fcl/math/bv/kIOS.h>
+#include <fcl/narrowphase/collision.h>
+#include <fcl/narrowphase/collision_object.h>
+#endif
+
+namespace app {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using collision::Pose;
+using collision::Real;
+using collision::TriangleMesh;
+using collision::Vec3;
+
+double secondsSince(Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+// A torus around local z, ring radius 1, tube radius 0.4: nu segments around the ring, nv around
+// the tube, 2 nu nv triangles.
+TriangleMesh makeTorus(int nu, int nv) {
+    constexpr Real kRing = 1.0;
+    constexpr Real kTube = 0.4;
+    TriangleMesh m;
+    for (int i = 0; i < nu; ++i) {
+        const Real u = 2 * std::numbers::pi_v<Real> * i / nu;
+        for (int j = 0; j < nv; ++j) {
+            const Real v = 2 * std::numbers::pi_v<Real> * j / nv;
+            const Real w = kRing + kTube * std::cos(v);
+            m.vertices.emplace_back(w * std::cos(u), w * std::sin(u), kTube * std::sin(v));
+        }
+    }
+    auto id = [&](int i, int j) { return static_cast<std::int32_t>((i % nu) * nv + (j % nv)); };
+    for (int i = 0; i < nu; ++i) {
+        for (int j = 0; j < nv; ++j) {
+            m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+            m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+        }
+    }
+    return m;
+}
+
+// One way of answering the two queries.
+class NarrowMethod {
+public:
+    virtual ~NarrowMethod() = default;
+    virtual std::string name() const = 0;
+    virtual bool hasCounters() const = 0;
+    /// Builds the trees of A and B (the same mesh); the caller times it.
+    virtual void build(const TriangleMesh& mesh) = 0;
+    virtual bool first(const Pose& b_in_a, collision::BvhQueryStats* stats) = 0;
+    /// Number of intersecting triangle pairs; `pairs` (may be null) gets them when available.
+    virtual std::size_t all(const Pose& b_in_a, collision::BvhQueryStats* stats,
+                            std::vector<collision::TrianglePair>* pairs) = 0;
+};
+
+class CdlabMethod final : public NarrowMethod {
+public:
+    explicit CdlabMethod(std::string_view bv) : bv_(bv) {}
+    std::string name() const override { return std::string(bv_); }
+    bool hasCounters() const override { return true; }
+    void build(const TriangleMesh& mesh) override {
+        a_ = collision::buildMeshBvh(bv_, mesh);
+        b_ = collision::buildMeshBvh(bv_, mesh);
+    }
+    bool first(const Pose& b_in_a, collision::BvhQueryStats* stats) override {
+        return a_->testOverlap(*b_, b_in_a, stats);
+    }
+    std::size_t all(const Pose& b_in_a, collision::BvhQueryStats* stats,
+                    std::vector<collision::TrianglePair>* pairs) override {
+        std::vector<collision::TrianglePair> found = a_->intersect(*b_, b_in_a, stats);
+        const std::size_t n = found.size();
+        if (pairs) *pairs = std::move(found);
+        return n;
+    }
+
+private:
+    std::string_view bv_;
+    std::unique_ptr<collision::MeshBvh> a_;
+    std::unique_ptr<collision::MeshBvh> b_;
+};
+
+#ifdef CDLAB_HAVE_FCL
+template <class BV>
+class FclMethod final : public NarrowMethod {
+public:
+    explicit FclMethod(std::string name) : name_(std::move(name)) {}
+    std::string name() const override { return name_; }
+    bool hasCounters() const override { return false; }
+    void build(const TriangleMesh& mesh) override {
+        std::vector<fcl::Vector3d> vertices;
+        vertices.reserve(mesh.vertices.size());
+        for (const Vec3& v : mesh.vertices) vertices.emplace_back(v.x(), v.y(), v.z());
+        std::vector<fcl::Triangle> triangles;
+        triangles.reserve(mesh.triangles.size());
+        for (const auto& t : mesh.triangles) {
+            triangles.emplace_back(static_cast<std::size_t>(t[0]), static_cast<std::size_t>(t[1]),
+                                   static_cast<std::size_t>(t[2]));
+        }
+        auto make = [&] {
+            auto model = std::make_shared<fcl::BVHModel<BV>>();
+            model->beginModel();
+            model->addSubModel(vertices, triangles);
+            model->endModel();
+            return model;
+        };
+        a_ = std::make_unique<fcl::CollisionObjectd>(make(), fcl::Transform3d::Identity());
+        model_b_ = make();
+    }
+    bool first(const Pose& b_in_a, collision::BvhQueryStats*) override {
+        return run(b_in_a, 1) > 0;
+    }
+    std::size_t all(const Pose& b_in_a, collision::BvhQueryStats*,
+                    std::vector<collision::TrianglePair>*) override {
+        return run(b_in_a, std::numeric_limits<std::size_t>::max());
+    }
+
+private:
+    std::size_t run(const Pose& b_in_a, std::size_t max_contacts) {
+        fcl::Transform3d tf = fcl::Transform3d::Identity();
+        tf.linear() = b_in_a.rotation();
+        tf.translation() = b_in_a.position;
+        const fcl::CollisionObjectd b(model_b_, tf);
+        fcl::CollisionRequestd request(max_contacts, false);
+        fcl::CollisionResultd result;
+        fcl::collide(a_.get(), &b, request, result);
+        return result.numContacts();
+    }
+
+    std::string name_;
+    std::unique_ptr<fcl::CollisionObjectd> a_;
+    std::shared_ptr<fcl::BVHModel<BV>> model_b_;
+};
+#endif
+
+std::unique_ptr<NarrowMethod> makeMethod(const std::string& name) {
+    for (const std::string_view bv : collision::bvhVolumeNames()) {
+        if (bv == name) return std::make_unique<CdlabMethod>(bv);
+    }
+#ifdef CDLAB_HAVE_FCL
+    if (name == "fcl-obbrss") return std::make_unique<FclMethod<fcl::OBBRSSd>>(name);
+    if (name == "fcl-obb") return std::make_unique<FclMethod<fcl::OBBd>>(name);
+    if (name == "fcl-rss") return std::make_unique<FclMethod<fcl::RSSd>>(name);
+    if (name == "fcl-kios") return std::make_unique<FclMethod<fcl::kIOSd>>(name);
+    if (name == "fcl-aabb") return std::make_unique<FclMethod<fcl::AABBd>>(name);
+    if (name == "fcl-kdop18") return std::make_unique<FclMethod<fcl::KDOPd<18>>>(name);
+#endif
+    return nullptr;
+}
+
+struct Row {
+    std::string method;
+    double build_ms = 0;  // one tree
+    double first_us = 0;
+    double all_us = 0;
+    double first_nv = 0;
+    double first_np = 0;
+    double all_nv = 0;
+    double all_np = 0;
+    int bool_mismatches = 0;
+    int count_mismatches = 0;
+    bool counters = false;
+};
+
+// Poses of B in A's frame from a fixed stream: B's centre uniform in [-1.6, 1.6]^3 (the tori's
+// bounding boxes overlap), uniform rotation; the first poses/2 that collide and the first
+// poses/2 that do not, by the brute-force answer computed here once per pose.
+struct Workload {
+    std::vector<Pose> poses;
+    std::vector<std::vector<collision::TrianglePair>> answers;
+};
+
+Workload makeWorkload(const TriangleMesh& mesh, const collision::MeshBvh& tree, int count,
+                      std::uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<Real> unit(0, 1);
+    Workload w;
+    int hits = 0;
+    int misses = 0;
+    const int half = count / 2;
+    for (int guard = 0; (hits < half || misses < half) && guard < 100 * count; ++guard) {
+        Pose p;
+        p.position = Vec3(unit(rng), unit(rng), unit(rng)) * Real(3.2) - Vec3::Constant(1.6);
+        // Shoemake's uniform rotation.
+        const Real u1 = unit(rng);
+        const Real u2 = 2 * std::numbers::pi_v<Real> * unit(rng);
+        const Real u3 = 2 * std::numbers::pi_v<Real> * unit(rng);
+        const Real a = std::sqrt(1 - u1);
+        const Real b = std::sqrt(u1);
+        p.orientation = collision::Quat(a * std::sin(u2), a * std::cos(u2), b * std::sin(u3),
+                                        b * std::cos(u3))
+                            .normalized();
+        // Classify with the tree (cheap); the brute force below is the reference.
+        const bool hit = tree.testOverlap(tree, p);
+        if ((hit && hits >= half) || (!hit && misses >= half)) continue;
+        (hit ? hits : misses) += 1;
+        w.poses.push_back(p);
+        // The brute force up to 10k x 10k triangles; beyond, its sweep form (the same list,
+        // tested equal to it in bvh_test).
+        const bool small = mesh.triangles.size() <= 20000;
+        w.answers.push_back(small ? collision::intersectMeshMeshBruteForce(mesh, mesh, p)
+                                  : collision::intersectMeshMeshSweep(mesh, mesh, p));
+    }
+    return w;
+}
+
+}  // namespace
+
+std::vector<std::string> narrowphaseBenchMethods() {
+    std::vector<std::string> names(collision::bvhVolumeNames().begin(),
+                                   collision::bvhVolumeNames().end());
+#ifdef CDLAB_HAVE_FCL
+    for (const char* n :
+         {"fcl-obbrss", "fcl-obb", "fcl-rss", "fcl-kios", "fcl-aabb", "fcl-kdop18"}) {
+        names.emplace_back(n);
+    }
+#endif
+    return names;
+}
+
+int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& out,
+                        std::ostream& err) {
+    if (options.poses < 2 || options.poses % 2 != 0) {
+        err << "cdlab bench narrowphase: --poses must be even and >= 2\n";
+        return 2;
+    }
+    if (options.reps < 1) {
+        err << "cdlab bench narrowphase: --reps must be >= 1\n";
+        return 2;
+    }
+    const int target = options.large ? 100000 : options.triangles;
+    if (target < 32) {
+        err << "cdlab bench narrowphase: --triangles must be >= 32\n";
+        return 2;
+    }
+    std::vector<std::string> names =
+        options.methods.empty() ? narrowphaseBenchMethods() : options.methods;
+    for (const std::string& n : names) {
+        if (!makeMethod(n)) {
+            err << "cdlab bench narrowphase: unknown method '" << n << "' (expected one of:";
+            for (const std::string& m : narrowphaseBenchMethods()) err << ' ' << m;
+            err << ")\n";
+            return 2;
+        }
+    }
+    // 2 nu nv triangles with nu = 2 nv.
+    const int nv = std::max(4, static_cast<int>(std::lround(std::sqrt(target / 4.0))));
+    const TriangleMesh mesh = makeTorus(2 * nv, nv);
+    const auto classify = collision::buildMeshBvh("obb", mesh);
+    const Workload w = makeWorkload(mesh, *classify, options.poses, options.seed);
+    const auto n_poses = static_cast<int>(w.poses.size());
+    int colliding = 0;
+    for (const auto& a : w.answers) colliding += a.empty() ? 0 : 1;
+    out << "narrowphase: two tori of " << mesh.triangles.size() << " triangles, " << n_poses
+        << " poses (" << colliding << " colliding), fastest of " << options.reps
+        << " repetitions per pose\n";
+
+    std::vector<Row> rows;
+    bool cdlab_wrong = false;
+    for (const std::string& n : names) {
+        std::unique_ptr<NarrowMethod> method = makeMethod(n);
+        Row row;
+        row.method = n;
+        row.counters = method->hasCounters();
+        double best_build = std::numeric_limits<double>::infinity();
+        for (int r = 0; r < std::min(options.reps, 3); ++r) {
+            const Clock::time_point t = Clock::now();
+            method->build(mesh);
+            best_build = std::min(best_build, secondsSince(t) / 2);  // two trees built
+        }
+        row.build_ms = 1e3 * best_build;
+        std::vector<collision::TrianglePair> pairs;
+        for (int i = 0; i < n_poses; ++i) {
+            const Pose& p = w.poses[static_cast<std::size_t>(i)];
+            const auto& expected = w.answers[static_cast<std::size_t>(i)];
+            double best_first = std::numeric_limits<double>::infinity();
+            double best_all = std::numeric_limits<double>::infinity();
+            collision::BvhQueryStats first_stats;
+            collision::BvhQueryStats all_stats;
+            bool hit = false;
+            std::size_t count = 0;
+            for (int r = 0; r < options.reps; ++r) {
+                collision::BvhQueryStats s1;
+                Clock::time_point t = Clock::now();
+                hit = method->first(p, &s1);
+                best_first = std::min(best_first, secondsSince(t));
+                collision::BvhQueryStats s2;
+                t = Clock::now();
+                count = method->all(p, &s2, r == 0 ? &pairs : nullptr);
+                best_all = std::min(best_all, secondsSince(t));
+                first_stats = s1;
+                all_stats = s2;
+            }
+            row.first_us += 1e6 * best_first / n_poses;
+            row.all_us += 1e6 * best_all / n_poses;
+            row.first_nv += static_cast<double>(first_stats.bv_tests) / n_poses;
+            row.first_np += static_cast<double>(first_stats.triangle_tests) / n_poses;
+            row.all_nv += static_cast<double>(all_stats.bv_tests) / n_poses;
+            row.all_np += static_cast<double>(all_stats.triangle_tests) / n_poses;
+            row.bool_mismatches += hit != !expected.empty();
+            row.count_mismatches += count != expected.size();
+            if (row.counters && pairs != expected) {
+                ++row.count_mismatches;  // same count but another list: still wrong
+            }
+        }
+        if (row.counters && (row.bool_mismatches > 0 || row.count_mismatches > 0)) {
+            cdlab_wrong = true;
+        }
+        rows.push_back(row);
+    }
+
+    out << std::left << std::setw(12) << "method" << std::right << std::setw(10) << "build_ms"
+        << std::setw(11) << "first_us" << std::setw(11) << "all_us" << std::setw(11) << "first_Nv"
+        << std::setw(10) << "first_Np" << std::setw(11) << "all_Nv" << std::setw(10) << "all_Np"
+        << std::setw(11) << "bool_diff" << std::setw(11) << "pair_diff" << '\n';
+    out << std::fixed;
+    for (const Row& r : rows) {
+        out << std::left << std::setw(12) << r.method << std::right << std::setprecision(2)
+            << std::setw(10) << r.build_ms << std::setprecision(1) << std::setw(11) << r.first_us
+            << std::setw(11) << r.all_us;
+        if (r.counters) {
+            out << std::setprecision(0) << std::setw(11) << r.first_nv << std::setw(10)
+                << r.first_np << std::setw(11) << r.all_nv << std::setw(10) << r.all_np;
+        } else {
+            out << std::setw(11) << "-" << std::setw(10) << "-" << std::setw(11) << "-"
+                << std::setw(10) << "-";
+        }
+        out << std::setw(11) << r.bool_mismatches << std::setw(11) << r.count_mismatches << '\n';
+    }
+    out.unsetf(std::ios::fixed);
+
+    if (options.json) {
+        nlohmann::json j;
+        j["triangles"] = mesh.triangles.size();
+        j["poses"] = n_poses;
+        j["colliding_poses"] = colliding;
+        j["reps"] = options.reps;
+        j["seed"] = options.seed;
+        nlohmann::json arr = nlohmann::json::array();
+        for (const Row& r : rows) {
+            nlohmann::json o{{"method", r.method},
+                             {"library", r.counters ? "cdlab" : "fcl"},
+                             {"build_ms", r.build_ms},
+                             {"first_us", r.first_us},
+                             {"all_us", r.all_us},
+                             {"bool_mismatches", r.bool_mismatches},
+                             {"pair_mismatches", r.count_mismatches}};
+            if (r.counters) {
+                o["first_nv"] = r.first_nv;
+                o["first_np"] = r.first_np;
+                o["all_nv"] = r.all_nv;
+                o["all_np"] = r.all_np;
+            }
+            arr.push_back(o);
+        }
+        j["rows"] = arr;
+        std::ofstream f(*options.json, std::ios::binary);
+        f << j.dump(2) << '\n';
+        f.close();
+        if (!f) {
+            err << "cdlab bench narrowphase: cannot write '" << options.json->string() << "'\n";
+            return 1;
+        }
+    }
+    if (cdlab_wrong) {
+        err << "cdlab bench narrowphase: a cdlab method disagrees with the brute force\n";
+        return 1;
+    }
+    return 0;
+}
+
+}  // namespace app

@@ -1,0 +1,98 @@
+// `cdlab bench narrowphase` end to end on small tori: table and JSON fields, every cdlab volume
+// type agrees with the brute force on every pose, half the poses collide; bad options exit 2.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "bench_narrowphase.h"
+#include "collision/bvh.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+    int exit_code = -1;
+    std::string out;
+    std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+}
+
+fs::path tempDir(const std::string& name) {
+    const fs::path d = fs::temp_directory_path() /
+                       ("cdlab_np_bench_" + name + "_" + std::to_string(::getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
+Result runCdlab(const std::string& args, const fs::path& work) {
+    const fs::path out = work / "stdout.txt";
+    const fs::path err = work / "stderr.txt";
+    const std::string cmd = std::string("cd ") + CDLAB_SOURCE_DIR + " && " + CDLAB_BINARY + " " +
+                            args + " > " + out.string() + " 2> " + err.string() + " < /dev/null";
+    const int status = std::system(cmd.c_str());
+    Result r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+}
+
+TEST(NarrowphaseBench, SmallToriTableAndJsonAgreeWithBruteForce) {
+    const fs::path work = tempDir("small");
+    const fs::path json = work / "np.json";
+    const Result r = runCdlab(
+        "bench narrowphase --triangles 600 --poses 6 --reps 1 --json " + json.string(), work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("first_us"), std::string::npos) << r.out;
+    const nlohmann::json j = nlohmann::json::parse(slurp(json));
+    EXPECT_EQ(j["poses"], 6);
+    EXPECT_EQ(j["colliding_poses"], 3);
+    EXPECT_GE(j["triangles"].get<int>(), 500);
+    int cdlab_rows = 0;
+    for (const auto& row : j["rows"]) {
+        for (const char* key : {"method", "build_ms", "first_us", "all_us", "bool_mismatches",
+                                "pair_mismatches"}) {
+            EXPECT_TRUE(row.contains(key)) << key;
+        }
+        if (row["library"] == "cdlab") {
+            ++cdlab_rows;
+            EXPECT_EQ(row["bool_mismatches"], 0) << row["method"];
+            EXPECT_EQ(row["pair_mismatches"], 0) << row["method"];
+            EXPECT_GT(row["all_nv"].get<double>(), 0) << row["method"];
+            EXPECT_GT(row["all_np"].get<double>(), 0) << row["method"];
+        }
+    }
+    EXPECT_EQ(cdlab_rows, static_cast<int>(collision::bvhVolumeNames().size()));
+}
+
+TEST(NarrowphaseBench, BadOptionsExitTwo) {
+    const fs::path work = tempDir("bad");
+    Result r = runCdlab("bench narrowphase --poses 3", work);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("--poses"), std::string::npos) << r.err;
+    r = runCdlab("bench narrowphase --methods obb,octree --poses 2", work);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("unknown method 'octree'"), std::string::npos) << r.err;
+    r = runCdlab("bench narrowphase --triangles 600 --poses 2 --reps 1 --methods obb --json " +
+                     (work / "no" / "such" / "dir.json").string(),
+                 work);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("cannot write"), std::string::npos) << r.err;
+}
+
+}  // namespace
