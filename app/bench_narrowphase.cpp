@@ -2,8 +2,9 @@
 // are collision/bvh.h; FCL (when CMake found it, CDLAB_HAVE_FCL) stays in this file.
 // Same inputs for every method: one torus mesh for A and B, B placed by the pose (A at the
 // identity). The reference answer per pose is cdlab's brute-force triangle loop
-// (intersectMeshMeshBruteForce; for --large its sweep form, the same list); cdlab methods must return its pair list exactly, FCL's boolean
-// and pair count are compared and mismatches reported (FCL's triangle test is not exact).
+// (intersectMeshMeshBruteForce; for --large its sweep form, the same list); cdlab methods must
+// return its pair list exactly, FCL's boolean and pair count are compared and mismatches reported
+// (FCL's triangle test is not exact).
 #include "bench_narrowphase.h"
 
 #include <algorithm>
@@ -217,9 +218,9 @@ Workload makeWorkload(const TriangleMesh& mesh, const collision::MeshBvh& tree, 
         const Real u3 = 2 * std::numbers::pi_v<Real> * unit(rng);
         const Real a = std::sqrt(1 - u1);
         const Real b = std::sqrt(u1);
-        p.orientation = collision::Quat(a * std::sin(u2), a * std::cos(u2), b * std::sin(u3),
-                                        b * std::cos(u3))
-                            .normalized();
+        p.orientation =
+            collision::Quat(a * std::sin(u2), a * std::cos(u2), b * std::sin(u3), b * std::cos(u3))
+                .normalized();
         // Classify with the tree (cheap); the brute force below is the reference.
         const bool hit = tree.testOverlap(tree, p);
         if ((hit && hits >= half) || (!hit && misses >= half)) continue;

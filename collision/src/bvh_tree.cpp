@@ -9,8 +9,8 @@
 #include <functional>
 #include <limits>
 #include <numeric>
-#include <sstream>
 #include <queue>
+#include <sstream>
 #include <type_traits>
 #include <unordered_map>
 
@@ -38,7 +38,7 @@ struct Builder {
     // Bottom-up builds: the split of each cluster's range (key first * (n + 1) + count), found
     // by bottomUpSplits; null for top-down.
     const std::unordered_map<std::int64_t, std::int32_t>* splits = nullptr;
-    std::vector<Vec3> scratch;                        // reused: no allocation per node
+    std::vector<Vec3> scratch;  // reused: no allocation per node
 
     // Builds the subtree over leaf-order range [first, first + count); returns its node index.
     std::int32_t build(std::int32_t first, std::int32_t count) {
@@ -60,11 +60,11 @@ struct Builder {
             node.count = count;
             return index;
         }
-        const std::int32_t split =
-            splits ? splits->at(static_cast<std::int64_t>(first) *
-                                    static_cast<std::int64_t>(ids.size() + 1) +
-                                count)
-                   : partition(first, count);
+        const std::int32_t split = splits
+                                       ? splits->at(static_cast<std::int64_t>(first) *
+                                                        static_cast<std::int64_t>(ids.size() + 1) +
+                                                    count)
+                                       : partition(first, count);
         build(first, split - first);
         const std::int32_t right = build(split, first + count - split);
         nodes[static_cast<std::size_t>(index)].right = right;
@@ -219,8 +219,9 @@ std::unordered_map<std::int64_t, std::int32_t> bottomUpSplits(
         a.alive = false;
         b.alive = false;
         const auto id = static_cast<std::int32_t>(clusters.size());
-        const Cluster merged{a.first, a.count + b.count, a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi),
-                             a.prev, b.next, true};
+        const Cluster merged{
+            a.first, a.count + b.count, a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi), a.prev, b.next,
+            true};
         splits[static_cast<std::int64_t>(merged.first) * key_base + merged.count] = b.first;
         if (merged.prev >= 0) clusters[static_cast<std::size_t>(merged.prev)].next = id;
         if (merged.next >= 0) clusters[static_cast<std::size_t>(merged.next)].prev = id;
@@ -305,8 +306,8 @@ bool traverse(const Bvh<BV>& a, const Bvh<BV>& b, const BvhTransform& x, BvhQuer
 // `volume` (in B's frame, placed by x) goes to on_triangle(i, corners) (leaf order), which returns
 // true to stop. Returns true when stopped.
 template <class BV, class OnTriangle>
-bool traverseVolume(const Bvh<BV>& a, const BV& volume, const BvhTransform& x,
-                    BvhQueryStats* stats, OnTriangle&& on_triangle) {
+bool traverseVolume(const Bvh<BV>& a, const BV& volume, const BvhTransform& x, BvhQueryStats* stats,
+                    OnTriangle&& on_triangle) {
     const auto& na = a.nodes();
     if (na.empty()) return false;
     std::int64_t bv_tests = 0;
@@ -415,8 +416,8 @@ public:
         return traverse(tree_, tb, x, stats,
                         [&](std::int32_t i, std::int32_t j, const std::array<Vec3, 3>& ta,
                             const std::array<Vec3, 3>& moved) {
-                            return visitor.visit(tree_.leafTriangleId(i), ta,
-                                                 tb.leafTriangleId(j), moved);
+                            return visitor.visit(tree_.leafTriangleId(i), ta, tb.leafTriangleId(j),
+                                                 moved);
                         });
     }
     bool visitNearBox(const Vec3& box_min, const Vec3& box_max, const Mat3& rotation,
@@ -481,8 +482,14 @@ Bvh<BV>::Bvh(const TriangleMesh& mesh, const BvhBuildOptions& options) {
     }
     std::unordered_map<std::int64_t, std::int32_t> splits;
     if (opts.build == BvhBuild::BottomUp) splits = bottomUpSplits(corners_, centroids, ids_);
-    Builder<BV> builder{opts,    nodes_, corners_, centroids, ids_, moments,
-                        opts.build == BvhBuild::BottomUp ? &splits : nullptr, {}};
+    Builder<BV> builder{opts,
+                        nodes_,
+                        corners_,
+                        centroids,
+                        ids_,
+                        moments,
+                        opts.build == BvhBuild::BottomUp ? &splits : nullptr,
+                        {}};
     builder.build(0, static_cast<std::int32_t>(n));
     // Corners into leaf order, so a leaf's triangles are contiguous in memory.
     std::vector<std::array<Vec3, 3>> by_mesh = std::move(corners_);
@@ -663,7 +670,9 @@ struct BoxView {
     Vec3 half = Vec3::Zero();
     Real radius = 0;
 };
-BoxView boxView(const BoundingSphere& s) { return {s.center, Mat3::Identity(), Vec3::Zero(), s.radius}; }
+BoxView boxView(const BoundingSphere& s) {
+    return {s.center, Mat3::Identity(), Vec3::Zero(), s.radius};
+}
 BoxView boxView(const Aabb& b) {
     return {(b.min + b.max) * Real(0.5), Mat3::Identity(), (b.max - b.min) * Real(0.5), 0};
 }
@@ -750,8 +759,7 @@ MeshDistance distanceBvhBvh(const Bvh<BV>& a, const Bvh<BV>& b, const Pose& b_in
             }
             continue;
         }
-        const bool descend_a =
-            node_b.isLeaf() || (!node_a.isLeaf() && node_a.cost >= node_b.cost);
+        const bool descend_a = node_b.isLeaf() || (!node_a.isLeaf() && node_a.cost >= node_b.cost);
         Item first{it.ia, it.ib, 0};
         Item second{it.ia, it.ib, 0};
         if (descend_a) {
@@ -830,8 +838,8 @@ std::vector<TrianglePair> intersectSelf(const Bvh<BV>& tree, BvhQueryStats* stat
     if (nodes.empty()) return pairs;
     // Same frame on both sides: the identity transform, and the corners as stored (the brute
     // force tests the same coordinates).
-    const BvhTransform x = makeBvhTransform(Mat3::Identity(), Vec3::Zero(), tree.scale(),
-                                            tree.scale());
+    const BvhTransform x =
+        makeBvhTransform(Mat3::Identity(), Vec3::Zero(), tree.scale(), tree.scale());
     std::int64_t bv_tests = 0;
     std::int64_t tri_tests = 0;
     auto testLeafTriangles = [&](std::int32_t i, std::int32_t j) {
@@ -899,7 +907,8 @@ std::vector<TrianglePair> intersectSelfBruteForce(const TriangleMesh& mesh, BvhQ
     std::int64_t tests = 0;
     const std::size_t n = mesh.triangles.size();
     auto corner = [&](std::size_t t, int k) -> const Vec3& {
-        return mesh.vertices[static_cast<std::size_t>(mesh.triangles[t][static_cast<std::size_t>(k)])];
+        return mesh
+            .vertices[static_cast<std::size_t>(mesh.triangles[t][static_cast<std::size_t>(k)])];
     };
     std::vector<Vec3> lo(n);
     std::vector<Vec3> hi(n);
@@ -978,7 +987,11 @@ std::vector<TrianglePair> intersectMeshMeshSweep(const TriangleMesh& a, const Tr
         std::int32_t id;
     };
     auto make = [](const Vec3& p, const Vec3& q, const Vec3& r, std::size_t id) {
-        return Tri{p, q, r, p.cwiseMin(q).cwiseMin(r), p.cwiseMax(q).cwiseMax(r),
+        return Tri{p,
+                   q,
+                   r,
+                   p.cwiseMin(q).cwiseMin(r),
+                   p.cwiseMax(q).cwiseMax(r),
                    static_cast<std::int32_t>(id)};
     };
     std::vector<Tri> ta;
@@ -1007,8 +1020,7 @@ std::vector<TrianglePair> intersectMeshMeshSweep(const TriangleMesh& a, const Tr
     for (const Tri& ti : ta) {
         // Every box with lo.x >= ti.lo.x - widest, moved down by a rounding margin (only widens
         // the scan: the exact box test below decides).
-        const Real from =
-            ti.lo.x() - widest - Real(4) * kEpsilon * (std::abs(ti.lo.x()) + widest);
+        const Real from = ti.lo.x() - widest - Real(4) * kEpsilon * (std::abs(ti.lo.x()) + widest);
         auto it = std::lower_bound(tb.begin(), tb.end(), from,
                                    [](const Tri& u, Real v) { return u.lo.x() < v; });
         for (; it != tb.end() && it->lo.x() <= ti.hi.x(); ++it) {

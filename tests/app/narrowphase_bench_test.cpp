@@ -32,8 +32,8 @@ std::string slurp(const fs::path& p) {
 }
 
 fs::path tempDir(const std::string& name) {
-    const fs::path d = fs::temp_directory_path() /
-                       ("cdlab_np_bench_" + name + "_" + std::to_string(::getpid()));
+    const fs::path d =
+        fs::temp_directory_path() / ("cdlab_np_bench_" + name + "_" + std::to_string(::getpid()));
     fs::remove_all(d);
     fs::create_directories(d);
     return d;
@@ -65,8 +65,8 @@ TEST(NarrowphaseBench, SmallToriTableAndJsonAgreeWithBruteForce) {
     EXPECT_GE(j["triangles"].get<int>(), 500);
     int cdlab_rows = 0;
     for (const auto& row : j["rows"]) {
-        for (const char* key : {"method", "build_ms", "first_us", "all_us", "bool_mismatches",
-                                "pair_mismatches"}) {
+        for (const char* key :
+             {"method", "build_ms", "first_us", "all_us", "bool_mismatches", "pair_mismatches"}) {
             EXPECT_TRUE(row.contains(key)) << key;
         }
         if (row["library"] == "cdlab") {

@@ -125,10 +125,11 @@ TEST_P(MeshNarrowPhase, MeshMeshTouchingPosesMatchBruteForce) {
                 const Pose pb = at(Vec3::Constant(offset * k) + c.offset * k);
                 const CollideOutput fast = collide(a, pa, a, pb);
                 const CollideOutput brute = collide(a_brute, pa, a_brute, pb);
-                EXPECT_EQ(fast.state, brute.state) << bv << " k=" << k << " " << c.offset.transpose();
+                EXPECT_EQ(fast.state, brute.state)
+                    << bv << " k=" << k << " " << c.offset.transpose();
                 if (offset == 0) {
-                    EXPECT_EQ(fast.state, c.expected) << bv << " k=" << k << " "
-                                                      << c.offset.transpose();
+                    EXPECT_EQ(fast.state, c.expected)
+                        << bv << " k=" << k << " " << c.offset.transpose();
                 }
             }
         }
@@ -194,13 +195,11 @@ TEST_P(MeshNarrowPhase, MeshConvexMatchesBruteForce) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(EveryVolume, MeshNarrowPhase,
-                         ::testing::ValuesIn(std::vector<std::string>(
-                             collision::bvhVolumeNames().begin(),
-                             collision::bvhVolumeNames().end())),
-                         [](const ::testing::TestParamInfo<std::string>& param) {
-                             return param.param;
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    EveryVolume, MeshNarrowPhase,
+    ::testing::ValuesIn(std::vector<std::string>(collision::bvhVolumeNames().begin(),
+                                                 collision::bvhVolumeNames().end())),
+    [](const ::testing::TestParamInfo<std::string>& param) { return param.param; });
 
 TEST(MeshShape, CarriesTheDefaultHierarchy) {
     const Shape s = meshShape(gridCube(), 1, collision::kDefaultMeshBvh);
