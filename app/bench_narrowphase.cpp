@@ -87,12 +87,16 @@ public:
 
 class CdlabMethod final : public NarrowMethod {
 public:
-    explicit CdlabMethod(std::string_view bv) : bv_(bv) {}
-    std::string name() const override { return std::string(bv_); }
+    CdlabMethod(std::string_view bv, collision::BvhBuild how) : bv_(bv), how_(how) {}
+    std::string name() const override {
+        return std::string(bv_) + (how_ == collision::BvhBuild::BottomUp ? "-bu" : "");
+    }
     bool hasCounters() const override { return true; }
     void build(const TriangleMesh& mesh) override {
-        a_ = collision::buildMeshBvh(bv_, mesh);
-        b_ = collision::buildMeshBvh(bv_, mesh);
+        collision::BvhBuildOptions options;
+        options.build = how_;
+        a_ = collision::buildMeshBvh(bv_, mesh, options);
+        b_ = collision::buildMeshBvh(bv_, mesh, options);
     }
     bool first(const Pose& b_in_a, collision::BvhQueryStats* stats) override {
         return a_->testOverlap(*b_, b_in_a, stats);
@@ -107,6 +111,7 @@ public:
 
 private:
     std::string_view bv_;
+    collision::BvhBuild how_;
     std::unique_ptr<collision::MeshBvh> a_;
     std::unique_ptr<collision::MeshBvh> b_;
 };
@@ -166,7 +171,10 @@ private:
 
 std::unique_ptr<NarrowMethod> makeMethod(const std::string& name) {
     for (const std::string_view bv : collision::bvhVolumeNames()) {
-        if (bv == name) return std::make_unique<CdlabMethod>(bv);
+        if (bv == name) return std::make_unique<CdlabMethod>(bv, collision::BvhBuild::TopDown);
+        if (std::string(bv) + "-bu" == name) {
+            return std::make_unique<CdlabMethod>(bv, collision::BvhBuild::BottomUp);
+        }
     }
 #ifdef CDLAB_HAVE_FCL
     if (name == "fcl-obbrss") return std::make_unique<FclMethod<fcl::OBBRSSd>>(name);
@@ -270,7 +278,7 @@ int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& ou
         if (!makeMethod(n)) {
             err << "cdlab bench narrowphase: unknown method '" << n << "' (expected one of:";
             for (const std::string& m : narrowphaseBenchMethods()) err << ' ' << m;
-            err << ")\n";
+            err << "; a volume name with -bu: its bottom-up build)\n";
             return 2;
         }
     }

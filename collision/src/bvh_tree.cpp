@@ -490,6 +490,7 @@ Bvh<BV>::Bvh(const TriangleMesh& mesh, const BvhBuildOptions& options) {
                         moments,
                         opts.build == BvhBuild::BottomUp ? &splits : nullptr,
                         {}};
+    builder.scratch.reserve(3 * n);  // the root's corners: no regrowth during the build
     builder.build(0, static_cast<std::int32_t>(n));
     // Corners into leaf order, so a leaf's triangles are contiguous in memory.
     std::vector<std::array<Vec3, 3>> by_mesh = std::move(corners_);

@@ -80,6 +80,24 @@ TEST(NarrowphaseBench, SmallToriTableAndJsonAgreeWithBruteForce) {
     EXPECT_EQ(cdlab_rows, static_cast<int>(collision::bvhVolumeNames().size()));
 }
 
+TEST(NarrowphaseBench, BottomUpBuildsAreCheckedToo) {
+    const fs::path work = tempDir("bu");
+    const fs::path json = work / "np.json";
+    const Result r = runCdlab(
+        "bench narrowphase --triangles 600 --poses 4 --reps 1 --methods "
+        "obb-bu,aabb-bu,obb --json " +
+            json.string(),
+        work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(slurp(json));
+    ASSERT_EQ(j["rows"].size(), 3u);
+    EXPECT_EQ(j["rows"][0]["method"], "obb-bu");
+    for (const auto& row : j["rows"]) {
+        EXPECT_EQ(row["library"], "cdlab");
+        EXPECT_EQ(row["pair_mismatches"], 0) << row["method"];
+    }
+}
+
 TEST(NarrowphaseBench, BadOptionsExitTwo) {
     const fs::path work = tempDir("bad");
     Result r = runCdlab("bench narrowphase --poses 3", work);
