@@ -232,6 +232,37 @@ std::unordered_map<std::int64_t, std::int32_t> bottomUpSplits(
     return splits;
 }
 
+// A traversal stack that lives on the call stack when the bound on its size fits (the usual
+// case: the bound is the sum of the tree depths), so a query allocates nothing; larger bounds
+// (very deep trees) fall back to the heap once per query.
+template <class T>
+class NodeStack {
+public:
+    explicit NodeStack(std::size_t bound) {
+        if (bound > kInline) {
+            heap_.resize(bound);
+            data_ = heap_.data();
+        }
+    }
+    NodeStack(const NodeStack&) = delete;
+    NodeStack& operator=(const NodeStack&) = delete;
+    void push(const T& v) {
+        CDLAB_ASSERT(size_ < capacity(), "traversal stack bound exceeded");
+        data_[size_++] = v;
+    }
+    T pop() { return data_[--size_]; }
+    bool empty() const { return size_ == 0; }
+    void clear() { size_ = 0; }
+
+private:
+    static constexpr std::size_t kInline = 256;
+    std::size_t capacity() const { return heap_.empty() ? kInline : heap_.size(); }
+    std::array<T, kInline> inline_{};
+    std::vector<T> heap_;
+    T* data_ = inline_.data();
+    std::size_t size_ = 0;
+};
+
 // The tandem traversal (Gottschalk 1996 §5): pop a node pair, test the volumes, and at two leaves
 // test their triangles; otherwise descend the node with the larger volume (a leaf never
 // descends). Every intersecting triangle pair goes to on_pair(i, j, ta, tb) (leaf-order indices,
@@ -246,16 +277,17 @@ bool traverse(const Bvh<BV>& a, const Bvh<BV>& b, const BvhTransform& x, BvhQuer
     std::int64_t tri_tests = 0;
     bool stopped = false;
     // Depth-first with an explicit stack; its size is bounded by depth(a) + depth(b) + 1.
-    std::vector<std::pair<std::int32_t, std::int32_t>> stack;
-    stack.reserve(static_cast<std::size_t>(2 * (a.depth() + b.depth()) + 4));
-    stack.emplace_back(0, 0);
+    // Each pop pushes at most two pairs and each push descends one level of A or B, so the
+    // stack never holds more than depth(a) + depth(b) + 1 pairs.
+    NodeStack<std::pair<std::int32_t, std::int32_t>> stack(
+        static_cast<std::size_t>(a.depth() + b.depth() + 2));
+    stack.push({0, 0});
     // B's node volume moved into A's frame, kept while the traversal descends A under the same
     // B node (the pair popped next after descending A has the same B node).
     [[maybe_unused]] BV moved_b{};
     [[maybe_unused]] std::int32_t moved_id = -1;
     while (!stack.empty() && !stopped) {
-        const auto [ia, ib] = stack.back();
-        stack.pop_back();
+        const auto [ia, ib] = stack.pop();
         const auto& node_a = na[static_cast<std::size_t>(ia)];
         const auto& node_b = nb[static_cast<std::size_t>(ib)];
         ++bv_tests;
@@ -288,11 +320,11 @@ bool traverse(const Bvh<BV>& a, const Bvh<BV>& b, const BvhTransform& x, BvhQuer
         }
         const bool descend_a = node_b.isLeaf() || (!node_a.isLeaf() && node_a.cost >= node_b.cost);
         if (descend_a) {
-            stack.emplace_back(node_a.right, ib);
-            stack.emplace_back(ia + 1, ib);
+            stack.push({node_a.right, ib});
+            stack.push({ia + 1, ib});
         } else {
-            stack.emplace_back(ia, node_b.right);
-            stack.emplace_back(ia, ib + 1);
+            stack.push({ia, node_b.right});
+            stack.push({ia, ib + 1});
         }
     }
     if (stats) {
@@ -312,14 +344,12 @@ bool traverseVolume(const Bvh<BV>& a, const BV& volume, const BvhTransform& x, B
     if (na.empty()) return false;
     std::int64_t bv_tests = 0;
     bool stopped = false;
-    std::vector<std::int32_t> stack;
-    stack.reserve(static_cast<std::size_t>(a.depth() + 2));
-    stack.push_back(0);
+    NodeStack<std::int32_t> stack(static_cast<std::size_t>(a.depth() + 2));
+    stack.push(0);
     [[maybe_unused]] BV moved{};
     if constexpr (MovableVolume<BV>) moved = BvTraits<BV>::move(volume, x);
     while (!stack.empty() && !stopped) {
-        const std::int32_t ia = stack.back();
-        stack.pop_back();
+        const std::int32_t ia = stack.pop();
         const auto& node = na[static_cast<std::size_t>(ia)];
         ++bv_tests;
         if constexpr (MovableVolume<BV>) {
@@ -336,8 +366,8 @@ bool traverseVolume(const Bvh<BV>& a, const BV& volume, const BvhTransform& x, B
             }
             continue;
         }
-        stack.push_back(node.right);
-        stack.push_back(ia + 1);
+        stack.push(node.right);
+        stack.push(ia + 1);
     }
     if (stats) stats->bv_tests += bv_tests;
     return stopped;
@@ -345,13 +375,13 @@ bool traverseVolume(const Bvh<BV>& a, const BV& volume, const BvhTransform& x, B
 
 // The closed surface of the box [lo, hi] as 12 triangles (36 corners): the fits that weight by
 // triangle area (OBB, RSS) see a box, not a point cloud.
-std::vector<Vec3> boxSurfaceCorners(const Vec3& lo, const Vec3& hi) {
+const std::vector<Vec3>& boxSurfaceCorners(const Vec3& lo, const Vec3& hi) {
     auto corner = [&](int bits) {
         return Vec3((bits & 1) ? hi.x() : lo.x(), (bits & 2) ? hi.y() : lo.y(),
                     (bits & 4) ? hi.z() : lo.z());
     };
-    std::vector<Vec3> out;
-    out.reserve(36);
+    thread_local std::vector<Vec3> out;  // reused: no allocation per query once warm
+    out.clear();
     for (int axis = 0; axis < 3; ++axis) {
         const int u = 1 << ((axis + 1) % 3);
         const int v = 1 << ((axis + 2) % 3);
