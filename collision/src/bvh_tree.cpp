@@ -39,9 +39,12 @@ struct Builder {
     // by bottomUpSplits; null for top-down.
     const std::unordered_map<std::int64_t, std::int32_t>* splits = nullptr;
     std::vector<Vec3> scratch;  // reused: no allocation per node
+    int depth = 0;              // longest root-to-leaf path so far (a lone leaf: 1)
 
-    // Builds the subtree over leaf-order range [first, first + count); returns its node index.
-    std::int32_t build(std::int32_t first, std::int32_t count) {
+    // Builds the subtree over leaf-order range [first, first + count) whose root is at `level`
+    // (the root: 1); returns its node index.
+    std::int32_t build(std::int32_t first, std::int32_t count, int level) {
+        depth = std::max(depth, level);
         const auto index = static_cast<std::int32_t>(nodes.size());
         nodes.emplace_back();
         scratch.clear();
@@ -65,8 +68,8 @@ struct Builder {
                                                         static_cast<std::int64_t>(ids.size() + 1) +
                                                     count)
                                        : partition(first, count);
-        build(first, split - first);
-        const std::int32_t right = build(split, first + count - split);
+        build(first, split - first, level + 1);
+        const std::int32_t right = build(split, first + count - split, level + 1);
         nodes[static_cast<std::size_t>(index)].right = right;
         return index;
     }
@@ -472,9 +475,6 @@ private:
 }  // namespace
 
 template <class BV>
-int measureDepth(const std::vector<typename Bvh<BV>::Node>& nodes);
-
-template <class BV>
 Bvh<BV>::Bvh(const TriangleMesh& mesh, const BvhBuildOptions& options) {
     CDLAB_ASSERT(options.max_leaf_triangles >= 1, "leaves need at least one triangle");
     const std::size_t n = mesh.triangles.size();
@@ -521,7 +521,7 @@ Bvh<BV>::Bvh(const TriangleMesh& mesh, const BvhBuildOptions& options) {
                         opts.build == BvhBuild::BottomUp ? &splits : nullptr,
                         {}};
     builder.scratch.reserve(3 * n);  // the root's corners: no regrowth during the build
-    builder.build(0, static_cast<std::int32_t>(n));
+    builder.build(0, static_cast<std::int32_t>(n), 1);
     // Corners into leaf order, so a leaf's triangles are contiguous in memory.
     std::vector<std::array<Vec3, 3>> by_mesh = std::move(corners_);
     corners_.resize(n);
@@ -529,27 +529,9 @@ Bvh<BV>::Bvh(const TriangleMesh& mesh, const BvhBuildOptions& options) {
         corners_[k] = by_mesh[static_cast<std::size_t>(ids_[k])];
         vertex_ids_[k] = mesh.triangles[static_cast<std::size_t>(ids_[k])];
     }
-    depth_ = measureDepth<BV>(nodes_);
+    depth_ = builder.depth;
 }
 
-template <class BV>
-int measureDepth(const std::vector<typename Bvh<BV>::Node>& nodes) {
-    using Node = typename Bvh<BV>::Node;
-    if (nodes.empty()) return 0;
-    int best = 0;
-    std::vector<std::pair<std::int32_t, int>> stack{{0, 1}};
-    while (!stack.empty()) {
-        const auto [i, d] = stack.back();
-        stack.pop_back();
-        best = std::max(best, d);
-        const Node& node = nodes[static_cast<std::size_t>(i)];
-        if (!node.isLeaf()) {
-            stack.emplace_back(i + 1, d + 1);
-            stack.emplace_back(node.right, d + 1);
-        }
-    }
-    return best;
-}
 
 template <class BV>
 std::int32_t Bvh<BV>::refit(const TriangleMesh& mesh) {
