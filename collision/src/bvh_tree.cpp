@@ -532,7 +532,6 @@ Bvh<BV>::Bvh(const TriangleMesh& mesh, const BvhBuildOptions& options) {
     depth_ = builder.depth;
 }
 
-
 template <class BV>
 std::int32_t Bvh<BV>::refit(const TriangleMesh& mesh) {
     CDLAB_ASSERT(mesh.triangles.size() == ids_.size(), "refit with another mesh");
