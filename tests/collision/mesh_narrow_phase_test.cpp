@@ -215,4 +215,28 @@ TEST(MeshShape, CarriesTheDefaultHierarchy) {
     EXPECT_TRUE(by_factory.bvh->validate());
 }
 
+// Shapes whose hierarchies cannot run one tandem traversal (different volume types, or one
+// without a hierarchy) fall back to the brute-force loop: same states, no BV tests.
+TEST(MeshShape, MixedOrMissingHierarchiesFallBackToBruteForce) {
+    const Shape obb = meshShape(torusA(), 1, "obb");
+    const Shape aabb = meshShape(torusB(), 1, "aabb");
+    const Shape none = meshShape(torusB(), 1, "");
+    const Shape brute_a = meshShape(torusA(), 1, "");
+    cdlab_test::Rng rng(5);
+    int colliding = 0;
+    for (int n = 0; n < 30; ++n) {
+        const Pose pa = at(rng.vec(-0.2, 0.2), rng.rotation());
+        const Pose pb = at(rng.vec(-1.6, 1.6), rng.rotation());
+        const CollideOutput expected = collide(brute_a, pa, none, pb);
+        for (const Shape* b : {&aabb, &none}) {
+            const CollideOutput out = collide(obb, pa, *b, pb);
+            EXPECT_EQ(out.state, expected.state) << n;
+            EXPECT_EQ(out.bv_tests, 0) << n;
+        }
+        colliding += collision::isColliding(expected.state);
+    }
+    EXPECT_GT(colliding, 5);
+    EXPECT_LT(colliding, 25);
+}
+
 }  // namespace
