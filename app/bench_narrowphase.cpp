@@ -2,8 +2,9 @@
 // are collision/bvh.h; FCL (when CMake found it, CDLAB_HAVE_FCL) stays in this file.
 // Same inputs for every method: one torus mesh for A and B, B placed by the pose (A at the
 // identity). The reference answer per pose is cdlab's brute-force triangle loop
-// (intersectMeshMeshBruteForce; for --large its sweep form, the same list); cdlab methods must return its pair list exactly, FCL's boolean
-// and pair count are compared and mismatches reported (FCL's triangle test is not exact).
+// (intersectMeshMeshBruteForce; for --large its sweep form, the same list); cdlab methods must
+// return its pair list exactly, FCL's boolean and pair count are compared and mismatches reported
+// (FCL's triangle test is not exact).
 #include "bench_narrowphase.h"
 
 #include <algorithm>
@@ -86,12 +87,16 @@ public:
 
 class CdlabMethod final : public NarrowMethod {
 public:
-    explicit CdlabMethod(std::string_view bv) : bv_(bv) {}
-    std::string name() const override { return std::string(bv_); }
+    CdlabMethod(std::string_view bv, collision::BvhBuild how) : bv_(bv), how_(how) {}
+    std::string name() const override {
+        return std::string(bv_) + (how_ == collision::BvhBuild::BottomUp ? "-bu" : "");
+    }
     bool hasCounters() const override { return true; }
     void build(const TriangleMesh& mesh) override {
-        a_ = collision::buildMeshBvh(bv_, mesh);
-        b_ = collision::buildMeshBvh(bv_, mesh);
+        collision::BvhBuildOptions options;
+        options.build = how_;
+        a_ = collision::buildMeshBvh(bv_, mesh, options);
+        b_ = collision::buildMeshBvh(bv_, mesh, options);
     }
     bool first(const Pose& b_in_a, collision::BvhQueryStats* stats) override {
         return a_->testOverlap(*b_, b_in_a, stats);
@@ -106,6 +111,7 @@ public:
 
 private:
     std::string_view bv_;
+    collision::BvhBuild how_;
     std::unique_ptr<collision::MeshBvh> a_;
     std::unique_ptr<collision::MeshBvh> b_;
 };
@@ -165,7 +171,10 @@ private:
 
 std::unique_ptr<NarrowMethod> makeMethod(const std::string& name) {
     for (const std::string_view bv : collision::bvhVolumeNames()) {
-        if (bv == name) return std::make_unique<CdlabMethod>(bv);
+        if (bv == name) return std::make_unique<CdlabMethod>(bv, collision::BvhBuild::TopDown);
+        if (std::string(bv) + "-bu" == name) {
+            return std::make_unique<CdlabMethod>(bv, collision::BvhBuild::BottomUp);
+        }
     }
 #ifdef CDLAB_HAVE_FCL
     if (name == "fcl-obbrss") return std::make_unique<FclMethod<fcl::OBBRSSd>>(name);
@@ -217,9 +226,9 @@ Workload makeWorkload(const TriangleMesh& mesh, const collision::MeshBvh& tree, 
         const Real u3 = 2 * std::numbers::pi_v<Real> * unit(rng);
         const Real a = std::sqrt(1 - u1);
         const Real b = std::sqrt(u1);
-        p.orientation = collision::Quat(a * std::sin(u2), a * std::cos(u2), b * std::sin(u3),
-                                        b * std::cos(u3))
-                            .normalized();
+        p.orientation =
+            collision::Quat(a * std::sin(u2), a * std::cos(u2), b * std::sin(u3), b * std::cos(u3))
+                .normalized();
         // Classify with the tree (cheap); the brute force below is the reference.
         const bool hit = tree.testOverlap(tree, p);
         if ((hit && hits >= half) || (!hit && misses >= half)) continue;
@@ -269,7 +278,7 @@ int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& ou
         if (!makeMethod(n)) {
             err << "cdlab bench narrowphase: unknown method '" << n << "' (expected one of:";
             for (const std::string& m : narrowphaseBenchMethods()) err << ' ' << m;
-            err << ")\n";
+            err << "; a volume name with -bu: its bottom-up build)\n";
             return 2;
         }
     }

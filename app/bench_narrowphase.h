@@ -18,7 +18,8 @@ struct BenchNarrowphaseOptions {
     int poses = 32;         ///< even, >= 2: half colliding, half not
     int reps = 3;  ///< repetitions per pose (and of the build, at most 3); the fastest counts
     std::uint64_t seed = 7;
-    /// Method names (cdlab volume names, "fcl-obbrss", ...); empty: all.
+    /// Method names (cdlab volume names, NAME-bu for the bottom-up build, "fcl-obbrss", ...);
+    /// empty: every volume name (top-down) and every FCL type.
     std::vector<std::string> methods;
     std::optional<std::filesystem::path> json;  ///< also write the table as JSON
 };

@@ -191,8 +191,8 @@ int main(int argc, char** argv) {
     bench_np_cmd->add_option("--seed", bench_np.seed, "pose seed")->capture_default_str();
     bench_np_cmd
         ->add_option("--methods", bench_np.methods,
-                     "comma-separated (default all): volume names and fcl-obbrss, fcl-obb, "
-                     "fcl-rss, fcl-kios, fcl-aabb, fcl-kdop18")
+                     "comma-separated (default all): volume names (NAME-bu: bottom-up build) "
+                     "and fcl-obbrss, fcl-obb, fcl-rss, fcl-kios, fcl-aabb, fcl-kdop18")
         ->delimiter(',');
     bench_np_cmd->add_option("--json", bench_np_json, "also write the table as JSON to FILE");
     // END bench subcommand

@@ -9,8 +9,8 @@
 #include <functional>
 #include <limits>
 #include <numeric>
-#include <sstream>
 #include <queue>
+#include <sstream>
 #include <type_traits>
 #include <unordered_map>
 
@@ -38,10 +38,13 @@ struct Builder {
     // Bottom-up builds: the split of each cluster's range (key first * (n + 1) + count), found
     // by bottomUpSplits; null for top-down.
     const std::unordered_map<std::int64_t, std::int32_t>* splits = nullptr;
-    std::vector<Vec3> scratch;                        // reused: no allocation per node
+    std::vector<Vec3> scratch;  // reused: no allocation per node
+    int depth = 0;              // longest root-to-leaf path so far (a lone leaf: 1)
 
-    // Builds the subtree over leaf-order range [first, first + count); returns its node index.
-    std::int32_t build(std::int32_t first, std::int32_t count) {
+    // Builds the subtree over leaf-order range [first, first + count) whose root is at `level`
+    // (the root: 1); returns its node index.
+    std::int32_t build(std::int32_t first, std::int32_t count, int level) {
+        depth = std::max(depth, level);
         const auto index = static_cast<std::int32_t>(nodes.size());
         nodes.emplace_back();
         scratch.clear();
@@ -60,13 +63,13 @@ struct Builder {
             node.count = count;
             return index;
         }
-        const std::int32_t split =
-            splits ? splits->at(static_cast<std::int64_t>(first) *
-                                    static_cast<std::int64_t>(ids.size() + 1) +
-                                count)
-                   : partition(first, count);
-        build(first, split - first);
-        const std::int32_t right = build(split, first + count - split);
+        const std::int32_t split = splits
+                                       ? splits->at(static_cast<std::int64_t>(first) *
+                                                        static_cast<std::int64_t>(ids.size() + 1) +
+                                                    count)
+                                       : partition(first, count);
+        build(first, split - first, level + 1);
+        const std::int32_t right = build(split, first + count - split, level + 1);
         nodes[static_cast<std::size_t>(index)].right = right;
         return index;
     }
@@ -219,8 +222,9 @@ std::unordered_map<std::int64_t, std::int32_t> bottomUpSplits(
         a.alive = false;
         b.alive = false;
         const auto id = static_cast<std::int32_t>(clusters.size());
-        const Cluster merged{a.first, a.count + b.count, a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi),
-                             a.prev, b.next, true};
+        const Cluster merged{
+            a.first, a.count + b.count, a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi), a.prev, b.next,
+            true};
         splits[static_cast<std::int64_t>(merged.first) * key_base + merged.count] = b.first;
         if (merged.prev >= 0) clusters[static_cast<std::size_t>(merged.prev)].next = id;
         if (merged.next >= 0) clusters[static_cast<std::size_t>(merged.next)].prev = id;
@@ -230,6 +234,37 @@ std::unordered_map<std::int64_t, std::int32_t> bottomUpSplits(
     }
     return splits;
 }
+
+// A traversal stack that lives on the call stack when the bound on its size fits (the usual
+// case: the bound is the sum of the tree depths), so a query allocates nothing; larger bounds
+// (very deep trees) fall back to the heap once per query.
+template <class T>
+class NodeStack {
+public:
+    explicit NodeStack(std::size_t bound) {
+        if (bound > kInline) {
+            heap_.resize(bound);
+            data_ = heap_.data();
+        }
+    }
+    NodeStack(const NodeStack&) = delete;
+    NodeStack& operator=(const NodeStack&) = delete;
+    void push(const T& v) {
+        CDLAB_ASSERT(size_ < capacity(), "traversal stack bound exceeded");
+        data_[size_++] = v;
+    }
+    T pop() { return data_[--size_]; }
+    bool empty() const { return size_ == 0; }
+    void clear() { size_ = 0; }
+
+private:
+    static constexpr std::size_t kInline = 256;
+    std::size_t capacity() const { return heap_.empty() ? kInline : heap_.size(); }
+    std::array<T, kInline> inline_{};
+    std::vector<T> heap_;
+    T* data_ = inline_.data();
+    std::size_t size_ = 0;
+};
 
 // The tandem traversal (Gottschalk 1996 §5): pop a node pair, test the volumes, and at two leaves
 // test their triangles; otherwise descend the node with the larger volume (a leaf never
@@ -245,16 +280,17 @@ bool traverse(const Bvh<BV>& a, const Bvh<BV>& b, const BvhTransform& x, BvhQuer
     std::int64_t tri_tests = 0;
     bool stopped = false;
     // Depth-first with an explicit stack; its size is bounded by depth(a) + depth(b) + 1.
-    std::vector<std::pair<std::int32_t, std::int32_t>> stack;
-    stack.reserve(static_cast<std::size_t>(2 * (a.depth() + b.depth()) + 4));
-    stack.emplace_back(0, 0);
+    // Each pop pushes at most two pairs and each push descends one level of A or B, so the
+    // stack never holds more than depth(a) + depth(b) + 1 pairs.
+    NodeStack<std::pair<std::int32_t, std::int32_t>> stack(
+        static_cast<std::size_t>(a.depth() + b.depth() + 2));
+    stack.push({0, 0});
     // B's node volume moved into A's frame, kept while the traversal descends A under the same
     // B node (the pair popped next after descending A has the same B node).
     [[maybe_unused]] BV moved_b{};
     [[maybe_unused]] std::int32_t moved_id = -1;
     while (!stack.empty() && !stopped) {
-        const auto [ia, ib] = stack.back();
-        stack.pop_back();
+        const auto [ia, ib] = stack.pop();
         const auto& node_a = na[static_cast<std::size_t>(ia)];
         const auto& node_b = nb[static_cast<std::size_t>(ib)];
         ++bv_tests;
@@ -287,11 +323,11 @@ bool traverse(const Bvh<BV>& a, const Bvh<BV>& b, const BvhTransform& x, BvhQuer
         }
         const bool descend_a = node_b.isLeaf() || (!node_a.isLeaf() && node_a.cost >= node_b.cost);
         if (descend_a) {
-            stack.emplace_back(node_a.right, ib);
-            stack.emplace_back(ia + 1, ib);
+            stack.push({node_a.right, ib});
+            stack.push({ia + 1, ib});
         } else {
-            stack.emplace_back(ia, node_b.right);
-            stack.emplace_back(ia, ib + 1);
+            stack.push({ia, node_b.right});
+            stack.push({ia, ib + 1});
         }
     }
     if (stats) {
@@ -305,20 +341,18 @@ bool traverse(const Bvh<BV>& a, const Bvh<BV>& b, const BvhTransform& x, BvhQuer
 // `volume` (in B's frame, placed by x) goes to on_triangle(i, corners) (leaf order), which returns
 // true to stop. Returns true when stopped.
 template <class BV, class OnTriangle>
-bool traverseVolume(const Bvh<BV>& a, const BV& volume, const BvhTransform& x,
-                    BvhQueryStats* stats, OnTriangle&& on_triangle) {
+bool traverseVolume(const Bvh<BV>& a, const BV& volume, const BvhTransform& x, BvhQueryStats* stats,
+                    OnTriangle&& on_triangle) {
     const auto& na = a.nodes();
     if (na.empty()) return false;
     std::int64_t bv_tests = 0;
     bool stopped = false;
-    std::vector<std::int32_t> stack;
-    stack.reserve(static_cast<std::size_t>(a.depth() + 2));
-    stack.push_back(0);
+    NodeStack<std::int32_t> stack(static_cast<std::size_t>(a.depth() + 2));
+    stack.push(0);
     [[maybe_unused]] BV moved{};
     if constexpr (MovableVolume<BV>) moved = BvTraits<BV>::move(volume, x);
     while (!stack.empty() && !stopped) {
-        const std::int32_t ia = stack.back();
-        stack.pop_back();
+        const std::int32_t ia = stack.pop();
         const auto& node = na[static_cast<std::size_t>(ia)];
         ++bv_tests;
         if constexpr (MovableVolume<BV>) {
@@ -335,8 +369,8 @@ bool traverseVolume(const Bvh<BV>& a, const BV& volume, const BvhTransform& x,
             }
             continue;
         }
-        stack.push_back(node.right);
-        stack.push_back(ia + 1);
+        stack.push(node.right);
+        stack.push(ia + 1);
     }
     if (stats) stats->bv_tests += bv_tests;
     return stopped;
@@ -344,13 +378,13 @@ bool traverseVolume(const Bvh<BV>& a, const BV& volume, const BvhTransform& x,
 
 // The closed surface of the box [lo, hi] as 12 triangles (36 corners): the fits that weight by
 // triangle area (OBB, RSS) see a box, not a point cloud.
-std::vector<Vec3> boxSurfaceCorners(const Vec3& lo, const Vec3& hi) {
+const std::vector<Vec3>& boxSurfaceCorners(const Vec3& lo, const Vec3& hi) {
     auto corner = [&](int bits) {
         return Vec3((bits & 1) ? hi.x() : lo.x(), (bits & 2) ? hi.y() : lo.y(),
                     (bits & 4) ? hi.z() : lo.z());
     };
-    std::vector<Vec3> out;
-    out.reserve(36);
+    thread_local std::vector<Vec3> out;  // reused: no allocation per query once warm
+    out.clear();
     for (int axis = 0; axis < 3; ++axis) {
         const int u = 1 << ((axis + 1) % 3);
         const int v = 1 << ((axis + 2) % 3);
@@ -415,8 +449,8 @@ public:
         return traverse(tree_, tb, x, stats,
                         [&](std::int32_t i, std::int32_t j, const std::array<Vec3, 3>& ta,
                             const std::array<Vec3, 3>& moved) {
-                            return visitor.visit(tree_.leafTriangleId(i), ta,
-                                                 tb.leafTriangleId(j), moved);
+                            return visitor.visit(tree_.leafTriangleId(i), ta, tb.leafTriangleId(j),
+                                                 moved);
                         });
     }
     bool visitNearBox(const Vec3& box_min, const Vec3& box_max, const Mat3& rotation,
@@ -439,9 +473,6 @@ private:
 };
 
 }  // namespace
-
-template <class BV>
-int measureDepth(const std::vector<typename Bvh<BV>::Node>& nodes);
 
 template <class BV>
 Bvh<BV>::Bvh(const TriangleMesh& mesh, const BvhBuildOptions& options) {
@@ -481,9 +512,16 @@ Bvh<BV>::Bvh(const TriangleMesh& mesh, const BvhBuildOptions& options) {
     }
     std::unordered_map<std::int64_t, std::int32_t> splits;
     if (opts.build == BvhBuild::BottomUp) splits = bottomUpSplits(corners_, centroids, ids_);
-    Builder<BV> builder{opts,    nodes_, corners_, centroids, ids_, moments,
-                        opts.build == BvhBuild::BottomUp ? &splits : nullptr, {}};
-    builder.build(0, static_cast<std::int32_t>(n));
+    Builder<BV> builder{opts,
+                        nodes_,
+                        corners_,
+                        centroids,
+                        ids_,
+                        moments,
+                        opts.build == BvhBuild::BottomUp ? &splits : nullptr,
+                        {}};
+    builder.scratch.reserve(3 * n);  // the root's corners: no regrowth during the build
+    builder.build(0, static_cast<std::int32_t>(n), 1);
     // Corners into leaf order, so a leaf's triangles are contiguous in memory.
     std::vector<std::array<Vec3, 3>> by_mesh = std::move(corners_);
     corners_.resize(n);
@@ -491,26 +529,7 @@ Bvh<BV>::Bvh(const TriangleMesh& mesh, const BvhBuildOptions& options) {
         corners_[k] = by_mesh[static_cast<std::size_t>(ids_[k])];
         vertex_ids_[k] = mesh.triangles[static_cast<std::size_t>(ids_[k])];
     }
-    depth_ = measureDepth<BV>(nodes_);
-}
-
-template <class BV>
-int measureDepth(const std::vector<typename Bvh<BV>::Node>& nodes) {
-    using Node = typename Bvh<BV>::Node;
-    if (nodes.empty()) return 0;
-    int best = 0;
-    std::vector<std::pair<std::int32_t, int>> stack{{0, 1}};
-    while (!stack.empty()) {
-        const auto [i, d] = stack.back();
-        stack.pop_back();
-        best = std::max(best, d);
-        const Node& node = nodes[static_cast<std::size_t>(i)];
-        if (!node.isLeaf()) {
-            stack.emplace_back(i + 1, d + 1);
-            stack.emplace_back(node.right, d + 1);
-        }
-    }
-    return best;
+    depth_ = builder.depth;
 }
 
 template <class BV>
@@ -663,7 +682,9 @@ struct BoxView {
     Vec3 half = Vec3::Zero();
     Real radius = 0;
 };
-BoxView boxView(const BoundingSphere& s) { return {s.center, Mat3::Identity(), Vec3::Zero(), s.radius}; }
+BoxView boxView(const BoundingSphere& s) {
+    return {s.center, Mat3::Identity(), Vec3::Zero(), s.radius};
+}
 BoxView boxView(const Aabb& b) {
     return {(b.min + b.max) * Real(0.5), Mat3::Identity(), (b.max - b.min) * Real(0.5), 0};
 }
@@ -750,8 +771,7 @@ MeshDistance distanceBvhBvh(const Bvh<BV>& a, const Bvh<BV>& b, const Pose& b_in
             }
             continue;
         }
-        const bool descend_a =
-            node_b.isLeaf() || (!node_a.isLeaf() && node_a.cost >= node_b.cost);
+        const bool descend_a = node_b.isLeaf() || (!node_a.isLeaf() && node_a.cost >= node_b.cost);
         Item first{it.ia, it.ib, 0};
         Item second{it.ia, it.ib, 0};
         if (descend_a) {
@@ -830,8 +850,8 @@ std::vector<TrianglePair> intersectSelf(const Bvh<BV>& tree, BvhQueryStats* stat
     if (nodes.empty()) return pairs;
     // Same frame on both sides: the identity transform, and the corners as stored (the brute
     // force tests the same coordinates).
-    const BvhTransform x = makeBvhTransform(Mat3::Identity(), Vec3::Zero(), tree.scale(),
-                                            tree.scale());
+    const BvhTransform x =
+        makeBvhTransform(Mat3::Identity(), Vec3::Zero(), tree.scale(), tree.scale());
     std::int64_t bv_tests = 0;
     std::int64_t tri_tests = 0;
     auto testLeafTriangles = [&](std::int32_t i, std::int32_t j) {
@@ -899,7 +919,8 @@ std::vector<TrianglePair> intersectSelfBruteForce(const TriangleMesh& mesh, BvhQ
     std::int64_t tests = 0;
     const std::size_t n = mesh.triangles.size();
     auto corner = [&](std::size_t t, int k) -> const Vec3& {
-        return mesh.vertices[static_cast<std::size_t>(mesh.triangles[t][static_cast<std::size_t>(k)])];
+        return mesh
+            .vertices[static_cast<std::size_t>(mesh.triangles[t][static_cast<std::size_t>(k)])];
     };
     std::vector<Vec3> lo(n);
     std::vector<Vec3> hi(n);
@@ -978,7 +999,11 @@ std::vector<TrianglePair> intersectMeshMeshSweep(const TriangleMesh& a, const Tr
         std::int32_t id;
     };
     auto make = [](const Vec3& p, const Vec3& q, const Vec3& r, std::size_t id) {
-        return Tri{p, q, r, p.cwiseMin(q).cwiseMin(r), p.cwiseMax(q).cwiseMax(r),
+        return Tri{p,
+                   q,
+                   r,
+                   p.cwiseMin(q).cwiseMin(r),
+                   p.cwiseMax(q).cwiseMax(r),
                    static_cast<std::int32_t>(id)};
     };
     std::vector<Tri> ta;
@@ -1007,8 +1032,7 @@ std::vector<TrianglePair> intersectMeshMeshSweep(const TriangleMesh& a, const Tr
     for (const Tri& ti : ta) {
         // Every box with lo.x >= ti.lo.x - widest, moved down by a rounding margin (only widens
         // the scan: the exact box test below decides).
-        const Real from =
-            ti.lo.x() - widest - Real(4) * kEpsilon * (std::abs(ti.lo.x()) + widest);
+        const Real from = ti.lo.x() - widest - Real(4) * kEpsilon * (std::abs(ti.lo.x()) + widest);
         auto it = std::lower_bound(tb.begin(), tb.end(), from,
                                    [](const Tri& u, Real v) { return u.lo.x() < v; });
         for (; it != tb.end() && it->lo.x() <= ti.hi.x(); ++it) {

@@ -108,9 +108,9 @@ TriangleMoments triangleMoments(const Vec3& p0, const Vec3& q0, const Vec3& r0,
     t.area = Real(0.5) * (q - p).cross(r - p).norm();
     const Vec3 m = (p + q + r) / Real(3);
     t.first = t.area * m;
-    t.second = t.area / Real(12) *
-               (Real(9) * m * m.transpose() + p * p.transpose() + q * q.transpose() +
-                r * r.transpose());
+    t.second =
+        t.area / Real(12) *
+        (Real(9) * m * m.transpose() + p * p.transpose() + q * q.transpose() + r * r.transpose());
     return t;
 }
 

@@ -221,8 +221,8 @@ public:
     bool visit(std::int32_t, const std::array<Vec3, 3>& t) override {
         if (!triangleBox(t[0], t[1], t[2]).overlaps(box_b_)) return false;
         ++tests_;
-        const CollideOutput res = collideConvexCores(ConvexCore::triangle(t[0], t[1], t[2]), core_b_,
-                                                     b_in_a_, ctx_.tolerance, ctx_.scale);
+        const CollideOutput res = collideConvexCores(ConvexCore::triangle(t[0], t[1], t[2]),
+                                                     core_b_, b_in_a_, ctx_.tolerance, ctx_.scale);
         iterations_ += res.iterations;
         penetrating_ = res.state == ContactState::Penetrating;
         touching_ = touching_ || res.state == ContactState::Touching;

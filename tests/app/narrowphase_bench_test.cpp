@@ -32,8 +32,8 @@ std::string slurp(const fs::path& p) {
 }
 
 fs::path tempDir(const std::string& name) {
-    const fs::path d = fs::temp_directory_path() /
-                       ("cdlab_np_bench_" + name + "_" + std::to_string(::getpid()));
+    const fs::path d =
+        fs::temp_directory_path() / ("cdlab_np_bench_" + name + "_" + std::to_string(::getpid()));
     fs::remove_all(d);
     fs::create_directories(d);
     return d;
@@ -65,8 +65,8 @@ TEST(NarrowphaseBench, SmallToriTableAndJsonAgreeWithBruteForce) {
     EXPECT_GE(j["triangles"].get<int>(), 500);
     int cdlab_rows = 0;
     for (const auto& row : j["rows"]) {
-        for (const char* key : {"method", "build_ms", "first_us", "all_us", "bool_mismatches",
-                                "pair_mismatches"}) {
+        for (const char* key :
+             {"method", "build_ms", "first_us", "all_us", "bool_mismatches", "pair_mismatches"}) {
             EXPECT_TRUE(row.contains(key)) << key;
         }
         if (row["library"] == "cdlab") {
@@ -78,6 +78,24 @@ TEST(NarrowphaseBench, SmallToriTableAndJsonAgreeWithBruteForce) {
         }
     }
     EXPECT_EQ(cdlab_rows, static_cast<int>(collision::bvhVolumeNames().size()));
+}
+
+TEST(NarrowphaseBench, BottomUpBuildsAreCheckedToo) {
+    const fs::path work = tempDir("bu");
+    const fs::path json = work / "np.json";
+    const Result r = runCdlab(
+        "bench narrowphase --triangles 600 --poses 4 --reps 1 --methods "
+        "obb-bu,aabb-bu,obb --json " +
+            json.string(),
+        work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(slurp(json));
+    ASSERT_EQ(j["rows"].size(), 3u);
+    EXPECT_EQ(j["rows"][0]["method"], "obb-bu");
+    for (const auto& row : j["rows"]) {
+        EXPECT_EQ(row["library"], "cdlab");
+        EXPECT_EQ(row["pair_mismatches"], 0) << row["method"];
+    }
 }
 
 TEST(NarrowphaseBench, BadOptionsExitTwo) {

@@ -251,8 +251,7 @@ const std::vector<TrianglePair>& bruteSelfAnswer(std::size_t k) {
     static std::map<std::size_t, std::vector<TrianglePair>> cache;
     auto it = cache.find(k);
     if (it == cache.end()) {
-        it = cache
-                 .emplace(k, collision::intersectSelfBruteForce(unionMesh(differentialPoses()[k])))
+        it = cache.emplace(k, collision::intersectSelfBruteForce(unionMesh(differentialPoses()[k])))
                  .first;
     }
     return it->second;
@@ -344,14 +343,14 @@ TYPED_TEST(BvhTyped, DistanceMatchesBruteForceWithWitnesses) {
             const auto& tb = mb.triangles[static_cast<std::size_t>(fast.b)];
             std::array<Vec3, 3> corners_b;
             for (std::size_t k = 0; k < 3; ++k) {
-                corners_b[k] = pose.orientation * mb.vertices[static_cast<std::size_t>(tb[k])] +
-                               pose.position;
+                corners_b[k] =
+                    pose.orientation * mb.vertices[static_cast<std::size_t>(tb[k])] + pose.position;
             }
             const Vec3 na = (ma.vertices[ta[1]] - ma.vertices[ta[0]])
                                 .cross(ma.vertices[ta[2]] - ma.vertices[ta[0]])
                                 .normalized();
-            const Vec3 nb = (corners_b[1] - corners_b[0]).cross(corners_b[2] - corners_b[0])
-                                .normalized();
+            const Vec3 nb =
+                (corners_b[1] - corners_b[0]).cross(corners_b[2] - corners_b[0]).normalized();
             EXPECT_NEAR(na.dot(fast.point_on_a - ma.vertices[ta[0]]), 0, tol);
             EXPECT_NEAR(nb.dot(fast.point_on_b - corners_b[0]), 0, tol);
             if (brute.distance > 0) {
@@ -375,8 +374,8 @@ TYPED_TEST(BvhTyped, DistanceMatchesBruteForceWithWitnesses) {
         EXPECT_NEAR(d.point_on_b.x(), 1 + g, 1e-12);
     }
     auto runtime = collision::buildMeshBvh(BvName<TypeParam>::value, cube);
-    EXPECT_NEAR(runtime->distance(*runtime, Pose{Vec3(0, 2.5, 0), Quat::Identity()}).distance,
-                0.5, 1e-12);
+    EXPECT_NEAR(runtime->distance(*runtime, Pose{Vec3(0, 2.5, 0), Quat::Identity()}).distance, 0.5,
+                1e-12);
 }
 
 TYPED_TEST(BvhTyped, BottomUpBuildGivesTheBruteForceAnswers) {
@@ -394,9 +393,10 @@ TYPED_TEST(BvhTyped, BottomUpBuildGivesTheBruteForceAnswers) {
         const Bvh<TypeParam> top(torusA(), BvhBuildOptions{BvhSplit::Median, leaf});
         bool differs = top.nodes().size() != a.nodes().size();
         for (std::size_t i = 0; !differs && i < a.nodes().size(); ++i) {
-            differs = top.nodes()[i].right != a.nodes()[i].right ||
-                      top.leafTriangleId(static_cast<std::int32_t>(i % torusA().triangles.size())) !=
-                          a.leafTriangleId(static_cast<std::int32_t>(i % torusA().triangles.size()));
+            differs =
+                top.nodes()[i].right != a.nodes()[i].right ||
+                top.leafTriangleId(static_cast<std::int32_t>(i % torusA().triangles.size())) !=
+                    a.leafTriangleId(static_cast<std::int32_t>(i % torusA().triangles.size()));
         }
         EXPECT_TRUE(differs);
         for (std::size_t k = 0; k < differentialPoses().size(); ++k) {
@@ -534,7 +534,8 @@ TEST(Bvh, SweepReferenceEqualsBruteForce) {
         BvhQueryStats brute_stats;
         BvhQueryStats sweep_stats;
         const Pose& p = differentialPoses()[i];
-        const auto brute = collision::intersectMeshMeshBruteForce(torusA(), torusB(), p, &brute_stats);
+        const auto brute =
+            collision::intersectMeshMeshBruteForce(torusA(), torusB(), p, &brute_stats);
         EXPECT_EQ(collision::intersectMeshMeshSweep(torusA(), torusB(), p, &sweep_stats), brute);
         EXPECT_EQ(sweep_stats.triangle_tests, brute_stats.triangle_tests);
         non_empty += !brute.empty();

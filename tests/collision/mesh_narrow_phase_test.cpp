@@ -125,10 +125,11 @@ TEST_P(MeshNarrowPhase, MeshMeshTouchingPosesMatchBruteForce) {
                 const Pose pb = at(Vec3::Constant(offset * k) + c.offset * k);
                 const CollideOutput fast = collide(a, pa, a, pb);
                 const CollideOutput brute = collide(a_brute, pa, a_brute, pb);
-                EXPECT_EQ(fast.state, brute.state) << bv << " k=" << k << " " << c.offset.transpose();
+                EXPECT_EQ(fast.state, brute.state)
+                    << bv << " k=" << k << " " << c.offset.transpose();
                 if (offset == 0) {
-                    EXPECT_EQ(fast.state, c.expected) << bv << " k=" << k << " "
-                                                      << c.offset.transpose();
+                    EXPECT_EQ(fast.state, c.expected)
+                        << bv << " k=" << k << " " << c.offset.transpose();
                 }
             }
         }
@@ -194,13 +195,11 @@ TEST_P(MeshNarrowPhase, MeshConvexMatchesBruteForce) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(EveryVolume, MeshNarrowPhase,
-                         ::testing::ValuesIn(std::vector<std::string>(
-                             collision::bvhVolumeNames().begin(),
-                             collision::bvhVolumeNames().end())),
-                         [](const ::testing::TestParamInfo<std::string>& param) {
-                             return param.param;
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    EveryVolume, MeshNarrowPhase,
+    ::testing::ValuesIn(std::vector<std::string>(collision::bvhVolumeNames().begin(),
+                                                 collision::bvhVolumeNames().end())),
+    [](const ::testing::TestParamInfo<std::string>& param) { return param.param; });
 
 TEST(MeshShape, CarriesTheDefaultHierarchy) {
     const Shape s = meshShape(gridCube(), 1, collision::kDefaultMeshBvh);
@@ -214,6 +213,30 @@ TEST(MeshShape, CarriesTheDefaultHierarchy) {
     EXPECT_EQ(by_factory.bvh->volumeName(), collision::kDefaultMeshBvh);
     EXPECT_EQ(by_factory.bvh->triangleCount(), static_cast<std::int32_t>(mesh->triangles.size()));
     EXPECT_TRUE(by_factory.bvh->validate());
+}
+
+// Shapes whose hierarchies cannot run one tandem traversal (different volume types, or one
+// without a hierarchy) fall back to the brute-force loop: same states, no BV tests.
+TEST(MeshShape, MixedOrMissingHierarchiesFallBackToBruteForce) {
+    const Shape obb = meshShape(torusA(), 1, "obb");
+    const Shape aabb = meshShape(torusB(), 1, "aabb");
+    const Shape none = meshShape(torusB(), 1, "");
+    const Shape brute_a = meshShape(torusA(), 1, "");
+    cdlab_test::Rng rng(5);
+    int colliding = 0;
+    for (int n = 0; n < 30; ++n) {
+        const Pose pa = at(rng.vec(-0.2, 0.2), rng.rotation());
+        const Pose pb = at(rng.vec(-1.6, 1.6), rng.rotation());
+        const CollideOutput expected = collide(brute_a, pa, none, pb);
+        for (const Shape* b : {&aabb, &none}) {
+            const CollideOutput out = collide(obb, pa, *b, pb);
+            EXPECT_EQ(out.state, expected.state) << n;
+            EXPECT_EQ(out.bv_tests, 0) << n;
+        }
+        colliding += collision::isColliding(expected.state);
+    }
+    EXPECT_GT(colliding, 5);
+    EXPECT_LT(colliding, 25);
 }
 
 }  // namespace

@@ -6,8 +6,8 @@
 
 #include <array>
 #include <compare>
-#include <limits>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -166,8 +166,8 @@ public:
 
 private:
     std::vector<Node> nodes_;
-    std::vector<std::array<Vec3, 3>> corners_;  // leaf order
-    std::vector<std::int32_t> ids_;             // leaf order -> mesh triangle index
+    std::vector<std::array<Vec3, 3>> corners_;             // leaf order
+    std::vector<std::int32_t> ids_;                        // leaf order -> mesh triangle index
     std::vector<std::array<std::int32_t, 3>> vertex_ids_;  // leaf order: the mesh's indices
     Real scale_ = 0;
     int depth_ = 0;
@@ -188,9 +188,9 @@ std::vector<TrianglePair> intersectBvhBvh(const Bvh<BV>& a, const Bvh<BV>& b, co
 
 /// Distance between two meshes with witnesses: the closest triangle pair and its closest points.
 struct MeshDistance {
-    Real distance = 0;         ///< >= 0; 0 when the meshes touch or cross; +inf for an empty mesh
-    std::int32_t a = -1;       ///< witness triangle of A (mesh index), -1 for an empty mesh
-    std::int32_t b = -1;       ///< witness triangle of B
+    Real distance = 0;    ///< >= 0; 0 when the meshes touch or cross; +inf for an empty mesh
+    std::int32_t a = -1;  ///< witness triangle of A (mesh index), -1 for an empty mesh
+    std::int32_t b = -1;  ///< witness triangle of B
     Vec3 point_on_a = Vec3::Zero();  ///< closest point on triangle a, in A's frame
     Vec3 point_on_b = Vec3::Zero();  ///< closest point on triangle b, in A's frame
 };
