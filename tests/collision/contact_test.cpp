@@ -654,4 +654,100 @@ TEST(Contact, TranslationAndScaleInvariance) {
     }
 }
 
+// Regression (sliver simplex): a 3.4e-5-thin box B whose corner touches a 4.6 x 0.017 x 2.8 box A.
+// GJK's final triangle spanned ~5.6 units but was ~1e-5 wide; its closest point, computed as
+// a + v ab + t ac, was off by ~1e-11, enough for support(-v) to return an old vertex, and GJK
+// stopped at 6.1e-6 (both contact() and collide() said Separated). The face-region point is now
+// the plane projection n (n.a) / |n|^2.
+//
+//        A (big, flat)          B (thin) touches A with one corner
+//   +-----------------+ <.>
+TEST(Contact, RegressionSliverSimplexStalledGjkAboveTouching) {
+    const Shape a = Shape::box(Vec3(0x1.289888f81391dp+2, 0x1.1a613d22f861bp-6, 0x1.684d03ee81fb4p+1));
+    const Shape b = Shape::box(Vec3(0x1.d83caccb95578p-7, 0x1.1ca5cd56bafcfp-15, 0x1.0e5426ff667f8p-8));
+    const Pose pa{Vec3(-0x1.21625414a1bfap+2, 0x1.3eef5f2c539b8p+0, -0x1.32e6fa2d341b6p+2),
+                  Quat(-0x1.fbdb13cfccedp-8, -0x1.161b9ab1491e3p-2, -0x1.93ee65958ce87p-2,
+                       0x1.c1724dc568b71p-1)};
+    const Pose pb{Vec3(-0x1.87e39e9a50fdep-1, 0x1.aa4aaab88fd2p-5, -0x1.27fe0f2f4b715p+1),
+                  Quat(0x1.be8b2bd3a1725p-2, -0x1.18190cc6f507bp-1, -0x1.6d12b60b688c9p-1,
+                       -0x1.7aceb02ca555ep-5)};
+    // Brute force: the deepest corner of B lies on A's surface (|sdf| ~ 1e-15).
+    Real deepest = std::numeric_limits<Real>::infinity();
+    for (int i = 0; i < 8; ++i) {
+        const Vec3& h = b.half_extents;
+        const Vec3 corner((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(),
+                          (i & 4) ? h.z() : -h.z());
+        deepest = std::min(deepest, surfaceDistance(a, pa, pb.apply(corner)));
+    }
+    ASSERT_NEAR(deepest, 0, 1e-14);
+    const ContactOutput out = contact(a, pa, b, pb);
+    EXPECT_EQ(out.state, ContactState::Touching);
+    EXPECT_NEAR(out.signed_distance, 0, 1e-12);
+    EXPECT_EQ(collide(a, pa, b, pb).state, ContactState::Touching);
+    expectMirror(out, contact(b, pb, a, pa), 0);
+}
+
+// Regression (EPA decision cap): two boxes placed exactly touching (B moved by -distance * normal)
+// made collide()'s bounded EPA re-add the same support point until its cap: Failed, and contact()
+// inherited it. A repeated support point now ends the decision as Touching.
+TEST(Contact, RegressionExactlyTouchingBoxesFailedInEpaDecision) {
+    const Shape a = Shape::box(Vec3(0x1.31177fc5952e4p-2, 0x1.c2db8553c31c9p-12, 0x1.2d2e1d7452189p-4));
+    const Shape b = Shape::box(Vec3(0x1.1028f80d6941bp+0, 0x1.29c227091cd84p-6, 0x1.4a23ab3e9f12ep-2));
+    const Pose pa{Vec3(-0x1.7fa74c2381be7p-2, 0x1.04ea69cdad63fp-3, -0x1.3a7ade3cbb3cap-1),
+                  Quat(-0x1.96d22e3cb2d5ap-1, 0x1.f6b71dc6ce5d9p-5, 0x1.3170643e007cep-1,
+                       -0x1.84ad33c03e13bp-4)};
+    const Pose pb{Vec3(0x1.91dadb5d2b3d4p-4, 0x1.cb122fb293672p-2, -0x1.c1043e19818e3p-1),
+                  Quat(-0x1.c579e67719f9ep-1, -0x1.7447530c6c849p-6, 0x1.398720a3a1339p-2,
+                       -0x1.649cc271f3809p-2)};
+    EXPECT_EQ(collide(a, pa, b, pb).state, ContactState::Touching);
+    EXPECT_EQ(collide(b, pb, a, pa).state, ContactState::Touching);
+    const ContactOutput out = contact(a, pa, b, pb);
+    EXPECT_EQ(out.state, ContactState::Touching);
+    EXPECT_GE(out.manifold_size, 1);
+    expectMirror(out, contact(b, pb, a, pa), 0);
+}
+
+// Thin and lopsided shapes placed exactly touching (moved by -distance * normal from a random
+// pose) or with coincident origins: contact() never fails, agrees with collide() and mirrors.
+TEST(Contact, ExtremeAspectRatiosTouchingAndCoincident) {
+    cdlab_test::Rng rng(12);
+    int touching = 0;
+    for (int n = 0; n < 20000; ++n) {
+        auto make = [&](int kind) {
+            const Real size = std::pow(Real(10), rng.uniform(-2, 1));
+            const Real thin = std::pow(Real(10), rng.uniform(-3, 0));
+            if (kind == 0) return Shape::sphere(size);
+            if (kind == 1) return Shape::box(Vec3(size, size * thin, size * rng.uniform(0.01, 1)));
+            if (kind == 2) return Shape::capsule(size * thin, size * rng.uniform(0, 2));
+            std::vector<Vec3> points;
+            for (int i = 0; i < 12; ++i) points.push_back(size * rng.vec(-1, 1).cwiseProduct(Vec3(1, thin, 1)));
+            return Shape::convexHull(hullOf(points));
+        };
+        const Shape a = make(rng.integer(0, 3));
+        const Shape b = make(rng.integer(0, 3));
+        const Real reach = boundingRadius(a) + boundingRadius(b);
+        const Pose pa = at(rng.vec(-1, 1) * reach, rng.rotation());
+        Pose pb = at(pa.position + rng.uniform(0, 1.1) * reach * (rng.rotation() * Vec3::UnitX()),
+                     rng.rotation());
+        if (n % 2 == 0) {
+            const ContactOutput first = contact(a, pa, b, pb);
+            ASSERT_NE(first.state, ContactState::Failed) << n;
+            pb.position -= first.signed_distance * first.normal;
+        } else if (n % 5 == 1) {
+            pb.position = pa.position;
+        }
+        const ContactOutput out = contact(a, pa, b, pb);
+        ASSERT_NE(out.state, ContactState::Failed) << n;
+        ASSERT_EQ(out.state, collide(a, pa, b, pb).state) << n;
+        const Real scale = std::max(boundingRadius(a), boundingRadius(b));
+        ASSERT_LE((out.point_b - out.point_a - out.signed_distance * out.normal).norm(), 1e-8 * scale)
+            << n;
+        if (pb.position != pa.position || a.type != b.type) {
+            expectMirror(out, contact(b, pb, a, pa), n);
+        }
+        if (out.state == ContactState::Touching) ++touching;
+    }
+    EXPECT_GT(touching, 5000);
+}
+
 }  // namespace
