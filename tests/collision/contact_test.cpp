@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <iomanip>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -742,12 +744,79 @@ TEST(Contact, ExtremeAspectRatiosTouchingAndCoincident) {
         const Real scale = std::max(boundingRadius(a), boundingRadius(b));
         ASSERT_LE((out.point_b - out.point_a - out.signed_distance * out.normal).norm(), 1e-8 * scale)
             << n;
+        // Manifold points: the witness identity with their own depth, never deeper than the
+        // contact (thin reference shapes once gave points beyond their far side).
+        for (int i = 0; i < out.manifold_size; ++i) {
+            const auto& m = out.manifold[static_cast<std::size_t>(i)];
+            ASSERT_LE((m.point_b - m.point_a + m.depth * out.normal).norm(), 1e-8 * scale) << n;
+            ASSERT_LE(m.depth, -out.signed_distance + 1e-8 * scale) << n;
+        }
         if (pb.position != pa.position || a.type != b.type) {
             expectMirror(out, contact(b, pb, a, pa), n);
         }
         if (out.state == ContactState::Touching) ++touching;
     }
     EXPECT_GT(touching, 5000);
+}
+
+// Hull face contacts get a clipped manifold like boxes: a box-shaped hull resting on a slab hull,
+// and a hexagonal prism (6-vertex face) resting on it, reduced to 4 points at the right depth.
+TEST(Contact, HullRestingOnHullGivesClippedManifold) {
+    const Shape ground = boxHull(Vec3(4, 4, 0.5));
+    const Shape crate = boxHull(Vec3(0.5, 0.7, 0.4));
+    std::vector<Vec3> prism_points;
+    for (int i = 0; i < 6; ++i) {
+        const Real t = Real(i) * Real(M_PI) / 3;
+        prism_points.emplace_back(0.6 * std::cos(t), 0.6 * std::sin(t), -0.3);
+        prism_points.emplace_back(0.6 * std::cos(t), 0.6 * std::sin(t), 0.3);
+    }
+    const Shape prism = Shape::convexHull(hullOf(prism_points));
+    const Pose pg = at(Vec3(1, 2, -3));
+    const Real depth = 0.02;
+    struct Case {
+        const Shape* shape;
+        Real half_height;
+        int expected_points;
+    };
+    for (const Case& c : {Case{&crate, 0.4, 4}, Case{&prism, 0.3, 4}}) {
+        const Pose pc = at(Vec3(1.3, 1.8, -3 + 0.5 + c.half_height - depth),
+                           axisAngle(0.4, Vec3::UnitZ()));
+        for (const bool swapped : {false, true}) {
+            const ContactOutput out =
+                swapped ? contact(*c.shape, pc, ground, pg) : contact(ground, pg, *c.shape, pc);
+            ASSERT_EQ(out.state, ContactState::Penetrating);
+            EXPECT_NEAR(out.signed_distance, -depth, 1e-9);
+            EXPECT_NEAR(std::abs(out.normal.z()), 1, 1e-12);
+            ASSERT_EQ(out.manifold_size, c.expected_points) << swapped;
+            for (int i = 0; i < out.manifold_size; ++i) {
+                const auto& m = out.manifold[static_cast<std::size_t>(i)];
+                EXPECT_NEAR(m.depth, depth, 1e-9);
+                const Vec3& on_ground = swapped ? m.point_b : m.point_a;
+                EXPECT_NEAR(on_ground.z(), -2.5, 1e-9);
+            }
+            if (swapped) {
+                expectConsistent(*c.shape, pc, ground, pg, out, 1e-9, "hull-rest", 0);
+            } else {
+                expectConsistent(ground, pg, *c.shape, pc, out, 1e-9, "hull-rest", 0);
+            }
+        }
+        // The manifold spans the face: the chosen points are far apart (not 4 near one corner).
+        const ContactOutput out = contact(ground, pg, *c.shape, pc);
+        Real spread = 0;
+        for (int i = 0; i < out.manifold_size; ++i) {
+            for (int j = 0; j < out.manifold_size; ++j) {
+                spread = std::max(spread, (out.manifold[static_cast<std::size_t>(i)].point_b -
+                                           out.manifold[static_cast<std::size_t>(j)].point_b)
+                                              .norm());
+            }
+        }
+        EXPECT_GT(spread, 1.0);
+    }
+    // Box (SAT path) on a hull ground: GJK/EPA normal, clipped manifold of 4.
+    const Pose pc = at(Vec3(0.5, 2, -3 + 0.5 + 0.4 - depth), axisAngle(0.2, Vec3::UnitZ()));
+    const ContactOutput mixed = contact(ground, pg, Shape::box(Vec3(0.5, 0.7, 0.4)), pc);
+    EXPECT_EQ(mixed.manifold_size, 4) << std::setprecision(17) << mixed.normal.transpose() << " sd " << mixed.signed_distance;
+    EXPECT_NEAR(mixed.signed_distance, -depth, 1e-9);
 }
 
 }  // namespace
