@@ -4,7 +4,8 @@
 // whole list divided by the pair count (no per-call clock overhead). Answers are compared as
 // signed distances (negative = penetration depth) relative to the pair's size; the "ext" columns
 // repeat every pair translated by 1e6 and scaled by 1e-4 and 1e4 and report the largest change
-// of the (rescaled) answer, the accuracy at the extremes. Bullet's headers and libraries stay in this file (CDLAB_HAVE_BULLET).
+// of the (rescaled) answer, the accuracy at the extremes. Bullet's headers and libraries stay in
+// this file (CDLAB_HAVE_BULLET).
 #include "bench_convex.h"
 
 #include <algorithm>
@@ -178,8 +179,8 @@ struct Variant {
     Real factor;
     Real offset;
 };
-constexpr std::array<Variant, 3> kVariants{{{"far", 1, kFarOffset}, {"small", 1e-4, 0},
-                                             {"large", 1e4, 0}}};
+constexpr std::array<Variant, 3> kVariants{
+    {{"far", 1, kFarOffset}, {"small", 1e-4, 0}, {"large", 1e4, 0}}};
 
 Shape scaledShape(const Shape& s, Real f) {
     Shape out = s;
@@ -201,8 +202,10 @@ std::vector<Pair> transformed(const std::vector<Pair>& pairs, const Variant& v) 
         Pair q;
         q.a = scaledShape(p.a, v.factor);
         q.b = scaledShape(p.b, v.factor);
-        q.pose_a = Pose{v.factor * p.pose_a.position + Vec3::Constant(v.offset), p.pose_a.orientation};
-        q.pose_b = Pose{v.factor * p.pose_b.position + Vec3::Constant(v.offset), p.pose_b.orientation};
+        q.pose_a =
+            Pose{v.factor * p.pose_a.position + Vec3::Constant(v.offset), p.pose_a.orientation};
+        q.pose_b =
+            Pose{v.factor * p.pose_b.position + Vec3::Constant(v.offset), p.pose_b.orientation};
         q.scale = p.scale * v.factor;
         out.push_back(std::move(q));
     }
@@ -341,8 +344,8 @@ Row runWorkload(const Workload& w, int index, const BenchConvexOptions& options)
     row.workload = w.name;
     row.method = w.method;
     row.queries = static_cast<int>(pairs.size());
-    const Answers ours =
-        timeQueries(pairs.size(), options.passes, [&](std::size_t i) { return cdlabQuery(pairs[i]); });
+    const Answers ours = timeQueries(pairs.size(), options.passes,
+                                     [&](std::size_t i) { return cdlabQuery(pairs[i]); });
     row.cdlab_us = ours.us;
     row.cdlab_failed = ours.failed;
     for (std::size_t i = 0; i < pairs.size(); ++i) {
@@ -413,24 +416,23 @@ void printTable(const std::vector<Row>& rows, double tolerance, std::ostream& ou
         << std::setw(8) << "queries" << std::setw(7) << "hits" << std::setw(10) << "cdlab_us"
         << std::setw(10) << "bullet_us" << std::setw(7) << "ratio" << std::setw(9) << "disagree"
         << std::setw(10) << "max_diff" << std::setw(11) << "cdlab_ext" << std::setw(11)
-        << "bullet_ext" << std::setw(8) << "failed" << "\n";
+        << "bullet_ext" << std::setw(8) << "failed"
+        << "\n";
     for (const Row& r : rows) {
         out << std::left << std::setw(29) << r.workload << std::setw(12) << r.method << std::right
             << std::setw(8) << r.queries << std::setw(7) << r.colliding << std::fixed
             << std::setprecision(3) << std::setw(10) << r.cdlab_us;
         if (r.bullet_us >= 0) {
             out << std::setw(10) << r.bullet_us << std::setw(7) << std::setprecision(2)
-                << r.cdlab_us / r.bullet_us << std::setw(9) << r.disagreements
-                << std::scientific << std::setprecision(1) << std::setw(10) << r.max_difference
-                << std::setw(11) << maxOf(r.cdlab_variant_error) << std::setw(11)
-                << maxOf(r.bullet_variant_error);
+                << r.cdlab_us / r.bullet_us << std::setw(9) << r.disagreements << std::scientific
+                << std::setprecision(1) << std::setw(10) << r.max_difference << std::setw(11)
+                << maxOf(r.cdlab_variant_error) << std::setw(11) << maxOf(r.bullet_variant_error);
         } else {
             out << std::setw(10) << "n/a" << std::setw(7) << "n/a" << std::setw(9) << "n/a"
                 << std::setw(10) << "n/a" << std::scientific << std::setprecision(1)
                 << std::setw(11) << maxOf(r.cdlab_variant_error) << std::setw(11) << "n/a";
         }
-        out << std::defaultfloat << std::setw(8)
-            << r.cdlab_failed + r.cdlab_variant_failed << "\n";
+        out << std::defaultfloat << std::setw(8) << r.cdlab_failed + r.cdlab_variant_failed << "\n";
     }
     out << "ratio = cdlab_us / bullet_us; disagree: |signed distance difference| > " << tolerance
         << " * size; ext: largest change of answer / factor after translating by 1e6 or scaling"
@@ -446,8 +448,7 @@ int runBenchConvex(const BenchConvexOptions& options, std::ostream& out, std::os
     }
     const std::vector<Workload> workloads{
         {"box-box separated", "SAT+GJK", ShapeType::Box, ShapeType::Box, false, Want::Separated},
-        {"hullbox-hullbox separated", "GJK", ShapeType::Box, ShapeType::Box, true,
-         Want::Separated},
+        {"hullbox-hullbox separated", "GJK", ShapeType::Box, ShapeType::Box, true, Want::Separated},
         {"box-box penetrating", "SAT+clip", ShapeType::Box, ShapeType::Box, false,
          Want::Penetrating},
         {"hullbox-hullbox penetrating", "GJK+EPA", ShapeType::Box, ShapeType::Box, true,

@@ -210,7 +210,8 @@ Vec3 toB(const RelativePose& b_in_a, const Vec3& p_in_a) {
 
 void setSingleManifold(Local& out) {
     out.manifold_size = 1;
-    out.manifold[0] = ManifoldPoint{out.point_a, out.point_b, std::max(Real(0), -out.signed_distance)};
+    out.manifold[0] =
+        ManifoldPoint{out.point_a, out.point_b, std::max(Real(0), -out.signed_distance)};
 }
 
 // ---- Closed forms (A's frame). ----
@@ -278,7 +279,8 @@ void closestSegmentSegment(const Vec3& p1, const Vec3& q1, const Vec3& p2, const
     }
     const Real b = d1.dot(d2);
     const Real denom = a * e - b * b;
-    if (denom > Real(16) * kEpsilon * a * e) s = std::clamp((b * f - c * e) / denom, Real(0), Real(1));
+    if (denom > Real(16) * kEpsilon * a * e)
+        s = std::clamp((b * f - c * e) / denom, Real(0), Real(1));
     t = (b * s + f) / e;
     if (t < 0) {
         t = 0;
@@ -358,8 +360,7 @@ void sphereBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ct
 
 // ---- GJK + EPA for any convex pair (A's frame). ----
 
-void generic(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
-             Local& out) {
+void generic(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx, Local& out) {
     const ConvexCore ca = ConvexCore::fromShape(a);
     const ConvexCore cb = ConvexCore::fromShape(b);
     const Real radii = ca.radius + cb.radius;
@@ -585,7 +586,8 @@ bool boxBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& 
         // A's edge along axis i at the support signs of n; B's along its axis j at -n.
         Vec3 ca = ea.cwiseProduct(Vec3(signOrPlus(n.x()), signOrPlus(n.y()), signOrPlus(n.z())));
         const Vec3 n_b = rot.transpose() * (-n);
-        Vec3 cb = eb.cwiseProduct(Vec3(signOrPlus(n_b.x()), signOrPlus(n_b.y()), signOrPlus(n_b.z())));
+        Vec3 cb =
+            eb.cwiseProduct(Vec3(signOrPlus(n_b.x()), signOrPlus(n_b.y()), signOrPlus(n_b.z())));
         Vec3 pa0 = ca;
         Vec3 pa1 = ca;
         pa0[edge_i] = -ea[edge_i];
@@ -759,7 +761,8 @@ bool facePolygon(const Shape& shape, const Vec3& dir, Real tol, Polygon& out) {
     });
     std::array<Vec3, kMaxPolygon> sorted{};
     for (int i = 0; i < out.n; ++i) {
-        sorted[static_cast<std::size_t>(i)] = out.v[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
+        sorted[static_cast<std::size_t>(i)] =
+            out.v[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
     }
     out.v = sorted;
     return true;
@@ -800,7 +803,8 @@ bool polytopeManifold(const Shape& a, const Shape& b, const RelativePose& rel, c
     }
     // Put B's face in A's frame.
     for (int i = 0; i < face_b.n; ++i) {
-        face_b.v[static_cast<std::size_t>(i)] = rel.rotation * face_b.v[static_cast<std::size_t>(i)] + rel.position;
+        face_b.v[static_cast<std::size_t>(i)] =
+            rel.rotation * face_b.v[static_cast<std::size_t>(i)] + rel.position;
     }
     face_b.normal = rel.rotation * face_b.normal;
     face_b.offset = face_b.normal.dot(face_b.v[0]);
@@ -812,7 +816,8 @@ bool polytopeManifold(const Shape& a, const Shape& b, const RelativePose& rel, c
     std::array<Vec3, 2 * kMaxPolygon> poly{};
     std::array<Vec3, 2 * kMaxPolygon> tmp{};
     int count = inc.n;
-    for (int i = 0; i < inc.n; ++i) poly[static_cast<std::size_t>(i)] = inc.v[static_cast<std::size_t>(i)];
+    for (int i = 0; i < inc.n; ++i)
+        poly[static_cast<std::size_t>(i)] = inc.v[static_cast<std::size_t>(i)];
     for (int e = 0; e < ref.n && count > 0; ++e) {
         const Vec3& p = ref.v[static_cast<std::size_t>(e)];
         const Vec3& q = ref.v[static_cast<std::size_t>((e + 1) % ref.n)];

@@ -337,8 +337,9 @@ EpaOutput epaPenetration(const ConvexCore& a, const ConvexCore& b, const Relativ
     Polytope poly;
     poly.eps = std::max(Real(64) * kEpsilon * scale, std::numeric_limits<Real>::min());
     const Real tol = std::max(kEpaRelativeTolerance * scale, std::numeric_limits<Real>::min());
-    for (int i = 0; i < start.n; ++i) poly.vert[static_cast<std::size_t>(poly.vertex_count++)] =
-        start.v[static_cast<std::size_t>(i)];
+    for (int i = 0; i < start.n; ++i)
+        poly.vert[static_cast<std::size_t>(poly.vertex_count++)] =
+            start.v[static_cast<std::size_t>(i)];
 
     // Every probed direction n gives an upper bound h(n) on the depth; the best one answers when
     // the obstacle is flat (zero volume) and the polytope cannot grow to a tetrahedron.
@@ -444,8 +445,8 @@ EpaOutput epaPenetration(const ConvexCore& a, const ConvexCore& b, const Relativ
         if (!converged) {
             const Real dup = kDuplicateRelative * std::max(w.w.norm(), scale);
             for (int i = 0; i < poly.vertex_count && !converged; ++i) {
-                converged = (poly.vert[static_cast<std::size_t>(i)].w - w.w).squaredNorm() <=
-                            dup * dup;
+                converged =
+                    (poly.vert[static_cast<std::size_t>(i)].w - w.w).squaredNorm() <= dup * dup;
             }
         }
         if (converged) {
@@ -457,10 +458,11 @@ EpaOutput epaPenetration(const ConvexCore& a, const ConvexCore& b, const Relativ
                 const Face& face = poly.faces[static_cast<std::size_t>(f)];
                 if (!face.valid || face.normal.isZero() || face.dist > closest.dist + tol) continue;
                 std::array<Real, 3> wt{};
-                const Real d2 = triangleClosest(poly.vert[static_cast<std::size_t>(face.v[0])].w,
-                                                poly.vert[static_cast<std::size_t>(face.v[1])].w,
-                                                poly.vert[static_cast<std::size_t>(face.v[2])].w, wt)
-                                    .squaredNorm();
+                const Real d2 =
+                    triangleClosest(poly.vert[static_cast<std::size_t>(face.v[0])].w,
+                                    poly.vert[static_cast<std::size_t>(face.v[1])].w,
+                                    poly.vert[static_cast<std::size_t>(face.v[2])].w, wt)
+                        .squaredNorm();
                 if (d2 < chosen2) {
                     chosen2 = d2;
                     chosen = face;

@@ -52,9 +52,9 @@ struct EpaOutput {
     /// Penetration depth of the cores (radii ignored), >= 0 up to rounding: translating B by
     /// depth * normal makes the cores touch.
     Real depth = 0;
-    Vec3 normal = Vec3::UnitX();    ///< unit, A's frame, from A towards B
-    Vec3 point_a = Vec3::Zero();    ///< deepest point of core A along normal, A's frame
-    Vec3 point_b = Vec3::Zero();    ///< deepest point of core B along -normal, A's frame
+    Vec3 normal = Vec3::UnitX();  ///< unit, A's frame, from A towards B
+    Vec3 point_a = Vec3::Zero();  ///< deepest point of core A along normal, A's frame
+    Vec3 point_b = Vec3::Zero();  ///< deepest point of core B along -normal, A's frame
     std::int32_t iterations = 0;
 };
 

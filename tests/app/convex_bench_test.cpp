@@ -40,8 +40,8 @@ fs::path tempDir(const std::string& name) {
 Result runCdlab(const std::string& args, const fs::path& work) {
     const fs::path out = work / "stdout.txt";
     const fs::path err = work / "stderr.txt";
-    const std::string cmd = std::string(CDLAB_BINARY) + " " + args + " > " + out.string() +
-                            " 2> " + err.string() + " < /dev/null";
+    const std::string cmd = std::string(CDLAB_BINARY) + " " + args + " > " + out.string() + " 2> " +
+                            err.string() + " < /dev/null";
     const int status = std::system(cmd.c_str());
     Result r;
     r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -56,7 +56,8 @@ TEST(ConvexBench, FewQueriesNoMismatchAndCompleteJson) {
     const Result r =
         runCdlab("bench convex --queries 200 --passes 1 --json " + json.string(), work);
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    for (const char* column : {"workload", "cdlab_us", "bullet_us", "disagree", "max_diff", "cdlab_ext"}) {
+    for (const char* column :
+         {"workload", "cdlab_us", "bullet_us", "disagree", "max_diff", "cdlab_ext"}) {
         EXPECT_NE(r.out.find(column), std::string::npos) << column;
     }
     ASSERT_TRUE(fs::exists(json));

@@ -7,11 +7,10 @@
 
 #include <gtest/gtest.h>
 
-#include <iomanip>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <iomanip>
 #include <memory>
 #include <vector>
 
@@ -380,9 +379,11 @@ TEST(Contact, EveryConvexPairAgreesWithCollideAndMirrors) {
                 const Real reach = boundingRadius(zoo[i]) + boundingRadius(zoo[j]);
                 const Pose pa = at(rng.vec(-1, 1), rng.rotation());
                 const Vec3 dir = rng.rotation() * Vec3::UnitX();
-                const Pose pb = at(pa.position + rng.uniform(0.1, 1.2) * reach * dir, rng.rotation());
+                const Pose pb =
+                    at(pa.position + rng.uniform(0.1, 1.2) * reach * dir, rng.rotation());
                 const ContactOutput out = contact(zoo[i], pa, zoo[j], pb);
-                ASSERT_EQ(out.state, collide(zoo[i], pa, zoo[j], pb).state) << i << " " << j << " " << n;
+                ASSERT_EQ(out.state, collide(zoo[i], pa, zoo[j], pb).state)
+                    << i << " " << j << " " << n;
                 expectConsistent(zoo[i], pa, zoo[j], pb, out, 1e-9, "zoo", n);
                 expectMirror(out, contact(zoo[j], pb, zoo[i], pa), n);
                 mix.add(out);
@@ -411,7 +412,8 @@ TEST(Contact, NearTouchingStateAgreesWithCollide) {
                 const Real tol = collision::kTouchRelativeTolerance * scale;
                 pb.position -= (first.signed_distance - rng.uniform(-3, 3) * tol) * first.normal;
                 const ContactOutput out = contact(zoo[i], pa, zoo[j], pb);
-                ASSERT_EQ(out.state, collide(zoo[i], pa, zoo[j], pb).state) << i << " " << j << " " << n;
+                ASSERT_EQ(out.state, collide(zoo[i], pa, zoo[j], pb).state)
+                    << i << " " << j << " " << n;
                 ASSERT_TRUE(out.normal.allFinite());
                 expectMirror(out, contact(zoo[j], pb, zoo[i], pa), n);
                 if (out.state == ContactState::Touching) ++touching;
@@ -478,7 +480,8 @@ TEST(Contact, DegenerateConfigurationsGiveFiniteNormals) {
         // Identical inputs (same shape, same pose) make contact(a, b) and contact(b, a) the
         // same call: no mirror is possible there.
         const bool identical = c.a.type == c.b.type && c.a.hull == c.b.hull &&
-                               c.a.half_extents == c.b.half_extents && c.pa.position == c.pb.position;
+                               c.a.half_extents == c.b.half_extents &&
+                               c.pa.position == c.pb.position;
         if (!identical) expectMirror(out, contact(c.b, c.pb, c.a, c.pa), static_cast<int>(n));
     }
     // Crossing capsule axes: depth is the sum of the radii along the common perpendicular.
@@ -525,9 +528,8 @@ TEST(Contact, BoxFeaturesForVertexEdgeFace) {
     EXPECT_EQ(out.feature_a.index, 2);
     // Box-box: B's vertex pushed into A's +z face; crossed edges.
     const Shape cube = Shape::box(Vec3(1, 1, 1));
-    const Pose corner_down =
-        at(Vec3(0.1, -0.2, 1 + std::sqrt(Real(3)) - 0.05),
-           Quat::FromTwoVectors(Vec3(1, 1, 1).normalized(), Vec3(0, 0, 1)));
+    const Pose corner_down = at(Vec3(0.1, -0.2, 1 + std::sqrt(Real(3)) - 0.05),
+                                Quat::FromTwoVectors(Vec3(1, 1, 1).normalized(), Vec3(0, 0, 1)));
     out = contact(cube, at(Vec3::Zero()), cube, corner_down);
     EXPECT_EQ(out.state, ContactState::Penetrating);
     EXPECT_NEAR(out.signed_distance, -0.05, 1e-12);
@@ -541,7 +543,7 @@ TEST(Contact, BoxFeaturesForVertexEdgeFace) {
     const Real r2 = std::sqrt(Real(2));
     const Vec3 u_img = Vec3(0, -1, -1) / r2;  // image of local (-1, -1, 0) / sqrt 2
     const Vec3 z_img = Vec3(0, -1, 1) / r2;
-    const Vec3 v_img = z_img.cross(u_img);    // image of local (1, -1, 0) / sqrt 2
+    const Vec3 v_img = z_img.cross(u_img);  // image of local (1, -1, 0) / sqrt 2
     collision::Mat3 rot;
     rot.col(0) = (v_img - u_img) / r2;
     rot.col(1) = -(u_img + v_img) / r2;
@@ -549,7 +551,8 @@ TEST(Contact, BoxFeaturesForVertexEdgeFace) {
     const Real h = 0.5;
     const Real pen = 0.01;
     const Shape small = Shape::box(Vec3(h, h, h));
-    const Pose crossed = at(Vec3(0, 1, 1) + h * Vec3(0, 1, 1) - pen * Vec3(0, 1, 1) / r2, Quat(rot));
+    const Pose crossed =
+        at(Vec3(0, 1, 1) + h * Vec3(0, 1, 1) - pen * Vec3(0, 1, 1) / r2, Quat(rot));
     out = contact(cube, at(Vec3::Zero()), small, crossed);
     ASSERT_EQ(out.state, ContactState::Penetrating);
     EXPECT_NEAR(out.signed_distance, -pen, 1e-12);
@@ -636,7 +639,8 @@ TEST(Contact, TranslationAndScaleInvariance) {
                         }
                         // Absolute rounding of coordinates near 1e6 is ~1e6 eps = 2e-10, relative
                         // to a size s: allow 1e-9 relative plus that.
-                        const Real tol = 1e-9 * scale + 64 * collision::kEpsilon * offset.norm() / s;
+                        const Real tol =
+                            1e-9 * scale + 64 * collision::kEpsilon * offset.norm() / s;
                         ASSERT_NEAR(out.signed_distance / s, ref.signed_distance, tol)
                             << i << " " << j << " " << n << " s=" << s;
                         if (std::abs(ref.signed_distance) > 1e-6 * scale &&
@@ -665,8 +669,10 @@ TEST(Contact, TranslationAndScaleInvariance) {
 //        A (big, flat)          B (thin) touches A with one corner
 //   +-----------------+ <.>
 TEST(Contact, RegressionSliverSimplexStalledGjkAboveTouching) {
-    const Shape a = Shape::box(Vec3(0x1.289888f81391dp+2, 0x1.1a613d22f861bp-6, 0x1.684d03ee81fb4p+1));
-    const Shape b = Shape::box(Vec3(0x1.d83caccb95578p-7, 0x1.1ca5cd56bafcfp-15, 0x1.0e5426ff667f8p-8));
+    const Shape a =
+        Shape::box(Vec3(0x1.289888f81391dp+2, 0x1.1a613d22f861bp-6, 0x1.684d03ee81fb4p+1));
+    const Shape b =
+        Shape::box(Vec3(0x1.d83caccb95578p-7, 0x1.1ca5cd56bafcfp-15, 0x1.0e5426ff667f8p-8));
     const Pose pa{Vec3(-0x1.21625414a1bfap+2, 0x1.3eef5f2c539b8p+0, -0x1.32e6fa2d341b6p+2),
                   Quat(-0x1.fbdb13cfccedp-8, -0x1.161b9ab1491e3p-2, -0x1.93ee65958ce87p-2,
                        0x1.c1724dc568b71p-1)};
@@ -693,8 +699,10 @@ TEST(Contact, RegressionSliverSimplexStalledGjkAboveTouching) {
 // made collide()'s bounded EPA re-add the same support point until its cap: Failed, and contact()
 // inherited it. A repeated support point now ends the decision as Touching.
 TEST(Contact, RegressionExactlyTouchingBoxesFailedInEpaDecision) {
-    const Shape a = Shape::box(Vec3(0x1.31177fc5952e4p-2, 0x1.c2db8553c31c9p-12, 0x1.2d2e1d7452189p-4));
-    const Shape b = Shape::box(Vec3(0x1.1028f80d6941bp+0, 0x1.29c227091cd84p-6, 0x1.4a23ab3e9f12ep-2));
+    const Shape a =
+        Shape::box(Vec3(0x1.31177fc5952e4p-2, 0x1.c2db8553c31c9p-12, 0x1.2d2e1d7452189p-4));
+    const Shape b =
+        Shape::box(Vec3(0x1.1028f80d6941bp+0, 0x1.29c227091cd84p-6, 0x1.4a23ab3e9f12ep-2));
     const Pose pa{Vec3(-0x1.7fa74c2381be7p-2, 0x1.04ea69cdad63fp-3, -0x1.3a7ade3cbb3cap-1),
                   Quat(-0x1.96d22e3cb2d5ap-1, 0x1.f6b71dc6ce5d9p-5, 0x1.3170643e007cep-1,
                        -0x1.84ad33c03e13bp-4)};
@@ -722,7 +730,8 @@ TEST(Contact, ExtremeAspectRatiosTouchingAndCoincident) {
             if (kind == 1) return Shape::box(Vec3(size, size * thin, size * rng.uniform(0.01, 1)));
             if (kind == 2) return Shape::capsule(size * thin, size * rng.uniform(0, 2));
             std::vector<Vec3> points;
-            for (int i = 0; i < 12; ++i) points.push_back(size * rng.vec(-1, 1).cwiseProduct(Vec3(1, thin, 1)));
+            for (int i = 0; i < 12; ++i)
+                points.push_back(size * rng.vec(-1, 1).cwiseProduct(Vec3(1, thin, 1)));
             return Shape::convexHull(hullOf(points));
         };
         const Shape a = make(rng.integer(0, 3));
@@ -742,7 +751,8 @@ TEST(Contact, ExtremeAspectRatiosTouchingAndCoincident) {
         ASSERT_NE(out.state, ContactState::Failed) << n;
         ASSERT_EQ(out.state, collide(a, pa, b, pb).state) << n;
         const Real scale = std::max(boundingRadius(a), boundingRadius(b));
-        ASSERT_LE((out.point_b - out.point_a - out.signed_distance * out.normal).norm(), 1e-8 * scale)
+        ASSERT_LE((out.point_b - out.point_a - out.signed_distance * out.normal).norm(),
+                  1e-8 * scale)
             << n;
         // Manifold points: the witness identity with their own depth, never deeper than the
         // contact (thin reference shapes once gave points beyond their far side).
@@ -779,8 +789,8 @@ TEST(Contact, HullRestingOnHullGivesClippedManifold) {
         int expected_points;
     };
     for (const Case& c : {Case{&crate, 0.4, 4}, Case{&prism, 0.3, 4}}) {
-        const Pose pc = at(Vec3(1.3, 1.8, -3 + 0.5 + c.half_height - depth),
-                           axisAngle(0.4, Vec3::UnitZ()));
+        const Pose pc =
+            at(Vec3(1.3, 1.8, -3 + 0.5 + c.half_height - depth), axisAngle(0.4, Vec3::UnitZ()));
         for (const bool swapped : {false, true}) {
             const ContactOutput out =
                 swapped ? contact(*c.shape, pc, ground, pg) : contact(ground, pg, *c.shape, pc);
@@ -815,7 +825,8 @@ TEST(Contact, HullRestingOnHullGivesClippedManifold) {
     // Box (SAT path) on a hull ground: GJK/EPA normal, clipped manifold of 4.
     const Pose pc = at(Vec3(0.5, 2, -3 + 0.5 + 0.4 - depth), axisAngle(0.2, Vec3::UnitZ()));
     const ContactOutput mixed = contact(ground, pg, Shape::box(Vec3(0.5, 0.7, 0.4)), pc);
-    EXPECT_EQ(mixed.manifold_size, 4) << std::setprecision(17) << mixed.normal.transpose() << " sd " << mixed.signed_distance;
+    EXPECT_EQ(mixed.manifold_size, 4)
+        << std::setprecision(17) << mixed.normal.transpose() << " sd " << mixed.signed_distance;
     EXPECT_NEAR(mixed.signed_distance, -depth, 1e-9);
 }
 
