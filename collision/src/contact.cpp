@@ -27,18 +27,18 @@ namespace {
 
 // Below kNormalRelative * scale a GJK distance is too small for (pb - pa) / d to be a reliable
 // direction (its rounding error is ~ kEpsilon * scale / d radians): EPA decides the normal.
-constexpr Real kNormalRelative = Real(1e-8);
+constexpr Real kNormalRelative = std::max(Real(1e-8), Real(1e3) * kEpsilon);
 // A direction shorter than kDirectionRelative * scale is undefined (coincident centres etc.).
 constexpr Real kDirectionRelative = Real(16) * kEpsilon;
 // Witness points within kFeatureRelative * scale of a face plane / edge / vertex lie on it.
-constexpr Real kFeatureRelative = Real(1e-9);
+constexpr Real kFeatureRelative = std::max(Real(1e-9), Real(64) * kEpsilon);
 // Width of the band around the touching thresholds where collide() decides the state.
 constexpr Real kReconcileBand = Real(1e-6);
 // SAT: a cross-product axis of near-parallel edges (|e_a x e_b| < kParallelSin) is skipped, as in
 // collideBoxBox; an edge axis must beat the best face axis by kEdgeBias * scale to be chosen
 // (faces give stable multi-point manifolds; Box2D / Bullet do the same).
 constexpr Real kParallelSin = Real(1e-6);
-constexpr Real kEdgeBias = Real(1e-9);
+constexpr Real kEdgeBias = std::max(Real(1e-9), Real(64) * kEpsilon);
 
 Real signOrPlus(Real x) { return x < 0 ? Real(-1) : Real(1); }
 

@@ -3,6 +3,7 @@
 // ConvexCore support mappings of gjk.h. Used by contact() (contact.cpp); private to collision.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 
@@ -63,7 +64,7 @@ inline constexpr int kEpaMaxIterations = 128;
 /// EPA stops when the support distance h(n) and the face distance differ by at most
 /// kEpaRelativeTolerance * scale: the depth is then accurate to that absolute error (the face
 /// distance is a lower bound on the depth, h(n) an upper bound; van den Bergen 2001 §4).
-inline constexpr Real kEpaRelativeTolerance = Real(1e-11);
+inline constexpr Real kEpaRelativeTolerance = std::max(Real(1e-11), Real(64) * kEpsilon);
 
 /// Penetration depth, normal and witness points of two overlapping cores, starting from GJK's
 /// final simplex `start` (any size 1..4; it is blown up to a tetrahedron). A flat configuration
