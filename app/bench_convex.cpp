@@ -237,6 +237,18 @@ Answers timeQueries(std::size_t n, int passes, Query&& query) {
     return ans;
 }
 
+bool isBoxLike(const Shape& s) {
+    return s.type == ShapeType::Box || s.type == ShapeType::ConvexHull;
+}
+
+// The same geometry through cdlab's other code path: a box as its 8-point hull (GJK/EPA) and a
+// box-hull back as a box (SAT, closed forms); round shapes stay.
+Shape otherPath(const Shape& s) {
+    if (s.type == ShapeType::Box) return asHull(s);
+    if (s.type == ShapeType::ConvexHull) return Shape::box(s.hull->vertices.back().cwiseAbs());
+    return s;
+}
+
 Real cdlabQuery(const Pair& p) {
     const collision::ContactOutput out = contact(p.a, p.pose_a, p.b, p.pose_b);
     if (out.state == ContactState::Failed) return std::numeric_limits<Real>::quiet_NaN();
@@ -310,6 +322,10 @@ struct Row {
     double cdlab_us = 0;
     double bullet_us = -1;  ///< -1 when Bullet is not built in
     int disagreements = 0;
+    /// Disagreements where cdlab's other path (boxes as hulls through GJK/EPA, or hulls as boxes
+    /// through SAT / closed forms) gives cdlab's answer too; -1 when the pair has no box.
+    int disagreements_confirmed = -1;
+    nlohmann::json disagreement_examples = nlohmann::json::array();
     double max_difference = 0;  ///< max |ours - Bullet's| / size
     /// Per variant (far, small, large): max |answer / factor - answer| / size; NaN answers are
     /// counted in *_variant_failed instead.
@@ -367,7 +383,31 @@ Row runWorkload(const Workload& w, int index, const BenchConvexOptions& options)
     for (std::size_t i = 0; i < pairs.size(); ++i) {
         const double diff = std::abs(ours.signed_distance[i] - theirs.signed_distance[i]);
         const double rel = diff / pairs[i].scale;
-        if (!(rel <= options.tolerance)) ++row.disagreements;  // NaN (a failure) disagrees too
+        if (!(rel <= options.tolerance)) {  // NaN (a failure) disagrees too
+            ++row.disagreements;
+            const bool has_box = isBoxLike(pairs[i].a) || isBoxLike(pairs[i].b);
+            Real other = std::numeric_limits<Real>::quiet_NaN();
+            if (has_box) {
+                Pair alt = pairs[i];
+                alt.a = otherPath(pairs[i].a);
+                alt.b = otherPath(pairs[i].b);
+                other = cdlabQuery(alt);
+                if (row.disagreements_confirmed < 0) row.disagreements_confirmed = 0;
+                if (std::abs(other - ours.signed_distance[i]) <=
+                    options.tolerance * pairs[i].scale) {
+                    ++row.disagreements_confirmed;
+                }
+            }
+            if (row.disagreement_examples.size() < 3) {
+                row.disagreement_examples.push_back(
+                    {{"pair", i},
+                     {"size", pairs[i].scale},
+                     {"cdlab", ours.signed_distance[i]},
+                     {"cdlab_other_path",
+                      has_box ? nlohmann::json(other) : nlohmann::json(nullptr)},
+                     {"bullet", theirs.signed_distance[i]}});
+            }
+        }
         if (std::isfinite(rel)) row.max_difference = std::max(row.max_difference, rel);
     }
     for (std::size_t k = 0; k < kVariants.size(); ++k) {
@@ -404,6 +444,8 @@ nlohmann::json rowJson(const Row& r) {
             j[std::string("bullet_") + kVariants[k].name + "_error"] = r.bullet_variant_error[k];
         }
         j["disagreements"] = r.disagreements;
+        j["disagreements_confirmed"] = r.disagreements_confirmed;
+        j["disagreement_examples"] = r.disagreement_examples;
         j["max_difference"] = r.max_difference;
     } else {
         j["bullet_us"] = nullptr;
@@ -415,8 +457,8 @@ void printTable(const std::vector<Row>& rows, double tolerance, std::ostream& ou
     out << std::left << std::setw(29) << "workload" << std::setw(12) << "cdlab_path" << std::right
         << std::setw(8) << "queries" << std::setw(7) << "hits" << std::setw(10) << "cdlab_us"
         << std::setw(10) << "bullet_us" << std::setw(7) << "ratio" << std::setw(9) << "disagree"
-        << std::setw(10) << "max_diff" << std::setw(11) << "cdlab_ext" << std::setw(11)
-        << "bullet_ext" << std::setw(8) << "failed"
+        << std::setw(10) << "confirmed" << std::setw(10) << "max_diff" << std::setw(11)
+        << "cdlab_ext" << std::setw(11) << "bullet_ext" << std::setw(8) << "failed"
         << "\n";
     for (const Row& r : rows) {
         out << std::left << std::setw(29) << r.workload << std::setw(12) << r.method << std::right
@@ -424,18 +466,24 @@ void printTable(const std::vector<Row>& rows, double tolerance, std::ostream& ou
             << std::setprecision(3) << std::setw(10) << r.cdlab_us;
         if (r.bullet_us >= 0) {
             out << std::setw(10) << r.bullet_us << std::setw(7) << std::setprecision(2)
-                << r.cdlab_us / r.bullet_us << std::setw(9) << r.disagreements << std::scientific
-                << std::setprecision(1) << std::setw(10) << r.max_difference << std::setw(11)
-                << maxOf(r.cdlab_variant_error) << std::setw(11) << maxOf(r.bullet_variant_error);
+                << r.cdlab_us / r.bullet_us << std::setw(9) << r.disagreements << std::setw(10)
+                << (r.disagreements_confirmed < 0 ? std::string("-")
+                                                  : std::to_string(r.disagreements_confirmed))
+                << std::scientific << std::setprecision(1) << std::setw(10) << r.max_difference
+                << std::setw(11) << maxOf(r.cdlab_variant_error) << std::setw(11)
+                << maxOf(r.bullet_variant_error);
         } else {
             out << std::setw(10) << "n/a" << std::setw(7) << "n/a" << std::setw(9) << "n/a"
-                << std::setw(10) << "n/a" << std::scientific << std::setprecision(1)
-                << std::setw(11) << maxOf(r.cdlab_variant_error) << std::setw(11) << "n/a";
+                << std::setw(10) << "n/a" << std::setw(10) << "n/a" << std::scientific
+                << std::setprecision(1) << std::setw(11) << maxOf(r.cdlab_variant_error)
+                << std::setw(11) << "n/a";
         }
         out << std::defaultfloat << std::setw(8) << r.cdlab_failed + r.cdlab_variant_failed << "\n";
     }
     out << "ratio = cdlab_us / bullet_us; disagree: |signed distance difference| > " << tolerance
-        << " * size; ext: largest change of answer / factor after translating by 1e6 or scaling"
+        << " * size; confirmed: of those, how many cdlab's other path (box <-> 8-point hull) "
+           "answers like cdlab; ext: largest change of answer / factor after translating by 1e6 or "
+           "scaling"
            " by 1e-4 and 1e4, relative to size (JSON: per variant); failed: cdlab Failed states\n";
 }
 
