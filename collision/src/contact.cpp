@@ -679,7 +679,7 @@ constexpr int kMaxPolygon = 32;
 constexpr Real kFaceAlignment = Real(1) - Real(1e-12);
 
 struct Polygon {
-    std::array<Vec3, kMaxPolygon> v{};
+    std::array<Vec3, kMaxPolygon> v;  // the first n are set
     int n = 0;
     Vec3 normal = Vec3::Zero();  // unit, outward
     Real offset = 0;             // normal . v for every vertex
@@ -688,8 +688,11 @@ struct Polygon {
 
 // The face of a box or hull (own frame) whose outward normal is closest to unit `dir`, as a
 // polygon ordered counter-clockwise around its normal; coplanar hull triangles are merged.
-bool facePolygon(const Shape& shape, const Vec3& dir, Real tol, Polygon& out) {
-    out = Polygon{};
+// Returns false (with out.alignment set) without building the polygon when the alignment is
+// below `min_alignment`.
+bool facePolygon(const Shape& shape, const Vec3& dir, Real tol, Real min_alignment, Polygon& out) {
+    out.n = 0;
+    out.alignment = -2;
     if (shape.type == ShapeType::Box) {
         int k = 0;
         dir.cwiseAbs().maxCoeff(&k);
@@ -710,7 +713,7 @@ bool facePolygon(const Shape& shape, const Vec3& dir, Real tol, Polygon& out) {
         out.normal = s * Vec3::Unit(k);
         out.offset = h[k];  // normal . vertex = s * (s h_k)
         out.alignment = out.normal.dot(dir);
-        return true;
+        return out.alignment >= min_alignment;
     }
     if (!shape.hull) return false;
     const ConvexPolytope& hull = *shape.hull;
@@ -729,7 +732,7 @@ bool facePolygon(const Shape& shape, const Vec3& dir, Real tol, Polygon& out) {
             best_normal = nrm / len;
         }
     }
-    if (best < 0) return false;
+    if (best < 0 || out.alignment < min_alignment) return false;
     out.normal = best_normal;
     out.offset = best_normal.dot(hull.vertices[static_cast<std::size_t>(hull.faces[best][0])]);
     // Every hull vertex on the plane belongs to the (convex) face polygon.
@@ -796,11 +799,14 @@ bool polytopeManifold(const Shape& a, const Shape& b, const RelativePose& rel, c
     Polygon face_a;
     Polygon face_b;
     const Vec3 n_in_b = rel.rotation.transpose() * (-out.normal);
-    // ref.normal is outward from the reference shape: for A it aligns with the normal (A to B),
-    // for B with -normal; `alignment` is measured against each shape's own direction.
-    if (!facePolygon(a, out.normal, tol, face_a) || !facePolygon(b, n_in_b, tol, face_b)) {
-        return false;
-    }
+    // Only a face aligned with the normal can be the reference: test both cheaply first, then
+    // build the other side's (incident) face whatever its alignment.
+    const bool a_ok = facePolygon(a, out.normal, tol, kFaceAlignment, face_a);
+    const bool b_ok = facePolygon(b, n_in_b, tol, kFaceAlignment, face_b);
+    if (!a_ok && !b_ok) return false;
+    const bool a_is_reference = a_ok && (!b_ok || face_a.alignment >= face_b.alignment);
+    if (a_is_reference && !b_ok && !facePolygon(b, n_in_b, tol, -2, face_b)) return false;
+    if (!a_is_reference && !a_ok && !facePolygon(a, out.normal, tol, -2, face_a)) return false;
     // Put B's face in A's frame.
     for (int i = 0; i < face_b.n; ++i) {
         face_b.v[static_cast<std::size_t>(i)] =
@@ -808,10 +814,8 @@ bool polytopeManifold(const Shape& a, const Shape& b, const RelativePose& rel, c
     }
     face_b.normal = rel.rotation * face_b.normal;
     face_b.offset = face_b.normal.dot(face_b.v[0]);
-    const bool a_is_reference = face_a.alignment >= face_b.alignment;
     const Polygon& ref = a_is_reference ? face_a : face_b;
     const Polygon& inc = a_is_reference ? face_b : face_a;
-    if (ref.alignment < kFaceAlignment) return false;
 
     std::array<Vec3, 2 * kMaxPolygon> poly{};
     std::array<Vec3, 2 * kMaxPolygon> tmp{};

@@ -212,20 +212,22 @@ void combine(const WitnessSimplex& s, const std::array<Real, 4>& weight, Vec3& p
 
 // ---- EPA polytope ----
 
+// Set entirely by Polytope::addFace; no default values, so the face array costs no zeroing.
 struct Face {
-    std::array<int, 3> v{};
-    Vec3 normal = Vec3::Zero();  // unit outward; zero when degenerate
-    Real dist = 0;               // normal . vertex
-    bool valid = true;
+    std::array<int, 3> v;
+    Vec3 normal;  // unit outward; zero when degenerate
+    Real dist;    // normal . vertex
+    bool valid;
 };
 
 constexpr int kMaxVertices = kEpaMaxIterations + 4;
 constexpr int kMaxFaces = 2 * kMaxVertices;
 
 struct Polytope {
-    std::array<SupportVertex, kMaxVertices> vert{};
+    // Only the first vertex_count / face_count entries are set (no zeroing of ~22 kB per call).
+    std::array<SupportVertex, kMaxVertices> vert;
     int vertex_count = 0;
-    std::array<Face, kMaxFaces> faces{};
+    std::array<Face, kMaxFaces> faces;
     int face_count = 0;
     Real eps = 0;
 
@@ -424,7 +426,7 @@ EpaOutput epaPenetration(const ConvexCore& a, const ConvexCore& b, const Relativ
     poly.addFace(0, 2, 3);
     poly.addFace(1, 3, 2);
 
-    std::array<std::array<int, 2>, 3 * kMaxFaces> edges{};
+    std::array<std::array<int, 2>, 3 * kMaxFaces> edges;  // the first edge_count are set
     for (int iter = 0; iter < kEpaMaxIterations; ++iter) {
         ++out.iterations;
         int best = -1;

@@ -13,11 +13,12 @@
 namespace collision {
 
 /// A vertex of the configuration-space obstacle A - B with the support points that made it,
-/// all in A's frame: w = a - b.
+/// all in A's frame: w = a - b. No default member values (EPA keeps arrays of them and must not
+/// pay for zeroing); value-initialise (`{}`) where zeros are needed.
 struct SupportVertex {
-    Vec3 w = Vec3::Zero();
-    Vec3 a = Vec3::Zero();
-    Vec3 b = Vec3::Zero();
+    Vec3 w;
+    Vec3 a;
+    Vec3 b;
 };
 
 /// A GJK simplex of up to four support vertices.
