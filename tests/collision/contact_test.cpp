@@ -171,7 +171,8 @@ Real pointSegmentDistance(const Vec3& p, const Vec3& a, const Vec3& b) {
 
 // Segment-segment distance by ternary search over the first parameter (the distance from a
 // moving point to a segment is convex in the parameter): an independent reference for RTCD 5.1.9.
-Real segmentSegmentReference(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2) {
+Real segmentSegmentReference(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2,
+                             Vec3* on1 = nullptr) {
     Real lo = 0;
     Real hi = 1;
     for (int i = 0; i < 200; ++i) {
@@ -184,6 +185,7 @@ Real segmentSegmentReference(const Vec3& p1, const Vec3& q1, const Vec3& p2, con
             lo = m1;
         }
     }
+    if (on1 != nullptr) *on1 = p1 + (lo + hi) / 2 * (q1 - p1);
     return pointSegmentDistance(p1 + (lo + hi) / 2 * (q1 - p1), p2, q2);
 }
 
@@ -242,6 +244,18 @@ TEST(Contact, SphereBoxMatchesClosedFormAndGjkEpaAgrees) {
         for (const Shape* s : {&box, &hull}) {
             const ContactOutput out = contact(sphere, ps, *s, pb);
             ASSERT_NEAR(out.signed_distance, expected, 1e-10 * scale) << n;
+            // Normal: from the centre to its closest box point outside (RTCD 5.1.3); inside,
+            // minus the normal of the nearest face (the way out is through it).
+            const Vec3 clamped = centre.cwiseMax(-h).cwiseMin(h);
+            Vec3 expected_normal_local;
+            if ((centre - clamped).norm() > 1e-9 * scale) {
+                expected_normal_local = (clamped - centre).normalized();
+            } else {
+                int k = 0;
+                (h - centre.cwiseAbs()).minCoeff(&k);
+                expected_normal_local = -Vec3::Unit(k) * (centre[k] < 0 ? -1 : 1);
+            }
+            ASSERT_LE((out.normal - pb.orientation * expected_normal_local).norm(), 1e-9) << n;
             ASSERT_EQ(out.state, collide(sphere, ps, *s, pb).state) << n;
             expectConsistent(sphere, ps, *s, pb, out, 1e-9, "sphere-box", n);
             expectMirror(out, contact(*s, pb, sphere, ps), n);
@@ -329,13 +343,19 @@ TEST(Contact, CapsuleCapsuleMatchesReference) {
         const Pose pb = at(pa.position + rng.vec(-1.4, 1.4), rng.rotation());
         const Vec3 ya = pa.orientation * Vec3::UnitY() * a.half_height;
         const Vec3 yb = pb.orientation * Vec3::UnitY() * b.half_height;
-        const Real expected = segmentSegmentReference(pa.position - ya, pa.position + ya,
-                                                      pb.position - yb, pb.position + yb) -
-                              a.radius - b.radius;
+        Vec3 on_a;
+        const Real core_distance = segmentSegmentReference(
+            pa.position - ya, pa.position + ya, pb.position - yb, pb.position + yb, &on_a);
+        const Real expected = core_distance - a.radius - b.radius;
         const Real scale = std::max(a.radius + a.half_height, b.radius + b.half_height);
         const ContactOutput out = contact(a, pa, b, pb);
         ASSERT_NEAR(out.signed_distance, expected, 1e-9 * scale) << n;
         ASSERT_EQ(out.state, collide(a, pa, b, pb).state) << n;
+        // Witness on A: its core point pushed out by the radius; the reference core point is
+        // found by ternary search (accurate to ~1e-8 of the length where the minimum is flat).
+        if (core_distance > 1e-3 * scale) {
+            ASSERT_LE((out.point_a - out.normal * a.radius - on_a).norm(), 1e-6 * scale) << n;
+        }
         expectConsistent(a, pa, b, pb, out, 1e-9, "capsule-capsule", n);
         expectMirror(out, contact(b, pb, a, pa), n);
         mix.add(out);
@@ -828,6 +848,49 @@ TEST(Contact, HullRestingOnHullGivesClippedManifold) {
     EXPECT_EQ(mixed.manifold_size, 4)
         << std::setprecision(17) << mixed.normal.transpose() << " sd " << mixed.signed_distance;
     EXPECT_NEAR(mixed.signed_distance, -depth, 1e-9);
+}
+
+// Hull witness features on a tetrahedron (no coplanar faces): a sphere over a vertex, over an
+// edge and over a face interior gets that vertex index, the edge as face * 3 + edge of a face
+// holding both endpoints, and a face whose plane holds the witness.
+TEST(Contact, HullFeaturesForVertexEdgeFace) {
+    const std::vector<Vec3> corners{Vec3(1, 1, 1), Vec3(1, -1, -1), Vec3(-1, 1, -1),
+                                    Vec3(-1, -1, 1)};
+    const Shape tet = Shape::convexHull(hullOf(corners));
+    const ConvexPolytope& hull = *tet.hull;
+    const Shape sphere = Shape::sphere(0.1);
+    const Pose pt = at(Vec3(100, 200, -300), axisAngle(0.7, Vec3(1, -1, 2)));
+    // Vertex: straight out beyond corner 0.
+    int v0 = -1;
+    for (std::size_t i = 0; i < hull.vertices.size(); ++i) {
+        if ((hull.vertices[i] - corners[0]).norm() < 1e-12) v0 = static_cast<int>(i);
+    }
+    ASSERT_GE(v0, 0);
+    ContactOutput out = contact(tet, pt, sphere, at(pt.apply(corners[0] * 1.2)));
+    EXPECT_EQ(out.feature_a.type, FeatureType::Vertex);
+    EXPECT_EQ(out.feature_a.index, v0);
+    // Edge: beyond the midpoint of corners 0 and 1, along the outward bisector.
+    const Vec3 mid = (corners[0] + corners[1]) / 2;
+    out = contact(tet, pt, sphere, at(pt.apply(mid + 0.12 * mid.normalized())));
+    ASSERT_EQ(out.feature_a.type, FeatureType::Edge);
+    const auto& face = hull.faces[static_cast<std::size_t>(out.feature_a.index / 3)];
+    const int e = out.feature_a.index % 3;
+    const Vec3 s = hull.vertices[static_cast<std::size_t>(face[static_cast<std::size_t>(e)])];
+    const Vec3 t =
+        hull.vertices[static_cast<std::size_t>(face[static_cast<std::size_t>((e + 1) % 3)])];
+    EXPECT_NEAR((s - t).norm(), (corners[0] - corners[1]).norm(), 1e-12);
+    EXPECT_NEAR((s + t - corners[0] - corners[1]).norm(), 0, 1e-12);
+    // Face: beyond the centroid of the face opposite corner 3, inside and outside.
+    const Vec3 centroid = (corners[0] + corners[1] + corners[2]) / 3;
+    for (const Real lift : {Real(0.15), Real(0.05)}) {
+        out = contact(tet, pt, sphere, at(pt.apply(centroid + lift * centroid.normalized())));
+        ASSERT_EQ(out.feature_a.type, FeatureType::Face) << lift;
+        const auto& f = hull.faces[static_cast<std::size_t>(out.feature_a.index)];
+        for (int k = 0; k < 3; ++k) {
+            const Vec3& c = hull.vertices[static_cast<std::size_t>(f[static_cast<std::size_t>(k)])];
+            EXPECT_GT((c - corners[3]).norm(), 1) << lift;  // corner 3 is not on that face
+        }
+    }
 }
 
 }  // namespace
