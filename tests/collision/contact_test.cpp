@@ -893,4 +893,40 @@ TEST(Contact, HullFeaturesForVertexEdgeFace) {
     }
 }
 
+// A mesh is its convex hull for contact(): the same answer as the hull shape, mirrored when
+// swapped, for a concave (L-shaped) mesh whose hull differs from its surface.
+TEST(Contact, MeshIsItsConvexHull) {
+    auto mesh = std::make_shared<collision::TriangleMesh>();
+    // An L-shaped prism: 6 profile corners at z = -0.5 and z = +0.5 (triangles only matter for
+    // collide(); contact() reads the hull).
+    const std::array<std::array<Real, 2>, 6> profile{
+        {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}}};
+    for (const Real z : {Real(-0.5), Real(0.5)}) {
+        for (const auto& p : profile) mesh->vertices.emplace_back(p[0] - 1, p[1] - 1, z);
+    }
+    mesh->triangles = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 5}};
+    const auto hull = hullOf(mesh->vertices);
+    const Shape as_mesh = Shape::triangleMesh(mesh, hull);
+    const Shape as_hull = Shape::convexHull(hull);
+    cdlab_test::Rng rng(13);
+    const Shape other = Shape::box(Vec3(0.4, 0.3, 0.2));
+    int colliding = 0;
+    for (int n = 0; n < 300; ++n) {
+        const Pose pm = at(rng.vec(-1, 1), rng.rotation());
+        const Pose po = at(pm.position + rng.vec(-2, 2), rng.rotation());
+        const ContactOutput m = contact(as_mesh, pm, other, po);
+        const ContactOutput h = contact(as_hull, pm, other, po);
+        ASSERT_EQ(m.state, h.state) << n;
+        ASSERT_EQ(m.signed_distance, h.signed_distance) << n;
+        ASSERT_EQ(m.normal, h.normal) << n;
+        ASSERT_EQ(m.point_a, h.point_a) << n;
+        ASSERT_EQ(m.feature_a.index, h.feature_a.index) << n;
+        expectMirror(m, contact(other, po, as_mesh, pm), n);
+        expectConsistent(as_hull, pm, other, po, m, 1e-9, "mesh", n);
+        if (isColliding(m.state)) ++colliding;
+    }
+    EXPECT_GT(colliding, 30);
+    EXPECT_LT(colliding, 270);
+}
+
 }  // namespace
