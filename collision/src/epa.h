@@ -61,7 +61,7 @@ struct EpaOutput {
 };
 
 /// EPA iteration cap (expansions of the polytope).
-inline constexpr int kEpaMaxIterations = 128;
+inline constexpr int kEpaMaxIterations = 256;
 /// EPA stops when the support distance h(n) and the face distance differ by at most
 /// kEpaRelativeTolerance * scale: the depth is then accurate to that absolute error (the face
 /// distance is a lower bound on the depth, h(n) an upper bound; van den Bergen 2001 §4).

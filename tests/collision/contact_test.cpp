@@ -16,6 +16,8 @@
 
 #include "collision/convex_hull.h"
 #include "collision/narrow_phase.h"
+// Private narrow-phase headers (collision/src is on the test include path) for the caps.
+#include "epa.h"
 #include "test_random.h"
 
 namespace {
@@ -927,6 +929,29 @@ TEST(Contact, MeshIsItsConvexHull) {
     }
     EXPECT_GT(colliding, 30);
     EXPECT_LT(colliding, 270);
+}
+
+// Finely tessellated hulls (2000 points on a sphere) make EPA work hardest: every query stays
+// within the iteration caps, none fails, and the state is collide()'s.
+TEST(Contact, FineHullsStayWithinTheIterationCaps) {
+    cdlab_test::Rng rng(14);
+    std::vector<Vec3> points;
+    for (int i = 0; i < 2000; ++i) points.push_back(rng.vec(-1, 1).normalized());
+    const Shape ball = Shape::convexHull(hullOf(points));
+    const Shape box = Shape::box(Vec3(0.5, 0.4, 0.3));
+    int penetrating = 0;
+    for (int n = 0; n < 150; ++n) {
+        const Shape& other = n % 2 == 0 ? ball : box;
+        const Pose pa = at(rng.vec(-1, 1), rng.rotation());
+        const Pose pb = at(pa.position + rng.vec(-1, 1) * 1.2, rng.rotation());
+        const ContactOutput out = contact(ball, pa, other, pb);
+        ASSERT_NE(out.state, ContactState::Failed) << n;
+        ASSERT_EQ(out.state, collide(ball, pa, other, pb).state) << n;
+        ASSERT_LE(out.iterations, collision::kGjkMaxIterations + collision::kEpaMaxIterations);
+        expectConsistent(ball, pa, other, pb, out, 1e-9, "fine hull", n);
+        if (out.state == ContactState::Penetrating) ++penetrating;
+    }
+    EXPECT_GT(penetrating, 50);
 }
 
 }  // namespace
