@@ -754,7 +754,13 @@ bool facePolygon(const Shape& shape, const Vec3& dir, Real tol, Real min_alignme
     std::array<int, kMaxPolygon> order{};
     for (int i = 0; i < out.n; ++i) {
         const Vec3 d = out.v[static_cast<std::size_t>(i)] - centre;
-        angle[static_cast<std::size_t>(i)] = std::atan2(d.dot(e2), d.dot(e1));
+        // Pseudo-angle in [-2, 2), monotonic in atan2(y, x) and far cheaper: only the order
+        // matters.
+        const Real x = d.dot(e1);
+        const Real y = d.dot(e2);
+        const Real r = std::abs(x) + std::abs(y);
+        const Real t = r > 0 ? x / r : Real(1);
+        angle[static_cast<std::size_t>(i)] = y < 0 ? t - 1 : 1 - t;
         order[static_cast<std::size_t>(i)] = i;
     }
     std::sort(order.begin(), order.begin() + out.n, [&](int x, int y) {
