@@ -960,8 +960,10 @@ ContactOutput contact(const Shape& a_in, const Pose& pose_a_in, const Shape& b_i
             local.state = c.state;
         }
     }
+    // The output never carries NaN or a non-unit normal: anything else is Failed.
     if (local.state == ContactState::Failed || !std::isfinite(local.signed_distance) ||
-        !local.normal.allFinite() || !local.point_a.allFinite() || !local.point_b.allFinite()) {
+        !local.normal.allFinite() || !(std::abs(local.normal.squaredNorm() - 1) < Real(1e-6)) ||
+        !local.point_a.allFinite() || !local.point_b.allFinite()) {
         failed.iterations = local.iterations;
         return failed;
     }
