@@ -11,9 +11,9 @@
 namespace app {
 
 struct BenchConvexOptions {
-    int queries = 20000;      ///< random pairs per workload
-    int passes = 5;           ///< timed passes over the pairs; the fastest pass is reported
-    std::uint64_t seed = 1;   ///< pose generator seed
+    int queries = 20000;     ///< random pairs per workload
+    int passes = 5;          ///< timed passes over the pairs; the fastest pass is reported
+    std::uint64_t seed = 1;  ///< pose generator seed
     /// Relative tolerance of the answer comparison: |ours - Bullet's| signed distance above
     /// tolerance * (larger bounding radius) counts as a disagreement.
     double tolerance = 1e-6;

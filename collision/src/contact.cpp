@@ -27,18 +27,18 @@ namespace {
 
 // Below kNormalRelative * scale a GJK distance is too small for (pb - pa) / d to be a reliable
 // direction (its rounding error is ~ kEpsilon * scale / d radians): EPA decides the normal.
-constexpr Real kNormalRelative = Real(1e-8);
+constexpr Real kNormalRelative = std::max(Real(1e-8), Real(1e3) * kEpsilon);
 // A direction shorter than kDirectionRelative * scale is undefined (coincident centres etc.).
 constexpr Real kDirectionRelative = Real(16) * kEpsilon;
 // Witness points within kFeatureRelative * scale of a face plane / edge / vertex lie on it.
-constexpr Real kFeatureRelative = Real(1e-9);
+constexpr Real kFeatureRelative = std::max(Real(1e-9), Real(64) * kEpsilon);
 // Width of the band around the touching thresholds where collide() decides the state.
 constexpr Real kReconcileBand = Real(1e-6);
 // SAT: a cross-product axis of near-parallel edges (|e_a x e_b| < kParallelSin) is skipped, as in
 // collideBoxBox; an edge axis must beat the best face axis by kEdgeBias * scale to be chosen
 // (faces give stable multi-point manifolds; Box2D / Bullet do the same).
 constexpr Real kParallelSin = Real(1e-6);
-constexpr Real kEdgeBias = Real(1e-9);
+constexpr Real kEdgeBias = std::max(Real(1e-9), Real(64) * kEpsilon);
 
 Real signOrPlus(Real x) { return x < 0 ? Real(-1) : Real(1); }
 
@@ -210,7 +210,8 @@ Vec3 toB(const RelativePose& b_in_a, const Vec3& p_in_a) {
 
 void setSingleManifold(Local& out) {
     out.manifold_size = 1;
-    out.manifold[0] = ManifoldPoint{out.point_a, out.point_b, std::max(Real(0), -out.signed_distance)};
+    out.manifold[0] =
+        ManifoldPoint{out.point_a, out.point_b, std::max(Real(0), -out.signed_distance)};
 }
 
 // ---- Closed forms (A's frame). ----
@@ -278,7 +279,8 @@ void closestSegmentSegment(const Vec3& p1, const Vec3& q1, const Vec3& p2, const
     }
     const Real b = d1.dot(d2);
     const Real denom = a * e - b * b;
-    if (denom > Real(16) * kEpsilon * a * e) s = std::clamp((b * f - c * e) / denom, Real(0), Real(1));
+    if (denom > Real(16) * kEpsilon * a * e)
+        s = std::clamp((b * f - c * e) / denom, Real(0), Real(1));
     t = (b * s + f) / e;
     if (t < 0) {
         t = 0;
@@ -358,8 +360,7 @@ void sphereBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ct
 
 // ---- GJK + EPA for any convex pair (A's frame). ----
 
-void generic(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
-             Local& out) {
+void generic(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx, Local& out) {
     const ConvexCore ca = ConvexCore::fromShape(a);
     const ConvexCore cb = ConvexCore::fromShape(b);
     const Real radii = ca.radius + cb.radius;
@@ -476,16 +477,16 @@ int clipFaceContact(const Vec3& hr, int k, Real s, const Vec3& hi, const Relativ
 // Keeps at most 4 of n points: the deepest, the farthest from it, the one spanning the largest
 // triangle with those two, and the one adding the most area outside that triangle (Gregorius,
 // "Robust Contact Creation for Physics Simulations", GDC 2015). Returns the chosen indices.
-int reduceManifold(const std::array<Vec3, 8>& p, const std::array<Real, 8>& depth, int n,
-                   const Vec3& normal, std::array<int, 4>& chosen) {
+int reduceManifold(const Vec3* p, const Real* depth, int n, const Vec3& normal,
+                   std::array<int, 4>& chosen) {
     if (n <= 4) {
         for (int i = 0; i < n; ++i) chosen[static_cast<std::size_t>(i)] = i;
         return n;
     }
-    auto at = [&](int i) -> const Vec3& { return p[static_cast<std::size_t>(i)]; };
+    auto at = [&](int i) -> const Vec3& { return p[i]; };
     int i0 = 0;
     for (int i = 1; i < n; ++i) {
-        if (depth[static_cast<std::size_t>(i)] > depth[static_cast<std::size_t>(i0)]) i0 = i;
+        if (depth[i] > depth[i0]) i0 = i;
     }
     int i1 = -1;
     Real best = -1;
@@ -585,7 +586,8 @@ bool boxBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& 
         // A's edge along axis i at the support signs of n; B's along its axis j at -n.
         Vec3 ca = ea.cwiseProduct(Vec3(signOrPlus(n.x()), signOrPlus(n.y()), signOrPlus(n.z())));
         const Vec3 n_b = rot.transpose() * (-n);
-        Vec3 cb = eb.cwiseProduct(Vec3(signOrPlus(n_b.x()), signOrPlus(n_b.y()), signOrPlus(n_b.z())));
+        Vec3 cb =
+            eb.cwiseProduct(Vec3(signOrPlus(n_b.x()), signOrPlus(n_b.y()), signOrPlus(n_b.z())));
         Vec3 pa0 = ca;
         Vec3 pa1 = ca;
         pa0[edge_i] = -ea[edge_i];
@@ -630,9 +632,20 @@ bool boxBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& 
             points[static_cast<std::size_t>(i)] = rot * points[static_cast<std::size_t>(i)] + t;
         }
     }
+    // Points deeper than the contact lie beyond the far side of a thin reference box.
+    const Real max_depth = std::max(Real(0), -best) + kFeatureRelative * ctx.scale;
+    int within = 0;
+    for (int i = 0; i < count; ++i) {
+        if (depths[static_cast<std::size_t>(i)] <= max_depth) {
+            points[static_cast<std::size_t>(within)] = points[static_cast<std::size_t>(i)];
+            depths[static_cast<std::size_t>(within)] = depths[static_cast<std::size_t>(i)];
+            ++within;
+        }
+    }
+    count = within;
     if (count == 0) return false;  // rounding at a grazing contact: let GJK/EPA answer
     std::array<int, 4> chosen{};
-    const int kept = reduceManifold(points, depths, count, n, chosen);
+    const int kept = reduceManifold(points.data(), depths.data(), count, n, chosen);
     out.normal = n;
     out.signed_distance = best;
     out.manifold_size = kept;
@@ -655,6 +668,208 @@ bool boxBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& 
     out.point_b = out.manifold[static_cast<std::size_t>(deepest)].point_b;
     out.feature_a = boxFeature(ea, out.point_a, tol);
     out.feature_b = boxFeature(eb, toB(rel, out.point_b), tol);
+    return true;
+}
+
+// ---- Face contacts of polytopes (box or hull) other than box-box: clipped manifold. ----
+
+// Polygons up to this many vertices are clipped; larger faces fall back to one point.
+constexpr int kMaxPolygon = 32;
+// A face is the contact face when its normal is within this of the contact normal (cosine).
+constexpr Real kFaceAlignment = Real(1) - Real(1e-12);
+
+struct Polygon {
+    std::array<Vec3, kMaxPolygon> v;  // the first n are set
+    int n = 0;
+    Vec3 normal = Vec3::Zero();  // unit, outward
+    Real offset = 0;             // normal . v for every vertex
+    Real alignment = -2;         // normal . direction
+};
+
+// The face of a box or hull (own frame) whose outward normal is closest to unit `dir`, as a
+// polygon ordered counter-clockwise around its normal; coplanar hull triangles are merged.
+// Returns false (with out.alignment set) without building the polygon when the alignment is
+// below `min_alignment`.
+bool facePolygon(const Shape& shape, const Vec3& dir, Real tol, Real min_alignment, Polygon& out) {
+    out.n = 0;
+    out.alignment = -2;
+    if (shape.type == ShapeType::Box) {
+        int k = 0;
+        dir.cwiseAbs().maxCoeff(&k);
+        const Real s = signOrPlus(dir[k]);
+        const Vec3& h = shape.half_extents;
+        const int u = (k + 1) % 3;
+        const int w = (k + 2) % 3;
+        const std::array<Real, 4> su{-1, 1, 1, -1};
+        const std::array<Real, 4> sw{-1, -1, 1, 1};
+        for (int c = 0; c < 4; ++c) {
+            Vec3 p;
+            p[k] = s * h[k];
+            p[u] = su[static_cast<std::size_t>(c)] * h[u];
+            p[w] = sw[static_cast<std::size_t>(c)] * h[w];
+            out.v[static_cast<std::size_t>(s > 0 ? c : 3 - c)] = p;  // CCW around s e_k
+        }
+        out.n = 4;
+        out.normal = s * Vec3::Unit(k);
+        out.offset = h[k];  // normal . vertex = s * (s h_k)
+        out.alignment = out.normal.dot(dir);
+        return out.alignment >= min_alignment;
+    }
+    if (!shape.hull) return false;
+    const ConvexPolytope& hull = *shape.hull;
+    int best = -1;
+    Vec3 best_normal = Vec3::Zero();
+    for (std::size_t f = 0; f < hull.faces.size(); ++f) {
+        const Vec3& a = hull.vertices[static_cast<std::size_t>(hull.faces[f][0])];
+        const Vec3 nrm = (hull.vertices[static_cast<std::size_t>(hull.faces[f][1])] - a)
+                             .cross(hull.vertices[static_cast<std::size_t>(hull.faces[f][2])] - a);
+        const Real len = nrm.norm();
+        if (!(len > 0)) continue;
+        const Real al = nrm.dot(dir) / len;
+        if (al > out.alignment) {
+            out.alignment = al;
+            best = static_cast<int>(f);
+            best_normal = nrm / len;
+        }
+    }
+    if (best < 0 || out.alignment < min_alignment) return false;
+    out.normal = best_normal;
+    out.offset = best_normal.dot(hull.vertices[static_cast<std::size_t>(hull.faces[best][0])]);
+    // Every hull vertex on the plane belongs to the (convex) face polygon.
+    Vec3 centre = Vec3::Zero();
+    for (const Vec3& p : hull.vertices) {
+        if (std::abs(best_normal.dot(p) - out.offset) <= tol) {
+            if (out.n >= kMaxPolygon) return false;
+            out.v[static_cast<std::size_t>(out.n++)] = p;
+            centre += p;
+        }
+    }
+    if (out.n < 3) return false;
+    centre /= Real(out.n);
+    int axis = 0;
+    best_normal.cwiseAbs().minCoeff(&axis);
+    const Vec3 e1 = best_normal.cross(Vec3::Unit(axis)).normalized();
+    const Vec3 e2 = best_normal.cross(e1);
+    std::array<Real, kMaxPolygon> angle{};
+    std::array<int, kMaxPolygon> order{};
+    for (int i = 0; i < out.n; ++i) {
+        const Vec3 d = out.v[static_cast<std::size_t>(i)] - centre;
+        // Pseudo-angle in [-2, 2), monotonic in atan2(y, x) and far cheaper: only the order
+        // matters.
+        const Real x = d.dot(e1);
+        const Real y = d.dot(e2);
+        const Real r = std::abs(x) + std::abs(y);
+        const Real t = r > 0 ? x / r : Real(1);
+        angle[static_cast<std::size_t>(i)] = y < 0 ? t - 1 : 1 - t;
+        order[static_cast<std::size_t>(i)] = i;
+    }
+    std::sort(order.begin(), order.begin() + out.n, [&](int x, int y) {
+        const Real ax = angle[static_cast<std::size_t>(x)];
+        const Real ay = angle[static_cast<std::size_t>(y)];
+        return ax < ay || (ax == ay && x < y);
+    });
+    std::array<Vec3, kMaxPolygon> sorted{};
+    for (int i = 0; i < out.n; ++i) {
+        sorted[static_cast<std::size_t>(i)] =
+            out.v[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
+    }
+    out.v = sorted;
+    return true;
+}
+
+// Sutherland-Hodgman (RTCD 8.3.4) against the half-space m . x <= c.
+int clipByPlane(const std::array<Vec3, 2 * kMaxPolygon>& in, int n, const Vec3& m, Real c,
+                std::array<Vec3, 2 * kMaxPolygon>& out) {
+    int k = 0;
+    for (int i = 0; i < n; ++i) {
+        const Vec3& p = in[static_cast<std::size_t>(i)];
+        const Vec3& q = in[static_cast<std::size_t>((i + 1) % n)];
+        const Real dp = m.dot(p) - c;
+        const Real dq = m.dot(q) - c;
+        if (dp <= 0 && k < 2 * kMaxPolygon) out[static_cast<std::size_t>(k++)] = p;
+        if (((dp < 0 && dq > 0) || (dp > 0 && dq < 0)) && k < 2 * kMaxPolygon) {
+            out[static_cast<std::size_t>(k++)] = p + (dp / (dp - dq)) * (q - p);
+        }
+    }
+    return k;
+}
+
+// Face contact between two polytopes (A's frame, normal from A to B): the reference face (the
+// face of A or B best aligned with the normal) clips the other shape's most anti-parallel face;
+// points below the reference plane (depth >= -tolerance) form the manifold, reduced to 4 like
+// box-box. Returns false (keep the single witness point) unless the reference face's normal is
+// the contact normal, i.e. a face-vertex, face-edge or face-face contact.
+bool polytopeManifold(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
+                      Local& out) {
+    const Real tol = kFeatureRelative * ctx.scale;
+    Polygon face_a;
+    Polygon face_b;
+    const Vec3 n_in_b = rel.rotation.transpose() * (-out.normal);
+    // Only a face aligned with the normal can be the reference: test both cheaply first, then
+    // build the other side's (incident) face whatever its alignment.
+    const bool a_ok = facePolygon(a, out.normal, tol, kFaceAlignment, face_a);
+    const bool b_ok = facePolygon(b, n_in_b, tol, kFaceAlignment, face_b);
+    if (!a_ok && !b_ok) return false;
+    const bool a_is_reference = a_ok && (!b_ok || face_a.alignment >= face_b.alignment);
+    if (a_is_reference && !b_ok && !facePolygon(b, n_in_b, tol, -2, face_b)) return false;
+    if (!a_is_reference && !a_ok && !facePolygon(a, out.normal, tol, -2, face_a)) return false;
+    // Put B's face in A's frame.
+    for (int i = 0; i < face_b.n; ++i) {
+        face_b.v[static_cast<std::size_t>(i)] =
+            rel.rotation * face_b.v[static_cast<std::size_t>(i)] + rel.position;
+    }
+    face_b.normal = rel.rotation * face_b.normal;
+    face_b.offset = face_b.normal.dot(face_b.v[0]);
+    const Polygon& ref = a_is_reference ? face_a : face_b;
+    const Polygon& inc = a_is_reference ? face_b : face_a;
+
+    std::array<Vec3, 2 * kMaxPolygon> poly{};
+    std::array<Vec3, 2 * kMaxPolygon> tmp{};
+    int count = inc.n;
+    for (int i = 0; i < inc.n; ++i)
+        poly[static_cast<std::size_t>(i)] = inc.v[static_cast<std::size_t>(i)];
+    for (int e = 0; e < ref.n && count > 0; ++e) {
+        const Vec3& p = ref.v[static_cast<std::size_t>(e)];
+        const Vec3& q = ref.v[static_cast<std::size_t>((e + 1) % ref.n)];
+        const Vec3 m = (q - p).cross(ref.normal);  // outward side plane (CCW polygon)
+        count = clipByPlane(poly, count, m, m.dot(p), tmp);
+        poly = tmp;
+    }
+    std::array<Vec3, 2 * kMaxPolygon> points{};
+    std::array<Real, 2 * kMaxPolygon> depths{};
+    int kept = 0;
+    // Depth along the contact normal to the reference plane, so that each point pair satisfies
+    // point_b - point_a = -depth * normal exactly (the normals differ by < 1.5e-6 rad).
+    const Real cos_ref = a_is_reference ? ref.normal.dot(out.normal) : -ref.normal.dot(out.normal);
+    const Real max_depth = std::max(Real(0), -out.signed_distance) + tol;
+    for (int i = 0; i < count; ++i) {
+        const Vec3& p = poly[static_cast<std::size_t>(i)];
+        const Real depth = (ref.offset - ref.normal.dot(p)) / cos_ref;
+        // Deeper than the contact itself means beyond the far side of a thin reference shape
+        // (the side planes bound the face's prism, not the shape): not a contact point.
+        if (depth >= -ctx.tolerance && depth <= max_depth) {
+            points[static_cast<std::size_t>(kept)] = p;
+            depths[static_cast<std::size_t>(kept)] = depth;
+            ++kept;
+        }
+    }
+    if (kept == 0) return false;
+    std::array<int, 4> chosen{};
+    const int m = reduceManifold(points.data(), depths.data(), kept, out.normal, chosen);
+    out.manifold_size = m;
+    for (int i = 0; i < m; ++i) {
+        const auto k = static_cast<std::size_t>(chosen[static_cast<std::size_t>(i)]);
+        ManifoldPoint& mp = out.manifold[static_cast<std::size_t>(i)];
+        mp.depth = std::max(depths[k], Real(0));
+        // The incident point, and its projection onto the reference face along the normal.
+        if (a_is_reference) {
+            mp.point_b = points[k];
+            mp.point_a = points[k] + depths[k] * out.normal;
+        } else {
+            mp.point_a = points[k];
+            mp.point_b = points[k] - depths[k] * out.normal;
+        }
+    }
     return true;
 }
 
@@ -745,15 +960,22 @@ ContactOutput contact(const Shape& a_in, const Pose& pose_a_in, const Shape& b_i
             local.state = c.state;
         }
     }
+    // The output never carries NaN or a non-unit normal: anything else is Failed.
     if (local.state == ContactState::Failed || !std::isfinite(local.signed_distance) ||
-        !local.normal.allFinite() || !local.point_a.allFinite() || !local.point_b.allFinite()) {
+        !local.normal.allFinite() || !(std::abs(local.normal.squaredNorm() - 1) < Real(1e-6)) ||
+        !local.point_a.allFinite() || !local.point_b.allFinite()) {
         failed.iterations = local.iterations;
         return failed;
     }
     if (local.state == ContactState::Separated) {
         local.manifold_size = 0;
     } else if (local.manifold_size == 0) {
-        setSingleManifold(local);
+        const bool polytopes =
+            (first.type == ShapeType::Box || first.type == ShapeType::ConvexHull) &&
+            (second.type == ShapeType::Box || second.type == ShapeType::ConvexHull);
+        if (!polytopes || !polytopeManifold(first, second, rel, ctx, local)) {
+            setSingleManifold(local);
+        }
     }
 
     // To world, once; then mirror if the canonical order swapped A and B.

@@ -54,44 +54,47 @@ void segmentWeights(const Vec3& p, const Vec3& q, Real& wp, Real& wq) {
 }
 
 // Closest point to the origin on triangle pqr by Voronoi regions (RTCD 5.1.5); weights in w.
-void triangleWeights(const Vec3& p, const Vec3& q, const Vec3& r, std::array<Real, 3>& w) {
+// In the face region the point is the plane projection n (n.p) / |n|^2 with signed-area weights:
+// for slivers far from the origin p + v pq + t pr loses accuracy like |p|^2 / area, enough to
+// stall GJK at a wrong distance (a 3e-5-thin box touching a 5-unit box came out 6e-6 apart).
+Vec3 triangleClosest(const Vec3& p, const Vec3& q, const Vec3& r, std::array<Real, 3>& w) {
     const Vec3 pq = q - p;
     const Vec3 pr = r - p;
     const Real d1 = -pq.dot(p);
     const Real d2 = -pr.dot(p);
     if (d1 <= 0 && d2 <= 0) {
         w = {1, 0, 0};
-        return;
+        return p;
     }
     const Real d3 = -pq.dot(q);
     const Real d4 = -pr.dot(q);
     if (d3 >= 0 && d4 <= d3) {
         w = {0, 1, 0};
-        return;
+        return q;
     }
     const Real vr = d1 * d4 - d3 * d2;
     if (vr <= 0 && d1 >= 0 && d3 <= 0) {
         const Real t = d1 / (d1 - d3);
         w = {1 - t, t, 0};
-        return;
+        return p + t * pq;
     }
     const Real d5 = -pq.dot(r);
     const Real d6 = -pr.dot(r);
     if (d6 >= 0 && d5 <= d6) {
         w = {0, 0, 1};
-        return;
+        return r;
     }
     const Real vq = d5 * d2 - d1 * d6;
     if (vq <= 0 && d2 >= 0 && d6 <= 0) {
         const Real t = d2 / (d2 - d6);
         w = {1 - t, 0, t};
-        return;
+        return p + t * pr;
     }
     const Real vp = d3 * d6 - d5 * d4;
     if (vp <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
         const Real t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
         w = {0, 1 - t, t};
-        return;
+        return q + t * (r - q);
     }
     const Real denom = vp + vq + vr;
     if (!(denom > kDegenerateRelative * pq.squaredNorm() * pr.squaredNorm())) {
@@ -109,25 +112,37 @@ void triangleWeights(const Vec3& p, const Vec3& q, const Vec3& r, std::array<Rea
         segmentWeights(r, p, a, b);
         if ((a * r + b * p).squaredNorm() < best2) best = {b, 0, a};
         w = best;
-        return;
+        return best[0] * p + best[1] * q + best[2] * r;
+    }
+    const Vec3 n = pq.cross(pr);
+    const Real nn = n.squaredNorm();
+    if (nn > 0) {
+        const Vec3 x = n * (n.dot(p) / nn);
+        const Real wp = n.dot((q - x).cross(r - x)) / nn;
+        const Real wq = n.dot((r - x).cross(p - x)) / nn;
+        w = {wp, wq, 1 - wp - wq};
+        return x;
     }
     const Real v = vq / denom;
     const Real t = vr / denom;
     w = {1 - v - t, v, t};
+    return p + v * pq + t * pr;
 }
 
 // Closest point of the simplex to the origin; reduces the simplex to the vertices with positive
 // weight and fills their weights. `enclosed` when a tetrahedron holds the origin (RTCD 5.1.6).
-void reduceSimplex(WitnessSimplex& s, std::array<Real, 4>& weight, bool& enclosed) {
+Vec3 reduceSimplex(WitnessSimplex& s, std::array<Real, 4>& weight, bool& enclosed) {
     enclosed = false;
     weight = {0, 0, 0, 0};
+    Vec3 point = s.v[0].w;
     if (s.n == 1) {
         weight[0] = 1;
     } else if (s.n == 2) {
         segmentWeights(s.v[0].w, s.v[1].w, weight[0], weight[1]);
+        point = weight[0] * s.v[0].w + weight[1] * s.v[1].w;
     } else if (s.n == 3) {
         std::array<Real, 3> w3{};
-        triangleWeights(s.v[0].w, s.v[1].w, s.v[2].w, w3);
+        point = triangleClosest(s.v[0].w, s.v[1].w, s.v[2].w, w3);
         weight = {w3[0], w3[1], w3[2], 0};
     } else {
         static constexpr int kFaces[4][4] = {
@@ -147,10 +162,11 @@ void reduceSimplex(WitnessSimplex& s, std::array<Real, 4>& weight, bool& enclose
             if (!flat && side_origin * side_opposite >= 0) continue;  // origin on o's side
             outside_any = true;
             std::array<Real, 3> w3{};
-            triangleWeights(p, q, r, w3);
-            const Real d2 = (w3[0] * p + w3[1] * q + w3[2] * r).squaredNorm();
+            const Vec3 x = triangleClosest(p, q, r, w3);
+            const Real d2 = x.squaredNorm();
             if (d2 < best) {
                 best = d2;
+                point = x;
                 weight = {0, 0, 0, 0};
                 weight[f[0]] = w3[0];
                 weight[f[1]] = w3[1];
@@ -159,7 +175,7 @@ void reduceSimplex(WitnessSimplex& s, std::array<Real, 4>& weight, bool& enclose
         }
         if (!outside_any) {
             enclosed = true;
-            return;
+            return Vec3::Zero();
         }
     }
     WitnessSimplex reduced;
@@ -176,6 +192,7 @@ void reduceSimplex(WitnessSimplex& s, std::array<Real, 4>& weight, bool& enclose
     }
     s = reduced;
     weight = reduced_weight;
+    return point;
 }
 
 Real maxNorm(const WitnessSimplex& s) {
@@ -184,13 +201,10 @@ Real maxNorm(const WitnessSimplex& s) {
     return m;
 }
 
-void combine(const WitnessSimplex& s, const std::array<Real, 4>& weight, Vec3& v, Vec3& pa,
-             Vec3& pb) {
-    v.setZero();
+void combine(const WitnessSimplex& s, const std::array<Real, 4>& weight, Vec3& pa, Vec3& pb) {
     pa.setZero();
     pb.setZero();
     for (int i = 0; i < s.n; ++i) {
-        v += weight[i] * s.v[i].w;
         pa += weight[i] * s.v[i].a;
         pb += weight[i] * s.v[i].b;
     }
@@ -198,20 +212,22 @@ void combine(const WitnessSimplex& s, const std::array<Real, 4>& weight, Vec3& v
 
 // ---- EPA polytope ----
 
+// Set entirely by Polytope::addFace; no default values, so the face array costs no zeroing.
 struct Face {
-    std::array<int, 3> v{};
-    Vec3 normal = Vec3::Zero();  // unit outward; zero when degenerate
-    Real dist = 0;               // normal . vertex
-    bool valid = true;
+    std::array<int, 3> v;
+    Vec3 normal;  // unit outward; zero when degenerate
+    Real dist;    // normal . vertex
+    bool valid;
 };
 
 constexpr int kMaxVertices = kEpaMaxIterations + 4;
 constexpr int kMaxFaces = 2 * kMaxVertices;
 
 struct Polytope {
-    std::array<SupportVertex, kMaxVertices> vert{};
+    // Only the first vertex_count / face_count entries are set (no zeroing of ~22 kB per call).
+    std::array<SupportVertex, kMaxVertices> vert;
     int vertex_count = 0;
-    std::array<Face, kMaxFaces> faces{};
+    std::array<Face, kMaxFaces> faces;
     int face_count = 0;
     Real eps = 0;
 
@@ -242,7 +258,7 @@ void faceOutput(const Polytope& poly, const Face& f, EpaOutput& out) {
     const SupportVertex& q = poly.vert[static_cast<std::size_t>(f.v[1])];
     const SupportVertex& r = poly.vert[static_cast<std::size_t>(f.v[2])];
     std::array<Real, 3> w{};
-    triangleWeights(p.w, q.w, r.w, w);
+    triangleClosest(p.w, q.w, r.w, w);
     out.normal = f.normal;
     out.depth = f.dist;
     out.point_a = w[0] * p.a + w[1] * q.a + w[2] * r.a;
@@ -292,16 +308,15 @@ GjkWitnessOutput gjkWitness(const ConvexCore& a, const ConvexCore& b, const Rela
         s.v[s.n++] = w;
         std::array<Real, 4> weight{};
         bool enclosed = false;
-        reduceSimplex(s, weight, enclosed);
+        const Vec3 v_next = reduceSimplex(s, weight, enclosed);
         if (enclosed) {
             out.state = GjkState::Overlapping;
             out.distance = 0;
             return out;
         }
-        Vec3 v_next;
         Vec3 pa;
         Vec3 pb;
-        combine(s, weight, v_next, pa, pb);
+        combine(s, weight, pa, pb);
         if (!(v_next.squaredNorm() < vv)) {
             s = before;  // |v| must decrease strictly; rounding stalled it
             out.state = GjkState::Separated;
@@ -324,8 +339,9 @@ EpaOutput epaPenetration(const ConvexCore& a, const ConvexCore& b, const Relativ
     Polytope poly;
     poly.eps = std::max(Real(64) * kEpsilon * scale, std::numeric_limits<Real>::min());
     const Real tol = std::max(kEpaRelativeTolerance * scale, std::numeric_limits<Real>::min());
-    for (int i = 0; i < start.n; ++i) poly.vert[static_cast<std::size_t>(poly.vertex_count++)] =
-        start.v[static_cast<std::size_t>(i)];
+    for (int i = 0; i < start.n; ++i)
+        poly.vert[static_cast<std::size_t>(poly.vertex_count++)] =
+            start.v[static_cast<std::size_t>(i)];
 
     // Every probed direction n gives an upper bound h(n) on the depth; the best one answers when
     // the obstacle is flat (zero volume) and the polytope cannot grow to a tetrahedron.
@@ -410,7 +426,7 @@ EpaOutput epaPenetration(const ConvexCore& a, const ConvexCore& b, const Relativ
     poly.addFace(0, 2, 3);
     poly.addFace(1, 3, 2);
 
-    std::array<std::array<int, 2>, 3 * kMaxFaces> edges{};
+    std::array<std::array<int, 2>, 3 * kMaxFaces> edges;  // the first edge_count are set
     for (int iter = 0; iter < kEpaMaxIterations; ++iter) {
         ++out.iterations;
         int best = -1;
@@ -431,8 +447,8 @@ EpaOutput epaPenetration(const ConvexCore& a, const ConvexCore& b, const Relativ
         if (!converged) {
             const Real dup = kDuplicateRelative * std::max(w.w.norm(), scale);
             for (int i = 0; i < poly.vertex_count && !converged; ++i) {
-                converged = (poly.vert[static_cast<std::size_t>(i)].w - w.w).squaredNorm() <=
-                            dup * dup;
+                converged =
+                    (poly.vert[static_cast<std::size_t>(i)].w - w.w).squaredNorm() <= dup * dup;
             }
         }
         if (converged) {
@@ -444,11 +460,11 @@ EpaOutput epaPenetration(const ConvexCore& a, const ConvexCore& b, const Relativ
                 const Face& face = poly.faces[static_cast<std::size_t>(f)];
                 if (!face.valid || face.normal.isZero() || face.dist > closest.dist + tol) continue;
                 std::array<Real, 3> wt{};
-                const Vec3& p = poly.vert[static_cast<std::size_t>(face.v[0])].w;
-                const Vec3& q = poly.vert[static_cast<std::size_t>(face.v[1])].w;
-                const Vec3& r = poly.vert[static_cast<std::size_t>(face.v[2])].w;
-                triangleWeights(p, q, r, wt);
-                const Real d2 = (wt[0] * p + wt[1] * q + wt[2] * r).squaredNorm();
+                const Real d2 =
+                    triangleClosest(poly.vert[static_cast<std::size_t>(face.v[0])].w,
+                                    poly.vert[static_cast<std::size_t>(face.v[1])].w,
+                                    poly.vert[static_cast<std::size_t>(face.v[2])].w, wt)
+                        .squaredNorm();
                 if (d2 < chosen2) {
                     chosen2 = d2;
                     chosen = face;

@@ -3,6 +3,7 @@
 // ConvexCore support mappings of gjk.h. Used by contact() (contact.cpp); private to collision.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 
@@ -12,11 +13,12 @@
 namespace collision {
 
 /// A vertex of the configuration-space obstacle A - B with the support points that made it,
-/// all in A's frame: w = a - b.
+/// all in A's frame: w = a - b. No default member values (EPA keeps arrays of them and must not
+/// pay for zeroing); value-initialise (`{}`) where zeros are needed.
 struct SupportVertex {
-    Vec3 w = Vec3::Zero();
-    Vec3 a = Vec3::Zero();
-    Vec3 b = Vec3::Zero();
+    Vec3 w;
+    Vec3 a;
+    Vec3 b;
 };
 
 /// A GJK simplex of up to four support vertices.
@@ -52,18 +54,18 @@ struct EpaOutput {
     /// Penetration depth of the cores (radii ignored), >= 0 up to rounding: translating B by
     /// depth * normal makes the cores touch.
     Real depth = 0;
-    Vec3 normal = Vec3::UnitX();    ///< unit, A's frame, from A towards B
-    Vec3 point_a = Vec3::Zero();    ///< deepest point of core A along normal, A's frame
-    Vec3 point_b = Vec3::Zero();    ///< deepest point of core B along -normal, A's frame
+    Vec3 normal = Vec3::UnitX();  ///< unit, A's frame, from A towards B
+    Vec3 point_a = Vec3::Zero();  ///< deepest point of core A along normal, A's frame
+    Vec3 point_b = Vec3::Zero();  ///< deepest point of core B along -normal, A's frame
     std::int32_t iterations = 0;
 };
 
 /// EPA iteration cap (expansions of the polytope).
-inline constexpr int kEpaMaxIterations = 128;
+inline constexpr int kEpaMaxIterations = 256;
 /// EPA stops when the support distance h(n) and the face distance differ by at most
 /// kEpaRelativeTolerance * scale: the depth is then accurate to that absolute error (the face
 /// distance is a lower bound on the depth, h(n) an upper bound; van den Bergen 2001 §4).
-inline constexpr Real kEpaRelativeTolerance = Real(1e-11);
+inline constexpr Real kEpaRelativeTolerance = std::max(Real(1e-11), Real(64) * kEpsilon);
 
 /// Penetration depth, normal and witness points of two overlapping cores, starting from GJK's
 /// final simplex `start` (any size 1..4; it is blown up to a tetrahedron). A flat configuration

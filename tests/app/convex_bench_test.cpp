@@ -40,8 +40,8 @@ fs::path tempDir(const std::string& name) {
 Result runCdlab(const std::string& args, const fs::path& work) {
     const fs::path out = work / "stdout.txt";
     const fs::path err = work / "stderr.txt";
-    const std::string cmd = std::string(CDLAB_BINARY) + " " + args + " > " + out.string() +
-                            " 2> " + err.string() + " < /dev/null";
+    const std::string cmd = std::string(CDLAB_BINARY) + " " + args + " > " + out.string() + " 2> " +
+                            err.string() + " < /dev/null";
     const int status = std::system(cmd.c_str());
     Result r;
     r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -56,7 +56,8 @@ TEST(ConvexBench, FewQueriesNoMismatchAndCompleteJson) {
     const Result r =
         runCdlab("bench convex --queries 200 --passes 1 --json " + json.string(), work);
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    for (const char* column : {"workload", "cdlab_us", "bullet_us", "disagree", "max_diff"}) {
+    for (const char* column :
+         {"workload", "cdlab_us", "bullet_us", "disagree", "max_diff", "cdlab_ext"}) {
         EXPECT_NE(r.out.find(column), std::string::npos) << column;
     }
     ASSERT_TRUE(fs::exists(json));
@@ -71,7 +72,11 @@ TEST(ConvexBench, FewQueriesNoMismatchAndCompleteJson) {
         EXPECT_EQ(row["queries"].get<int>(), 200) << name;
         EXPECT_EQ(row["cdlab_failed"].get<int>(), 0) << name;
         EXPECT_GT(row["cdlab_us"].get<double>(), 0) << name;
-        EXPECT_LE(row["cdlab_far_error"].get<double>(), 1e-9) << name;
+        // cdlab's answers survive translation by 1e6 and scaling by 1e-4 / 1e4 (relative to size).
+        EXPECT_EQ(row["cdlab_variant_failed"].get<int>(), 0) << name;
+        for (const char* key : {"cdlab_far_error", "cdlab_small_error", "cdlab_large_error"}) {
+            EXPECT_LE(row[key].get<double>(), 1e-9) << name << " " << key;
+        }
         if (name.find("separated") != std::string::npos) {
             EXPECT_EQ(row["colliding"].get<int>(), 0) << name;
             ++separated_rows;

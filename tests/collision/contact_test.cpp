@@ -10,11 +10,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <iomanip>
 #include <memory>
 #include <vector>
 
 #include "collision/convex_hull.h"
 #include "collision/narrow_phase.h"
+// Private narrow-phase headers (collision/src is on the test include path) for the caps.
+#include "epa.h"
 #include "test_random.h"
 
 namespace {
@@ -170,7 +173,8 @@ Real pointSegmentDistance(const Vec3& p, const Vec3& a, const Vec3& b) {
 
 // Segment-segment distance by ternary search over the first parameter (the distance from a
 // moving point to a segment is convex in the parameter): an independent reference for RTCD 5.1.9.
-Real segmentSegmentReference(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2) {
+Real segmentSegmentReference(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2,
+                             Vec3* on1 = nullptr) {
     Real lo = 0;
     Real hi = 1;
     for (int i = 0; i < 200; ++i) {
@@ -183,6 +187,7 @@ Real segmentSegmentReference(const Vec3& p1, const Vec3& q1, const Vec3& p2, con
             lo = m1;
         }
     }
+    if (on1 != nullptr) *on1 = p1 + (lo + hi) / 2 * (q1 - p1);
     return pointSegmentDistance(p1 + (lo + hi) / 2 * (q1 - p1), p2, q2);
 }
 
@@ -241,6 +246,18 @@ TEST(Contact, SphereBoxMatchesClosedFormAndGjkEpaAgrees) {
         for (const Shape* s : {&box, &hull}) {
             const ContactOutput out = contact(sphere, ps, *s, pb);
             ASSERT_NEAR(out.signed_distance, expected, 1e-10 * scale) << n;
+            // Normal: from the centre to its closest box point outside (RTCD 5.1.3); inside,
+            // minus the normal of the nearest face (the way out is through it).
+            const Vec3 clamped = centre.cwiseMax(-h).cwiseMin(h);
+            Vec3 expected_normal_local;
+            if ((centre - clamped).norm() > 1e-9 * scale) {
+                expected_normal_local = (clamped - centre).normalized();
+            } else {
+                int k = 0;
+                (h - centre.cwiseAbs()).minCoeff(&k);
+                expected_normal_local = -Vec3::Unit(k) * (centre[k] < 0 ? -1 : 1);
+            }
+            ASSERT_LE((out.normal - pb.orientation * expected_normal_local).norm(), 1e-9) << n;
             ASSERT_EQ(out.state, collide(sphere, ps, *s, pb).state) << n;
             expectConsistent(sphere, ps, *s, pb, out, 1e-9, "sphere-box", n);
             expectMirror(out, contact(*s, pb, sphere, ps), n);
@@ -328,13 +345,19 @@ TEST(Contact, CapsuleCapsuleMatchesReference) {
         const Pose pb = at(pa.position + rng.vec(-1.4, 1.4), rng.rotation());
         const Vec3 ya = pa.orientation * Vec3::UnitY() * a.half_height;
         const Vec3 yb = pb.orientation * Vec3::UnitY() * b.half_height;
-        const Real expected = segmentSegmentReference(pa.position - ya, pa.position + ya,
-                                                      pb.position - yb, pb.position + yb) -
-                              a.radius - b.radius;
+        Vec3 on_a;
+        const Real core_distance = segmentSegmentReference(
+            pa.position - ya, pa.position + ya, pb.position - yb, pb.position + yb, &on_a);
+        const Real expected = core_distance - a.radius - b.radius;
         const Real scale = std::max(a.radius + a.half_height, b.radius + b.half_height);
         const ContactOutput out = contact(a, pa, b, pb);
         ASSERT_NEAR(out.signed_distance, expected, 1e-9 * scale) << n;
         ASSERT_EQ(out.state, collide(a, pa, b, pb).state) << n;
+        // Witness on A: its core point pushed out by the radius; the reference core point is
+        // found by ternary search (accurate to ~1e-8 of the length where the minimum is flat).
+        if (core_distance > 1e-3 * scale) {
+            ASSERT_LE((out.point_a - out.normal * a.radius - on_a).norm(), 1e-6 * scale) << n;
+        }
         expectConsistent(a, pa, b, pb, out, 1e-9, "capsule-capsule", n);
         expectMirror(out, contact(b, pb, a, pa), n);
         mix.add(out);
@@ -378,9 +401,11 @@ TEST(Contact, EveryConvexPairAgreesWithCollideAndMirrors) {
                 const Real reach = boundingRadius(zoo[i]) + boundingRadius(zoo[j]);
                 const Pose pa = at(rng.vec(-1, 1), rng.rotation());
                 const Vec3 dir = rng.rotation() * Vec3::UnitX();
-                const Pose pb = at(pa.position + rng.uniform(0.1, 1.2) * reach * dir, rng.rotation());
+                const Pose pb =
+                    at(pa.position + rng.uniform(0.1, 1.2) * reach * dir, rng.rotation());
                 const ContactOutput out = contact(zoo[i], pa, zoo[j], pb);
-                ASSERT_EQ(out.state, collide(zoo[i], pa, zoo[j], pb).state) << i << " " << j << " " << n;
+                ASSERT_EQ(out.state, collide(zoo[i], pa, zoo[j], pb).state)
+                    << i << " " << j << " " << n;
                 expectConsistent(zoo[i], pa, zoo[j], pb, out, 1e-9, "zoo", n);
                 expectMirror(out, contact(zoo[j], pb, zoo[i], pa), n);
                 mix.add(out);
@@ -409,7 +434,8 @@ TEST(Contact, NearTouchingStateAgreesWithCollide) {
                 const Real tol = collision::kTouchRelativeTolerance * scale;
                 pb.position -= (first.signed_distance - rng.uniform(-3, 3) * tol) * first.normal;
                 const ContactOutput out = contact(zoo[i], pa, zoo[j], pb);
-                ASSERT_EQ(out.state, collide(zoo[i], pa, zoo[j], pb).state) << i << " " << j << " " << n;
+                ASSERT_EQ(out.state, collide(zoo[i], pa, zoo[j], pb).state)
+                    << i << " " << j << " " << n;
                 ASSERT_TRUE(out.normal.allFinite());
                 expectMirror(out, contact(zoo[j], pb, zoo[i], pa), n);
                 if (out.state == ContactState::Touching) ++touching;
@@ -476,7 +502,8 @@ TEST(Contact, DegenerateConfigurationsGiveFiniteNormals) {
         // Identical inputs (same shape, same pose) make contact(a, b) and contact(b, a) the
         // same call: no mirror is possible there.
         const bool identical = c.a.type == c.b.type && c.a.hull == c.b.hull &&
-                               c.a.half_extents == c.b.half_extents && c.pa.position == c.pb.position;
+                               c.a.half_extents == c.b.half_extents &&
+                               c.pa.position == c.pb.position;
         if (!identical) expectMirror(out, contact(c.b, c.pb, c.a, c.pa), static_cast<int>(n));
     }
     // Crossing capsule axes: depth is the sum of the radii along the common perpendicular.
@@ -523,9 +550,8 @@ TEST(Contact, BoxFeaturesForVertexEdgeFace) {
     EXPECT_EQ(out.feature_a.index, 2);
     // Box-box: B's vertex pushed into A's +z face; crossed edges.
     const Shape cube = Shape::box(Vec3(1, 1, 1));
-    const Pose corner_down =
-        at(Vec3(0.1, -0.2, 1 + std::sqrt(Real(3)) - 0.05),
-           Quat::FromTwoVectors(Vec3(1, 1, 1).normalized(), Vec3(0, 0, 1)));
+    const Pose corner_down = at(Vec3(0.1, -0.2, 1 + std::sqrt(Real(3)) - 0.05),
+                                Quat::FromTwoVectors(Vec3(1, 1, 1).normalized(), Vec3(0, 0, 1)));
     out = contact(cube, at(Vec3::Zero()), cube, corner_down);
     EXPECT_EQ(out.state, ContactState::Penetrating);
     EXPECT_NEAR(out.signed_distance, -0.05, 1e-12);
@@ -539,7 +565,7 @@ TEST(Contact, BoxFeaturesForVertexEdgeFace) {
     const Real r2 = std::sqrt(Real(2));
     const Vec3 u_img = Vec3(0, -1, -1) / r2;  // image of local (-1, -1, 0) / sqrt 2
     const Vec3 z_img = Vec3(0, -1, 1) / r2;
-    const Vec3 v_img = z_img.cross(u_img);    // image of local (1, -1, 0) / sqrt 2
+    const Vec3 v_img = z_img.cross(u_img);  // image of local (1, -1, 0) / sqrt 2
     collision::Mat3 rot;
     rot.col(0) = (v_img - u_img) / r2;
     rot.col(1) = -(u_img + v_img) / r2;
@@ -547,7 +573,8 @@ TEST(Contact, BoxFeaturesForVertexEdgeFace) {
     const Real h = 0.5;
     const Real pen = 0.01;
     const Shape small = Shape::box(Vec3(h, h, h));
-    const Pose crossed = at(Vec3(0, 1, 1) + h * Vec3(0, 1, 1) - pen * Vec3(0, 1, 1) / r2, Quat(rot));
+    const Pose crossed =
+        at(Vec3(0, 1, 1) + h * Vec3(0, 1, 1) - pen * Vec3(0, 1, 1) / r2, Quat(rot));
     out = contact(cube, at(Vec3::Zero()), small, crossed);
     ASSERT_EQ(out.state, ContactState::Penetrating);
     EXPECT_NEAR(out.signed_distance, -pen, 1e-12);
@@ -634,7 +661,8 @@ TEST(Contact, TranslationAndScaleInvariance) {
                         }
                         // Absolute rounding of coordinates near 1e6 is ~1e6 eps = 2e-10, relative
                         // to a size s: allow 1e-9 relative plus that.
-                        const Real tol = 1e-9 * scale + 64 * collision::kEpsilon * offset.norm() / s;
+                        const Real tol =
+                            1e-9 * scale + 64 * collision::kEpsilon * offset.norm() / s;
                         ASSERT_NEAR(out.signed_distance / s, ref.signed_distance, tol)
                             << i << " " << j << " " << n << " s=" << s;
                         if (std::abs(ref.signed_distance) > 1e-6 * scale &&
@@ -652,6 +680,278 @@ TEST(Contact, TranslationAndScaleInvariance) {
             }
         }
     }
+}
+
+// Regression (sliver simplex): a 3.4e-5-thin box B whose corner touches a 4.6 x 0.017 x 2.8 box A.
+// GJK's final triangle spanned ~5.6 units but was ~1e-5 wide; its closest point, computed as
+// a + v ab + t ac, was off by ~1e-11, enough for support(-v) to return an old vertex, and GJK
+// stopped at 6.1e-6 (both contact() and collide() said Separated). The face-region point is now
+// the plane projection n (n.a) / |n|^2.
+//
+//        A (big, flat)          B (thin) touches A with one corner
+//   +-----------------+ <.>
+TEST(Contact, RegressionSliverSimplexStalledGjkAboveTouching) {
+    const Shape a =
+        Shape::box(Vec3(0x1.289888f81391dp+2, 0x1.1a613d22f861bp-6, 0x1.684d03ee81fb4p+1));
+    const Shape b =
+        Shape::box(Vec3(0x1.d83caccb95578p-7, 0x1.1ca5cd56bafcfp-15, 0x1.0e5426ff667f8p-8));
+    const Pose pa{Vec3(-0x1.21625414a1bfap+2, 0x1.3eef5f2c539b8p+0, -0x1.32e6fa2d341b6p+2),
+                  Quat(-0x1.fbdb13cfccedp-8, -0x1.161b9ab1491e3p-2, -0x1.93ee65958ce87p-2,
+                       0x1.c1724dc568b71p-1)};
+    const Pose pb{Vec3(-0x1.87e39e9a50fdep-1, 0x1.aa4aaab88fd2p-5, -0x1.27fe0f2f4b715p+1),
+                  Quat(0x1.be8b2bd3a1725p-2, -0x1.18190cc6f507bp-1, -0x1.6d12b60b688c9p-1,
+                       -0x1.7aceb02ca555ep-5)};
+    // Brute force: the deepest corner of B lies on A's surface (|sdf| ~ 1e-15).
+    Real deepest = std::numeric_limits<Real>::infinity();
+    for (int i = 0; i < 8; ++i) {
+        const Vec3& h = b.half_extents;
+        const Vec3 corner((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(),
+                          (i & 4) ? h.z() : -h.z());
+        deepest = std::min(deepest, surfaceDistance(a, pa, pb.apply(corner)));
+    }
+    ASSERT_NEAR(deepest, 0, 1e-14);
+    const ContactOutput out = contact(a, pa, b, pb);
+    EXPECT_EQ(out.state, ContactState::Touching);
+    EXPECT_NEAR(out.signed_distance, 0, 1e-12);
+    EXPECT_EQ(collide(a, pa, b, pb).state, ContactState::Touching);
+    expectMirror(out, contact(b, pb, a, pa), 0);
+}
+
+// Regression (EPA decision cap): two boxes placed exactly touching (B moved by -distance * normal)
+// made collide()'s bounded EPA re-add the same support point until its cap: Failed, and contact()
+// inherited it. A repeated support point now ends the decision as Touching.
+TEST(Contact, RegressionExactlyTouchingBoxesFailedInEpaDecision) {
+    const Shape a =
+        Shape::box(Vec3(0x1.31177fc5952e4p-2, 0x1.c2db8553c31c9p-12, 0x1.2d2e1d7452189p-4));
+    const Shape b =
+        Shape::box(Vec3(0x1.1028f80d6941bp+0, 0x1.29c227091cd84p-6, 0x1.4a23ab3e9f12ep-2));
+    const Pose pa{Vec3(-0x1.7fa74c2381be7p-2, 0x1.04ea69cdad63fp-3, -0x1.3a7ade3cbb3cap-1),
+                  Quat(-0x1.96d22e3cb2d5ap-1, 0x1.f6b71dc6ce5d9p-5, 0x1.3170643e007cep-1,
+                       -0x1.84ad33c03e13bp-4)};
+    const Pose pb{Vec3(0x1.91dadb5d2b3d4p-4, 0x1.cb122fb293672p-2, -0x1.c1043e19818e3p-1),
+                  Quat(-0x1.c579e67719f9ep-1, -0x1.7447530c6c849p-6, 0x1.398720a3a1339p-2,
+                       -0x1.649cc271f3809p-2)};
+    EXPECT_EQ(collide(a, pa, b, pb).state, ContactState::Touching);
+    EXPECT_EQ(collide(b, pb, a, pa).state, ContactState::Touching);
+    const ContactOutput out = contact(a, pa, b, pb);
+    EXPECT_EQ(out.state, ContactState::Touching);
+    EXPECT_GE(out.manifold_size, 1);
+    expectMirror(out, contact(b, pb, a, pa), 0);
+}
+
+// Thin and lopsided shapes placed exactly touching (moved by -distance * normal from a random
+// pose) or with coincident origins: contact() never fails, agrees with collide() and mirrors.
+TEST(Contact, ExtremeAspectRatiosTouchingAndCoincident) {
+    cdlab_test::Rng rng(12);
+    int touching = 0;
+    for (int n = 0; n < 20000; ++n) {
+        auto make = [&](int kind) {
+            const Real size = std::pow(Real(10), rng.uniform(-2, 1));
+            const Real thin = std::pow(Real(10), rng.uniform(-3, 0));
+            if (kind == 0) return Shape::sphere(size);
+            if (kind == 1) return Shape::box(Vec3(size, size * thin, size * rng.uniform(0.01, 1)));
+            if (kind == 2) return Shape::capsule(size * thin, size * rng.uniform(0, 2));
+            std::vector<Vec3> points;
+            for (int i = 0; i < 12; ++i)
+                points.push_back(size * rng.vec(-1, 1).cwiseProduct(Vec3(1, thin, 1)));
+            return Shape::convexHull(hullOf(points));
+        };
+        const Shape a = make(rng.integer(0, 3));
+        const Shape b = make(rng.integer(0, 3));
+        const Real reach = boundingRadius(a) + boundingRadius(b);
+        const Pose pa = at(rng.vec(-1, 1) * reach, rng.rotation());
+        Pose pb = at(pa.position + rng.uniform(0, 1.1) * reach * (rng.rotation() * Vec3::UnitX()),
+                     rng.rotation());
+        if (n % 2 == 0) {
+            const ContactOutput first = contact(a, pa, b, pb);
+            ASSERT_NE(first.state, ContactState::Failed) << n;
+            pb.position -= first.signed_distance * first.normal;
+        } else if (n % 5 == 1) {
+            pb.position = pa.position;
+        }
+        const ContactOutput out = contact(a, pa, b, pb);
+        ASSERT_NE(out.state, ContactState::Failed) << n;
+        ASSERT_EQ(out.state, collide(a, pa, b, pb).state) << n;
+        const Real scale = std::max(boundingRadius(a), boundingRadius(b));
+        ASSERT_LE((out.point_b - out.point_a - out.signed_distance * out.normal).norm(),
+                  1e-8 * scale)
+            << n;
+        // Manifold points: the witness identity with their own depth, never deeper than the
+        // contact (thin reference shapes once gave points beyond their far side).
+        for (int i = 0; i < out.manifold_size; ++i) {
+            const auto& m = out.manifold[static_cast<std::size_t>(i)];
+            ASSERT_LE((m.point_b - m.point_a + m.depth * out.normal).norm(), 1e-8 * scale) << n;
+            ASSERT_LE(m.depth, -out.signed_distance + 1e-8 * scale) << n;
+        }
+        if (pb.position != pa.position || a.type != b.type) {
+            expectMirror(out, contact(b, pb, a, pa), n);
+        }
+        if (out.state == ContactState::Touching) ++touching;
+    }
+    EXPECT_GT(touching, 5000);
+}
+
+// Hull face contacts get a clipped manifold like boxes: a box-shaped hull resting on a slab hull,
+// and a hexagonal prism (6-vertex face) resting on it, reduced to 4 points at the right depth.
+TEST(Contact, HullRestingOnHullGivesClippedManifold) {
+    const Shape ground = boxHull(Vec3(4, 4, 0.5));
+    const Shape crate = boxHull(Vec3(0.5, 0.7, 0.4));
+    std::vector<Vec3> prism_points;
+    for (int i = 0; i < 6; ++i) {
+        const Real t = Real(i) * Real(M_PI) / 3;
+        prism_points.emplace_back(0.6 * std::cos(t), 0.6 * std::sin(t), -0.3);
+        prism_points.emplace_back(0.6 * std::cos(t), 0.6 * std::sin(t), 0.3);
+    }
+    const Shape prism = Shape::convexHull(hullOf(prism_points));
+    const Pose pg = at(Vec3(1, 2, -3));
+    const Real depth = 0.02;
+    struct Case {
+        const Shape* shape;
+        Real half_height;
+        int expected_points;
+    };
+    for (const Case& c : {Case{&crate, 0.4, 4}, Case{&prism, 0.3, 4}}) {
+        const Pose pc =
+            at(Vec3(1.3, 1.8, -3 + 0.5 + c.half_height - depth), axisAngle(0.4, Vec3::UnitZ()));
+        for (const bool swapped : {false, true}) {
+            const ContactOutput out =
+                swapped ? contact(*c.shape, pc, ground, pg) : contact(ground, pg, *c.shape, pc);
+            ASSERT_EQ(out.state, ContactState::Penetrating);
+            EXPECT_NEAR(out.signed_distance, -depth, 1e-9);
+            EXPECT_NEAR(std::abs(out.normal.z()), 1, 1e-12);
+            ASSERT_EQ(out.manifold_size, c.expected_points) << swapped;
+            for (int i = 0; i < out.manifold_size; ++i) {
+                const auto& m = out.manifold[static_cast<std::size_t>(i)];
+                EXPECT_NEAR(m.depth, depth, 1e-9);
+                const Vec3& on_ground = swapped ? m.point_b : m.point_a;
+                EXPECT_NEAR(on_ground.z(), -2.5, 1e-9);
+            }
+            if (swapped) {
+                expectConsistent(*c.shape, pc, ground, pg, out, 1e-9, "hull-rest", 0);
+            } else {
+                expectConsistent(ground, pg, *c.shape, pc, out, 1e-9, "hull-rest", 0);
+            }
+        }
+        // The manifold spans the face: the chosen points are far apart (not 4 near one corner).
+        const ContactOutput out = contact(ground, pg, *c.shape, pc);
+        Real spread = 0;
+        for (int i = 0; i < out.manifold_size; ++i) {
+            for (int j = 0; j < out.manifold_size; ++j) {
+                spread = std::max(spread, (out.manifold[static_cast<std::size_t>(i)].point_b -
+                                           out.manifold[static_cast<std::size_t>(j)].point_b)
+                                              .norm());
+            }
+        }
+        EXPECT_GT(spread, 1.0);
+    }
+    // Box (SAT path) on a hull ground: GJK/EPA normal, clipped manifold of 4.
+    const Pose pc = at(Vec3(0.5, 2, -3 + 0.5 + 0.4 - depth), axisAngle(0.2, Vec3::UnitZ()));
+    const ContactOutput mixed = contact(ground, pg, Shape::box(Vec3(0.5, 0.7, 0.4)), pc);
+    EXPECT_EQ(mixed.manifold_size, 4)
+        << std::setprecision(17) << mixed.normal.transpose() << " sd " << mixed.signed_distance;
+    EXPECT_NEAR(mixed.signed_distance, -depth, 1e-9);
+}
+
+// Hull witness features on a tetrahedron (no coplanar faces): a sphere over a vertex, over an
+// edge and over a face interior gets that vertex index, the edge as face * 3 + edge of a face
+// holding both endpoints, and a face whose plane holds the witness.
+TEST(Contact, HullFeaturesForVertexEdgeFace) {
+    const std::vector<Vec3> corners{Vec3(1, 1, 1), Vec3(1, -1, -1), Vec3(-1, 1, -1),
+                                    Vec3(-1, -1, 1)};
+    const Shape tet = Shape::convexHull(hullOf(corners));
+    const ConvexPolytope& hull = *tet.hull;
+    const Shape sphere = Shape::sphere(0.1);
+    const Pose pt = at(Vec3(100, 200, -300), axisAngle(0.7, Vec3(1, -1, 2)));
+    // Vertex: straight out beyond corner 0.
+    int v0 = -1;
+    for (std::size_t i = 0; i < hull.vertices.size(); ++i) {
+        if ((hull.vertices[i] - corners[0]).norm() < 1e-12) v0 = static_cast<int>(i);
+    }
+    ASSERT_GE(v0, 0);
+    ContactOutput out = contact(tet, pt, sphere, at(pt.apply(corners[0] * 1.2)));
+    EXPECT_EQ(out.feature_a.type, FeatureType::Vertex);
+    EXPECT_EQ(out.feature_a.index, v0);
+    // Edge: beyond the midpoint of corners 0 and 1, along the outward bisector.
+    const Vec3 mid = (corners[0] + corners[1]) / 2;
+    out = contact(tet, pt, sphere, at(pt.apply(mid + 0.12 * mid.normalized())));
+    ASSERT_EQ(out.feature_a.type, FeatureType::Edge);
+    const auto& face = hull.faces[static_cast<std::size_t>(out.feature_a.index / 3)];
+    const int e = out.feature_a.index % 3;
+    const Vec3 s = hull.vertices[static_cast<std::size_t>(face[static_cast<std::size_t>(e)])];
+    const Vec3 t =
+        hull.vertices[static_cast<std::size_t>(face[static_cast<std::size_t>((e + 1) % 3)])];
+    EXPECT_NEAR((s - t).norm(), (corners[0] - corners[1]).norm(), 1e-12);
+    EXPECT_NEAR((s + t - corners[0] - corners[1]).norm(), 0, 1e-12);
+    // Face: beyond the centroid of the face opposite corner 3, inside and outside.
+    const Vec3 centroid = (corners[0] + corners[1] + corners[2]) / 3;
+    for (const Real lift : {Real(0.15), Real(0.05)}) {
+        out = contact(tet, pt, sphere, at(pt.apply(centroid + lift * centroid.normalized())));
+        ASSERT_EQ(out.feature_a.type, FeatureType::Face) << lift;
+        const auto& f = hull.faces[static_cast<std::size_t>(out.feature_a.index)];
+        for (int k = 0; k < 3; ++k) {
+            const Vec3& c = hull.vertices[static_cast<std::size_t>(f[static_cast<std::size_t>(k)])];
+            EXPECT_GT((c - corners[3]).norm(), 1) << lift;  // corner 3 is not on that face
+        }
+    }
+}
+
+// A mesh is its convex hull for contact(): the same answer as the hull shape, mirrored when
+// swapped, for a concave (L-shaped) mesh whose hull differs from its surface.
+TEST(Contact, MeshIsItsConvexHull) {
+    auto mesh = std::make_shared<collision::TriangleMesh>();
+    // An L-shaped prism: 6 profile corners at z = -0.5 and z = +0.5 (triangles only matter for
+    // collide(); contact() reads the hull).
+    const std::array<std::array<Real, 2>, 6> profile{
+        {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}}};
+    for (const Real z : {Real(-0.5), Real(0.5)}) {
+        for (const auto& p : profile) mesh->vertices.emplace_back(p[0] - 1, p[1] - 1, z);
+    }
+    mesh->triangles = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 5}};
+    const auto hull = hullOf(mesh->vertices);
+    const Shape as_mesh = Shape::triangleMesh(mesh, hull);
+    const Shape as_hull = Shape::convexHull(hull);
+    cdlab_test::Rng rng(13);
+    const Shape other = Shape::box(Vec3(0.4, 0.3, 0.2));
+    int colliding = 0;
+    for (int n = 0; n < 300; ++n) {
+        const Pose pm = at(rng.vec(-1, 1), rng.rotation());
+        const Pose po = at(pm.position + rng.vec(-2, 2), rng.rotation());
+        const ContactOutput m = contact(as_mesh, pm, other, po);
+        const ContactOutput h = contact(as_hull, pm, other, po);
+        ASSERT_EQ(m.state, h.state) << n;
+        ASSERT_EQ(m.signed_distance, h.signed_distance) << n;
+        ASSERT_EQ(m.normal, h.normal) << n;
+        ASSERT_EQ(m.point_a, h.point_a) << n;
+        ASSERT_EQ(m.feature_a.index, h.feature_a.index) << n;
+        expectMirror(m, contact(other, po, as_mesh, pm), n);
+        expectConsistent(as_hull, pm, other, po, m, 1e-9, "mesh", n);
+        if (isColliding(m.state)) ++colliding;
+    }
+    EXPECT_GT(colliding, 30);
+    EXPECT_LT(colliding, 270);
+}
+
+// Finely tessellated hulls (2000 points on a sphere) make EPA work hardest: every query stays
+// within the iteration caps, none fails, and the state is collide()'s.
+TEST(Contact, FineHullsStayWithinTheIterationCaps) {
+    cdlab_test::Rng rng(14);
+    std::vector<Vec3> points;
+    for (int i = 0; i < 2000; ++i) points.push_back(rng.vec(-1, 1).normalized());
+    const Shape ball = Shape::convexHull(hullOf(points));
+    const Shape box = Shape::box(Vec3(0.5, 0.4, 0.3));
+    int penetrating = 0;
+    for (int n = 0; n < 150; ++n) {
+        const Shape& other = n % 2 == 0 ? ball : box;
+        const Pose pa = at(rng.vec(-1, 1), rng.rotation());
+        const Pose pb = at(pa.position + rng.vec(-1, 1) * 1.2, rng.rotation());
+        const ContactOutput out = contact(ball, pa, other, pb);
+        ASSERT_NE(out.state, ContactState::Failed) << n;
+        ASSERT_EQ(out.state, collide(ball, pa, other, pb).state) << n;
+        ASSERT_LE(out.iterations, collision::kGjkMaxIterations + collision::kEpaMaxIterations);
+        expectConsistent(ball, pa, other, pb, out, 1e-9, "fine hull", n);
+        if (out.state == ContactState::Penetrating) ++penetrating;
+    }
+    EXPECT_GT(penetrating, 50);
 }
 
 }  // namespace
