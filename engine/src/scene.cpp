@@ -267,7 +267,8 @@ Vec3 SceneParser::readVec3(const YAML::Node& n, const std::string& path) const {
 void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
     const std::string path = "world";
     const std::vector<Entry> es =
-        entries(n, path, {"bounds", "gravity", "time_step", "steps_per_frame", "frames"});
+        entries(n, path, {"bounds", "gravity", "time_step", "steps_per_frame", "frames",
+                          "integrator"});
     {
         const Entry& b = require(es, "bounds", n, path);
         const std::string bp = childPath(path, "bounds");
@@ -297,6 +298,13 @@ void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
         } else if (e.key == "frames") {
             scene.frames = readInt(e.value, p);
             if (scene.frames < 1) fail(e.value, p, "must be >= 1");
+        } else if (e.key == "integrator") {
+            const std::string name = readString(e.value, p);
+            if (!findIntegrator(name, scene.world.integrator)) {
+                fail(e.value, p,
+                     "unknown integrator '" + name + "' (expected one of: " + integratorNames() +
+                         ")");
+            }
         }
     }
 }

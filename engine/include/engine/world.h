@@ -14,6 +14,20 @@
 
 namespace engine {
 
+/// Time integrator of the step. State is (x, q, P, L); the only force is gravity and no torque
+/// acts, so L (world frame) is constant and the gyroscopic term of Euler's equations is carried
+/// by w = R I^-1 R^T L: |L| is conserved exactly by every integrator, they differ in x and q.
+enum class Integrator : std::uint8_t {
+    ExplicitEuler,      ///< x += v(t) dt, P += F dt, q += 1/2 w q dt then normalised (first order)
+    SemiImplicitEuler,  ///< P first, x with the new v; q turned exactly by w at the half step
+    Rk4,                ///< classical Runge-Kutta 4 on (x, P, q, L), q normalised after the step
+};
+std::string_view integratorName(Integrator integrator);  ///< scene name, e.g. "rk4"
+/// Integrator by scene name; false when the name is unknown.
+bool findIntegrator(std::string_view name, Integrator& out);
+/// "explicit_euler, semi_implicit_euler, rk4", for error messages.
+std::string integratorNames();
+
 /// Overlap state of a body, the worst over its pairs.
 enum class BodyState : std::uint8_t { Apart, Flagged, Colliding };
 std::string_view bodyStateName(BodyState state);  ///< "apart", "flagged", "colliding"
@@ -23,6 +37,7 @@ struct WorldSettings {
     Vec3 gravity = Vec3::Zero();   ///< m/s^2
     Real time_step = Real(1) / 60; ///< s, > 0
     std::string broad_phase = "sap";  ///< registry name
+    Integrator integrator = Integrator::SemiImplicitEuler;
 };
 
 /// Wall-clock time per stage of the last step, in seconds, and the broad phase's counters.
@@ -47,7 +62,7 @@ public:
 
     BodyId addBody(Body body);
 
-    /// One time step: integrate (semi-implicit Euler), reflect off the bounds, then detect.
+    /// One time step: integrate (settings().integrator), reflect off the bounds, then detect.
     void step();
     /// Recomputes volumes, pairs and states at the current state, without moving anything.
     void detect();
@@ -72,6 +87,9 @@ public:
 
 private:
     void integrate(Real dt);
+    void integrateExplicitEuler(Real dt);
+    void integrateSemiImplicitEuler(Real dt);
+    void integrateRk4(Real dt);
     void reflectOffBounds();
     void updateVolumes();
     void runCollisionPipeline();
