@@ -76,9 +76,91 @@ Real gapAlong(const Shape& a, const Pose& pa, const Shape& b, const Pose& pb, co
     return n.dot(pb.position - pa.position) - supportValue(a, na) - supportValue(b, -nb);
 }
 
+// The point of the shape (at `pose`) closest to world point `q`: closed forms for spheres
+// (RTCD 5.1.3 idea), boxes (RTCD 5.1.3, clamp in the local frame) and capsules (closest point on
+// the segment, RTCD 5.1.2, then the sphere). Hulls and meshes: the support point towards q
+// (a point of the shape, not necessarily the closest: witness quality only, not safety).
+Vec3 closestPointOnShape(const Shape& shape, const Pose& pose, const Vec3& q) {
+    const Vec3 p = pose.applyInverse(q);
+    Vec3 local = Vec3::Zero();
+    switch (shape.type) {
+        case ShapeType::Sphere: {
+            const Real len = p.norm();
+            local = len > shape.radius ? Vec3(p * (shape.radius / len)) : p;
+            break;
+        }
+        case ShapeType::Box:
+            local = p.cwiseMax(-shape.half_extents).cwiseMin(shape.half_extents);
+            break;
+        case ShapeType::Capsule: {
+            const Vec3 c(0, std::clamp(p.y(), -shape.half_height, shape.half_height), 0);
+            const Vec3 d = p - c;
+            const Real len = d.norm();
+            local = len > shape.radius ? Vec3(c + d * (shape.radius / len)) : p;
+            break;
+        }
+        case ShapeType::ConvexHull:
+        case ShapeType::Mesh: local = supportPoint(shape, p); break;
+    }
+    return pose.apply(local);
+}
+
+// A witness on the shape's support feature along local `dir`: for boxes the centre of the
+// supporting face or edge (components of dir below kFeatureRelative * |dir| count as zero), so
+// a face or edge contact is not reported at one arbitrary corner; other shapes: supportPoint.
+constexpr Real kFeatureRelative = Real(1e-6);
+Vec3 featureCentreSupport(const Shape& shape, const Vec3& dir) {
+    if (shape.type != ShapeType::Box) return supportPoint(shape, dir);
+    const Real eps = kFeatureRelative * dir.norm();
+    Vec3 p;
+    for (int k = 0; k < 3; ++k) {
+        p[k] = std::abs(dir[k]) <= eps ? Real(0)
+                                       : (dir[k] < 0 ? -shape.half_extents[k]
+                                                     : shape.half_extents[k]);
+    }
+    return p;
+}
+
 bool finiteSweep(const Sweep& s) {
     return s.start.position.allFinite() && s.start.orientation.coeffs().allFinite() &&
-           s.translation.allFinite() && s.rotation.allFinite();
+           s.translation.allFinite() && s.rotation.allFinite() && s.spin.allFinite();
+}
+
+// Largest distance of the shape's points from the line through the local origin along the
+// unit local direction `e` (a point at distance rho moves at |w| rho when spun about e).
+Real maxDistanceFromAxis(const Shape& shape, const Vec3& e) {
+    auto off = [&e](const Vec3& p) { return (p - p.dot(e) * e).norm(); };
+    switch (shape.type) {
+        case ShapeType::Sphere: return shape.radius;
+        case ShapeType::Box: {
+            Real m = 0;
+            for (int k = 0; k < 8; ++k) {
+                const Vec3 c((k & 1) ? shape.half_extents.x() : -shape.half_extents.x(),
+                             (k & 2) ? shape.half_extents.y() : -shape.half_extents.y(),
+                             (k & 4) ? shape.half_extents.z() : -shape.half_extents.z());
+                m = std::max(m, off(c));
+            }
+            return m;
+        }
+        case ShapeType::Capsule:
+            return std::max(off(Vec3(0, shape.half_height, 0)),
+                            off(Vec3(0, -shape.half_height, 0))) +
+                   shape.radius;
+        case ShapeType::ConvexHull:
+        case ShapeType::Mesh: {
+            Real m = 0;
+            for (const Vec3& v : shape.hull->vertices) m = std::max(m, off(v));
+            return m;
+        }
+    }
+    return 0;
+}
+
+// |spin| times the largest distance from the spin axis: the fastest a point moves by the spin.
+Real spinSpeed(const Shape& shape, const Vec3& spin) {
+    const Real w = spin.norm();
+    if (!(w > 0)) return 0;
+    return w * maxDistanceFromAxis(shape, spin / w);
 }
 
 }  // namespace
@@ -86,14 +168,17 @@ bool finiteSweep(const Sweep& s) {
 Pose Sweep::at(Real t) const {
     Pose p;
     p.position = start.position + t * translation;
+    p.orientation = start.orientation;
     const Real angle = rotation.norm();
     if (angle > 0) {
-        p.orientation =
-            (Quat(Eigen::AngleAxis<Real>(t * angle, rotation / angle)) * start.orientation)
-                .normalized();
-    } else {
-        p.orientation = start.orientation;
+        p.orientation = Quat(Eigen::AngleAxis<Real>(t * angle, rotation / angle)) * p.orientation;
     }
+    const Real spin_angle = spin.norm();
+    if (spin_angle > 0) {
+        p.orientation =
+            p.orientation * Quat(Eigen::AngleAxis<Real>(t * spin_angle, spin / spin_angle));
+    }
+    if (angle > 0 || spin_angle > 0) p.orientation.normalize();
     return p;
 }
 
@@ -117,6 +202,7 @@ ToiOutput timeOfImpact(const ToiInput& input) {
         input.tolerance > 0 ? input.tolerance : kToiRelativeTolerance * std::min(ra, rb);
     const Real t_max = std::clamp(input.t_max, Real(0), Real(1));
     const Vec3 rel_translation = input.sweep_a.translation - input.sweep_b.translation;
+    const Real spin_speed = spinSpeed(a, input.sweep_a.spin) + spinSpeed(b, input.sweep_b.spin);
 
     Vec3 last_normal = Vec3::Zero();
     Real t = 0;
@@ -158,8 +244,22 @@ ToiOutput timeOfImpact(const ToiInput& input) {
         out.t = t;
         out.distance = std::max(gap, Real(0));
         out.normal = n;
-        out.point_a = pa.apply(supportPoint(a, pa.orientation.conjugate() * n));
-        out.point_b = pb.apply(supportPoint(b, pb.orientation.conjugate() * (-n)));
+        {
+            // Witness points by one alternating projection from each side's support point along
+            // the normal (exact for a vertex, sphere or capsule end against a face); the pair
+            // closer together wins.
+            const Vec3 sa = pa.apply(featureCentreSupport(a, pa.orientation.conjugate() * n));
+            const Vec3 sb = pb.apply(featureCentreSupport(b, pb.orientation.conjugate() * (-n)));
+            const Vec3 a_of_sb = closestPointOnShape(a, pa, sb);
+            const Vec3 b_of_sa = closestPointOnShape(b, pb, sa);
+            if ((sb - a_of_sb).squaredNorm() <= (b_of_sa - sa).squaredNorm()) {
+                out.point_a = a_of_sb;
+                out.point_b = sb;
+            } else {
+                out.point_a = sa;
+                out.point_b = b_of_sa;
+            }
+        }
         if (gap <= input.target_gap + tolerance) {
             // Within reach at t. At t = 0 the pair may already interpenetrate (round cores are
             // apart while the shapes overlap): the full shapes decide Overlapped.
@@ -172,9 +272,10 @@ ToiOutput timeOfImpact(const ToiInput& input) {
             return out;
         }
         // Largest rate (per unit t) at which the gap along the fixed n can shrink: translation
-        // along n plus the speed of the farthest point of each body across n.
+        // along n, the speed of the farthest point of each body across n by the world rotation,
+        // and the fastest point speed of the body-frame spins (in any direction).
         const Real mu = rel_translation.dot(n) + input.sweep_a.rotation.cross(n).norm() * ra +
-                        input.sweep_b.rotation.cross(n).norm() * rb;
+                        input.sweep_b.rotation.cross(n).norm() * rb + spin_speed;
         if (!(mu > 0)) {
             out.state = CcdState::Separated;  // the gap along n never shrinks
             out.t = t_max;

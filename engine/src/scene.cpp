@@ -49,7 +49,7 @@ constexpr Real kMinGyrationFraction = Real(1e-3);
 constexpr std::string_view kBodyKeys[] = {
     "name",  "shape",    "radius",           "half_height", "half_extents", "file",
     "scale", "position", "orientation_wxyz", "euler_deg",   "velocity",     "angular_velocity",
-    "mass",  "density",  "repeat"};
+    "mass",  "density",  "repeat",           "static"};
 constexpr std::string_view kRepeatKeys[] = {"count", "seed", "region", "speed", "spin",
                                             "random_orientation"};
 // Keys that `repeat` generates itself.
@@ -268,7 +268,7 @@ void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
     const std::string path = "world";
     const std::vector<Entry> es =
         entries(n, path, {"bounds", "gravity", "time_step", "steps_per_frame", "frames",
-                          "integrator"});
+                          "integrator", "ccd"});
     {
         const Entry& b = require(es, "bounds", n, path);
         const std::string bp = childPath(path, "bounds");
@@ -298,6 +298,13 @@ void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
         } else if (e.key == "frames") {
             scene.frames = readInt(e.value, p);
             if (scene.frames < 1) fail(e.value, p, "must be >= 1");
+        } else if (e.key == "ccd") {
+            const std::string name = readString(e.value, p);
+            if (!findCcdMethod(name, scene.world.ccd)) {
+                fail(e.value, p,
+                     "unknown ccd method '" + name + "' (expected one of: " + ccdMethodNames() +
+                         ")");
+            }
         } else if (e.key == "integrator") {
             const std::string name = readString(e.value, p);
             if (!findIntegrator(name, scene.world.integrator)) {
@@ -511,6 +518,7 @@ std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
     const Entry* density_entry = nullptr;
     Real mass = 0;
     Real density = 1000;
+    bool is_static = false;
 
     const Entry* repeat_entry = find(es, "repeat");
     if (repeat_entry != nullptr) {
@@ -586,6 +594,15 @@ std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
             density = readReal(v, p);
             if (!(density > 0)) fail(v, p, "must be > 0 (kg/m^3)");
             density_entry = &e;
+        } else if (e.key == "static") {
+            is_static = readBool(v, p);
+        }
+    }
+    if (is_static) {
+        for (const Entry& e : es) {
+            if (e.key == "velocity" || e.key == "angular_velocity") {
+                fail(e.key_node, childPath(path, e.key), "a static body does not move");
+            }
         }
     }
 
@@ -643,12 +660,14 @@ std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
     }
 
     Body body = makeBody(std::move(name), std::move(shape), props);
-    auto place = [&props](Body& b, const Vec3& p, const Quat& q, const Vec3& v, const Vec3& w) {
+    auto place = [&props, is_static](Body& b, const Vec3& p, const Quat& q, const Vec3& v,
+                                     const Vec3& w) {
         b.position = p;
         b.orientation = q;
         b.linear_momentum = props.mass * v;
         const Mat3 r = q.toRotationMatrix();
         b.angular_momentum = r * props.inertia * r.transpose() * w;
+        if (is_static) setStatic(b);
     };
     if (repeat_entry == nullptr) {
         place(body, position, orientation, velocity, angular_velocity);

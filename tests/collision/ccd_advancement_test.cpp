@@ -179,6 +179,11 @@ TEST(ConservativeAdvancement, NeverLaterThanSampledFirstContactOnRandomPairs) {
         sb.start.orientation = rng.rotation();
         sb.translation = rng.vec(-1, 1);
         sb.rotation = rng.vec(-3, 3);
+        if (i % 2 == 1) {
+            // Body-frame spins as well (the engine's torque-free sweep).
+            sa.spin = rng.vec(-6, 6);
+            sb.spin = rng.vec(-6, 6);
+        }
         ToiInput in = makeInput(a, sa, b, sb);
         in.max_iterations = 200;
         const ToiOutput out = timeOfImpact(in);
@@ -218,7 +223,7 @@ TEST(ConservativeAdvancement, NeverLaterThanSampledFirstContactOnRandomPairs) {
     RecordProperty("hits", hits);
     RecordProperty("separated", separated);
     RecordProperty("failed", failed);
-    // Both outcomes are exercised (measured: 55 hits, 245 separated, 0 failed of 300).
+    // Both outcomes are exercised (measured: 61 hits, 239 separated, 0 failed of 300).
     EXPECT_GT(hits, kPairs / 10);
     EXPECT_GT(separated, kPairs / 10);
     EXPECT_EQ(failed, 0);
@@ -250,6 +255,17 @@ TEST(ConservativeAdvancement, OverlapCapAndBadInput) {
     bad = in;
     bad.b = nullptr;
     EXPECT_EQ(timeOfImpact(bad).state, CcdState::Failed);
+}
+
+TEST(ConservativeAdvancement, SweepSpinTurnsInTheBodyFrame) {
+    // R(t rotation) q0 R(t spin): with q0 a quarter turn about z, a body spin about local x is
+    // a turn about world y.
+    Sweep s;
+    s.start.orientation = Quat(Eigen::AngleAxis<Real>(M_PI / 2, Vec3::UnitZ()));
+    s.spin = Vec3(0.8, 0, 0);
+    const Pose p = s.at(0.5);
+    const Quat expected = Quat(Eigen::AngleAxis<Real>(0.4, Vec3::UnitY())) * s.start.orientation;
+    EXPECT_NEAR(p.orientation.angularDistance(expected), 0, 1e-12);
 }
 
 TEST(ConservativeAdvancement, SweepPoseFollowsTheRotationVector) {

@@ -106,13 +106,16 @@ CcdOutput edgeEdgeCcdNaive(const EdgeEdgeCcdInput& input);
 struct Shape;
 
 /// Motion of a body over one step, t in [0, 1]: its local origin moves linearly by
-/// `translation` and the body turns at constant rate about the fixed world axis of `rotation`
-/// (rotation vector: unit axis * angle in rad, any angle, through the local origin).
-/// Pose at t: position = start.position + t translation, orientation = R(t rotation) start.q.
+/// `translation`; the body turns at constant rate about the fixed world axis of `rotation` and,
+/// at the same time, about the body-fixed axis of `spin` (both rotation vectors: unit axis *
+/// angle in rad, any angle, through the local origin). Pose at t:
+/// position = start.position + t translation, orientation = R(t rotation) start.q R(t spin).
+/// (A torque-free symmetric body moves exactly so: precession about L, spin about its axis.)
 struct Sweep {
     Pose start;
     Vec3 translation = Vec3::Zero();  ///< m, world frame, over the whole step
     Vec3 rotation = Vec3::Zero();     ///< rad, world frame, over the whole step
+    Vec3 spin = Vec3::Zero();         ///< rad, body (local) frame, over the whole step
 
     /// The pose at step fraction `t` (any real t; [0, 1] is the step).
     Pose at(Real t) const;
@@ -145,8 +148,11 @@ struct ToiOutput {
     Real t = 0;           ///< fraction of the step
     Real distance = 0;    ///< lower bound on the gap at t (m); 0 when Overlapped or Failed early
     Vec3 normal = Vec3::Zero();   ///< unit, from A towards B at t (Hit, Failed after 1 query)
-    Vec3 point_a = Vec3::Zero();  ///< support point of A along normal at t: the witness on A
-    Vec3 point_b = Vec3::Zero();  ///< support point of B along -normal at t: the witness on B
+    /// Witnesses at t, world: the support point of one shape along the normal and the point of
+    /// the other shape closest to it (exact closest points for sphere/box/capsule vertex or
+    /// round contacts; for face-face contact one corner of the contact region).
+    Vec3 point_a = Vec3::Zero();
+    Vec3 point_b = Vec3::Zero();
     int iterations = 0;           ///< distance queries made
 };
 
@@ -155,8 +161,9 @@ struct ToiOutput {
 /// "Interactive continuous collision detection for non-convex polyhedra", Vis. Comput. 2006):
 /// at the current t, GJK gives a direction n; the gap along n (a rigorous lower bound on the
 /// distance, from the support functions) cannot shrink faster than
-/// mu = (dA - dB).n + |rotA x n| rA + |rotB x n| rB per unit t (r = bounding radius about the
-/// local origin), so t advances by (gap - target_gap) / mu, which never passes the first time
+/// mu = (dA - dB).n + |rotA x n| rA + |rotB x n| rB + |spinA| sA + |spinB| sB per unit t
+/// (r = bounding radius about the local origin, s = largest distance from the spin axis), so
+/// t advances by (gap - target_gap) / mu, which never passes the first time
 /// the gap reaches target_gap. Guarantee: conservative (never later than first contact), up to
 /// floating-point rounding of the gap (relative, positions are subtracted first). Cost: one
 /// GJK per iteration; pure translation converges in 1-2 iterations, fast rotation near
