@@ -4,6 +4,7 @@
 
 #include "bench_broadphase.h"
 #include "bench_ccd.h"
+#include "bench_convex.h"
 #include "collision/broad_phase.h"
 #include "query_command.h"
 #include "run_command.h"
@@ -105,6 +106,21 @@ int main(int argc, char** argv) {
                               "CCD cost per frame, off vs on");
     bool bench_ccd_no_scenes = false;
     bench_ccd_cmd->add_flag("--no-scenes", bench_ccd_no_scenes, "skip the tunnelling scenes");
+    app::BenchConvexOptions bench_convex;
+    std::string bench_convex_json;
+    CLI::App* bench_convex_cmd = bench_cmd->add_subcommand(
+        "convex", "convex contact queries (GJK, EPA, SAT, closed forms) beside Bullet's GJK/EPA: "
+                  "us/query, answers compared");
+    bench_convex_cmd->add_option("--queries", bench_convex.queries, "random pairs per workload")
+        ->capture_default_str();
+    bench_convex_cmd->add_option("--passes", bench_convex.passes, "timed passes (fastest kept)")
+        ->capture_default_str();
+    bench_convex_cmd->add_option("--seed", bench_convex.seed, "pose seed")->capture_default_str();
+    bench_convex_cmd
+        ->add_option("--tolerance", bench_convex.tolerance,
+                     "relative answer tolerance for counting disagreements")
+        ->capture_default_str();
+    bench_convex_cmd->add_option("--json", bench_convex_json, "also write the rows as JSON to FILE");
     // END bench subcommand
 
     try {
@@ -144,6 +160,10 @@ int main(int argc, char** argv) {
         }
         bench_ccd.scenes = !bench_ccd_no_scenes;
         return app::runBenchCcd(bench_ccd, std::cout, std::cerr);
+    }
+    if (bench_convex_cmd->parsed()) {
+        if (!bench_convex_json.empty()) bench_convex.json = bench_convex_json;
+        return app::runBenchConvex(bench_convex, std::cout, std::cerr);
     }
     // END bench dispatch
     return 2;

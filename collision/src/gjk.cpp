@@ -122,6 +122,19 @@ Vec3 closestOnTriangle(const Vec3& a, const Vec3& b, const Vec3& c, std::array<R
         w = best;
         return best_p;
     }
+    // Face region: the origin's projection onto the plane, x = n (n.a) / |n|^2, with its
+    // signed-area coordinates as weights. For slivers far from the origin this is much more
+    // accurate than a + v ab + t ac, whose error grows like |a|^2 / area and can stall GJK at a
+    // wrong distance (a 3e-5-thin box touching a 5-unit box came out 6e-6 apart).
+    const Vec3 n = ab.cross(ac);
+    const Real nn = n.squaredNorm();
+    if (nn > 0) {
+        const Vec3 x = n * (n.dot(a) / nn);
+        const Real wa = n.dot((b - x).cross(c - x)) / nn;
+        const Real wb = n.dot((c - x).cross(a - x)) / nn;
+        w = {wa, wb, 1 - wa - wb};
+        return x;
+    }
     const Real v = vb / denom;
     const Real t = vc / denom;
     w = {1 - v - t, v, t};
@@ -320,6 +333,13 @@ ContactState epaDecide(const MinkowskiDifference& cso, const Simplex& start, Rea
         if (h - closest.dist <= poly.eps) {
             // Converged at depth ~ threshold: the bounds no longer separate; call it touching.
             return ContactState::Touching;
+        }
+        // A support point already in the polytope cannot grow it: the depth is closest.dist up
+        // to rounding (<= threshold here). Without this check exactly touching boxes re-added
+        // the same vertex until the cap and came out Failed.
+        const Real dup = kDuplicateRelative * std::max(w.norm(), scale);
+        for (int i = 0; i < poly.vertex_count; ++i) {
+            if ((poly.w[i] - w).squaredNorm() <= dup * dup) return ContactState::Touching;
         }
         if (poly.vertex_count >= kEpaMaxVertices) return ContactState::Failed;
         const int new_index = poly.vertex_count;

@@ -58,6 +58,24 @@ struct ContactOutput {
     std::int32_t iterations = 0;  ///< GJK + EPA iterations, when they ran
 };
 
+/// Conventions of the implementation (collision/src/contact.cpp), added after the agreement:
+/// - Box edge k*4 + s_i + 2*s_j is the edge parallel to axis k whose other two coordinates (axes
+///   i < j) are +half_extents where s = 1 and -half_extents where s = 0.
+/// - point_b - point_a = signed_distance * normal up to rounding (~1e-9 of the size), in every
+///   state; manifold points obey the same with their own depth and lie on the two surfaces.
+/// - Undefined directions get a fixed normal in the frame of the canonically first shape
+///   (order: sphere < box < capsule < hull, a mesh counting as a hull; same types by pose and
+///   dimensions): coincident sphere centres -> that sphere's local +x; a sphere centre on a
+///   capsule's axis -> the capsule's local +x; crossing capsule axes -> their common
+///   perpendicular towards B's centre (parallel, coaxial: the first capsule's local +x); other
+///   pairs -> EPA's deterministic answer. contact(b, a) mirrors it, except for identical inputs
+///   (same shape and pose), where both calls are the same call.
+/// - Accuracy: closed forms to rounding; GJK distance to kGjkRelativeTolerance (gjk.h) or
+///   rounding; EPA depth to 1e-11 * size; box-box SAT exact up to rounding, except that a face
+///   axis is preferred over an edge axis less than 1e-9 * size deeper (stable manifolds).
+/// - State: within 1e-6 * size of the touching band the state is collide()'s own and the signed
+///   distance is moved into that state's range (by at most that much). For meshes (their hull
+///   here, triangles in collide()) the states may differ.
 /// Full convex query of `a` at `pose_a` against `b` at `pose_b`. Convex shapes only (a Mesh
 /// is treated as its convex hull here; triangle-level mesh contact goes through the BVH).
 /// Guarantees: never NaN, never hangs (iteration caps -> Failed); the same touching convention

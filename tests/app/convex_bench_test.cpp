@@ -1,0 +1,106 @@
+// `cdlab bench convex` end to end on a few queries: every workload row present, the JSON
+// complete, no failed query and (when Bullet is built in) no disagreement with Bullet's GJK/EPA;
+// a bad option gets exit code 2.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+    int exit_code = -1;
+    std::string out;
+    std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+}
+
+fs::path tempDir(const std::string& name) {
+    const fs::path d = fs::temp_directory_path() /
+                       ("cdlab_convex_bench_" + name + "_" + std::to_string(::getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
+Result runCdlab(const std::string& args, const fs::path& work) {
+    const fs::path out = work / "stdout.txt";
+    const fs::path err = work / "stderr.txt";
+    const std::string cmd = std::string(CDLAB_BINARY) + " " + args + " > " + out.string() +
+                            " 2> " + err.string() + " < /dev/null";
+    const int status = std::system(cmd.c_str());
+    Result r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+}
+
+TEST(ConvexBench, FewQueriesNoMismatchAndCompleteJson) {
+    const fs::path work = tempDir("smoke");
+    const fs::path json = work / "convex.json";
+    const Result r =
+        runCdlab("bench convex --queries 200 --passes 1 --json " + json.string(), work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    for (const char* column : {"workload", "cdlab_us", "bullet_us", "disagree", "max_diff", "cdlab_ext"}) {
+        EXPECT_NE(r.out.find(column), std::string::npos) << column;
+    }
+    ASSERT_TRUE(fs::exists(json));
+    EXPECT_FALSE(fs::exists(json.string() + ".partial"));
+    const nlohmann::json doc = nlohmann::json::parse(slurp(json));
+    ASSERT_EQ(doc["rows"].size(), 8u);
+    const bool bullet = doc["bullet"].get<bool>();
+    int separated_rows = 0;
+    int penetrating_rows = 0;
+    for (const nlohmann::json& row : doc["rows"]) {
+        const std::string name = row["workload"].get<std::string>();
+        EXPECT_EQ(row["queries"].get<int>(), 200) << name;
+        EXPECT_EQ(row["cdlab_failed"].get<int>(), 0) << name;
+        EXPECT_GT(row["cdlab_us"].get<double>(), 0) << name;
+        // cdlab's answers survive translation by 1e6 and scaling by 1e-4 / 1e4 (relative to size).
+        EXPECT_EQ(row["cdlab_variant_failed"].get<int>(), 0) << name;
+        for (const char* key : {"cdlab_far_error", "cdlab_small_error", "cdlab_large_error"}) {
+            EXPECT_LE(row[key].get<double>(), 1e-9) << name << " " << key;
+        }
+        if (name.find("separated") != std::string::npos) {
+            EXPECT_EQ(row["colliding"].get<int>(), 0) << name;
+            ++separated_rows;
+        }
+        if (name.find("penetrating") != std::string::npos) {
+            EXPECT_EQ(row["colliding"].get<int>(), 200) << name;
+            ++penetrating_rows;
+        }
+        if (bullet) {
+            EXPECT_EQ(row["disagreements"].get<int>(), 0) << name;
+            EXPECT_EQ(row["bullet_failed"].get<int>(), 0) << name;
+            EXPECT_LE(row["max_difference"].get<double>(), doc["tolerance"].get<double>()) << name;
+        }
+    }
+    EXPECT_EQ(separated_rows, 2);
+    EXPECT_EQ(penetrating_rows, 2);
+    fs::remove_all(work);
+}
+
+TEST(ConvexBench, BadOptionExitsTwo) {
+    const fs::path work = tempDir("bad");
+    const Result r = runCdlab("bench convex --queries 0", work);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("--queries"), std::string::npos) << r.err;
+    fs::remove_all(work);
+}
+
+}  // namespace
