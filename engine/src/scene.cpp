@@ -49,7 +49,7 @@ constexpr Real kMinGyrationFraction = Real(1e-3);
 constexpr std::string_view kBodyKeys[] = {
     "name",  "shape",    "radius",           "half_height", "half_extents", "file",
     "scale", "position", "orientation_wxyz", "euler_deg",   "velocity",     "angular_velocity",
-    "mass",  "density",  "repeat",           "static"};
+    "mass",  "density",  "repeat",           "static",      "restitution",  "friction"};
 constexpr std::string_view kRepeatKeys[] = {"count", "seed", "region", "speed", "spin",
                                             "random_orientation"};
 // Keys that `repeat` generates itself.
@@ -268,7 +268,7 @@ void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
     const std::string path = "world";
     const std::vector<Entry> es =
         entries(n, path, {"bounds", "gravity", "time_step", "steps_per_frame", "frames",
-                          "integrator", "ccd"});
+                          "integrator", "ccd", "response", "restitution", "friction"});
     {
         const Entry& b = require(es, "bounds", n, path);
         const std::string bp = childPath(path, "bounds");
@@ -298,6 +298,19 @@ void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
         } else if (e.key == "frames") {
             scene.frames = readInt(e.value, p);
             if (scene.frames < 1) fail(e.value, p, "must be >= 1");
+        } else if (e.key == "response") {
+            const std::string name = readString(e.value, p);
+            if (!findResponse(name, scene.world.response)) {
+                fail(e.value, p, "unknown response '" + name + "' (expected one of: none, impulse)");
+            }
+        } else if (e.key == "restitution") {
+            scene.world.restitution = readReal(e.value, p);
+            if (!(scene.world.restitution >= 0 && scene.world.restitution <= 1)) {
+                fail(e.value, p, "must be in [0, 1]");
+            }
+        } else if (e.key == "friction") {
+            scene.world.friction = readReal(e.value, p);
+            if (!(scene.world.friction >= 0)) fail(e.value, p, "must be >= 0");
         } else if (e.key == "ccd") {
             const std::string name = readString(e.value, p);
             if (!findCcdMethod(name, scene.world.ccd)) {
@@ -519,6 +532,8 @@ std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
     Real mass = 0;
     Real density = 1000;
     bool is_static = false;
+    Real restitution = scene.world.restitution;
+    Real friction = scene.world.friction;
 
     const Entry* repeat_entry = find(es, "repeat");
     if (repeat_entry != nullptr) {
@@ -596,6 +611,12 @@ std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
             density_entry = &e;
         } else if (e.key == "static") {
             is_static = readBool(v, p);
+        } else if (e.key == "restitution") {
+            restitution = readReal(v, p);
+            if (!(restitution >= 0 && restitution <= 1)) fail(v, p, "must be in [0, 1]");
+        } else if (e.key == "friction") {
+            friction = readReal(v, p);
+            if (!(friction >= 0)) fail(v, p, "must be >= 0");
         }
     }
     if (is_static) {
@@ -660,6 +681,8 @@ std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
     }
 
     Body body = makeBody(std::move(name), std::move(shape), props);
+    body.restitution = restitution;
+    body.friction = friction;
     auto place = [&props, is_static](Body& b, const Vec3& p, const Quat& q, const Vec3& v,
                                      const Vec3& w) {
         b.position = p;

@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "collision/narrow_phase.h"
+#include "contact_solver.h"
 
 namespace engine {
 
@@ -58,7 +59,31 @@ constexpr CcdEntry kCcdMethods[] = {
     {CcdMethod::ConservativeAdvancement, "conservative_advancement"},
 };
 
+struct ResponseEntry {
+    Response response;
+    std::string_view name;
+};
+
+constexpr ResponseEntry kResponses[] = {{Response::None, "none"}, {Response::Impulse, "impulse"}};
+
 }  // namespace
+
+std::string_view responseName(Response response) {
+    for (const ResponseEntry& e : kResponses) {
+        if (e.response == response) return e.name;
+    }
+    return "none";
+}
+
+bool findResponse(std::string_view name, Response& out) {
+    for (const ResponseEntry& e : kResponses) {
+        if (e.name == name) {
+            out = e.response;
+            return true;
+        }
+    }
+    return false;
+}
 
 std::string_view ccdMethodName(CcdMethod method) {
     for (const CcdEntry& e : kCcdMethods) {
@@ -122,7 +147,9 @@ std::string_view bodyStateName(BodyState state) {
 }
 
 World::World(WorldSettings settings)
-    : settings_(std::move(settings)), broad_phase_(makeBroadPhase(settings_.broad_phase)) {}
+    : settings_(std::move(settings)), broad_phase_(makeBroadPhase(settings_.broad_phase)) {
+    if (settings_.response == Response::Impulse) solver_ = std::make_unique<ContactSolver>();
+}
 
 World::~World() = default;
 World::World(World&&) noexcept = default;
@@ -148,15 +175,15 @@ void World::setBroadPhase(const std::string& name) {
     proxies_inserted_ = false;
 }
 
-void World::integrate(Real dt) {
+void World::integrate(Real dt, const Vec3& gravity) {
     switch (settings_.integrator) {
-        case Integrator::ExplicitEuler: integrateExplicitEuler(dt); break;
-        case Integrator::SemiImplicitEuler: integrateSemiImplicitEuler(dt); break;
-        case Integrator::Rk4: integrateRk4(dt); break;
+        case Integrator::ExplicitEuler: integrateExplicitEuler(dt, gravity); break;
+        case Integrator::SemiImplicitEuler: integrateSemiImplicitEuler(dt, gravity); break;
+        case Integrator::Rk4: integrateRk4(dt, gravity); break;
     }
 }
 
-void World::integrateExplicitEuler(Real dt) {
+void World::integrateExplicitEuler(Real dt, const Vec3& gravity) {
     // Forward Euler on every component, all derivatives taken at the start of the step:
     // x_{n+1} = x_n + v_n dt, P_{n+1} = P_n + m g dt, q_{n+1} = q_n + 1/2 (0, w_n) q_n dt
     // (Baraff, "Physically Based Modeling", SIGGRAPH course notes, rigid body dynamics §2.9),
@@ -165,7 +192,7 @@ void World::integrateExplicitEuler(Real dt) {
     for (Body& b : bodies_) {
         if (b.is_static) continue;
         b.position += b.velocity() * dt;
-        b.linear_momentum += b.mass * settings_.gravity * dt;
+        b.linear_momentum += b.mass * gravity * dt;
         const Vec3 w = b.angularVelocity();
         if (!(w.squaredNorm() > 0)) continue;
         const Quat dq = Quat(0, w.x(), w.y(), w.z()) * b.orientation;
@@ -174,7 +201,7 @@ void World::integrateExplicitEuler(Real dt) {
     }
 }
 
-void World::integrateSemiImplicitEuler(Real dt) {
+void World::integrateSemiImplicitEuler(Real dt, const Vec3& gravity) {
     // Semi-implicit (symplectic) Euler for translation: momentum first, then position with the
     // new velocity. Rotation: no torque acts, so L (world) is constant, and the free rigid body
     // H = sum_k L_k^2 / (2 I_k) (principal frame, I_0 <= I_1 <= I_2) is split around the middle
@@ -192,7 +219,7 @@ void World::integrateSemiImplicitEuler(Real dt) {
     }
     for (Body& b : bodies_) {
         if (b.is_static) continue;
-        b.linear_momentum += b.mass * settings_.gravity * dt;
+        b.linear_momentum += b.mass * gravity * dt;
         b.position += b.velocity() * dt;
         const Real l_norm = b.angular_momentum.norm();
         if (!(l_norm > 0)) continue;
@@ -227,7 +254,7 @@ void World::integrateSemiImplicitEuler(Real dt) {
     }
 }
 
-void World::integrateRk4(Real dt) {
+void World::integrateRk4(Real dt, const Vec3& gravity) {
     // Classical Runge-Kutta 4 on y = (x, P, q, L) with y' = (P/m, m g, 1/2 (0, w(q)) q, 0), where
     // w(q) = R(q) I^-1 R(q)^T L and R(q) is the rotation of q normalised (the stages leave the
     // unit sphere by O(dt^5)); q is normalised once after the step. Gravity is constant, so x is
@@ -236,7 +263,7 @@ void World::integrateRk4(Real dt) {
     for (Body& b : bodies_) {
         if (b.is_static) continue;
         const Vec3 v0 = b.velocity();
-        const Vec3 a = settings_.gravity;
+        const Vec3 a = gravity;
         // x'' = g is constant: the four stages give x + v dt + g dt^2 / 2 exactly.
         b.position += v0 * dt + a * (dt * dt / 2);
         b.linear_momentum += b.mass * a * dt;
@@ -273,7 +300,8 @@ constexpr Real kCcdTargetGapFraction = Real(1e-3);
 // Iteration cap of one time-of-impact query (Failed -> the pair is stopped at the safe time).
 constexpr int kCcdMaxIterations = 64;
 // Restitution of the impulse that resolves a time of impact while `response` is none: elastic
-// and frictionless, like the reflection off the bounds (kinetic energy kept).
+// and frictionless, like the reflection off the bounds (kinetic energy kept). With response
+// impulse the pair's restitution (the larger of the two) is used instead.
 constexpr Real kCcdRestitution = 1;
 
 // Velocity of the material point at world `p` of body `b` placed at `pose` (m/s).
@@ -434,7 +462,10 @@ void World::resolveContinuous() {
                        e.normal.dot((inv_ia * ra.cross(e.normal)).cross(ra)) +
                        e.normal.dot((inv_ib * rb.cross(e.normal)).cross(rb));
         if (!(k > 0)) continue;  // two static bodies never get here (neither moves)
-        const Vec3 impulse = (-(1 + kCcdRestitution) * vn / k) * e.normal;
+        const Real e_pair = settings_.response == Response::Impulse
+                                ? std::max(a.restitution, b.restitution)
+                                : kCcdRestitution;
+        const Vec3 impulse = (-(1 + e_pair) * vn / k) * e.normal;
         if (!a.is_static) {
             a.linear_momentum -= impulse;
             a.angular_momentum -= ra.cross(impulse);
@@ -444,6 +475,38 @@ void World::resolveContinuous() {
             b.angular_momentum += rb.cross(impulse);
         }
     }
+}
+
+void World::findResponsePairs(Real margin_fraction) {
+    // Sort-and-sweep on x over the AABBs of the last detection grown by margin_fraction times
+    // each body's bounding radius (the exact AABBs of resting bodies barely touch, and lose
+    // their pair the moment the solver lifts one by a hair). Output sorted, a < b.
+    const std::size_t n = bodies_.size();
+    sweep_order_.clear();
+    grown_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const Body& b = bodies_[i];
+        const Real r = b.local_bounds.sphere.center.norm() + b.local_bounds.sphere.radius;
+        grown_[i].min = volumes_[i].aabb.min - Vec3::Constant(margin_fraction * r);
+        grown_[i].max = volumes_[i].aabb.max + Vec3::Constant(margin_fraction * r);
+        sweep_order_.push_back(static_cast<BodyId>(i));
+    }
+    std::sort(sweep_order_.begin(), sweep_order_.end(), [this](BodyId x, BodyId y) {
+        const Real ax = grown_[x].min.x(), ay = grown_[y].min.x();
+        return ax < ay || (ax == ay && x < y);
+    });
+    response_pairs_.clear();
+    for (std::size_t k = 0; k < n; ++k) {
+        const BodyId i = sweep_order_[k];
+        for (std::size_t m = k + 1; m < n; ++m) {
+            const BodyId j = sweep_order_[m];
+            if (grown_[j].min.x() > grown_[i].max.x()) break;
+            if (bodies_[i].is_static && bodies_[j].is_static) continue;
+            if (!grown_[i].overlaps(grown_[j])) continue;
+            response_pairs_.push_back({std::min(i, j), std::max(i, j)});
+        }
+    }
+    std::sort(response_pairs_.begin(), response_pairs_.end());
 }
 
 void World::reflectOffBounds() {
@@ -531,8 +594,27 @@ void World::step() {
         step_start_.resize(bodies_.size());
         for (std::size_t i = 0; i < bodies_.size(); ++i) step_start_[i] = bodies_[i].pose();
     }
-    integrate(settings_.time_step);
-    time_ += settings_.time_step;
+    const Real dt = settings_.time_step;
+    if (solver_) {
+        // Impulse response: gravity as a velocity kick, then the contact solver on the pairs
+        // whose AABBs, grown by the speculative margin, overlap (touching, penetrating or close),
+        // then the integrator moves the bodies with the solved velocities (no further gravity).
+        for (Body& b : bodies_) {
+            if (!b.is_static) b.linear_momentum += b.mass * settings_.gravity * dt;
+        }
+        t = Clock::now();
+        const ContactSolverSettings solver_settings;
+        findResponsePairs(solver_settings.margin_fraction);
+        solver_->solve(bodies_, response_pairs_, dt, solver_settings, pseudo_linear_,
+                       pseudo_angular_);
+        stats_.response_s = secondsSince(t);
+        stats_.contact_points = solver_->pointCount();
+        t = Clock::now();
+        integrate(dt, Vec3::Zero());
+    } else {
+        integrate(dt, settings_.gravity);
+    }
+    time_ += dt;
     ++step_count_;
     stats_.integrate_s = secondsSince(t);
 
@@ -540,6 +622,23 @@ void World::step() {
         t = Clock::now();
         resolveContinuous();
         stats_.ccd_s = secondsSince(t);
+    }
+    if (solver_) {
+        // Split-impulse position correction: this step's pseudo velocities move the bodies;
+        // the momenta are not changed by them (L is only turned along with the body).
+        for (std::size_t i = 0; i < bodies_.size(); ++i) {
+            Body& b = bodies_[i];
+            if (b.is_static) continue;
+            b.position += pseudo_linear_[i] * dt;
+            const Vec3 turn = pseudo_angular_[i] * dt;
+            const Real angle = turn.norm();
+            if (angle > 0) {
+                // L turns with the body, so the correction leaves 1/2 L.I^-1 L unchanged.
+                const Quat r(Eigen::AngleAxis<Real>(angle, turn / angle));
+                b.orientation = (r * b.orientation).normalized();
+                b.angular_momentum = r * b.angular_momentum;
+            }
+        }
     }
 
     t = Clock::now();

@@ -39,6 +39,8 @@ struct Body {
     /// principal axes) and the principal moments, ascending (kg m^2). Set by makeBody.
     Quat principal_frame = Quat::Identity();
     Vec3 principal_moments = Vec3::Ones();
+    Real restitution = Real(0.5);  ///< in [0, 1]; a pair uses the larger of its two
+    Real friction = Real(0.5);     ///< Coulomb coefficient >= 0; a pair uses sqrt(mu_a mu_b)
     /// Infinite mass: inv_mass = 0, inverse inertia 0, zero momenta; never moves (setStatic).
     bool is_static = false;
 

@@ -40,6 +40,14 @@ bool findCcdMethod(std::string_view name, CcdMethod& out);
 /// "off, conservative_advancement", for error messages.
 std::string ccdMethodNames();
 
+/// Contact response of the step (world.response in scene files).
+enum class Response : std::uint8_t {
+    None,     ///< detection only: bodies pass through each other (the bounds still reflect)
+    Impulse,  ///< sequential impulses at contact() manifolds: restitution, friction, resting
+};
+std::string_view responseName(Response response);  ///< "none", "impulse"
+bool findResponse(std::string_view name, Response& out);
+
 /// A time of impact the CCD stage acted on in the last step: the pair was stopped at `t` (a
 /// fraction of the step), `pose_a`/`pose_b` are the bodies' poses there, world frame.
 struct ToiEvent {
@@ -64,6 +72,9 @@ struct WorldSettings {
     std::string broad_phase = "sap";  ///< registry name
     Integrator integrator = Integrator::SemiImplicitEuler;
     CcdMethod ccd = CcdMethod::Off;
+    Response response = Response::None;
+    Real restitution = Real(0.5);  ///< default of bodies that do not set theirs (scene files)
+    Real friction = Real(0.5);     ///< default of bodies that do not set theirs (scene files)
 };
 
 /// Wall-clock time per stage of the last step, in seconds, and the broad phase's counters.
@@ -73,13 +84,17 @@ struct StepStats {
     double broad_phase_s = 0;
     double narrow_phase_s = 0;
     double ccd_s = 0;  ///< continuous stage (0 when ccd is off)
+    double response_s = 0;  ///< contact solver (0 when response is none)
     double total_s = 0;
     collision::BroadPhaseCounters broad;
     std::int64_t narrow_tests = 0;
     std::int64_t triangle_tests = 0;
     std::int64_t toi_queries = 0;  ///< timeOfImpact calls in the continuous stage
     std::int64_t toi_events = 0;   ///< pairs stopped at their time of impact
+    std::int64_t contact_points = 0;  ///< manifold points the contact solver handled
 };
+
+class ContactSolver;
 
 class World {
 public:
@@ -118,13 +133,14 @@ public:
     std::uint64_t stateHash() const;
 
 private:
-    void integrate(Real dt);
-    void integrateExplicitEuler(Real dt);
-    void integrateSemiImplicitEuler(Real dt);
-    void integrateRk4(Real dt);
+    void integrate(Real dt, const Vec3& gravity);
+    void integrateExplicitEuler(Real dt, const Vec3& gravity);
+    void integrateSemiImplicitEuler(Real dt, const Vec3& gravity);
+    void integrateRk4(Real dt, const Vec3& gravity);
     void reflectOffBounds();
     void updateVolumes();
     void resolveContinuous();
+    void findResponsePairs(Real margin_fraction);
     void runCollisionPipeline();
 
     WorldSettings settings_;
@@ -149,6 +165,11 @@ private:
     std::vector<BodyId> sweep_order_;
     std::vector<collision::ProxyPair> ccd_pairs_;
     std::vector<ToiEvent> toi_events_;
+    std::unique_ptr<ContactSolver> solver_;  ///< only with response: impulse
+    std::vector<collision::Aabb> grown_;
+    std::vector<collision::ProxyPair> response_pairs_;
+    std::vector<Vec3> pseudo_linear_;
+    std::vector<Vec3> pseudo_angular_;
     StepStats stats_;
     Real time_ = 0;
     std::int64_t step_count_ = 0;
