@@ -170,4 +170,20 @@ struct ToiOutput {
 /// grazing contact may need many: capped by max_iterations -> Failed with a safe t.
 ToiOutput timeOfImpact(const ToiInput& input);
 
+// ---- Continuous OBB test with interval arithmetic (ccd_obb.cpp). ----
+
+struct Obb;
+
+/// Can two moving OBBs overlap at some time of [t0, t1] (fractions of the step)? `box_a` is an
+/// OBB in the local frame of a body moving by `sweep_a` (so its world box at t is the local box
+/// placed at sweep_a.at(t)); likewise B. Redon, Kheddar, Coquillart, "Fast continuous collision
+/// detection between rigid bodies", Eurographics 2002: the 15 separating-axis inequalities of
+/// RTCD 4.4.1 evaluated in interval arithmetic over the time interval (sin/cos of the turning
+/// angles enclosed on their interval). Guarantee: conservative -- false only when the boxes are
+/// proven separated for every t in [t0, t1] (with a relative slack of 1e-9 of the pair's size
+/// for the rounding of the non-directed interval operations); true may be a false alarm, more
+/// often on long intervals (callers bisect). O(1). Non-finite input or t0 > t1 -> true.
+bool testObbSweep(const Obb& box_a, const Sweep& sweep_a, const Obb& box_b, const Sweep& sweep_b,
+                  Real t0, Real t1);
+
 }  // namespace collision
