@@ -17,6 +17,8 @@
 #include <sstream>
 
 #include "collision/ccd.h"
+#include "engine/scene.h"
+#include "engine/world.h"
 
 namespace app {
 namespace {
@@ -256,6 +258,41 @@ void printTable(const std::vector<Row>& rows, std::ostream& out) {
     }
 }
 
+struct SceneRow {
+    std::string scene;
+    std::string ccd;
+    int frames = 0;
+    double step_us = 0;        ///< mean World::step wall time per frame, microseconds
+    double ccd_us = 0;         ///< mean CCD stage time per frame, microseconds
+    double toi_queries = 0;    ///< mean timeOfImpact calls per frame
+    std::int64_t toi_events = 0;  ///< total times of impact acted on
+};
+
+// Runs the scene's frames with the given CCD method; times come from World::lastStats.
+SceneRow runScene(const engine::Scene& scene, engine::CcdMethod method) {
+    engine::Scene copy = scene;
+    copy.world.ccd = method;
+    engine::World world = engine::makeWorld(copy);
+    SceneRow row;
+    row.scene = scene.name;
+    row.ccd = std::string(engine::ccdMethodName(method));
+    row.frames = scene.frames;
+    double step_s = 0, ccd_s = 0, queries = 0;
+    for (int f = 0; f < scene.frames; ++f) {
+        for (int k = 0; k < scene.steps_per_frame; ++k) {
+            world.step();
+            step_s += world.lastStats().total_s;
+            ccd_s += world.lastStats().ccd_s;
+            queries += static_cast<double>(world.lastStats().toi_queries);
+            row.toi_events += world.lastStats().toi_events;
+        }
+    }
+    row.step_us = 1e6 * step_s / scene.frames;
+    row.ccd_us = 1e6 * ccd_s / scene.frames;
+    row.toi_queries = queries / scene.frames;
+    return row;
+}
+
 }  // namespace
 
 std::vector<std::string> ccdBenchMethods() { return {"conservative", "naive"}; }
@@ -319,11 +356,60 @@ int runBenchCcd(const BenchCcdOptions& options, std::ostream& out, std::ostream&
             status = 1;
         }
     }
+    // The engine's CCD stage per frame in the tunnelling scenes, off vs on.
+    std::vector<SceneRow> scene_rows;
+    if (options.scenes) {
+        const fs::path dir = options.scenes_dir;
+        const bool found = fs::is_regular_file(dir / "tunnel_sphere.yaml") &&
+                           fs::is_regular_file(dir / "tunnel_bar.yaml");
+        if (!found && options.scenes_explicit) {
+            err << dir.string() << ":1:1: no tunnel_sphere.yaml and tunnel_bar.yaml here\n";
+            return 2;
+        }
+        if (found) {
+            for (const char* name : {"tunnel_sphere.yaml", "tunnel_bar.yaml"}) {
+                engine::Scene scene;
+                try {
+                    scene = engine::loadScene(dir / name);
+                } catch (const engine::SceneError& e) {
+                    err << e.what() << "\n";
+                    return 2;
+                }
+                for (const engine::CcdMethod m :
+                     {engine::CcdMethod::Off, engine::CcdMethod::ConservativeAdvancement}) {
+                    scene_rows.push_back(runScene(scene, m));
+                }
+            }
+            out << "\n"
+                << std::left << std::setw(16) << "scene" << std::setw(26) << "ccd" << std::right
+                << std::setw(7) << "frames" << std::setw(14) << "step_us/frame" << std::setw(13)
+                << "ccd_us/frame" << std::setw(15) << "queries/frame" << std::setw(11)
+                << "toi_events" << "\n";
+            for (const SceneRow& r : scene_rows) {
+                out << std::left << std::setw(16) << r.scene << std::setw(26) << r.ccd
+                    << std::right << std::setw(7) << r.frames << std::fixed
+                    << std::setprecision(2) << std::setw(14) << r.step_us << std::setw(13)
+                    << r.ccd_us << std::setw(15) << r.toi_queries
+                    << std::setw(11) << r.toi_events << std::defaultfloat << "\n";
+            }
+        }
+    }
+
     if (options.json) {
         nlohmann::json doc;
         doc["benchmark"] = "ccd";
         doc["rows"] = nlohmann::json::array();
         for (const Row& r : rows) doc["rows"].push_back(rowJson(r));
+        doc["scenes"] = nlohmann::json::array();
+        for (const SceneRow& r : scene_rows) {
+            doc["scenes"].push_back(nlohmann::json{{"scene", r.scene},
+                                                   {"ccd", r.ccd},
+                                                   {"frames", r.frames},
+                                                   {"step_us_per_frame", r.step_us},
+                                                   {"ccd_us_per_frame", r.ccd_us},
+                                                   {"toi_queries_per_frame", r.toi_queries},
+                                                   {"toi_events", r.toi_events}});
+        }
         // Written next to the target and renamed, so a partial file never looks complete.
         const fs::path partial = fs::path(options.json->string() + ".partial");
         {

@@ -1,6 +1,7 @@
 // app/bench_ccd.h -- `cdlab bench ccd`: the conservative and naive vertex-face / edge-edge CCD
 // methods on the sample queries of Wang et al. 2021 (or any directory in their CSV layout):
-// false negatives, false positives and microseconds per query, per method, query set and kind.
+// false negatives, false positives and microseconds per query, per method, query set and kind;
+// then the per-frame cost of the engine's CCD stage in the tunnelling scenes, off vs on.
 #pragma once
 
 #include <filesystem>
@@ -17,6 +18,12 @@ struct BenchCcdOptions {
     std::vector<std::filesystem::path> dirs;
     std::optional<std::filesystem::path> json;  ///< also write the table as JSON
     std::string method = "all";                 ///< conservative | naive | all
+    /// Folder holding tunnel_sphere.yaml and tunnel_bar.yaml: each is run with ccd off and with
+    /// ccd conservative_advancement, reporting the step time and the CCD stage's time per frame.
+    /// Default "scenes" (skipped when absent); an explicitly given folder must hold them.
+    std::filesystem::path scenes_dir = "scenes";
+    bool scenes_explicit = false;
+    bool scenes = true;  ///< false: --no-scenes
 };
 
 /// Method names accepted by --method.

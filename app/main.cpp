@@ -161,6 +161,12 @@ int main(int argc, char** argv) {
     bench_ccd_cmd->add_option("--method", bench_ccd.method, "conservative, naive or all")
         ->check(CLI::IsMember({"conservative", "naive", "all"}))
         ->capture_default_str();
+    std::string bench_ccd_scenes;
+    bench_ccd_cmd->add_option("--scenes", bench_ccd_scenes,
+                              "folder with tunnel_sphere.yaml and tunnel_bar.yaml (default scenes): "
+                              "CCD cost per frame, off vs on");
+    bool bench_ccd_no_scenes = false;
+    bench_ccd_cmd->add_flag("--no-scenes", bench_ccd_no_scenes, "skip the tunnelling scenes");
     app::BenchConvexOptions bench_convex;
     std::string bench_convex_json;
     CLI::App* bench_convex_cmd = bench_cmd->add_subcommand(
@@ -252,6 +258,11 @@ int main(int argc, char** argv) {
     if (bench_ccd_cmd->parsed()) {
         for (const std::string& d : bench_ccd_dirs) bench_ccd.dirs.emplace_back(d);
         if (!bench_ccd_json.empty()) bench_ccd.json = bench_ccd_json;
+        if (!bench_ccd_scenes.empty()) {
+            bench_ccd.scenes_dir = bench_ccd_scenes;
+            bench_ccd.scenes_explicit = true;
+        }
+        bench_ccd.scenes = !bench_ccd_no_scenes;
         return app::runBenchCcd(bench_ccd, std::cout, std::cerr);
     }
     if (bench_convex_cmd->parsed()) {

@@ -3,6 +3,8 @@
 
 #include <utility>
 
+#include <Eigen/Eigenvalues>
+
 namespace engine {
 
 Mat3 Body::invInertiaWorld() const {
@@ -17,6 +19,14 @@ Real Body::kineticEnergy() const {
     return Real(0.5) * mass * v.squaredNorm() + Real(0.5) * angularVelocity().dot(angular_momentum);
 }
 
+void setStatic(Body& body) {
+    body.is_static = true;
+    body.inv_mass = 0;
+    body.inv_inertia_body = Mat3::Zero();
+    body.linear_momentum = Vec3::Zero();
+    body.angular_momentum = Vec3::Zero();
+}
+
 Body makeBody(std::string name, collision::Shape shape, const MassProperties& mass) {
     Body b;
     b.name = std::move(name);
@@ -26,6 +36,12 @@ Body makeBody(std::string name, collision::Shape shape, const MassProperties& ma
     b.inv_mass = Real(1) / mass.mass;
     b.inertia_body = mass.inertia;
     b.inv_inertia_body = mass.inertia.inverse();
+    // Principal axes for the splitting integrator (world.cpp): I = V diag(moments) V^T.
+    const Eigen::SelfAdjointEigenSolver<Mat3> eig(mass.inertia);
+    Mat3 v = eig.eigenvectors();
+    if (v.determinant() < 0) v.col(2) = -v.col(2);  // a proper rotation
+    b.principal_frame = Quat(v).normalized();
+    b.principal_moments = eig.eigenvalues();
     return b;
 }
 

@@ -626,6 +626,29 @@ void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& c
         if (options.draw.aabb) debug.drawAabb(v.aabb, color);
         if (options.draw.obb) debug.drawObb(v.obb, color);
     }
+
+    // CCD: each moving body of a time-of-impact event at its pose there (spheres as spheres,
+    // other shapes as their OBB), and the contact normal, in blue. Read-only use of the events.
+    const auto bodies = world.bodies();
+    for (const engine::ToiEvent& e : world.toiEvents()) {
+        for (const auto& [id, pose] : {std::pair{e.a, e.pose_a}, std::pair{e.b, e.pose_b}}) {
+            if (id < 0 || static_cast<std::size_t>(id) >= bodies.size()) continue;
+            const engine::Body& b = bodies[static_cast<std::size_t>(id)];
+            if (b.is_static) continue;
+            if (b.shape.type == collision::ShapeType::Sphere) {
+                debug.drawSphere(collision::transformSphere(b.local_bounds.sphere, pose), kToiColor);
+            } else {
+                debug.drawObb(collision::transformObb(b.local_bounds.obb, pose), kToiColor);
+            }
+        }
+        Real size = 0;
+        for (const engine::BodyId id : {e.a, e.b}) {
+            if (id >= 0 && static_cast<std::size_t>(id) < bodies.size()) {
+                size = std::max(size, bodies[static_cast<std::size_t>(id)].local_bounds.sphere.radius);
+            }
+        }
+        debug.drawLine(e.point, e.point + e.normal * size, kToiColor);
+    }
 }
 
 void Renderer::Impl::drawTriangles() {

@@ -88,6 +88,24 @@ TEST(CcdBench, UnitTestSetTableAndJsonWithNoFalseNegatives) {
         }
     }
     EXPECT_EQ(conservative_rows, 2);
+    // The tunnelling scenes, off vs on: the stage does nothing when off and acts when on.
+    ASSERT_TRUE(doc.contains("scenes"));
+    ASSERT_EQ(doc["scenes"].size(), 4u);
+    for (const nlohmann::json& row : doc["scenes"]) {
+        for (const char* key : {"scene", "ccd", "frames", "step_us_per_frame", "ccd_us_per_frame",
+                                "toi_queries_per_frame", "toi_events"}) {
+            EXPECT_TRUE(row.contains(key)) << key;
+        }
+        if (row["ccd"] == "off") {
+            EXPECT_EQ(row["toi_events"].get<int>(), 0);
+            EXPECT_EQ(row["toi_queries_per_frame"].get<double>(), 0.0);
+            EXPECT_EQ(row["ccd_us_per_frame"].get<double>(), 0.0);
+        } else {
+            EXPECT_EQ(row["ccd"], "conservative_advancement");
+            EXPECT_GT(row["toi_events"].get<int>(), 0) << row.dump();
+        }
+    }
+    EXPECT_NE(r.out.find("ccd_us/frame"), std::string::npos);
     // Measured: the naive cubic misses 5 of the unit-test edge-edge contacts.
     EXPECT_GT(naive_false_negatives, 0);
 }
@@ -95,12 +113,20 @@ TEST(CcdBench, UnitTestSetTableAndJsonWithNoFalseNegatives) {
 TEST(CcdBench, MethodFilterAndBadInput) {
     const fs::path work = tempDir("bad");
     const Result only =
-        runCdlab("bench ccd tests/data/ccd-sample-queries/unit-tests --method naive", work);
+        runCdlab("bench ccd tests/data/ccd-sample-queries/unit-tests --method naive --no-scenes",
+                 work);
     ASSERT_EQ(only.exit_code, 0) << only.err;
     EXPECT_EQ(only.out.find("conservative"), std::string::npos);
 
     const Result method = runCdlab("bench ccd --method fastest", work);
     EXPECT_EQ(method.exit_code, 2);
+
+    const Result no_scenes = runCdlab(
+        "bench ccd tests/data/ccd-sample-queries/unit-tests --method naive --scenes " +
+            (work / "nope").string(),
+        work);
+    EXPECT_EQ(no_scenes.exit_code, 2);
+    EXPECT_NE(no_scenes.err.find("no tunnel_sphere.yaml"), std::string::npos) << no_scenes.err;
 
     const Result missing = runCdlab("bench ccd " + (work / "nope").string(), work);
     EXPECT_EQ(missing.exit_code, 2);

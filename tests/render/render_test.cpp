@@ -15,6 +15,7 @@
 #include "collision/convex_hull.h"
 #include "collision/shape.h"
 #include "engine/body.h"
+#include "engine/scene.h"
 #include "engine/world.h"
 #include "render/image.h"
 #include "render/renderer.h"
@@ -578,3 +579,29 @@ TEST(Video, AnFfmpegThatDiesBecomesARenderError) {
 }
 
 }  // namespace
+
+// CCD: the pose at the time of impact is drawn in blue in the frame of the step that acted on
+// it, and nothing is blue in a frame without events. The bar of tunnel_bar_ccd.yaml first hits
+// the wall in step 8 (frame 8).
+TEST(Renderer, TimeOfImpactPoseIsDrawnInBlue) {
+    const engine::Scene scene =
+        engine::loadScene(fs::path(CDLAB_SOURCE_DIR) / "scenes" / "tunnel_bar_ccd.yaml");
+    engine::World world = engine::makeWorld(scene);
+    render::Renderer renderer(320, 180);
+    render::FrameOptions options;
+    options.draw = scene.draw;
+    const Rgb blue = toRgb(render::kToiColor);
+    auto countBlue = [&blue](const render::Image& image) {
+        int n = 0;
+        for (int y = 0; y < image.height; ++y) {
+            for (int x = 0; x < image.width; ++x) n += close(pixelAt(image, x, y), blue, 40);
+        }
+        return n;
+    };
+    world.step();
+    ASSERT_TRUE(world.toiEvents().empty());
+    EXPECT_EQ(countBlue(renderer.render(world, scene.camera, options)), 0);
+    for (int i = 1; i < 8; ++i) world.step();
+    ASSERT_FALSE(world.toiEvents().empty());
+    EXPECT_GT(countBlue(renderer.render(world, scene.camera, options)), 50);
+}

@@ -35,6 +35,14 @@ struct Body {
     Real inv_mass = 1;
     Mat3 inertia_body = Mat3::Identity();
     Mat3 inv_inertia_body = Mat3::Identity();
+    /// Principal frame of the inertia in the body frame (a proper rotation; its columns are the
+    /// principal axes) and the principal moments, ascending (kg m^2). Set by makeBody.
+    Quat principal_frame = Quat::Identity();
+    Vec3 principal_moments = Vec3::Ones();
+    Real restitution = Real(0.5);  ///< in [0, 1]; a pair uses the larger of its two
+    Real friction = Real(0.5);     ///< Coulomb coefficient >= 0; a pair uses sqrt(mu_a mu_b)
+    /// Infinite mass: inv_mass = 0, inverse inertia 0, zero momenta; never moves (setStatic).
+    bool is_static = false;
 
     Vec3 position = Vec3::Zero();       ///< m, centre of mass, world
     Quat orientation = Quat::Identity();
@@ -50,6 +58,10 @@ struct Body {
     /// 1/2 m v^2 + 1/2 w.L (J).
     Real kineticEnergy() const;
 };
+
+/// Makes `body` static (immovable, infinite mass and inertia): zero inverses and momenta.
+/// `mass` and `inertia_body` keep the values of the shape, for reference.
+void setStatic(Body& body);
 
 /// Builds a body from a shape and its mass properties; fits the local bounding volumes.
 Body makeBody(std::string name, collision::Shape shape, const MassProperties& mass);

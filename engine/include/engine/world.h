@@ -11,9 +11,56 @@
 #include "collision/bounding_volumes.h"
 #include "collision/broad_phase.h"
 #include "collision/bvh.h"
+#include "collision/ccd.h"
 #include "engine/body.h"
 
 namespace engine {
+
+/// Time integrator of the step. State is (x, q, P, L); the only force is gravity and no torque
+/// acts, so L (world frame) is constant and the gyroscopic term of Euler's equations is carried
+/// by w = R I^-1 R^T L: |L| is conserved exactly by every integrator, they differ in x and q.
+enum class Integrator : std::uint8_t {
+    ExplicitEuler,      ///< x += v(t) dt, P += F dt, q += 1/2 w q dt then normalised (first order)
+    SemiImplicitEuler,  ///< P first, x with the new v; q by the exact-rotation splitting (2nd order)
+    Rk4,                ///< Runge-Kutta 4 on (x, P, q, L); unstable for thin fast-spinning bodies
+};
+std::string_view integratorName(Integrator integrator);  ///< scene name, e.g. "rk4"
+/// Integrator by scene name; false when the name is unknown.
+bool findIntegrator(std::string_view name, Integrator& out);
+/// "explicit_euler, semi_implicit_euler, rk4", for error messages.
+std::string integratorNames();
+
+/// Continuous collision detection policy of the step (world.ccd in scene files).
+enum class CcdMethod : std::uint8_t {
+    Off,                      ///< discrete only: fast or thin bodies may tunnel; costs nothing
+    ConservativeAdvancement,  ///< collision::timeOfImpact on every pair whose swept bounds meet
+};
+std::string_view ccdMethodName(CcdMethod method);  ///< "off", "conservative_advancement"
+/// CCD method by scene name; false when the name is unknown.
+bool findCcdMethod(std::string_view name, CcdMethod& out);
+/// "off, conservative_advancement", for error messages.
+std::string ccdMethodNames();
+
+/// Contact response of the step (world.response in scene files).
+enum class Response : std::uint8_t {
+    None,     ///< detection only: bodies pass through each other (the bounds still reflect)
+    Impulse,  ///< sequential impulses at contact() manifolds: restitution, friction, resting
+};
+std::string_view responseName(Response response);  ///< "none", "impulse"
+bool findResponse(std::string_view name, Response& out);
+
+/// A time of impact the CCD stage acted on in the last step: the pair was stopped at `t` (a
+/// fraction of the step), `pose_a`/`pose_b` are the bodies' poses there, world frame.
+struct ToiEvent {
+    BodyId a = 0;
+    BodyId b = 0;
+    Real t = 0;
+    Pose pose_a;
+    Pose pose_b;
+    Vec3 point = Vec3::Zero();   ///< m, world: midpoint of the witness points
+    Vec3 normal = Vec3::Zero();  ///< unit, world, from a towards b
+    bool failed = false;         ///< the query hit its iteration cap (t is then a safe time)
+};
 
 /// Overlap state of a body, the worst over its pairs.
 enum class BodyState : std::uint8_t { Apart, Flagged, Colliding };
@@ -27,6 +74,11 @@ struct WorldSettings {
     /// Node volume of mesh bodies' hierarchies (collision::bvhVolumeNames()); scene key
     /// `world.mesh_bvh`. Read when mesh bodies are built (scene loading), not by the World.
     std::string mesh_bvh{collision::kDefaultMeshBvh};
+    Integrator integrator = Integrator::SemiImplicitEuler;
+    CcdMethod ccd = CcdMethod::Off;
+    Response response = Response::None;
+    Real restitution = Real(0.5);  ///< default of bodies that do not set theirs (scene files)
+    Real friction = Real(0.5);     ///< default of bodies that do not set theirs (scene files)
 };
 
 /// Wall-clock time per stage of the last step, in seconds, and the broad phase's counters.
@@ -35,12 +87,19 @@ struct StepStats {
     double volumes_s = 0;
     double broad_phase_s = 0;
     double narrow_phase_s = 0;
+    double ccd_s = 0;  ///< continuous stage (0 when ccd is off)
+    double response_s = 0;  ///< contact solver (0 when response is none)
     double total_s = 0;
     collision::BroadPhaseCounters broad;
     std::int64_t narrow_tests = 0;
     std::int64_t triangle_tests = 0;  ///< triangle-level tests of the narrow phase (meshes)
     std::int64_t bv_tests = 0;        ///< mesh-hierarchy node tests of the narrow phase
+    std::int64_t toi_queries = 0;  ///< timeOfImpact calls in the continuous stage
+    std::int64_t toi_events = 0;   ///< pairs stopped at their time of impact
+    std::int64_t contact_points = 0;  ///< manifold points the contact solver handled
 };
+
+class ContactSolver;
 
 class World {
 public:
@@ -52,7 +111,8 @@ public:
 
     BodyId addBody(Body body);
 
-    /// One time step: integrate (semi-implicit Euler), reflect off the bounds, then detect.
+    /// One time step: integrate (settings().integrator); with ccd on, stop every pair at its time
+    /// of impact (see world.cpp); reflect off the bounds; then detect.
     void step();
     /// Recomputes volumes, pairs and states at the current state, without moving anything.
     void detect();
@@ -69,6 +129,8 @@ public:
     std::span<const collision::ProxyPair> collidingPairs() const { return colliding_; }
     const collision::BroadPhase& broadPhase() const { return *broad_phase_; }
     const StepStats& lastStats() const { return stats_; }
+    /// Times of impact acted on in the last step, sorted by (t, a, b); empty when ccd is off.
+    std::span<const ToiEvent> toiEvents() const { return toi_events_; }
     Real time() const { return time_; }
     std::int64_t stepCount() const { return step_count_; }
 
@@ -76,9 +138,14 @@ public:
     std::uint64_t stateHash() const;
 
 private:
-    void integrate(Real dt);
+    void integrate(Real dt, const Vec3& gravity);
+    void integrateExplicitEuler(Real dt, const Vec3& gravity);
+    void integrateSemiImplicitEuler(Real dt, const Vec3& gravity);
+    void integrateRk4(Real dt, const Vec3& gravity);
     void reflectOffBounds();
     void updateVolumes();
+    void resolveContinuous();
+    void findResponsePairs(Real margin_fraction);
     void runCollisionPipeline();
 
     WorldSettings settings_;
@@ -88,6 +155,26 @@ private:
     std::vector<collision::ProxyPair> flagged_;
     std::vector<collision::ProxyPair> colliding_;
     std::unique_ptr<collision::BroadPhase> broad_phase_;
+    // Continuous stage scratch, reused across steps (no per-step allocation once warm).
+    struct SweptBody {
+        collision::Sweep sweep;
+        collision::Aabb box;  ///< swept bounds over the step
+        Real radius = 0;      ///< bounding radius about the centre of mass
+        Real clamp_t = 1;     ///< earliest accepted time of impact
+        bool moving = false;
+    };
+    std::vector<Pose> step_start_;
+    std::vector<Vec3> step_rotation_;  ///< semi-implicit Euler's rotation of the step (ccd on)
+    std::vector<Vec3> step_spin_;
+    std::vector<SweptBody> swept_;
+    std::vector<BodyId> sweep_order_;
+    std::vector<collision::ProxyPair> ccd_pairs_;
+    std::vector<ToiEvent> toi_events_;
+    std::unique_ptr<ContactSolver> solver_;  ///< only with response: impulse
+    std::vector<collision::Aabb> grown_;
+    std::vector<collision::ProxyPair> response_pairs_;
+    std::vector<Vec3> pseudo_linear_;
+    std::vector<Vec3> pseudo_angular_;
     StepStats stats_;
     Real time_ = 0;
     std::int64_t step_count_ = 0;

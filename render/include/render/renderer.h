@@ -20,6 +20,10 @@ inline constexpr collision::Color kBackgroundColor{26 / 255.0f, 28 / 255.0f, 36 
 /// The shaded bodies' base colour (a neutral grey-blue) before lighting.
 inline constexpr collision::Color kBodyColor{0.56f, 0.63f, 0.74f, 1.0f};
 
+/// Wireframes of the bodies at the times of impact the CCD stage acted on in the last step
+/// (World::toiEvents), and the contact normal there: blue.
+inline constexpr collision::Color kToiColor{0.25f, 0.5f, 1.0f, 1.0f};
+
 /// What one frame shows. With draw.hud and any volume drawn, a colour legend
 /// (apart / flagged / colliding) goes bottom-left.
 struct FrameOptions {

@@ -1,0 +1,345 @@
+// engine/src/contact_solver.cpp -- sequential impulses (Catto, "Fast and Simple Physics using
+// Sequential Impulses", GDC 2006; "Iterative Dynamics with Temporal Coherence", GDC 2005;
+// Mirtich & Canny 1995 for the impulse model) with accumulated-impulse clamping, warm starting,
+// Coulomb friction on two tangent directions clamped by mu * normal impulse, restitution above a
+// velocity threshold, and split-impulse position correction (pseudo velocities, Catto 2006 /
+// Bullet's split impulse) so that pushing bodies apart never adds kinetic energy.
+// Invariant: pairs arrive sorted and manifold points keep contact()'s order, and every loop runs
+// in that order a fixed number of times: the result is deterministic.
+#include "contact_solver.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include "collision/narrow_phase.h"
+
+namespace engine {
+
+namespace {
+
+// Matching distance for warm starting, relative to the smaller bounding radius of the pair.
+constexpr Real kMatchFraction = Real(0.1);
+
+Real boundingRadius(const Body& b) {
+    return b.local_bounds.sphere.center.norm() + b.local_bounds.sphere.radius;
+}
+
+// Two unit tangents completing n (Erin Catto's b2 / Jolt's GetNormalizedPerpendicular idea).
+void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
+    const Vec3 axis = std::abs(n.x()) < Real(0.57735) ? Vec3(Vec3::UnitX()) : Vec3(Vec3::UnitY());
+    t1 = n.cross(axis).normalized();
+    t2 = n.cross(t1);
+}
+
+Real effectiveMass(const Body& a, const Body& b, const Mat3& ia, const Mat3& ib, const Vec3& ra,
+                   const Vec3& rb, const Vec3& d) {
+    const Real k = a.inv_mass + b.inv_mass + d.dot((ia * ra.cross(d)).cross(ra)) +
+                   d.dot((ib * rb.cross(d)).cross(rb));
+    return k > 0 ? 1 / k : 0;
+}
+
+struct Velocities {
+    Vec3 v = Vec3::Zero();
+    Vec3 w = Vec3::Zero();
+};
+
+// Box-box face manifold by clipping (RTCD 5.x; Gottschalk's reference/incident faces, as in
+// Box2D's b2CollidePolygons): the incident face of B (most anti-parallel to n) clipped by the
+// side planes of A's reference face (most parallel to n), points kept within `margin` of it,
+// reduced to at most 4 (deepest first, then the farthest from those kept). Used when contact()
+// reports fewer than 3 points for two boxes whose normal is within kFaceCos of a face normal of
+// A: nearly aligned boxes make an edge axis tie with the face axis, and one point cannot hold a
+// box at rest. Points: point_a on the reference face, point_b on the incident face.
+constexpr Real kFaceCos = Real(0.9995);  // about 1.8 degrees
+
+int boxFaceManifold(const Body& a, const Pose& pa, const Body& b, const Pose& pb, const Vec3& n,
+                    Real margin, std::array<collision::ManifoldPoint, 4>& out) {
+    const Mat3 ra = pa.rotation();
+    const Mat3 rb = pb.rotation();
+    const Vec3& ha = a.shape.half_extents;
+    const Vec3& hb = b.shape.half_extents;
+    int k = 0;
+    for (int i = 1; i < 3; ++i) {
+        if (std::abs(ra.col(i).dot(n)) > std::abs(ra.col(k).dot(n))) k = i;
+    }
+    if (std::abs(ra.col(k).dot(n)) < kFaceCos) return 0;
+    const Vec3 nf = ra.col(k).dot(n) >= 0 ? Vec3(ra.col(k)) : Vec3(-ra.col(k));
+    const Vec3 ca = pa.position + nf * ha[k];
+    const int iu = (k + 1) % 3, iv = (k + 2) % 3;
+    const Vec3 u = ra.col(iu), v = ra.col(iv);
+    int j = 0;
+    for (int i = 1; i < 3; ++i) {
+        if (std::abs(rb.col(i).dot(n)) > std::abs(rb.col(j).dot(n))) j = i;
+    }
+    const Vec3 m = rb.col(j).dot(n) >= 0 ? Vec3(-rb.col(j)) : Vec3(rb.col(j));
+    const Vec3 cb = pb.position + m * hb[j];
+    const int ju = (j + 1) % 3, jv = (j + 2) % 3;
+    const Vec3 bu = rb.col(ju) * hb[ju], bv = rb.col(jv) * hb[jv];
+    std::array<Vec3, 8> poly{cb - bu - bv, cb + bu - bv, cb + bu + bv, cb - bu + bv};
+    int count = 4;
+    // Sutherland-Hodgman against |(p - ca).u| <= ha[iu] and |(p - ca).v| <= ha[iv].
+    const std::array<std::pair<Vec3, Real>, 4> planes{
+        std::pair{u, ha[iu]}, std::pair{Vec3(-u), ha[iu]}, std::pair{v, ha[iv]},
+        std::pair{Vec3(-v), ha[iv]}};
+    for (const auto& [dir, h] : planes) {
+        std::array<Vec3, 8> next;
+        int next_count = 0;
+        for (int i = 0; i < count && next_count < 8; ++i) {
+            const Vec3& p0 = poly[static_cast<std::size_t>(i)];
+            const Vec3& p1 = poly[static_cast<std::size_t>((i + 1) % count)];
+            const Real d0 = (p0 - ca).dot(dir) - h;
+            const Real d1 = (p1 - ca).dot(dir) - h;
+            if (d0 <= 0) next[static_cast<std::size_t>(next_count++)] = p0;
+            if ((d0 < 0 && d1 > 0) || (d0 > 0 && d1 < 0)) {
+                if (next_count < 8) {
+                    next[static_cast<std::size_t>(next_count++)] = p0 + (p1 - p0) * (d0 / (d0 - d1));
+                }
+            }
+        }
+        poly = next;
+        count = next_count;
+        if (count == 0) return 0;
+    }
+    // Depth of each clipped point below the reference face; keep those within the margin.
+    std::array<Real, 8> depth{};
+    std::array<bool, 8> used{};
+    int candidates = 0;
+    for (int i = 0; i < count; ++i) {
+        depth[static_cast<std::size_t>(i)] = (ca - poly[static_cast<std::size_t>(i)]).dot(nf);
+        used[static_cast<std::size_t>(i)] = !(depth[static_cast<std::size_t>(i)] >= -margin);
+        candidates += used[static_cast<std::size_t>(i)] ? 0 : 1;
+    }
+    int kept = 0;
+    while (kept < 4 && kept < candidates) {
+        int best = -1;
+        Real score = -1;
+        for (int i = 0; i < count; ++i) {
+            if (used[static_cast<std::size_t>(i)]) continue;
+            Real sc = 0;
+            if (kept == 0) {
+                sc = depth[static_cast<std::size_t>(i)] + 1e6 * margin;  // deepest first
+            } else {
+                sc = std::numeric_limits<Real>::max();
+                for (int q = 0; q < kept; ++q) {
+                    sc = std::min(sc, (poly[static_cast<std::size_t>(i)] -
+                                       out[static_cast<std::size_t>(q)].point_b).squaredNorm());
+                }
+            }
+            if (sc > score) {
+                score = sc;
+                best = i;
+            }
+        }
+        const std::size_t bi = static_cast<std::size_t>(best);
+        used[bi] = true;
+        collision::ManifoldPoint& mp = out[static_cast<std::size_t>(kept++)];
+        mp.point_b = poly[bi];
+        mp.point_a = poly[bi] + depth[bi] * nf;
+        mp.depth = depth[bi];
+    }
+    return kept;
+}
+
+}  // namespace
+
+void ContactSolver::solve(std::span<Body> bodies, std::span<const collision::ProxyPair> pairs,
+                          Real dt, const ContactSolverSettings& settings,
+                          std::vector<Vec3>& pseudo_linear, std::vector<Vec3>& pseudo_angular) {
+    const std::size_t n = bodies.size();
+    pseudo_linear.assign(n, Vec3::Zero());
+    pseudo_angular.assign(n, Vec3::Zero());
+    points_.clear();
+
+    // World inverse inertias at the present poses, once per body.
+    std::vector<Mat3> inv_inertia(n);
+    std::vector<Velocities> vel(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        inv_inertia[i] = bodies[i].invInertiaWorld();
+        vel[i].v = bodies[i].velocity();
+        vel[i].w = inv_inertia[i] * bodies[i].angular_momentum;
+    }
+
+    for (const collision::ProxyPair& pair : pairs) {
+        const Body& a = bodies[pair.a];
+        const Body& b = bodies[pair.b];
+        if (a.is_static && b.is_static) continue;
+        const Real size = std::min(boundingRadius(a), boundingRadius(b));
+        const collision::ContactOutput c0 =
+            collision::contact(a.shape, a.pose(), b.shape, b.pose());
+        const Real margin = settings.margin_fraction * size;
+        if (c0.state == collision::ContactState::Failed) continue;
+        if (c0.state == collision::ContactState::Separated && !(c0.signed_distance < margin)) {
+            continue;
+        }
+        // Speculative manifold (Catto, GDC 2013 "Continuous collision"): the manifold of the
+        // pair with B pushed `shift` deeper along the normal, its points moved back, so that
+        // corners within the margin of touching are kept (with a negative depth = their gap)
+        // and a resting box keeps all four contacts from step to step. A point with a gap may
+        // approach by at most the gap in this step.
+        const Real shift = std::max(c0.signed_distance, Real(0)) + margin;
+        Pose moved = b.pose();
+        moved.position -= shift * c0.normal;
+        collision::ContactOutput c = collision::contact(a.shape, a.pose(), b.shape, moved);
+        if (!collision::isColliding(c.state) || c.manifold_size == 0) continue;
+        if (c.manifold_size < 3 && a.shape.type == collision::ShapeType::Box &&
+            b.shape.type == collision::ShapeType::Box) {
+            std::array<collision::ManifoldPoint, 4> face{};
+            const int found = boxFaceManifold(a, a.pose(), b, moved, c.normal, margin, face);
+            if (found > c.manifold_size) {
+                c.manifold = face;
+                c.manifold_size = found;
+            }
+        }
+        for (int k = 0; k < c.manifold_size; ++k) {
+            collision::ManifoldPoint& m = c.manifold[static_cast<std::size_t>(k)];
+            m.point_b += shift * c.normal;
+            m.depth -= shift;  // < 0: a gap
+        }
+        // Previous points of this pair (previous_ is sorted by (a, b)).
+        Point key;
+        key.a = pair.a;
+        key.b = pair.b;
+        const auto range = std::equal_range(
+            previous_.begin(), previous_.end(), key,
+            [](const Point& x, const Point& y) { return x.a < y.a || (x.a == y.a && x.b < y.b); });
+        const Real e = std::max(a.restitution, b.restitution);
+        const Real mu = std::sqrt(a.friction * b.friction);
+        for (int k = 0; k < c.manifold_size; ++k) {
+            const collision::ManifoldPoint& m = c.manifold[static_cast<std::size_t>(k)];
+            Point p;
+            p.a = pair.a;
+            p.b = pair.b;
+            const Vec3 at = (m.point_a + m.point_b) / 2;
+            p.ra = at - a.position;
+            p.rb = at - b.position;
+            p.normal = c.normal;
+            tangents(p.normal, p.t1, p.t2);
+            const Mat3& ia = inv_inertia[pair.a];
+            const Mat3& ib = inv_inertia[pair.b];
+            p.mass_n = effectiveMass(a, b, ia, ib, p.ra, p.rb, p.normal);
+            p.mass_t1 = effectiveMass(a, b, ia, ib, p.ra, p.rb, p.t1);
+            p.mass_t2 = effectiveMass(a, b, ia, ib, p.ra, p.rb, p.t2);
+            p.friction = mu;
+            p.depth = m.depth;
+            p.slop = settings.slop_fraction * size;
+            p.local_a = a.pose().applyInverse(at);
+            p.feature_a = c.feature_a;
+            p.feature_b = c.feature_b;
+            const Vec3 dv = (vel[pair.b].v + vel[pair.b].w.cross(p.rb)) -
+                            (vel[pair.a].v + vel[pair.a].w.cross(p.ra));
+            const Real vn = dv.dot(p.normal);
+            const bool bounce = vn < -settings.restitution_threshold;
+            if (m.depth < 0 && !(bounce && -vn * dt > -m.depth)) {
+                // Speculative, not closing the gap in this step: approach by at most the gap.
+                p.velocity_bias = m.depth / dt;
+            } else {
+                // Touching, or a speculative point that closes its gap within the step: bounce
+                // now (the pair turns back at most the gap early, less than the margin).
+                p.velocity_bias = bounce ? -e * vn : 0;
+            }
+            // Warm start: the nearest previous point of the same pair and features.
+            Real best = kMatchFraction * size;
+            for (auto it = range.first; it != range.second; ++it) {
+                if (it->feature_a.type != p.feature_a.type ||
+                    it->feature_a.index != p.feature_a.index ||
+                    it->feature_b.type != p.feature_b.type ||
+                    it->feature_b.index != p.feature_b.index) {
+                    continue;
+                }
+                const Real d = (it->local_a - p.local_a).norm();
+                if (d < best) {
+                    best = d;
+                    p.impulse_n = it->impulse_n;
+                    // Tangent impulses carried over as a world vector onto the new basis.
+                    const Vec3 ft = it->impulse_t1 * it->t1 + it->impulse_t2 * it->t2;
+                    p.impulse_t1 = ft.dot(p.t1);
+                    p.impulse_t2 = ft.dot(p.t2);
+                }
+            }
+            points_.push_back(p);
+        }
+    }
+
+    auto apply = [&](const Point& p, const Vec3& impulse) {
+        Body& a = bodies[p.a];
+        Body& b = bodies[p.b];
+        if (!a.is_static) {
+            vel[p.a].v -= impulse * a.inv_mass;
+            vel[p.a].w -= inv_inertia[p.a] * p.ra.cross(impulse);
+        }
+        if (!b.is_static) {
+            vel[p.b].v += impulse * b.inv_mass;
+            vel[p.b].w += inv_inertia[p.b] * p.rb.cross(impulse);
+        }
+    };
+    // Warm starting.
+    for (const Point& p : points_) {
+        apply(p, p.impulse_n * p.normal + p.impulse_t1 * p.t1 + p.impulse_t2 * p.t2);
+    }
+    auto relative = [&](const Point& p) -> Vec3 {
+        return (vel[p.b].v + vel[p.b].w.cross(p.rb)) - (vel[p.a].v + vel[p.a].w.cross(p.ra));
+    };
+    for (int it = 0; it < settings.velocity_iterations; ++it) {
+        for (Point& p : points_) {
+            // Friction first (clamped by the present normal impulse), then the normal.
+            const Vec3 dv = relative(p);
+            const Real max_f = p.friction * p.impulse_n;
+            const Real old1 = p.impulse_t1;
+            const Real old2 = p.impulse_t2;
+            Real new1 = old1 - p.mass_t1 * dv.dot(p.t1);
+            Real new2 = old2 - p.mass_t2 * dv.dot(p.t2);
+            // Coulomb cone clamped as a disc (isotropic friction).
+            const Real len = std::sqrt(new1 * new1 + new2 * new2);
+            if (len > max_f && len > 0) {
+                new1 *= max_f / len;
+                new2 *= max_f / len;
+            }
+            p.impulse_t1 = new1;
+            p.impulse_t2 = new2;
+            apply(p, (new1 - old1) * p.t1 + (new2 - old2) * p.t2);
+
+            const Real vn = relative(p).dot(p.normal);
+            const Real old_n = p.impulse_n;
+            p.impulse_n = std::max(old_n - p.mass_n * (vn - p.velocity_bias), Real(0));
+            apply(p, (p.impulse_n - old_n) * p.normal);
+        }
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+        Body& b = bodies[i];
+        if (b.is_static) continue;
+        b.linear_momentum = b.mass * vel[i].v;
+        // L = I_world w = R I R^T w.
+        const Mat3 r = b.orientation.toRotationMatrix();
+        b.angular_momentum = r * (b.inertia_body * (r.transpose() * vel[i].w));
+    }
+
+    // Split impulse: pseudo velocities that remove baumgarte * (depth - slop) / dt of each
+    // penetration, applied to the positions of this step only (never to the momenta).
+    for (int it = 0; it < settings.position_iterations; ++it) {
+        for (Point& p : points_) {
+            const Vec3 dv = (pseudo_linear[p.b] + pseudo_angular[p.b].cross(p.rb)) -
+                            (pseudo_linear[p.a] + pseudo_angular[p.a].cross(p.ra));
+            const Real target = settings.baumgarte * std::max(p.depth - p.slop, Real(0)) / dt;
+            const Real old = p.pseudo_n;
+            p.pseudo_n = std::max(old - p.mass_n * (dv.dot(p.normal) - target), Real(0));
+            const Vec3 impulse = (p.pseudo_n - old) * p.normal;
+            const Body& a = bodies[p.a];
+            const Body& b = bodies[p.b];
+            if (!a.is_static) {
+                pseudo_linear[p.a] -= impulse * a.inv_mass;
+                pseudo_angular[p.a] -= inv_inertia[p.a] * p.ra.cross(impulse);
+            }
+            if (!b.is_static) {
+                pseudo_linear[p.b] += impulse * b.inv_mass;
+                pseudo_angular[p.b] += inv_inertia[p.b] * p.rb.cross(impulse);
+            }
+        }
+    }
+
+    previous_ = points_;  // already sorted by (a, b): pairs were sorted
+}
+
+}  // namespace engine

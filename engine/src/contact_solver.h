@@ -1,0 +1,74 @@
+// engine/src/contact_solver.h -- impulse-based contact response (private to the engine): a
+// sequential-impulse solver over the manifolds of collision::contact() for the colliding pairs.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "collision/broad_phase.h"
+#include "collision/contact.h"
+#include "engine/body.h"
+
+namespace engine {
+
+/// Solver parameters (the world's settings pass them through).
+struct ContactSolverSettings {
+    int velocity_iterations = 30;
+    int position_iterations = 5;
+    Real baumgarte = Real(0.2);  ///< fraction of the penetration removed per step (split impulse)
+    /// Penetration left alone, relative to the smaller bounding radius of the pair.
+    Real slop_fraction = Real(0.005);
+    /// Pairs closer than this (relative to the smaller bounding radius) but not touching get
+    /// speculative contacts, so resting bodies keep their contacts from step to step.
+    Real margin_fraction = Real(0.02);
+    /// Restitution applies only when the pair approaches faster than this (m/s); slower
+    /// contacts come to rest instead of bouncing forever in tiny hops.
+    Real restitution_threshold = Real(0.5);
+};
+
+/// One frame's worth of contact constraints with warm starting across frames.
+class ContactSolver {
+public:
+    /// Builds the constraints of the candidate `pairs` (sorted; touching, penetrating, or closer
+    /// than the margin: speculative) at the bodies' present poses,
+    /// warm-starts them from the previous call's accumulated impulses (same body pair, same
+    /// witness features, nearest point within 10 % of the smaller body's radius), runs the
+    /// velocity iterations (changing the momenta), then the split-impulse position iterations,
+    /// whose pseudo velocities go to `pseudo_linear` / `pseudo_angular` (m/s, rad/s, world): the
+    /// caller moves the bodies by them for one step only, so position correction adds no energy.
+    void solve(std::span<Body> bodies, std::span<const collision::ProxyPair> pairs, Real dt,
+               const ContactSolverSettings& settings, std::vector<Vec3>& pseudo_linear,
+               std::vector<Vec3>& pseudo_angular);
+
+    /// Contact points solved in the last call.
+    int pointCount() const { return static_cast<int>(points_.size()); }
+
+private:
+    struct Point {
+        BodyId a = 0;
+        BodyId b = 0;
+        Vec3 ra = Vec3::Zero();  ///< contact point - centre of mass of a, world
+        Vec3 rb = Vec3::Zero();
+        Vec3 normal = Vec3::Zero();  ///< a towards b
+        Vec3 t1 = Vec3::Zero();
+        Vec3 t2 = Vec3::Zero();
+        Real mass_n = 0;  ///< 1 / effective mass along the normal
+        Real mass_t1 = 0;
+        Real mass_t2 = 0;
+        Real friction = 0;
+        Real velocity_bias = 0;  ///< restitution target for the normal velocity
+        Real depth = 0;
+        Real slop = 0;
+        Real impulse_n = 0;  ///< accumulated, >= 0
+        Real impulse_t1 = 0;
+        Real impulse_t2 = 0;
+        Real pseudo_n = 0;  ///< accumulated split impulse, >= 0
+        Vec3 local_a = Vec3::Zero();  ///< contact point in a's body frame (warm-start matching)
+        collision::Feature feature_a;
+        collision::Feature feature_b;
+    };
+    std::vector<Point> points_;
+    std::vector<Point> previous_;  ///< last call's points, sorted by (a, b)
+};
+
+}  // namespace engine

@@ -1,0 +1,236 @@
+// tests/engine/response_test.cpp -- impulse response (response: impulse): elastic head-on
+// spheres exchange velocities with momentum exact and energy kept; kinetic energy never grows
+// for restitution <= 1 in a long random box pile; the shipped 5-box stack rests without drift
+// or jitter; a 1:1000 mass-ratio stack holds; runs are bit-identical; response none costs
+// nothing (no solver).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+#include <string>
+
+#include "engine/scene.h"
+#include "engine/world.h"
+
+namespace engine {
+namespace {
+
+using collision::Shape;
+const std::filesystem::path kScenes = std::filesystem::path(CDLAB_SOURCE_DIR) / "scenes";
+
+MassProperties boxMass(const Vec3& h, Real mass) {
+    MassProperties m;
+    m.mass = mass;
+    m.inertia = Vec3(h.y() * h.y() + h.z() * h.z(), h.x() * h.x() + h.z() * h.z(),
+                     h.x() * h.x() + h.y() * h.y())
+                    .asDiagonal();
+    m.inertia *= mass / 3;
+    return m;
+}
+
+MassProperties sphereMass(Real r, Real mass) {
+    MassProperties m;
+    m.mass = mass;
+    m.inertia = Mat3::Identity() * (Real(0.4) * mass * r * r);
+    return m;
+}
+
+WorldSettings impulseWorld(Real half_size) {
+    WorldSettings s;
+    s.bounds = collision::Aabb{Vec3::Constant(-half_size), Vec3::Constant(half_size)};
+    s.time_step = Real(1) / 60;
+    s.response = Response::Impulse;
+    return s;
+}
+
+TEST(Response, HeadOnElasticSpheresExchangeVelocities) {
+    WorldSettings s = impulseWorld(100);
+    World world(s);
+    for (const Real x : {Real(-2), Real(2)}) {
+        Body b = makeBody("ball", Shape::sphere(0.5), sphereMass(0.5, 2));
+        b.restitution = 1;
+        b.friction = 0.5;
+        b.position = Vec3(x, 0, 0);
+        b.linear_momentum = b.mass * Vec3(x < 0 ? 3 : -1, 0, 0);
+        world.addBody(b);
+    }
+    world.detect();
+    const Vec3 p0 = world.bodies()[0].linear_momentum + world.bodies()[1].linear_momentum;
+    const Real e0 = world.bodies()[0].kineticEnergy() + world.bodies()[1].kineticEnergy();
+    for (int i = 0; i < 120; ++i) world.step();
+    const Body& a = world.bodies()[0];
+    const Body& b = world.bodies()[1];
+    // Equal masses, e = 1, head on: the velocities are exchanged.
+    EXPECT_NEAR(a.velocity().x(), -1, 1e-12);
+    EXPECT_NEAR(b.velocity().x(), 3, 1e-12);
+    EXPECT_NEAR(a.velocity().y(), 0, 1e-12);
+    const Vec3 p1 = a.linear_momentum + b.linear_momentum;
+    EXPECT_LE((p1 - p0).norm(), 1e-12 * p0.norm());
+    const Real e1 = a.kineticEnergy() + b.kineticEnergy();
+    EXPECT_NEAR(e1, e0, 1e-12 * e0);
+    EXPECT_LT(a.position.x(), b.position.x() - 1);  // they bounced apart
+}
+
+TEST(Response, KineticEnergyNeverExceedsItsStartInALongRandomBoxPile) {
+    // 24 boxes with random restitution in [0, 1] and friction in [0, 1], no gravity, inside a
+    // 4 m box they reflect off (elastic): 10^4 steps, kinetic energy checked every step.
+    WorldSettings s = impulseWorld(2);
+    World world(s);
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<Real> u(-1, 1);
+    for (int i = 0; i < 24; ++i) {
+        const Vec3 h(0.2 + 0.1 * std::abs(u(rng)), 0.15 + 0.1 * std::abs(u(rng)), 0.2);
+        Body b = makeBody("box", Shape::box(h), boxMass(h, 1 + std::abs(u(rng))));
+        b.restitution = std::abs(u(rng)) * 1;
+        b.friction = std::abs(u(rng));
+        b.position = Vec3(u(rng), u(rng), u(rng)) * 1.5;
+        b.orientation = Quat(Eigen::AngleAxis<Real>(3 * u(rng), Vec3(u(rng), u(rng), 1).normalized()));
+        b.linear_momentum = b.mass * Vec3(u(rng), u(rng), u(rng)) * 3;
+        const Mat3 r = b.orientation.toRotationMatrix();
+        b.angular_momentum = r * b.inertia_body * r.transpose() * Vec3(u(rng), u(rng), u(rng)) * 2;
+        world.addBody(b);
+    }
+    world.detect();
+    auto energy = [&world]() {
+        Real e = 0;
+        for (const Body& b : world.bodies()) e += b.kineticEnergy();
+        return e;
+    };
+    Real previous = energy();
+    const Real e0 = previous;
+    std::int64_t contact_steps = 0;
+    Real worst = 0;
+    Real worst_free = 0;
+    Real highest = 0;
+    for (int i = 0; i < 10000; ++i) {
+        world.step();
+        const Real e = energy();
+        if (world.lastStats().contact_points > 0) {
+            worst = std::max(worst, (e - previous) / e0);
+        } else {
+            worst_free = std::max(worst_free, (e - previous) / e0);
+        }
+        highest = std::max(highest, e / e0 - 1);
+        previous = e;
+        contact_steps += world.lastStats().contact_points > 0 ? 1 : 0;
+    }
+    char text[96];
+    std::snprintf(text, sizeof text, "%.3e %.3e %.3e %.3e", worst, worst_free, highest,
+                  previous / e0);
+    RecordProperty("step_gain_contact_free_highest_final", text);
+    // The kinetic energy never exceeds its initial value. (Measured: highest 0; single steps
+    // with contacts can gain up to 3.2e-5 of E0 -- sequential impulses are not monotone -- and
+    // free steps 5.9e-8, the splitting integrator's bounded oscillation.)
+    EXPECT_LE(highest, 1e-9);
+    EXPECT_LT(previous, e0);             // friction and e < 1 dissipate
+    EXPECT_GT(contact_steps, 1000);      // the pile really collides
+}
+
+Real maxDrift(const World& world, const std::vector<Vec3>& start) {
+    Real d = 0;
+    for (std::size_t i = 0; i < start.size(); ++i) {
+        d = std::max(d, (world.bodies()[i].position - start[i]).norm());
+    }
+    return d;
+}
+
+TEST(Response, FiveBoxStackRestsWithoutDriftOrJitter) {
+    World world = makeWorld(loadScene(kScenes / "stack.yaml"));
+    std::vector<Vec3> start;
+    for (const Body& b : world.bodies()) start.push_back(b.position);
+    Real late_speed = 0;
+    for (int i = 0; i < 600; ++i) {  // 10 s at dt = 1/60
+        world.step();
+        if (i >= 300) {
+            for (const Body& b : world.bodies()) late_speed = std::max(late_speed, b.velocity().norm());
+        }
+    }
+    const Real drift = maxDrift(world, start);
+    RecordProperty("drift_m", std::to_string(drift));
+    RecordProperty("late_max_speed", std::to_string(late_speed));
+    EXPECT_LT(drift, 0.01);        // 1 % of the 1 m box
+    EXPECT_LT(late_speed, 1e-3);   // no jitter once settled (m/s)
+    EXPECT_EQ(world.lastStats().contact_points, 20);  // 4 points per resting face
+}
+
+// Mass ratio 1:1000 with the heavy box below: holds. (The other way round, 1000 kg on 1 kg, the
+// sequential-impulse solver does not converge at 30 iterations: the light box is squeezed into
+// the floor; not handled, see the report.)
+TEST(Response, MassRatioOneToThousandStackHolds) {
+    WorldSettings s = impulseWorld(10);
+    s.gravity = Vec3(0, -9.81, 0);
+    World world(s);
+    const Vec3 floor_h(4, 0.25, 4);
+    Body floor = makeBody("floor", Shape::box(floor_h), boxMass(floor_h, 1));
+    floor.position = Vec3(0, -0.25, 0);
+    setStatic(floor);
+    world.addBody(floor);
+    const Vec3 h(0.5, 0.5, 0.5);
+    for (const Real mass : {Real(1000), Real(1)}) {
+        Body b = makeBody("box", Shape::box(h), boxMass(h, mass));
+        b.position = Vec3(0, mass == 1000 ? 0.5 : 1.5, 0);
+        world.addBody(b);
+    }
+    world.detect();
+    std::vector<Vec3> start;
+    for (const Body& b : world.bodies()) start.push_back(b.position);
+    Real late_speed = 0;
+    for (int i = 0; i < 600; ++i) {
+        world.step();
+        if (i >= 300) {
+            for (const Body& b : world.bodies()) late_speed = std::max(late_speed, b.velocity().norm());
+        }
+    }
+    const Real drift = maxDrift(world, start);
+    RecordProperty("drift_m", std::to_string(drift));
+    EXPECT_LT(drift, 0.01);
+    EXPECT_LT(late_speed, 1e-3);
+}
+
+TEST(Response, RunsAreBitIdenticalAndNoneMeansNoSolver) {
+    World a = makeWorld(loadScene(kScenes / "bounce.yaml"));
+    World b = makeWorld(loadScene(kScenes / "bounce.yaml"));
+    for (int i = 0; i < 400; ++i) {
+        a.step();
+        b.step();
+    }
+    EXPECT_EQ(a.stateHash(), b.stateHash());
+    EXPECT_GT(a.lastStats().contact_points, 0);
+
+    Scene off = loadScene(kScenes / "bounce.yaml");
+    off.world.response = Response::None;
+    World c = makeWorld(off);
+    for (int i = 0; i < 10; ++i) c.step();
+    EXPECT_EQ(c.lastStats().contact_points, 0);
+    EXPECT_EQ(c.lastStats().response_s, 0);
+}
+
+TEST(Response, SceneKeys) {
+    const Scene s = loadScene(kScenes / "bounce.yaml");
+    EXPECT_EQ(s.world.response, Response::Impulse);
+    EXPECT_EQ(s.bodies[1].restitution, 0.9);
+    EXPECT_EQ(s.bodies[1].friction, 0.4);  // the world's default
+    EXPECT_TRUE(s.bodies[0].is_static);
+    try {
+        parseScene("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  restitution: 1.5\n",
+                   "t.yaml", ".");
+        FAIL() << "accepted restitution 1.5";
+    } catch (const SceneError& e) {
+        EXPECT_EQ(std::string(e.what()), "t.yaml:3:16: world.restitution: must be in [0, 1]");
+    }
+    try {
+        parseScene("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  response: magic\n", "t.yaml",
+                   ".");
+        FAIL() << "accepted an unknown response";
+    } catch (const SceneError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  "t.yaml:3:13: world.response: unknown response 'magic' (expected one of: none, "
+                  "impulse)");
+    }
+}
+
+}  // namespace
+}  // namespace engine
