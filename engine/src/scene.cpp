@@ -51,7 +51,7 @@ constexpr Real kMinGyrationFraction = Real(1e-3);
 constexpr std::string_view kBodyKeys[] = {
     "name",  "shape",    "radius",           "half_height", "half_extents", "file",
     "scale", "position", "orientation_wxyz", "euler_deg",   "velocity",     "angular_velocity",
-    "mass",  "density",  "repeat"};
+    "mass",  "density",  "repeat",           "static",      "restitution",  "friction"};
 constexpr std::string_view kRepeatKeys[] = {"count", "seed", "region", "speed", "spin",
                                             "random_orientation"};
 // Keys that `repeat` generates itself.
@@ -167,8 +167,9 @@ std::string formatMessage(const std::string& file, const YAML::Mark& mark, const
                           const std::string& what) {
     const int line = mark.is_null() || mark.line < 0 ? 1 : mark.line + 1;
     const int col = mark.is_null() || mark.column < 0 ? 1 : mark.column + 1;
+    // The key path is escaped too: a quoted key may hold a newline or any control character.
     return file + ":" + std::to_string(line) + ":" + std::to_string(col) + ": " +
-           (path.empty() ? "scene" : path) + ": " + printable(what);
+           printable(path.empty() ? "scene" : path) + ": " + printable(what);
 }
 
 void SceneParser::fail(const YAML::Mark& mark, const std::string& path,
@@ -277,8 +278,8 @@ Vec3 SceneParser::readVec3(const YAML::Node& n, const std::string& path) const {
 void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
     const std::string path = "world";
     const std::vector<Entry> es =
-        entries(n, path,
-                {"bounds", "gravity", "time_step", "steps_per_frame", "frames", "mesh_bvh"});
+        entries(n, path, {"bounds", "gravity", "time_step", "steps_per_frame", "frames",
+                          "mesh_bvh", "integrator", "ccd", "response", "restitution", "friction"});
     {
         const Entry& b = require(es, "bounds", n, path);
         const std::string bp = childPath(path, "bounds");
@@ -320,6 +321,33 @@ void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
                      "unknown bounding volume '" + name + "' (expected one of: " + list + ")");
             }
             scene.world.mesh_bvh = name;
+        } else if (e.key == "response") {
+            const std::string name = readString(e.value, p);
+            if (!findResponse(name, scene.world.response)) {
+                fail(e.value, p, "unknown response '" + name + "' (expected one of: none, impulse)");
+            }
+        } else if (e.key == "restitution") {
+            scene.world.restitution = readReal(e.value, p);
+            if (!(scene.world.restitution >= 0 && scene.world.restitution <= 1)) {
+                fail(e.value, p, "must be in [0, 1]");
+            }
+        } else if (e.key == "friction") {
+            scene.world.friction = readReal(e.value, p);
+            if (!(scene.world.friction >= 0)) fail(e.value, p, "must be >= 0");
+        } else if (e.key == "ccd") {
+            const std::string name = readString(e.value, p);
+            if (!findCcdMethod(name, scene.world.ccd)) {
+                fail(e.value, p,
+                     "unknown ccd method '" + name + "' (expected one of: " + ccdMethodNames() +
+                         ")");
+            }
+        } else if (e.key == "integrator") {
+            const std::string name = readString(e.value, p);
+            if (!findIntegrator(name, scene.world.integrator)) {
+                fail(e.value, p,
+                     "unknown integrator '" + name + "' (expected one of: " + integratorNames() +
+                         ")");
+            }
         }
     }
 }
@@ -552,6 +580,9 @@ std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
     const Entry* density_entry = nullptr;
     Real mass = 0;
     Real density = 1000;
+    bool is_static = false;
+    Real restitution = scene.world.restitution;
+    Real friction = scene.world.friction;
 
     const Entry* repeat_entry = find(es, "repeat");
     if (repeat_entry != nullptr) {
@@ -627,6 +658,21 @@ std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
             density = readReal(v, p);
             if (!(density > 0)) fail(v, p, "must be > 0 (kg/m^3)");
             density_entry = &e;
+        } else if (e.key == "static") {
+            is_static = readBool(v, p);
+        } else if (e.key == "restitution") {
+            restitution = readReal(v, p);
+            if (!(restitution >= 0 && restitution <= 1)) fail(v, p, "must be in [0, 1]");
+        } else if (e.key == "friction") {
+            friction = readReal(v, p);
+            if (!(friction >= 0)) fail(v, p, "must be >= 0");
+        }
+    }
+    if (is_static) {
+        for (const Entry& e : es) {
+            if (e.key == "velocity" || e.key == "angular_velocity") {
+                fail(e.key_node, childPath(path, e.key), "a static body does not move");
+            }
         }
     }
 
@@ -685,12 +731,16 @@ std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
     }
 
     Body body = makeBody(std::move(name), std::move(shape), props);
-    auto place = [&props](Body& b, const Vec3& p, const Quat& q, const Vec3& v, const Vec3& w) {
+    body.restitution = restitution;
+    body.friction = friction;
+    auto place = [&props, is_static](Body& b, const Vec3& p, const Quat& q, const Vec3& v,
+                                     const Vec3& w) {
         b.position = p;
         b.orientation = q;
         b.linear_momentum = props.mass * v;
         const Mat3 r = q.toRotationMatrix();
         b.angular_momentum = r * props.inertia * r.transpose() * w;
+        if (is_static) setStatic(b);
     };
     if (repeat_entry == nullptr) {
         place(body, position, orientation, velocity, angular_velocity);

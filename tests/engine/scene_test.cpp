@@ -661,6 +661,9 @@ TEST(SceneErrors, HostileYamlFailsCleanly) {
         "world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n"
         "bodies:\n  - shape: sphere\n    radius: 1e-300\n    position: [0, 0, 0]\n",
         "world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  frames: 99999999999999999999\n",
+        // A quoted key with a newline: the key path in the message is escaped too (found by
+        // the fuzzer in CI).
+        "world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  \"fr\\names\": 3\n",
     };
     for (const std::string& text : cases) {
         const std::string err = errorOf(text);
