@@ -128,6 +128,36 @@ struct ExtraBroadPhase {
     std::string first_mismatch;  // empty while they agree
 };
 
+// a's centre in b's OBB frame (coordinates along b's box axes, relative to its centre).
+engine::Vec3 localCentre(const engine::World& world, engine::BodyId a, engine::BodyId b) {
+    const collision::Obb& box = world.volumes()[b].obb;
+    return box.axes.transpose() * (world.bodies()[a].position - box.center);
+}
+
+// Tunnelling: the axis of b's box along which a starts farthest out and on which side; a has
+// passed once its centre is beyond the box on the other side.
+struct TunnelTracker {
+    int axis = 0;
+    double side = 1;
+    bool starts_outside = false;
+    bool passed = false;
+    int passed_frame = -1;
+};
+
+struct ToiTracker {
+    bool seen = false;
+    double time = 0;
+    bool failed = false;  // the first event came from a query that hit its cap
+};
+
+struct RestTracker {
+    engine::Vec3 origin = engine::Vec3::Zero();
+    double max_displacement = 0;
+    int displacement_frame = -1;
+    double max_speed = 0;
+    int speed_frame = -1;
+};
+
 struct PairTracker {
     bool every_held = true;
     int first_violation = -1;
@@ -172,9 +202,9 @@ std::string verifyPauseDump(const fs::path& dir, int frame, const engine::Scene&
     return {};
 }
 
-std::string formatDouble(double v) {
+std::string formatDouble(double v, int digits = 3) {
     std::ostringstream s;
-    s.precision(3);
+    s.precision(digits);
     s << v;
     return s.str();
 }
@@ -222,6 +252,27 @@ std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames, const f
     const double energy0 = totalEnergy(world);
     double max_drift = 0;
     int max_drift_frame = 0;
+    double max_rise = 0;
+    int max_rise_frame = 0;
+    std::vector<TunnelTracker> tunnels(ex.tunnelling.size());
+    for (std::size_t k = 0; k < ex.tunnelling.size(); ++k) {
+        const engine::TunnelExpectation& t = ex.tunnelling[k];
+        const engine::Vec3 c = localCentre(world, t.a, t.b);
+        const engine::Vec3 h = world.volumes()[t.b].obb.half_extents;
+        double best = -1;
+        for (int axis = 0; axis < 3; ++axis) {
+            const double out = std::abs(double(c[axis])) - double(h[axis]);
+            const double relative = out / std::max(double(h[axis]), 1e-300);
+            if (out > 0 && relative > best) {
+                best = relative;
+                tunnels[k].axis = axis;
+                tunnels[k].side = c[axis] >= 0 ? 1.0 : -1.0;
+                tunnels[k].starts_outside = true;
+            }
+        }
+    }
+    std::vector<ToiTracker> tois(ex.toi.size());
+    std::vector<RestTracker> rests(ex.rest.size());
     std::vector<PairTracker> pair_state(ex.pairs.size());
     std::vector<std::array<long, 3>> color_counts(ex.colors.size());
     std::vector<std::string> dump_problems(ex.pause_dumps.size());
@@ -252,12 +303,40 @@ std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames, const f
             e.first_mismatch = "differs at frame " + std::to_string(frame) + ", step " +
                                std::to_string(world.stepCount()) + ": " + report;
         }
-        if (ex.energy_drift_max) {
-            const double drift = std::abs(totalEnergy(world) - energy0) /
-                                 std::max(std::abs(energy0), kMinReferenceEnergy);
-            if (drift > max_drift) {
-                max_drift = drift;
+        if (ex.energy_drift_max || ex.energy_rise_max) {
+            const double change =
+                (totalEnergy(world) - energy0) / std::max(std::abs(energy0), kMinReferenceEnergy);
+            if (std::abs(change) > max_drift) {
+                max_drift = std::abs(change);
                 max_drift_frame = frame;
+            }
+            if (change > max_rise) {
+                max_rise = change;
+                max_rise_frame = frame;
+            }
+        }
+        for (std::size_t k = 0; k < ex.tunnelling.size(); ++k) {
+            TunnelTracker& t = tunnels[k];
+            if (!t.starts_outside || t.passed) continue;
+            const engine::TunnelExpectation& te = ex.tunnelling[k];
+            const double c = localCentre(world, te.a, te.b)[t.axis];
+            if (t.side * c < -double(world.volumes()[te.b].obb.half_extents[t.axis])) {
+                t.passed = true;
+                t.passed_frame = frame;
+            }
+        }
+    };
+    // The CCD stage's events of the step that just ran, as simulated times.
+    auto observeToi = [&](double step_start) {
+        const double dt = double(world.settings().time_step);
+        for (const engine::ToiEvent& e : world.toiEvents()) {
+            for (std::size_t k = 0; k < ex.toi.size(); ++k) {
+                const engine::ToiExpectation& te = ex.toi[k];
+                if (tois[k].seen || std::min(te.a, te.b) != std::min(e.a, e.b) ||
+                    std::max(te.a, te.b) != std::max(e.a, e.b)) {
+                    continue;
+                }
+                tois[k] = {true, step_start + double(e.t) * dt, e.failed};
             }
         }
     };
@@ -267,8 +346,10 @@ std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames, const f
             observeStep(0);
         } else {
             for (int s = 0; s < scene.steps_per_frame; ++s) {
+                const double step_start = double(world.time());
                 world.step();
                 observeStep(frame);
+                observeToi(step_start);
             }
         }
         for (std::size_t i = 0; i < n; ++i) {
@@ -277,6 +358,23 @@ std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames, const f
                 std::max(max_displacement[i], double((b.position - start_position[i]).norm()));
             max_rotation[i] = std::max(max_rotation[i],
                                        double(b.orientation.angularDistance(start_orientation[i])));
+        }
+        for (std::size_t k = 0; k < ex.rest.size(); ++k) {
+            const engine::RestExpectation& r = ex.rest[k];
+            if (frame < r.frames.first || frame > r.frames.last) continue;
+            const engine::Body& b = world.bodies()[r.body];
+            RestTracker& t = rests[k];
+            if (frame == r.frames.first) t.origin = b.position;
+            const double d = double((b.position - t.origin).norm());
+            const double v = double(b.velocity().norm());
+            if (d > t.max_displacement || t.displacement_frame < 0) {
+                t.max_displacement = d;
+                t.displacement_frame = frame;
+            }
+            if (v > t.max_speed || t.speed_frame < 0) {
+                t.max_speed = v;
+                t.speed_frame = frame;
+            }
         }
         for (std::size_t k = 0; k < ex.pairs.size(); ++k) {
             const engine::PairExpectation& p = ex.pairs[k];
@@ -353,6 +451,81 @@ std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames, const f
         if (!r.pass) {
             r.reason = "relative drift " + formatDouble(max_drift) + " at frame " +
                        std::to_string(max_drift_frame) + " (E0 = " + formatDouble(energy0) + " J)";
+        }
+        rows.push_back(r);
+    }
+    if (ex.energy_rise_max) {
+        CheckRow r{"energy rise <= " + formatDouble(double(*ex.energy_rise_max)),
+                   max_rise <= double(*ex.energy_rise_max), ""};
+        if (!r.pass) {
+            r.reason = "energy rose by " + formatDouble(max_rise) + " of E0 at frame " +
+                       std::to_string(max_rise_frame) + " (E0 = " + formatDouble(energy0) + " J)";
+        }
+        rows.push_back(r);
+    }
+    for (std::size_t k = 0; k < ex.tunnelling.size(); ++k) {
+        const engine::TunnelExpectation& te = ex.tunnelling[k];
+        const TunnelTracker& t = tunnels[k];
+        CheckRow r{
+            te.a_name + (te.passes ? " passes through " : " never passes through ") + te.b_name,
+            false, ""};
+        if (!t.starts_outside) {
+            r.reason = te.a_name + "'s centre starts inside " + te.b_name + "'s box";
+        } else if (te.passes) {
+            r.pass = t.passed;
+            if (!r.pass) r.reason = "it never got to the other side";
+        } else {
+            r.pass = !t.passed;
+            if (!r.pass) r.reason = "on the other side at frame " + std::to_string(t.passed_frame);
+        }
+        rows.push_back(r);
+    }
+    for (std::size_t k = 0; k < ex.toi.size(); ++k) {
+        const engine::ToiExpectation& te = ex.toi[k];
+        const ToiTracker& t = tois[k];
+        CheckRow r{"first time of impact " + te.a_name + " / " + te.b_name + " in [" +
+                       formatDouble(double(te.time - te.tolerance), 8) + ", " +
+                       formatDouble(double(te.time), 8) + "] s",
+                   false, ""};
+        std::ostringstream got;
+        got.precision(9);
+        got << t.time;
+        if (!t.seen) {
+            r.reason = "the CCD stage reported no time of impact for the pair";
+        } else if (t.failed) {
+            r.reason = "the query hit its iteration cap (Failed) at t = " + got.str() + " s";
+        } else if (t.time > double(te.time)) {
+            r.reason = "t = " + got.str() + " s is later than the contact";
+        } else if (t.time < double(te.time - te.tolerance)) {
+            r.reason = "t = " + got.str() + " s is too early";
+        } else {
+            r.pass = true;
+        }
+        rows.push_back(r);
+    }
+    for (std::size_t k = 0; k < ex.rest.size(); ++k) {
+        const engine::RestExpectation& re = ex.rest[k];
+        const RestTracker& t = rests[k];
+        std::string what = re.name + " at rest at " + frameText(re.frames) + ":";
+        if (re.max_displacement)
+            what += " moves <= " + formatDouble(double(*re.max_displacement)) + " m";
+        if (re.max_speed) what += " speed <= " + formatDouble(double(*re.max_speed)) + " m/s";
+        CheckRow r{what, true, ""};
+        if (re.frames.last >= frames) {
+            r.pass = false;
+            r.reason = "the run has only " + std::to_string(frames) + " frames";
+        } else {
+            if (re.max_displacement && t.max_displacement > double(*re.max_displacement)) {
+                r.pass = false;
+                r.reason = "moved " + formatDouble(t.max_displacement) + " m by frame " +
+                           std::to_string(t.displacement_frame);
+            }
+            if (re.max_speed && t.max_speed > double(*re.max_speed)) {
+                r.pass = false;
+                r.reason += (r.reason.empty() ? "" : "; ") + std::string("speed ") +
+                            formatDouble(t.max_speed) + " m/s at frame " +
+                            std::to_string(t.speed_frame);
+            }
         }
         rows.push_back(r);
     }

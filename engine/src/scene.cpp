@@ -52,8 +52,8 @@ constexpr std::string_view kBodyKeys[] = {
     "name",  "shape",    "radius",           "half_height", "half_extents", "file",
     "scale", "position", "orientation_wxyz", "euler_deg",   "velocity",     "angular_velocity",
     "mass",  "density",  "repeat",           "static",      "restitution",  "friction"};
-constexpr std::string_view kRepeatKeys[] = {"count", "seed", "region", "speed", "spin",
-                                            "random_orientation"};
+constexpr std::string_view kRepeatKeys[] = {"count", "seed", "region",
+                                            "speed", "spin", "random_orientation"};
 // Keys that `repeat` generates itself.
 constexpr std::string_view kGeneratedKeys[] = {"position", "velocity", "angular_velocity",
                                                "orientation_wxyz", "euler_deg"};
@@ -278,8 +278,9 @@ Vec3 SceneParser::readVec3(const YAML::Node& n, const std::string& path) const {
 void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
     const std::string path = "world";
     const std::vector<Entry> es =
-        entries(n, path, {"bounds", "gravity", "time_step", "steps_per_frame", "frames",
-                          "mesh_bvh", "integrator", "ccd", "response", "restitution", "friction"});
+        entries(n, path,
+                {"bounds", "gravity", "time_step", "steps_per_frame", "frames", "mesh_bvh",
+                 "integrator", "ccd", "response", "restitution", "friction"});
     {
         const Entry& b = require(es, "bounds", n, path);
         const std::string bp = childPath(path, "bounds");
@@ -324,7 +325,8 @@ void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
         } else if (e.key == "response") {
             const std::string name = readString(e.value, p);
             if (!findResponse(name, scene.world.response)) {
-                fail(e.value, p, "unknown response '" + name + "' (expected one of: none, impulse)");
+                fail(e.value, p,
+                     "unknown response '" + name + "' (expected one of: none, impulse)");
             }
         } else if (e.key == "restitution") {
             scene.world.restitution = readReal(e.value, p);
@@ -754,8 +756,10 @@ std::vector<Body> SceneParser::repeatBody(const Body& base, const Entry& entry,
                                           const std::string& path, const Scene& scene,
                                           Place&& place) const {
     const YAML::Node& n = entry.value;
-    if (!n.IsMap()) fail(n, path, "expected a mapping with keys: " + join({"count", "seed",
-                                       "region", "speed", "spin", "random_orientation"}));
+    if (!n.IsMap())
+        fail(n, path,
+             "expected a mapping with keys: " +
+                 join({"count", "seed", "region", "speed", "spin", "random_orientation"}));
     const std::vector<Entry> es = entries(
         n, path, std::vector<std::string_view>(std::begin(kRepeatKeys), std::end(kRepeatKeys)));
     const Entry& count_entry = require(es, "count", n, path);
@@ -849,8 +853,9 @@ void SceneParser::parseExpect(const YAML::Node& n, Scene& scene) const {
     ex.present = true;
     if (n.IsNull()) return;  // "expect:" with nothing after it: nothing to check
     const std::vector<Entry> es =
-        entries(n, path, {"frames", "min_bodies", "min_moving_rotating", "broadphases",
-                          "energy_drift_max", "pause_dumps", "pairs", "colors"});
+        entries(n, path,
+                {"frames", "min_bodies", "min_moving_rotating", "broadphases", "energy_drift_max",
+                 "energy_rise_max", "pause_dumps", "pairs", "colors", "tunnelling", "toi", "rest"});
     // The run length first: every frame below must lie inside it.
     if (const Entry* f = find(es, "frames")) {
         const int v = readInt(f->value, childPath(path, "frames"));
@@ -861,8 +866,9 @@ void SceneParser::parseExpect(const YAML::Node& n, Scene& scene) const {
     auto readFrame = [&](const YAML::Node& v, const std::string& p) {
         const int f = readInt(v, p);
         if (f < 0 || f >= run_frames) {
-            fail(v, p, "frame out of range (the check runs frames 0.." +
-                           std::to_string(run_frames - 1) + ")");
+            fail(v, p,
+                 "frame out of range (the check runs frames 0.." + std::to_string(run_frames - 1) +
+                     ")");
         }
         return f;
     };
@@ -899,8 +905,9 @@ void SceneParser::parseExpect(const YAML::Node& n, Scene& scene) const {
         const auto it = by_name.find(name);
         if (it == by_name.end()) fail(v, p, "no body is named '" + name + "'");
         if (it->second.size() > 1) {
-            fail(v, p, "the name '" + name + "' is given to " +
-                           std::to_string(it->second.size()) + " bodies");
+            fail(v, p,
+                 "the name '" + name + "' is given to " + std::to_string(it->second.size()) +
+                     " bodies");
         }
         return it->second.front();
     };
@@ -922,6 +929,65 @@ void SceneParser::parseExpect(const YAML::Node& n, Scene& scene) const {
             const Real d = readReal(e.value, p);
             if (!(d >= 0)) fail(e.value, p, "must be >= 0 (relative drift)");
             ex.energy_drift_max = d;
+        } else if (e.key == "energy_rise_max") {
+            const Real d = readReal(e.value, p);
+            if (!(d >= 0)) fail(e.value, p, "must be >= 0 (relative rise)");
+            ex.energy_rise_max = d;
+        } else if (e.key == "tunnelling" || e.key == "toi") {
+            const std::vector<YAML::Node> list = readList(e.value, p);
+            for (std::size_t i = 0; i < list.size(); ++i) {
+                const std::string ip = indexPath(p, i);
+                const bool tunnel = e.key == "tunnelling";
+                const std::vector<Entry> te =
+                    tunnel ? entries(list[i], ip, {"a", "b", "passes"})
+                           : entries(list[i], ip, {"a", "b", "time", "tolerance"});
+                const Entry& a = require(te, "a", list[i], ip);
+                const Entry& b = require(te, "b", list[i], ip);
+                const BodyId ia = readBody(a.value, childPath(ip, "a"));
+                const BodyId ib = readBody(b.value, childPath(ip, "b"));
+                if (ia == ib) fail(b.value, childPath(ip, "b"), "must differ from 'a'");
+                if (tunnel) {
+                    TunnelExpectation t{ia, ib, a.value.Scalar(), b.value.Scalar()};
+                    t.passes =
+                        readBool(require(te, "passes", list[i], ip).value, childPath(ip, "passes"));
+                    ex.tunnelling.push_back(std::move(t));
+                } else {
+                    ToiExpectation t{ia, ib, a.value.Scalar(), b.value.Scalar()};
+                    const Entry& time = require(te, "time", list[i], ip);
+                    t.time = readReal(time.value, childPath(ip, "time"));
+                    if (!(t.time >= 0)) fail(time.value, childPath(ip, "time"), "must be >= 0");
+                    const Entry& tol = require(te, "tolerance", list[i], ip);
+                    t.tolerance = readReal(tol.value, childPath(ip, "tolerance"));
+                    if (!(t.tolerance > 0)) {
+                        fail(tol.value, childPath(ip, "tolerance"), "must be > 0");
+                    }
+                    ex.toi.push_back(std::move(t));
+                }
+            }
+        } else if (e.key == "rest") {
+            const std::vector<YAML::Node> list = readList(e.value, p);
+            for (std::size_t i = 0; i < list.size(); ++i) {
+                const std::string ip = indexPath(p, i);
+                const std::vector<Entry> re =
+                    entries(list[i], ip, {"body", "frames", "max_displacement", "max_speed"});
+                const Entry& body = require(re, "body", list[i], ip);
+                RestExpectation r;
+                r.body = readBody(body.value, childPath(ip, "body"));
+                r.name = body.value.Scalar();
+                r.frames =
+                    readFrames(require(re, "frames", list[i], ip).value, childPath(ip, "frames"));
+                for (const char* key : {"max_displacement", "max_speed"}) {
+                    const Entry* m = find(re, key);
+                    if (m == nullptr) continue;
+                    const Real v = readReal(m->value, childPath(ip, key));
+                    if (!(v >= 0)) fail(m->value, childPath(ip, key), "must be >= 0");
+                    (std::string_view(key) == "max_speed" ? r.max_speed : r.max_displacement) = v;
+                }
+                if (!r.max_displacement && !r.max_speed) {
+                    fail(list[i], ip, "needs 'max_displacement' or 'max_speed' (or both)");
+                }
+                ex.rest.push_back(std::move(r));
+            }
         } else if (e.key == "broadphases") {
             const std::vector<YAML::Node> list = readList(e.value, p);
             for (std::size_t i = 0; i < list.size(); ++i) {
@@ -954,8 +1020,8 @@ void SceneParser::parseExpect(const YAML::Node& n, Scene& scene) const {
                 pair.a_name = a.value.Scalar();
                 pair.b_name = b.value.Scalar();
                 if (pair.a == pair.b) fail(b.value, childPath(ip, "b"), "must differ from 'a'");
-                pair.frames = readFrames(require(pe, "frames", list[i], ip).value,
-                                         childPath(ip, "frames"));
+                pair.frames =
+                    readFrames(require(pe, "frames", list[i], ip).value, childPath(ip, "frames"));
                 if (const Entry* w = find(pe, "when")) {
                     const std::string when = readString(w->value, childPath(ip, "when"));
                     if (when != "every" && when != "any") {
@@ -1041,8 +1107,8 @@ Scene SceneParser::parse(const std::string& text) {
              "expected a mapping with keys: world, broadphase, output, camera, draw, bodies, "
              "expect");
     }
-    const std::vector<Entry> es = entries(
-        root, "", {"world", "broadphase", "output", "camera", "draw", "bodies", "expect"});
+    const std::vector<Entry> es =
+        entries(root, "", {"world", "broadphase", "output", "camera", "draw", "bodies", "expect"});
     parseWorld(require(es, "world", root, "").value, scene);
     for (const Entry& e : es) {
         if (e.key == "broadphase") {
@@ -1099,8 +1165,8 @@ void SceneParser::applyOverrides(YAML::Node& root) const {
             const std::string& p = parts[i];
             const bool last = i + 1 == parts.size();
             if (node.IsSequence()) {
-                const bool digits = std::all_of(p.begin(), p.end(),
-                                                [](char c) { return c >= '0' && c <= '9'; });
+                const bool digits =
+                    std::all_of(p.begin(), p.end(), [](char c) { return c >= '0' && c <= '9'; });
                 const std::size_t index = digits && p.size() < 9 ? std::stoul(p) : node.size();
                 if (index >= node.size()) {
                     fail(node, where,

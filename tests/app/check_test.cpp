@@ -111,6 +111,74 @@ TEST(Check, WrongExpectationsFailWithTheReason) {
     fs::remove_all(dir);
 }
 
+// Tunnelling, time of impact, rest and energy rise, each both ways. Without response a passes
+// through b: relative to b, a's centre goes from x = -3.1 at 2 m/s and is beyond b's box
+// (half extent 0.5) once -3.1 + 2 t > 0.5, t > 1.8 s: frame 19 (the first frame after).
+TEST(Check, TunnellingTimeOfImpactRestAndEnergyRise) {
+    const fs::path dir = tempDir("motion");
+    const engine::Scene off = parse(kTwoSpheres +
+                                    "expect:\n"
+                                    "  tunnelling:\n"
+                                    "    - {a: a, b: b, passes: true}\n"
+                                    "    - {a: a, b: b, passes: false}\n"
+                                    "    - {a: a, b: c, passes: true}\n"
+                                    "  toi:\n"
+                                    "    - {a: a, b: b, time: 1.05, tolerance: 0.01}\n"
+                                    "  rest:\n"
+                                    "    - {body: c, frames: [0, 24], max_displacement: 0, "
+                                    "max_speed: 0}\n"
+                                    "    - {body: a, frames: [3, 6], max_displacement: 0.25, "
+                                    "max_speed: 0.5}\n");
+    std::vector<CheckRow> rows = checkScene(off, 25, dir);
+    ASSERT_EQ(rows.size(), 6u);
+    const CheckRow* passes = findRow(rows, "a passes through b");
+    ASSERT_NE(passes, nullptr);
+    EXPECT_TRUE(passes->pass) << passes->reason;
+    EXPECT_EQ(findRow(rows, "a never passes through b")->reason, "on the other side at frame 19");
+    EXPECT_EQ(findRow(rows, "a passes through c")->reason, "it never got to the other side");
+    EXPECT_EQ(findRow(rows, "first time of impact a / b")->reason,
+              "the CCD stage reported no time of impact for the pair");
+    EXPECT_TRUE(findRow(rows, "c at rest")->pass);
+    // a moves 0.1 m per frame: 0.3 m over frames 3..6, at 1 m/s.
+    EXPECT_EQ(findRow(rows, "a at rest")->reason, "moved 0.3 m by frame 6; speed 1 m/s at frame 3");
+
+    // With CCD the spheres stop just before their first contact (1.05 s, exact), short by the
+    // stage's target gap (1e-3 to 2e-3 of the radius: 0.5 to 1 mm, 0.25 to 0.5 ms at 2 m/s),
+    // and bounce apart.
+    std::string text = kTwoSpheres;
+    text.replace(text.find("frames: 25}"), 11, "frames: 25, ccd: conservative_advancement}");
+    const engine::Scene on = parse(text +
+                                   "expect:\n"
+                                   "  tunnelling:\n"
+                                   "    - {a: a, b: b, passes: false}\n"
+                                   "  toi:\n"
+                                   "    - {a: a, b: b, time: 1.05, tolerance: 5e-4}\n"
+                                   "    - {a: b, b: a, time: 1.0, tolerance: 0.01}\n"
+                                   "    - {a: a, b: b, time: 1.2, tolerance: 0.1}\n"
+                                   "  energy_rise_max: 0\n"
+                                   "  energy_drift_max: 1e-12\n");
+    rows = checkScene(on, 25, dir);
+    ASSERT_EQ(rows.size(), 6u);
+    for (const char* good : {"a never passes", "in [1.0495, 1.05]", "energy rise", "drift"}) {
+        const CheckRow* r = findRow(rows, good);
+        ASSERT_NE(r, nullptr) << good;
+        EXPECT_TRUE(r->pass) << good << ": " << r->reason;
+    }
+    EXPECT_NE(findRow(rows, "b / a in [0.99, 1]")->reason.find("later than the contact"),
+              std::string::npos);
+    EXPECT_NE(findRow(rows, "a / b in [1.1, 1.2]")->reason.find("too early"), std::string::npos);
+
+    // Gravity with explicit Euler gains energy at every step.
+    text = kTwoSpheres;
+    text.replace(text.find("frames: 25}"), 11,
+                 "frames: 25, gravity: [0, -9.81, 0], integrator: explicit_euler}");
+    rows = checkScene(parse(text + "expect:\n  energy_rise_max: 1e-6\n"), 25, dir);
+    ASSERT_EQ(rows.size(), 1u);
+    EXPECT_FALSE(rows[0].pass);
+    EXPECT_EQ(rows[0].reason.rfind("energy rose by ", 0), 0u) << rows[0].reason;
+    fs::remove_all(dir);
+}
+
 TEST(Check, ShortRunsAndMissingSectionsFail) {
     const fs::path dir = tempDir("short");
     std::vector<CheckRow> rows = checkScene(parse(kTwoSpheres), 25, dir);

@@ -154,6 +154,31 @@ TEST(SceneExpectErrors, ValuesAndContradictions) {
     EXPECT_SCENE_ERROR(kScene + "  pairs: {a: a}\n", "8:10: expect.pairs: ", "expected a list");
 }
 
+TEST(SceneExpectErrors, TunnellingTimeOfImpactAndRest) {
+    EXPECT_SCENE_ERROR(kScene + "  energy_rise_max: -0.1\n",
+                       "8:20: expect.energy_rise_max: ", "must be >= 0");
+    EXPECT_SCENE_ERROR(kScene + "  tunnelling:\n    - {a: a, b: a, passes: false}\n",
+                       "9:17: expect.tunnelling[0].b: ", "must differ from 'a'");
+    EXPECT_SCENE_ERROR(kScene + "  tunnelling:\n    - {a: a, b: b}\n",
+                       "9:7: expect.tunnelling[0].passes: ", "required key is missing");
+    EXPECT_SCENE_ERROR(kScene + "  tunnelling:\n    - {a: a, b: b, passes: 2}\n",
+                       "9:28: expect.tunnelling[0].passes: ", "expected true or false");
+    EXPECT_SCENE_ERROR(kScene + "  toi:\n    - {a: a, b: b, time: 1, tolerance: 0}\n",
+                       "9:40: expect.toi[0].tolerance: ", "must be > 0");
+    EXPECT_SCENE_ERROR(kScene + "  toi:\n    - {a: a, b: b, time: -1, tolerance: 1}\n",
+                       "9:26: expect.toi[0].time: ", "must be >= 0");
+    EXPECT_SCENE_ERROR(kScene + "  toi:\n    - {a: a, b: b, time: 1, tolerance: 1, t: 3}\n",
+                       "9:43: expect.toi[0].t: ", "unknown key 't'");
+    EXPECT_SCENE_ERROR(kScene + "  rest:\n    - {body: b, frames: [0, 9]}\n",
+                       "9:7: expect.rest[0]: ", "needs 'max_displacement' or 'max_speed'");
+    EXPECT_SCENE_ERROR(kScene + "  rest:\n    - {body: twin, frames: 1, max_speed: 1}\n",
+                       "9:14: expect.rest[0].body: ", "given to 2 bodies");
+    EXPECT_SCENE_ERROR(kScene + "  rest:\n    - {body: a, frames: [0, 10], max_speed: 1}\n",
+                       "9:29: expect.rest[0].frames[1]: ", "frame out of range");
+    EXPECT_SCENE_ERROR(kScene + "  rest:\n    - {body: a, frames: 1, max_speed: -1}\n",
+                       "9:39: expect.rest[0].max_speed: ", "must be >= 0");
+}
+
 }  // namespace
 }  // namespace engine
 

@@ -46,15 +46,15 @@ struct FrameRange {
 
 /// `expect.pairs[i]`: what must hold for one named pair of bodies over a frame range.
 struct PairExpectation {
-    BodyId a = 0;                  ///< body index; a != b
+    BodyId a = 0;  ///< body index; a != b
     BodyId b = 0;
-    std::string a_name;            ///< as written in the scene, for reports
+    std::string a_name;  ///< as written in the scene, for reports
     std::string b_name;
     FrameRange frames;
-    bool every = true;             ///< true: at every frame of the range; false: at some frame
-    std::optional<bool> colliding; ///< confirmed by the narrow phase (or must not be)
-    std::optional<bool> flagged;   ///< flagged by the broad phase (or must not be)
-    int line = 0;                  ///< 1-based position of the entry in the scene file
+    bool every = true;              ///< true: at every frame of the range; false: at some frame
+    std::optional<bool> colliding;  ///< confirmed by the narrow phase (or must not be)
+    std::optional<bool> flagged;    ///< flagged by the broad phase (or must not be)
+    int line = 0;                   ///< 1-based position of the entry in the scene file
     int column = 0;
 };
 
@@ -68,31 +68,71 @@ struct ColorExpectation {
     int column = 0;
 };
 
+/// `expect.tunnelling[i]`: whether body `a` passes through body `b`. a's centre starts outside
+/// b's oriented box on one side of one of its axes (the axis along which it is farthest out,
+/// relative to b's half extent); `a` has passed when, at some step, its centre is beyond b's box
+/// on the opposite side of that axis. Checked after every step, so a pass within one step (the
+/// tunnelling this expectation exists for) is seen.
+struct TunnelExpectation {
+    BodyId a = 0;
+    BodyId b = 0;
+    std::string a_name;
+    std::string b_name;
+    bool passes = false;  ///< true: it must pass (a scene showing tunnelling); false: it never may
+};
+
+/// `expect.toi[i]`: the first time of impact the CCD stage reports for the pair, in seconds of
+/// simulated time, must lie in [time - tolerance, time] (CCD never reports a time later than
+/// the true contact, and may stop short by its target gap).
+struct ToiExpectation {
+    BodyId a = 0;
+    BodyId b = 0;
+    std::string a_name;
+    std::string b_name;
+    Real time = 0;       ///< s, the exact first contact
+    Real tolerance = 0;  ///< s, > 0
+};
+
+/// `expect.rest[i]`: over a frame range, the body stays within `max_displacement` of where it
+/// was at the range's first frame, and its speed never exceeds `max_speed` (resting contact:
+/// no drift, no jitter).
+struct RestExpectation {
+    BodyId body = 0;
+    std::string name;
+    FrameRange frames;
+    std::optional<Real> max_displacement;  ///< m
+    std::optional<Real> max_speed;         ///< m/s, of the centre of mass
+};
+
 /// The optional top-level `expect:` section: outcomes `cdlab check` verifies. Frames are
 /// validated against `frames` (or the scene's frame count); body names must exist (unique).
 struct Expectations {
-    bool present = false;             ///< the scene has an `expect:` section
-    std::optional<int> frames;        ///< frames to run for the check (default: scene.frames)
+    bool present = false;       ///< the scene has an `expect:` section
+    std::optional<int> frames;  ///< frames to run for the check (default: scene.frames)
     std::optional<int> min_bodies;
     std::optional<int> min_moving_rotating;  ///< bodies displaced and rotated by the last frame
     std::vector<std::string> broad_phases;   ///< each must equal its brute reference every step
     std::optional<Real> energy_drift_max;    ///< max |E(t) - E(0)| / |E(0)|, E kinetic+potential
+    std::optional<Real> energy_rise_max;     ///< max (E(t) - E(0)) / |E(0)|: energy never grows
     std::vector<int> pause_dumps;            ///< frames whose pause PNG + JSON must be written
     std::vector<PairExpectation> pairs;
     std::vector<ColorExpectation> colors;
+    std::vector<TunnelExpectation> tunnelling;
+    std::vector<ToiExpectation> toi;
+    std::vector<RestExpectation> rest;
 };
 // END expect (self-grading scenes)
 
 struct Scene {
-    std::string name;               ///< file stem
+    std::string name;  ///< file stem
     WorldSettings world;
-    int frames = 120;               ///< frames to write (frame 0 is the initial state)
-    int steps_per_frame = 1;        ///< integrator steps between two frames
+    int frames = 120;         ///< frames to write (frame 0 is the initial state)
+    int steps_per_frame = 1;  ///< integrator steps between two frames
     OutputSettings output;
     CameraSettings camera;
     DrawSettings draw;
     std::vector<Body> bodies;
-    Expectations expect;            ///< `expect:` (self-grading), empty when absent
+    Expectations expect;  ///< `expect:` (self-grading), empty when absent
 };
 
 /// A bad scene file. what() is "FILE:LINE:COL: key.path: what is wrong" (1-based line and column).
