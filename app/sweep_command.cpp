@@ -18,6 +18,7 @@
 #include <sstream>
 #include <utility>
 
+#include "collision/contact.h"
 #include "output_files.h"
 #include "render/chart.h"
 #include "render/image.h"
@@ -81,31 +82,52 @@ SweepRun measure(const engine::Scene& scene, double duration, FirstContacts& fir
     run.time_step = scene.world.time_step;
     run.steps = std::max<std::int64_t>(1, std::llround(duration / run.time_step));
 
-    auto record = [&first, &world]() {
+    // Contacts the run saw: pairs confirmed at the end of a step, and pairs the CCD stage
+    // stopped at their time of impact within it (they never overlap at a step's end).
+    auto record = [&first, &world, &run](double step_start) {
+        const double dt = double(world.settings().time_step);
+        for (const engine::ToiEvent& e : world.toiEvents()) {
+            first.try_emplace(PairKey{std::min(e.a, e.b), std::max(e.a, e.b)},
+                              step_start + double(e.t) * dt);
+        }
+        const auto bodies = world.bodies();
         for (const collision::ProxyPair& p : world.collidingPairs()) {
             first.try_emplace(PairKey{p.a, p.b}, double(world.time()));
+            // Depth of convex pairs (a mesh would answer as its hull, an overestimate).
+            const engine::Body& a = bodies[p.a];
+            const engine::Body& b = bodies[p.b];
+            if (!a.shape.isConvex() || !b.shape.isConvex()) continue;
+            const collision::ContactOutput c =
+                collision::contact(a.shape, a.pose(), b.shape, b.pose());
+            if (c.state == collision::ContactState::Penetrating) {
+                run.max_penetration = std::max(run.max_penetration, -double(c.signed_distance));
+            }
         }
     };
-    record();
+    record(double(world.time()));
     double energy_scale = 0;
     const double e0 = totalEnergy(world, energy_scale);
     std::vector<double> l0;
     for (const engine::Body& b : world.bodies()) l0.push_back(b.angular_momentum.norm());
 
     for (std::int64_t s = 0; s < run.steps; ++s) {
+        const double step_start = double(world.time());
         world.step();
         const engine::StepStats& st = world.lastStats();
         run.ms_integrate += 1e3 * st.integrate_s;
         run.ms_volumes += 1e3 * st.volumes_s;
         run.ms_broad += 1e3 * st.broad_phase_s;
         run.ms_narrow += 1e3 * st.narrow_phase_s;
+        run.ms_ccd += 1e3 * st.ccd_s;
+        run.ms_response += 1e3 * st.response_s;
+        run.toi_events += st.toi_events;
         run.ms_step += 1e3 * st.total_s;
         run.flagged += double(world.flaggedPairs().size());
         run.confirmed += double(world.collidingPairs().size());
         run.bv_tests += double(st.broad.volume_tests);
         run.narrow_tests += double(st.narrow_tests);
         run.triangle_tests += double(st.triangle_tests);
-        record();
+        record(step_start);
         double scale_now = 0;
         const double e = totalEnergy(world, scale_now);
         if (energy_scale > 0) {
@@ -119,9 +141,9 @@ SweepRun measure(const engine::Scene& scene, double duration, FirstContacts& fir
         }
     }
     const double n = double(run.steps);
-    for (double* v :
-         {&run.ms_integrate, &run.ms_volumes, &run.ms_broad, &run.ms_narrow, &run.ms_step,
-          &run.flagged, &run.confirmed, &run.bv_tests, &run.narrow_tests, &run.triangle_tests}) {
+    for (double* v : {&run.ms_integrate, &run.ms_volumes, &run.ms_broad, &run.ms_narrow,
+                      &run.ms_ccd, &run.ms_response, &run.ms_step, &run.flagged, &run.confirmed,
+                      &run.bv_tests, &run.narrow_tests, &run.triangle_tests}) {
         *v /= n;
     }
     run.broad_false_positives = run.flagged - run.confirmed;
@@ -169,18 +191,20 @@ std::string csvField(const std::string& s) {
 
 std::string csvTable(const std::vector<SweepRun>& runs) {
     std::ostringstream csv;
-    csv << "run,time_step,steps,ms_integrate,ms_volumes,ms_broad,ms_narrow,ms_step,"
-           "ms_per_simulated_s,flagged,confirmed,broad_false_positives,bv_tests,narrow_tests,"
-           "triangle_tests,pairs_confirmed_total,missed_pairs,extra_pairs,"
+    csv << "run,time_step,steps,ms_integrate,ms_volumes,ms_broad,ms_narrow,ms_ccd,ms_response,"
+           "ms_step,ms_per_simulated_s,flagged,confirmed,broad_false_positives,bv_tests,"
+           "narrow_tests,triangle_tests,toi_events,max_penetration_m,pairs_confirmed_total,"
+           "missed_pairs,extra_pairs,"
            "max_first_contact_error_s,mean_first_contact_error_s,max_energy_drift,"
            "max_angular_momentum_drift,state_hash\n";
     for (const SweepRun& r : runs) {
         csv << csvField(r.label) << ',' << fmt(r.time_step, "%.17g") << ',' << r.steps;
-        for (double v : {r.ms_integrate, r.ms_volumes, r.ms_broad, r.ms_narrow, r.ms_step,
-                         r.ms_per_simulated_s, r.flagged, r.confirmed, r.broad_false_positives,
-                         r.bv_tests, r.narrow_tests, r.triangle_tests}) {
+        for (double v : {r.ms_integrate, r.ms_volumes, r.ms_broad, r.ms_narrow, r.ms_ccd,
+                         r.ms_response, r.ms_step, r.ms_per_simulated_s, r.flagged, r.confirmed,
+                         r.broad_false_positives, r.bv_tests, r.narrow_tests, r.triangle_tests}) {
             csv << ',' << fmt(v, "%.6g");
         }
+        csv << ',' << r.toi_events << ',' << fmt(r.max_penetration, "%.6g");
         csv << ',' << r.pairs_confirmed_total << ',' << r.missed_pairs << ',' << r.extra_pairs;
         for (double v : {r.max_first_contact_error, r.mean_first_contact_error, r.max_energy_drift,
                          r.max_angular_momentum_drift}) {
@@ -254,8 +278,11 @@ std::string markdownReport(const SweepOptions& options, const engine::Scene& bas
        << " steps)" << (options.reference.empty() ? "" : ", " + reference.label)
        << "; it confirmed " << reference.pairs_confirmed_total << " distinct pairs.\n";
     md << "- A pair is *missed* when the reference confirms it and the run never does; "
-          "*extra* the other way round. First-contact error compares the first step at which "
-          "each common pair is confirmed (resolution: the larger time step).\n";
+          "*extra* the other way round; a pair the CCD stage stopped at its time of impact "
+          "(*CCD stops*) counts as a contact at that time. First-contact error compares each "
+          "common pair's first contact: the end of the first step that confirms it "
+          "(resolution: the larger time step) or its time of impact. Max depth: the deepest "
+          "overlap of a confirmed pair of convex bodies at the end of a step.\n";
     md << "- Energy drift: max over steps of |E - E0| / (sum of |kinetic| + |potential| terms at "
           "t = 0); |L| drift: max over bodies and steps of the relative change of a body's "
           "angular momentum.\n";
@@ -265,10 +292,11 @@ std::string markdownReport(const SweepOptions& options, const engine::Scene& bas
     }
     md << "\n| run | dt (s) | steps |";
     if (options.report_timing) md << " ms/step | ms per sim. s |";
-    md << " flagged/step | confirmed/step | BP false pos./step | Nv/step | Np/step | missed | "
-          "extra | max TOI err (s) | energy drift | abs L drift |\n|---|---|---|";
+    md << " flagged/step | confirmed/step | BP false pos./step | Nv/step | Np/step | CCD stops | "
+          "missed | extra | max TOI err (s) | max depth (m) | energy drift | abs L drift "
+          "|\n|---|---|---|";
     if (options.report_timing) md << "---|---|";
-    md << "---|---|---|---|---|---|---|---|---|---|\n";
+    md << "---|---|---|---|---|---|---|---|---|---|---|---|\n";
     auto row = [&](const SweepRun& r) {
         md << "| " << r.label << " | " << fmt(r.time_step) << " | " << r.steps << " |";
         if (options.report_timing) {
@@ -277,10 +305,10 @@ std::string markdownReport(const SweepOptions& options, const engine::Scene& bas
         }
         md << ' ' << fmt(r.flagged, "%.2f") << " | " << fmt(r.confirmed, "%.2f") << " | "
            << fmt(r.broad_false_positives, "%.2f") << " | " << fmt(r.bv_tests, "%.0f") << " | "
-           << fmt(r.triangle_tests, "%.0f") << " | " << r.missed_pairs << " | " << r.extra_pairs
-           << " | " << fmt(r.max_first_contact_error, "%.3g") << " | "
-           << fmt(r.max_energy_drift, "%.2e") << " | " << fmt(r.max_angular_momentum_drift, "%.2e")
-           << " |\n";
+           << fmt(r.triangle_tests, "%.0f") << " | " << r.toi_events << " | " << r.missed_pairs
+           << " | " << r.extra_pairs << " | " << fmt(r.max_first_contact_error, "%.3g") << " | "
+           << fmt(r.max_penetration, "%.3g") << " | " << fmt(r.max_energy_drift, "%.2e") << " | "
+           << fmt(r.max_angular_momentum_drift, "%.2e") << " |\n";
     };
     for (const SweepRun& r : runs) row(r);
     SweepRun ref_row = reference;

@@ -46,19 +46,24 @@ struct SweepRun {
     std::vector<engine::SceneOverride> overrides;
     double time_step = 0;
     std::int64_t steps = 0;
-    double ms_integrate = 0, ms_volumes = 0, ms_broad = 0, ms_narrow = 0, ms_step = 0;
+    double ms_integrate = 0, ms_volumes = 0, ms_broad = 0, ms_narrow = 0, ms_ccd = 0,
+           ms_response = 0, ms_step = 0;
     double ms_per_simulated_s = 0;
-    double flagged = 0;                      ///< broad-phase pairs per step
-    double confirmed = 0;                    ///< narrow-phase confirmed pairs per step
-    double broad_false_positives = 0;        ///< flagged - confirmed, per step
-    double bv_tests = 0;                     ///< broad-phase bounding-volume tests per step (Nv)
-    double narrow_tests = 0;                 ///< narrow-phase pair tests per step
-    double triangle_tests = 0;               ///< triangle tests per step (Np)
-    std::int64_t pairs_confirmed_total = 0;  ///< distinct pairs ever confirmed
+    double flagged = 0;                ///< broad-phase pairs per step
+    double confirmed = 0;              ///< narrow-phase confirmed pairs per step
+    double broad_false_positives = 0;  ///< flagged - confirmed, per step
+    double bv_tests = 0;               ///< broad-phase bounding-volume tests per step (Nv)
+    double narrow_tests = 0;           ///< narrow-phase pair tests per step
+    double triangle_tests = 0;         ///< triangle tests per step (Np)
+    std::int64_t toi_events = 0;       ///< pairs the CCD stage stopped, whole run
+    double max_penetration = 0;  ///< m, deepest overlap of a confirmed convex pair at a step end
+    std::int64_t pairs_confirmed_total = 0;  ///< distinct pairs ever confirmed (or CCD-stopped)
     std::int64_t missed_pairs = 0;           ///< confirmed in the reference, never in this run
     std::int64_t extra_pairs = 0;            ///< confirmed in this run, never in the reference
-    double max_first_contact_error = 0;      ///< s, |first contact - reference's|, common pairs
-    double mean_first_contact_error = 0;     ///< s
+    /// s, |first contact - reference's|, common pairs. A pair's first contact is the end of the
+    /// first step that confirms it, or the time of impact when the CCD stage stopped it first.
+    double max_first_contact_error = 0;
+    double mean_first_contact_error = 0;  ///< s
     double max_energy_drift = 0;  ///< max over steps |E - E0| / (sum of |energy terms| at 0)
     double max_angular_momentum_drift = 0;  ///< max over bodies and steps | |L| - |L0| | / |L0|
     std::uint64_t state_hash = 0;

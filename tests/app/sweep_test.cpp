@@ -126,6 +126,38 @@ TEST(Sweep, TimeStepThatTunnelsMissesTheContactAndBroadPhasesAgree) {
     fs::remove_all(o.out_dir);
 }
 
+// CCD as a sweep choice: with conservative advancement the bullet is stopped at its time of
+// impact (x = -0.1, t = 0.07 s) even at dt = 0.05, which counts as the contact; without it the
+// coarse step misses the plate and the fine step sees the bullet inside it.
+TEST(Sweep, CcdStopsCountAsContactsWithTheirTimeOfImpact) {
+    app::SweepOptions o;
+    o.scene = kScene;
+    o.vary = {"world.ccd=off,conservative_advancement", "world.time_step=0.05,0.005"};
+    o.reference = {"world.ccd=conservative_advancement"};
+    o.out_dir = tempDir("ccd");
+    const Outcome r = sweep(o);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto rows = readCsv(o.out_dir / "results.csv");
+    ASSERT_EQ(rows.size(), 4u);
+    // off, dt 0.05: never sees the plate.
+    EXPECT_EQ(rows[0].at("missed_pairs"), "1");
+    EXPECT_EQ(rows[0].at("toi_events"), "0");
+    // off, dt 0.005: confirmed at the end of a step with the sphere inside the plate: the
+    // bullet moves 0.1 m per step, so the first confirmed sample overlaps by up to 0.1 m.
+    EXPECT_EQ(rows[1].at("missed_pairs"), "0");
+    EXPECT_GT(std::stod(rows[1].at("max_penetration_m")), 0);
+    EXPECT_LE(std::stod(rows[1].at("max_penetration_m")), 0.1 + 1e-9);
+    for (int i : {2, 3}) {
+        EXPECT_EQ(rows[i].at("missed_pairs"), "0") << i;
+        EXPECT_GE(std::stoi(rows[i].at("toi_events")), 1) << i;
+        EXPECT_EQ(std::stod(rows[i].at("max_penetration_m")), 0) << i;
+        // Both this run and the reference stop at the time of impact, 0.07 s, short by the
+        // stage's target gap (about 1e-4 m at 20 m/s: 5e-6 s).
+        EXPECT_LT(std::stod(rows[i].at("max_first_contact_error_s")), 1e-5) << i;
+    }
+    fs::remove_all(o.out_dir);
+}
+
 TEST(Sweep, ReportWithoutTimingIsBitIdentical) {
     app::SweepOptions o;
     o.scene = kScene;
