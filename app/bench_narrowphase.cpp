@@ -126,7 +126,7 @@ public:
     void build(const TriangleMesh& mesh) override {
         std::vector<fcl::Vector3d> vertices;
         vertices.reserve(mesh.vertices.size());
-        for (const Vec3& v : mesh.vertices) vertices.emplace_back(v.x(), v.y(), v.z());
+        for (const Vec3& v : mesh.vertices) vertices.push_back(v.cast<double>());
         std::vector<fcl::Triangle> triangles;
         triangles.reserve(mesh.triangles.size());
         for (const auto& t : mesh.triangles) {
@@ -154,8 +154,8 @@ public:
 private:
     std::size_t run(const Pose& b_in_a, std::size_t max_contacts) {
         fcl::Transform3d tf = fcl::Transform3d::Identity();
-        tf.linear() = b_in_a.rotation();
-        tf.translation() = b_in_a.position;
+        tf.linear() = b_in_a.rotation().cast<double>();
+        tf.translation() = b_in_a.position.cast<double>();
         const fcl::CollisionObjectd b(model_b_, tf);
         fcl::CollisionRequestd request(max_contacts, false);
         fcl::CollisionResultd result;
