@@ -55,6 +55,7 @@ struct SweepRun {
     double bv_tests = 0;               ///< broad-phase bounding-volume tests per step (Nv)
     double narrow_tests = 0;           ///< narrow-phase pair tests per step
     double triangle_tests = 0;         ///< triangle tests per step (Np)
+    double mesh_bv_tests = 0;          ///< mesh-hierarchy node tests per step
     std::int64_t toi_events = 0;       ///< pairs the CCD stage stopped, whole run
     double max_penetration = 0;  ///< m, deepest overlap of a confirmed convex pair at a step end
     std::int64_t pairs_confirmed_total = 0;  ///< distinct pairs ever confirmed (or CCD-stopped)
