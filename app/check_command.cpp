@@ -561,10 +561,16 @@ std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames, const f
     for (std::size_t k = 0; k < ex.colors.size(); ++k) {
         const engine::ColorExpectation& c = ex.colors[k];
         std::string what;
-        for (engine::BodyState s : c.present) what += (what.empty() ? "" : " ") + colorName(s);
+        for (engine::BodyState s : c.present) {
+            if (!what.empty()) what += ' ';
+            what += colorName(s);
+        }
         if (!c.absent.empty()) {
             what += what.empty() ? "no" : ", no";
-            for (engine::BodyState s : c.absent) what += " " + colorName(s);
+            for (engine::BodyState s : c.absent) {
+                what += ' ';
+                what += colorName(s);
+            }
         }
         CheckRow r{"colours " + what + " at frame " + std::to_string(c.frame), true, ""};
         if (c.frame >= frames) {

@@ -95,7 +95,8 @@ int boxFaceManifold(const Body& a, const Pose& pa, const Body& b, const Pose& pb
             if (d0 <= 0) next[static_cast<std::size_t>(next_count++)] = p0;
             if ((d0 < 0 && d1 > 0) || (d0 > 0 && d1 < 0)) {
                 if (next_count < 8) {
-                    next[static_cast<std::size_t>(next_count++)] = p0 + (p1 - p0) * (d0 / (d0 - d1));
+                    next[static_cast<std::size_t>(next_count++)] =
+                        p0 + (p1 - p0) * (d0 / (d0 - d1));
                 }
             }
         }
@@ -125,7 +126,8 @@ int boxFaceManifold(const Body& a, const Pose& pa, const Body& b, const Pose& pb
                 sc = std::numeric_limits<Real>::max();
                 for (int q = 0; q < kept; ++q) {
                     sc = std::min(sc, (poly[static_cast<std::size_t>(i)] -
-                                       out[static_cast<std::size_t>(q)].point_b).squaredNorm());
+                                       out[static_cast<std::size_t>(q)].point_b)
+                                          .squaredNorm());
                 }
             }
             if (sc > score) {
@@ -340,6 +342,15 @@ void ContactSolver::solve(std::span<Body> bodies, std::span<const collision::Pro
     }
 
     previous_ = points_;  // already sorted by (a, b): pairs were sorted
+}
+
+void ContactSolver::pushedPairs(std::vector<collision::ProxyPair>& out) const {
+    out.clear();
+    for (const Point& p : points_) {
+        if (p.impulse_n > 0) out.push_back({std::min(p.a, p.b), std::max(p.a, p.b)});
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
 }
 
 }  // namespace engine

@@ -42,6 +42,9 @@ public:
 
     /// Contact points solved in the last call.
     int pointCount() const { return static_cast<int>(points_.size()); }
+    /// The pairs of the last solve with a positive normal impulse at some point (pushed apart,
+    /// including speculative contacts not yet touching), sorted, each once.
+    void pushedPairs(std::vector<collision::ProxyPair>& out) const;
 
 private:
     struct Point {
@@ -62,7 +65,7 @@ private:
         Real impulse_n = 0;  ///< accumulated, >= 0
         Real impulse_t1 = 0;
         Real impulse_t2 = 0;
-        Real pseudo_n = 0;  ///< accumulated split impulse, >= 0
+        Real pseudo_n = 0;            ///< accumulated split impulse, >= 0
         Vec3 local_a = Vec3::Zero();  ///< contact point in a's body frame (warm-start matching)
         collision::Feature feature_a;
         collision::Feature feature_b;

@@ -611,6 +611,7 @@ void World::step() {
                        pseudo_angular_);
         stats_.response_s = secondsSince(t);
         stats_.contact_points = solver_->pointCount();
+        solver_->pushedPairs(pushed_);
         t = Clock::now();
         integrate(dt, Vec3::Zero());
     } else {

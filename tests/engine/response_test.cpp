@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "engine/scene.h"
 #include "engine/world.h"
@@ -74,6 +75,43 @@ TEST(Response, HeadOnElasticSpheresExchangeVelocities) {
     EXPECT_LT(a.position.x(), b.position.x() - 1);  // they bounced apart
 }
 
+// The solver reports the pairs it pushed: the head-on spheres close at 4 m/s from a gap of 3 m,
+// so they meet at t = 0.75 s (step 45 of 1/60 s); the pair is pushed in the steps around that
+// moment only (speculatively before the touch, or at it), never while far apart or separating.
+TEST(Response, PushedPairsAreTheContactsTheSolverActedOn) {
+    World world(impulseWorld(100));
+    for (const Real x : {Real(-2), Real(2)}) {
+        Body b = makeBody("ball", Shape::sphere(0.5), sphereMass(0.5, 2));
+        b.restitution = 1;
+        b.position = Vec3(x, 0, 0);
+        b.linear_momentum = b.mass * Vec3(x < 0 ? 3 : -1, 0, 0);
+        world.addBody(b);
+    }
+    world.detect();
+    std::vector<int> pushed_steps;
+    for (int i = 0; i < 120; ++i) {
+        const Real gap_before = world.bodies()[1].position.x() - world.bodies()[0].position.x() - 1;
+        world.step();
+        if (world.pushedPairs().empty()) continue;
+        ASSERT_EQ(world.pushedPairs().size(), 1u);
+        EXPECT_EQ(world.pushedPairs()[0], (collision::ProxyPair{0, 1}));
+        // Pushed only when the approach (4 m/s) would close the gap within this step.
+        EXPECT_LE(gap_before, 4 * world.settings().time_step + 1e-12) << "step " << i;
+        pushed_steps.push_back(i);
+    }
+    ASSERT_FALSE(pushed_steps.empty());
+    EXPECT_LE(pushed_steps.size(), 2u);
+    EXPECT_NEAR(pushed_steps.front(), 44, 1);
+
+    Scene off = loadScene(kScenes / "bounce.yaml");
+    off.world.response = Response::None;
+    World none = makeWorld(off);
+    for (int i = 0; i < 200; ++i) {
+        none.step();
+        EXPECT_TRUE(none.pushedPairs().empty());
+    }
+}
+
 TEST(Response, KineticEnergyNeverExceedsItsStartInALongRandomBoxPile) {
     // 24 boxes with random restitution in [0, 1] and friction in [0, 1], no gravity, inside a
     // 4 m box they reflect off (elastic): 10^4 steps, kinetic energy checked every step.
@@ -87,7 +125,8 @@ TEST(Response, KineticEnergyNeverExceedsItsStartInALongRandomBoxPile) {
         b.restitution = std::abs(u(rng)) * 1;
         b.friction = std::abs(u(rng));
         b.position = Vec3(u(rng), u(rng), u(rng)) * 1.5;
-        b.orientation = Quat(Eigen::AngleAxis<Real>(3 * u(rng), Vec3(u(rng), u(rng), 1).normalized()));
+        b.orientation =
+            Quat(Eigen::AngleAxis<Real>(3 * u(rng), Vec3(u(rng), u(rng), 1).normalized()));
         b.linear_momentum = b.mass * Vec3(u(rng), u(rng), u(rng)) * 3;
         const Mat3 r = b.orientation.toRotationMatrix();
         b.angular_momentum = r * b.inertia_body * r.transpose() * Vec3(u(rng), u(rng), u(rng)) * 2;
@@ -125,8 +164,8 @@ TEST(Response, KineticEnergyNeverExceedsItsStartInALongRandomBoxPile) {
     // with contacts can gain up to 3.2e-5 of E0 -- sequential impulses are not monotone -- and
     // free steps 5.9e-8, the splitting integrator's bounded oscillation.)
     EXPECT_LE(highest, 1e-9);
-    EXPECT_LT(previous, e0);             // friction and e < 1 dissipate
-    EXPECT_GT(contact_steps, 1000);      // the pile really collides
+    EXPECT_LT(previous, e0);         // friction and e < 1 dissipate
+    EXPECT_GT(contact_steps, 1000);  // the pile really collides
 }
 
 Real maxDrift(const World& world, const std::vector<Vec3>& start) {
@@ -145,14 +184,15 @@ TEST(Response, FiveBoxStackRestsWithoutDriftOrJitter) {
     for (int i = 0; i < 600; ++i) {  // 10 s at dt = 1/60
         world.step();
         if (i >= 300) {
-            for (const Body& b : world.bodies()) late_speed = std::max(late_speed, b.velocity().norm());
+            for (const Body& b : world.bodies())
+                late_speed = std::max(late_speed, b.velocity().norm());
         }
     }
     const Real drift = maxDrift(world, start);
     RecordProperty("drift_m", std::to_string(drift));
     RecordProperty("late_max_speed", std::to_string(late_speed));
-    EXPECT_LT(drift, 0.01);        // 1 % of the 1 m box
-    EXPECT_LT(late_speed, 1e-3);   // no jitter once settled (m/s)
+    EXPECT_LT(drift, 0.01);                           // 1 % of the 1 m box
+    EXPECT_LT(late_speed, 1e-3);                      // no jitter once settled (m/s)
     EXPECT_EQ(world.lastStats().contact_points, 20);  // 4 points per resting face
 }
 
@@ -181,7 +221,8 @@ TEST(Response, MassRatioOneToThousandStackHolds) {
     for (int i = 0; i < 600; ++i) {
         world.step();
         if (i >= 300) {
-            for (const Body& b : world.bodies()) late_speed = std::max(late_speed, b.velocity().norm());
+            for (const Body& b : world.bodies())
+                late_speed = std::max(late_speed, b.velocity().norm());
         }
     }
     const Real drift = maxDrift(world, start);
@@ -215,8 +256,8 @@ TEST(Response, SceneKeys) {
     EXPECT_EQ(s.bodies[1].friction, 0.4);  // the world's default
     EXPECT_TRUE(s.bodies[0].is_static);
     try {
-        parseScene("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  restitution: 1.5\n",
-                   "t.yaml", ".");
+        parseScene("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  restitution: 1.5\n", "t.yaml",
+                   ".");
         FAIL() << "accepted restitution 1.5";
     } catch (const SceneError& e) {
         EXPECT_EQ(std::string(e.what()), "t.yaml:3:16: world.restitution: must be in [0, 1]");

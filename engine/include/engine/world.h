@@ -21,7 +21,8 @@ namespace engine {
 /// by w = R I^-1 R^T L: |L| is conserved exactly by every integrator, they differ in x and q.
 enum class Integrator : std::uint8_t {
     ExplicitEuler,      ///< x += v(t) dt, P += F dt, q += 1/2 w q dt then normalised (first order)
-    SemiImplicitEuler,  ///< P first, x with the new v; q by the exact-rotation splitting (2nd order)
+    SemiImplicitEuler,  ///< P first, x with the new v; q by the exact-rotation splitting (2nd
+                        ///< order)
     Rk4,                ///< Runge-Kutta 4 on (x, P, q, L); unstable for thin fast-spinning bodies
 };
 std::string_view integratorName(Integrator integrator);  ///< scene name, e.g. "rk4"
@@ -68,9 +69,9 @@ std::string_view bodyStateName(BodyState state);  ///< "apart", "flagged", "coll
 
 struct WorldSettings {
     collision::Aabb bounds{Vec3::Constant(-10), Vec3::Constant(10)};  ///< m; bodies reflect off it
-    Vec3 gravity = Vec3::Zero();   ///< m/s^2
-    Real time_step = Real(1) / 60; ///< s, > 0
-    std::string broad_phase = "sap";  ///< registry name
+    Vec3 gravity = Vec3::Zero();                                      ///< m/s^2
+    Real time_step = Real(1) / 60;                                    ///< s, > 0
+    std::string broad_phase = "sap";                                  ///< registry name
     /// Node volume of mesh bodies' hierarchies (collision::bvhVolumeNames()); scene key
     /// `world.mesh_bvh`. Read when mesh bodies are built (scene loading), not by the World.
     std::string mesh_bvh{collision::kDefaultMeshBvh};
@@ -87,15 +88,15 @@ struct StepStats {
     double volumes_s = 0;
     double broad_phase_s = 0;
     double narrow_phase_s = 0;
-    double ccd_s = 0;  ///< continuous stage (0 when ccd is off)
+    double ccd_s = 0;       ///< continuous stage (0 when ccd is off)
     double response_s = 0;  ///< contact solver (0 when response is none)
     double total_s = 0;
     collision::BroadPhaseCounters broad;
     std::int64_t narrow_tests = 0;
     std::int64_t triangle_tests = 0;  ///< triangle-level tests of the narrow phase (meshes)
     std::int64_t bv_tests = 0;        ///< mesh-hierarchy node tests of the narrow phase
-    std::int64_t toi_queries = 0;  ///< timeOfImpact calls in the continuous stage
-    std::int64_t toi_events = 0;   ///< pairs stopped at their time of impact
+    std::int64_t toi_queries = 0;     ///< timeOfImpact calls in the continuous stage
+    std::int64_t toi_events = 0;      ///< pairs stopped at their time of impact
     std::int64_t contact_points = 0;  ///< manifold points the contact solver handled
 };
 
@@ -127,6 +128,9 @@ public:
     std::span<const collision::ProxyPair> flaggedPairs() const { return flagged_; }
     /// Flagged pairs the narrow phase confirmed (touching or penetrating), sorted.
     std::span<const collision::ProxyPair> collidingPairs() const { return colliding_; }
+    /// Pairs the contact solver pushed apart in the last step (a positive normal impulse, which
+    /// includes speculative contacts that had not touched yet), sorted; empty without response.
+    std::span<const collision::ProxyPair> pushedPairs() const { return pushed_; }
     const collision::BroadPhase& broadPhase() const { return *broad_phase_; }
     const StepStats& lastStats() const { return stats_; }
     /// Times of impact acted on in the last step, sorted by (t, a, b); empty when ccd is off.
@@ -173,6 +177,7 @@ private:
     std::unique_ptr<ContactSolver> solver_;  ///< only with response: impulse
     std::vector<collision::Aabb> grown_;
     std::vector<collision::ProxyPair> response_pairs_;
+    std::vector<collision::ProxyPair> pushed_;
     std::vector<Vec3> pseudo_linear_;
     std::vector<Vec3> pseudo_angular_;
     StepStats stats_;
