@@ -366,6 +366,33 @@ TEST(Contact, CapsuleCapsuleMatchesReference) {
     mix.expectBalanced("capsule-capsule");
 }
 
+TEST(Contact, SphereCapsuleMatchesClosedFormInBothOrders) {
+    cdlab_test::Rng rng(15);
+    Mix mix;
+    for (int n = 0; n < 3000; ++n) {
+        const Shape s = Shape::sphere(rng.uniform(0.1, 1.0));
+        const Shape c = Shape::capsule(rng.uniform(0.1, 0.8), rng.uniform(0.1, 1.5));
+        const Pose pc = at(rng.vec(-1, 1), rng.rotation());
+        const Pose ps = at(pc.position + rng.vec(-1.6, 1.6), rng.rotation());
+        // RTCD 5.1.2: the centre against the capsule's segment, minus both radii.
+        const Vec3 axis = pc.orientation * Vec3::UnitY() * c.half_height;
+        const Real expected =
+            pointSegmentDistance(ps.position, pc.position - axis, pc.position + axis) - s.radius -
+            c.radius;
+        const Real scale = std::max(s.radius, c.radius + c.half_height);
+        const ContactOutput sc = contact(s, ps, c, pc);
+        const ContactOutput cs = contact(c, pc, s, ps);
+        ASSERT_NEAR(sc.signed_distance, expected, 1e-12 * scale) << n;
+        ASSERT_EQ(sc.state, collide(s, ps, c, pc).state) << n;
+        ASSERT_EQ(cs.state, collide(c, pc, s, ps).state) << n;
+        expectConsistent(s, ps, c, pc, sc, 1e-12, "sphere-capsule", n);
+        expectConsistent(c, pc, s, ps, cs, 1e-12, "capsule-sphere", n);
+        expectMirror(sc, cs, n);
+        mix.add(sc);
+    }
+    mix.expectBalanced("sphere-capsule");
+}
+
 // A random convex hull: points on an ellipsoid-ish cloud (fixed seed).
 Shape randomHull(cdlab_test::Rng& rng, Real size) {
     std::vector<Vec3> points;
@@ -413,6 +440,45 @@ TEST(Contact, EveryConvexPairAgreesWithCollideAndMirrors) {
             }
             EXPECT_GT(mix.colliding, 40) << i << " " << j;
             EXPECT_LT(mix.colliding, 360) << i << " " << j;
+        }
+    }
+}
+
+// Swapping A and B mirrors the answer for every pair type in all three states: each random pose
+// is also moved to exact touching (B by -signed_distance * normal) and pushed 0.2 * size deeper.
+// collide() agrees in both orders, and every pair type reaches every state.
+TEST(Contact, EveryConvexPairMirrorsWhenSeparatedTouchingAndPenetrating) {
+    cdlab_test::Rng rng(16);
+    const std::vector<Shape> zoo = shapeZoo(rng);
+    for (std::size_t i = 0; i < zoo.size(); ++i) {
+        for (std::size_t j = 0; j < zoo.size(); ++j) {
+            std::array<int, 3> states{0, 0, 0};
+            for (int n = 0; n < 60; ++n) {
+                const Real scale = std::max(boundingRadius(zoo[i]), boundingRadius(zoo[j]));
+                const Pose pa = at(rng.vec(-1, 1), rng.rotation());
+                const Vec3 dir = rng.rotation() * Vec3::UnitX();
+                const Real reach = boundingRadius(zoo[i]) + boundingRadius(zoo[j]);
+                const Pose start =
+                    at(pa.position + rng.uniform(0.2, 1.2) * reach * dir, rng.rotation());
+                const ContactOutput first = contact(zoo[i], pa, zoo[j], start);
+                ASSERT_NE(first.state, ContactState::Failed) << i << " " << j << " " << n;
+                for (const Real push : {Real(-1), Real(0), Real(0.2) * scale}) {
+                    Pose pb = start;
+                    if (push >= 0) pb.position -= (first.signed_distance + push) * first.normal;
+                    const ContactOutput ab = contact(zoo[i], pa, zoo[j], pb);
+                    const ContactOutput ba = contact(zoo[j], pb, zoo[i], pa);
+                    ASSERT_NE(ab.state, ContactState::Failed) << i << " " << j << " " << n;
+                    expectMirror(ab, ba, n);
+                    ASSERT_EQ(collide(zoo[i], pa, zoo[j], pb).state, ab.state)
+                        << i << " " << j << " " << n;
+                    ASSERT_EQ(collide(zoo[j], pb, zoo[i], pa).state, ab.state)
+                        << i << " " << j << " " << n;
+                    ++states[static_cast<std::size_t>(ab.state)];
+                }
+            }
+            EXPECT_GT(states[0], 5) << i << " " << j;
+            EXPECT_GT(states[1], 5) << i << " " << j;
+            EXPECT_GT(states[2], 5) << i << " " << j;
         }
     }
 }
