@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <sstream>
 #include <vector>
 
 #include "collision/contact.h"
@@ -163,7 +164,9 @@ TEST(ContactReference, PolytopeDepthEqualsMinimumOverlap) {
     }
     EXPECT_GT(penetrating, 2000);
     EXPECT_GT(separated, 200);
-    RecordProperty("worst_relative_depth_error", std::to_string(worst));
+    std::ostringstream worst_text;
+    worst_text << worst;
+    RecordProperty("worst_relative_depth_error", worst_text.str());
 }
 
 // Pairs with a round shape: the sampled reference is an upper bound on the depth, so the depth of
@@ -173,7 +176,7 @@ TEST(ContactReference, PolytopeDepthEqualsMinimumOverlap) {
 TEST(ContactReference, RoundPairDepthWithinSampledOverlap) {
     cdlab_test::Rng rng(23);
     int penetrating = 0;
-    for (int n = 0; n < 2000; ++n) {
+    for (int n = 0; n < 1200; ++n) {
         const Shape round = n % 2 == 0 ? Shape::sphere(rng.uniform(0.2, 1.2))
                                        : Shape::capsule(rng.uniform(0.1, 0.6), rng.uniform(0.1, 1));
         const Shape other =
@@ -193,7 +196,7 @@ TEST(ContactReference, RoundPairDepthWithinSampledOverlap) {
         ASSERT_LE(depth, ref.overlap + kDepthRelative * scale) << n;
         ASSERT_GE(depth, ref.overlap - 2e-2 * scale) << n;
     }
-    EXPECT_GT(penetrating, 500);
+    EXPECT_GT(penetrating, 300);
 }
 
 // Every convex pair type: contact()'s signed distance lies within the reference bounds (closed
