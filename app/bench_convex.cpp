@@ -5,7 +5,10 @@
 // signed distances (negative = penetration depth) relative to the pair's size; the "ext" columns
 // repeat every pair translated by 1e6 and scaled by 1e-4 and 1e4 and report the largest change
 // of the (rescaled) answer, the accuracy at the extremes. Bullet's headers and libraries stay in
-// this file (CDLAB_HAVE_BULLET).
+// this file (CDLAB_HAVE_BULLET). Fairness: Bullet gets the same geometry with zero margins (a
+// btBoxShape in box rows, a btConvexHullShape of the same points in hull rows), and the pairs of
+// the separated/penetrating rows are chosen by a ground truth neither library computes
+// (signedDistanceReference: closed forms, or the exact projection-overlap reference for boxes).
 #include "bench_convex.h"
 
 #include <algorithm>
@@ -22,11 +25,13 @@
 #include <vector>
 
 #include "collision/contact.h"
+#include "collision/contact_reference.h"
 #include "collision/narrow_phase.h"
 
 #ifdef CDLAB_HAVE_BULLET
 #include <BulletCollision/CollisionShapes/btBoxShape.h>
 #include <BulletCollision/CollisionShapes/btCapsuleShape.h>
+#include <BulletCollision/CollisionShapes/btConvexHullShape.h>
 #include <BulletCollision/CollisionShapes/btSphereShape.h>
 #include <BulletCollision/NarrowPhaseCollision/btGjkEpaPenetrationDepthSolver.h>
 #include <BulletCollision/NarrowPhaseCollision/btGjkPairDetector.h>
@@ -150,15 +155,14 @@ std::vector<Pair> makePairs(const Workload& w, int count, Random& rng) {
                 pose->position[k] = std::ldexp(std::round(std::ldexp(pose->position[k], 20)), -20);
             }
         }
-        // The reference state (collide) picks the pairs; near-touching pairs are left out so the
-        // two libraries are compared where the answer is well defined.
-        const collision::CollideOutput c = collide(p.a, p.pose_a, p.b, p.pose_b);
-        const bool separated = c.state == ContactState::Separated && c.distance > 1e-3 * p.scale;
-        bool penetrating = c.state == ContactState::Penetrating;
-        if (penetrating) {
-            const collision::ContactOutput full = contact(p.a, p.pose_a, p.b, p.pose_b);
-            penetrating = full.signed_distance < -1e-3 * p.scale;
-        }
+        // A ground truth neither library computes picks the pairs (closed forms; boxes: the
+        // exact projection-overlap reference); pairs within 1e-3 * size of touching, or that
+        // the reference cannot place, are left out so the comparison is where the answer is
+        // well defined.
+        const collision::SignedDistanceBounds truth =
+            collision::signedDistanceReference(p.a, p.pose_a, p.b, p.pose_b);
+        const bool separated = truth.lower > 1e-3 * p.scale;
+        const bool penetrating = truth.upper < -1e-3 * p.scale;
         if (w.want == Want::Separated && !separated) continue;
         if (w.want == Want::Penetrating && !penetrating) continue;
         if (w.want == Want::Either && !separated && !penetrating) continue;
@@ -258,6 +262,8 @@ Real cdlabQuery(const Pair& p) {
 #ifdef CDLAB_HAVE_BULLET
 std::unique_ptr<btConvexShape> bulletShape(const Shape& s) {
     switch (s.type) {
+        // Spheres and capsules keep Bullet's implicit margin: it is their radius (a point or a
+        // segment inflated by it, as cdlab's cores), so the geometry is exact.
         case ShapeType::Sphere:
             return std::make_unique<btSphereShape>(s.radius);
         case ShapeType::Capsule:
@@ -269,11 +275,14 @@ std::unique_ptr<btConvexShape> bulletShape(const Shape& s) {
             return box;
         }
         default: {
-            // Hull-boxes: the same box for Bullet (its box support is exact).
-            const Vec3 h = s.hull->vertices.back().cwiseAbs();
-            auto box = std::make_unique<btBoxShape>(btVector3(h.x(), h.y(), h.z()));
-            box->setMargin(0);
-            return box;
+            // Hulls: the same points (a box's 8 corners in the hull rows), no margin, so Bullet
+            // runs the same point-cloud support as cdlab's GJK/EPA path.
+            auto hull = std::make_unique<btConvexHullShape>();
+            for (const Vec3& v : s.hull->vertices)
+                hull->addPoint(btVector3(v.x(), v.y(), v.z()), false);
+            hull->recalcLocalAabb();
+            hull->setMargin(0);
+            return hull;
         }
     }
 }

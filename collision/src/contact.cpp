@@ -360,6 +360,59 @@ void sphereBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ct
 
 // ---- GJK + EPA for any convex pair (A's frame). ----
 
+// Near-touching pairs (gap or depth below kNormalRelative * scale): B is shifted into A by
+// kShiftRelative * scale along a trial normal, so the cores overlap far above rounding, and GJK +
+// EPA answer there: EPA's normal is a face normal of A - B made from support-point differences
+// (exact to rounding), not a direction through a rounding-sized gap. The shift is repeated along
+// the new normal until it no longer changes; then the witnesses shifted back satisfy
+// point_b - point_a = separation * normal with separation = shift * (trial . normal) - depth.
+constexpr Real kShiftRelative = Real(4) * kNormalRelative;
+constexpr int kShiftRounds = 4;
+constexpr Real kSameNormal = Real(1e-12);
+
+struct Shifted {
+    Vec3 normal;
+    Real separation;
+    Vec3 core_a;
+    Vec3 core_b;
+};
+
+bool shiftedEpa(const ConvexCore& ca, const ConvexCore& cb, const RelativePose& rel,
+                const Vec3& trial, Real scale, Shifted& out, std::int32_t& iterations) {
+    const Real shift = kShiftRelative * scale;
+    // A rounding-sized gap or depth leaves the trial normal arbitrary, even pointing from B to A:
+    // then shifting along it separates the cores, and its opposite is tried.
+    Vec3 dir = trial;
+    bool flipped = false;
+    for (int round = 0; round < kShiftRounds; ++round) {
+        RelativePose moved = rel;
+        moved.position -= shift * dir;
+        const GjkWitnessOutput g = gjkWitness(ca, cb, moved, scale);
+        iterations += g.iterations;
+        EpaOutput e;
+        if (g.state == GjkState::Overlapping) {
+            e = epaPenetration(ca, cb, moved, g.simplex, scale);
+            iterations += e.iterations;
+        }
+        if (e.state != EpaState::Converged || !(e.depth > 0)) {
+            if (round > 0 || flipped) return false;
+            dir = -dir;
+            flipped = true;
+            --round;
+            continue;
+        }
+        if ((e.normal - dir).norm() <= kSameNormal) {
+            out.normal = e.normal;
+            out.separation = shift * dir.dot(e.normal) - e.depth;
+            out.core_a = e.point_a;
+            out.core_b = e.point_b + shift * dir;
+            return true;
+        }
+        dir = e.normal;
+    }
+    return false;
+}
+
 void generic(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx, Local& out) {
     const ConvexCore ca = ConvexCore::fromShape(a);
     const ConvexCore cb = ConvexCore::fromShape(b);
@@ -379,27 +432,40 @@ void generic(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx&
     } else {
         const EpaOutput e = epaPenetration(ca, cb, rel, g.simplex, ctx.scale);
         out.iterations += e.iterations;
-        if (e.state == EpaState::Converged) {
+        // EPA started from a simplex without the origin (GJK stopped Separated, tiny gap) ends on
+        // a face the origin lies outside of: a negative "depth" whose witnesses are not closest
+        // points (point_b - point_a was off signed_distance * normal by more than the gap) and
+        // whose normal may be far off. Such a pair is separated: GJK's distance and closest
+        // points answer, consistent by construction (point_b - point_a = distance * normal).
+        const bool epa_penetrating = e.state == EpaState::Converged && e.depth > 0;
+        if (g.state == GjkState::Separated && g.distance > 0 && !epa_penetrating &&
+            (g.point_b - g.point_a).norm() > 0) {
+            core_a = g.point_a;
+            core_b = g.point_b;
+            out.normal = (core_b - core_a).normalized();
+            out.signed_distance = g.distance;
+        } else if (e.state == EpaState::Converged) {
             core_a = e.point_a;
             core_b = e.point_b;
             out.normal = e.normal;
-            out.signed_distance = -e.depth - radii;
-        } else if (g.state == GjkState::Separated && g.distance > 0) {
-            // Tiny gap and no EPA answer: GJK's direction is the best there is.
-            core_a = g.point_a;
-            core_b = g.point_b;
-            const Vec3 diff = core_b - core_a;
-            const Real len = diff.norm();
-            if (!(len > 0)) {
-                out.state = ContactState::Failed;
-                return;
-            }
-            out.normal = diff / len;
-            out.signed_distance = g.distance - radii;
+            out.signed_distance = -e.depth;
         } else {
             out.state = ContactState::Failed;
             return;
         }
+        // Either direction runs through a gap or depth of rounding size (a face-to-face touching
+        // pair got normals 70 degrees off its face normal): shiftedEpa() measures the contact
+        // again with the cores overlapping well above rounding. Only an answer whose normal is
+        // stable under the shift replaces this one (face contacts, not vertex-vertex).
+        Shifted shifted;
+        if (std::abs(out.signed_distance) <= kNormalRelative * ctx.scale &&
+            shiftedEpa(ca, cb, rel, out.normal, ctx.scale, shifted, out.iterations)) {
+            out.normal = shifted.normal;
+            out.signed_distance = shifted.separation;
+            core_a = shifted.core_a;
+            core_b = shifted.core_b;
+        }
+        out.signed_distance -= radii;
     }
     out.point_a = core_a + ca.radius * out.normal;
     out.point_b = core_b - cb.radius * out.normal;

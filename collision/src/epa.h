@@ -51,8 +51,10 @@ enum class EpaState : std::uint8_t { Converged, Failed };
 
 struct EpaOutput {
     EpaState state = EpaState::Failed;
-    /// Penetration depth of the cores (radii ignored), >= 0 up to rounding: translating B by
-    /// depth * normal makes the cores touch.
+    /// Penetration depth of the cores (radii ignored), >= 0 up to rounding when `start` holds
+    /// the origin: translating B by depth * normal makes the cores touch. From a simplex without
+    /// the origin (GJK stopped Separated) it can be negative, with the normal and witnesses of a
+    /// face the origin lies outside of: not the closest points; use GJK's answer then.
     Real depth = 0;
     Vec3 normal = Vec3::UnitX();  ///< unit, A's frame, from A towards B
     Vec3 point_a = Vec3::Zero();  ///< deepest point of core A along normal, A's frame

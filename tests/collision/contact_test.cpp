@@ -14,6 +14,7 @@
 #include <memory>
 #include <vector>
 
+#include "collision/contact_reference.h"
 #include "collision/convex_hull.h"
 #include "collision/narrow_phase.h"
 // Private narrow-phase headers (collision/src is on the test include path) for the caps.
@@ -365,6 +366,33 @@ TEST(Contact, CapsuleCapsuleMatchesReference) {
     mix.expectBalanced("capsule-capsule");
 }
 
+TEST(Contact, SphereCapsuleMatchesClosedFormInBothOrders) {
+    cdlab_test::Rng rng(15);
+    Mix mix;
+    for (int n = 0; n < 3000; ++n) {
+        const Shape s = Shape::sphere(rng.uniform(0.1, 1.0));
+        const Shape c = Shape::capsule(rng.uniform(0.1, 0.8), rng.uniform(0.1, 1.5));
+        const Pose pc = at(rng.vec(-1, 1), rng.rotation());
+        const Pose ps = at(pc.position + rng.vec(-1.6, 1.6), rng.rotation());
+        // RTCD 5.1.2: the centre against the capsule's segment, minus both radii.
+        const Vec3 axis = pc.orientation * Vec3::UnitY() * c.half_height;
+        const Real expected =
+            pointSegmentDistance(ps.position, pc.position - axis, pc.position + axis) - s.radius -
+            c.radius;
+        const Real scale = std::max(s.radius, c.radius + c.half_height);
+        const ContactOutput sc = contact(s, ps, c, pc);
+        const ContactOutput cs = contact(c, pc, s, ps);
+        ASSERT_NEAR(sc.signed_distance, expected, 1e-12 * scale) << n;
+        ASSERT_EQ(sc.state, collide(s, ps, c, pc).state) << n;
+        ASSERT_EQ(cs.state, collide(c, pc, s, ps).state) << n;
+        expectConsistent(s, ps, c, pc, sc, 1e-12, "sphere-capsule", n);
+        expectConsistent(c, pc, s, ps, cs, 1e-12, "capsule-sphere", n);
+        expectMirror(sc, cs, n);
+        mix.add(sc);
+    }
+    mix.expectBalanced("sphere-capsule");
+}
+
 // A random convex hull: points on an ellipsoid-ish cloud (fixed seed).
 Shape randomHull(cdlab_test::Rng& rng, Real size) {
     std::vector<Vec3> points;
@@ -412,6 +440,95 @@ TEST(Contact, EveryConvexPairAgreesWithCollideAndMirrors) {
             }
             EXPECT_GT(mix.colliding, 40) << i << " " << j;
             EXPECT_LT(mix.colliding, 360) << i << " " << j;
+        }
+    }
+}
+
+// Swapping A and B mirrors the answer for every pair type in all three states: each random pose
+// is also moved to exact touching (B by -signed_distance * normal) and pushed 0.2 * size deeper.
+// collide() agrees in both orders, and every pair type reaches every state.
+TEST(Contact, EveryConvexPairMirrorsWhenSeparatedTouchingAndPenetrating) {
+    cdlab_test::Rng rng(16);
+    const std::vector<Shape> zoo = shapeZoo(rng);
+    for (std::size_t i = 0; i < zoo.size(); ++i) {
+        for (std::size_t j = 0; j < zoo.size(); ++j) {
+            std::array<int, 3> states{0, 0, 0};
+            for (int n = 0; n < 60; ++n) {
+                const Real scale = std::max(boundingRadius(zoo[i]), boundingRadius(zoo[j]));
+                const Pose pa = at(rng.vec(-1, 1), rng.rotation());
+                const Vec3 dir = rng.rotation() * Vec3::UnitX();
+                const Real reach = boundingRadius(zoo[i]) + boundingRadius(zoo[j]);
+                const Pose start =
+                    at(pa.position + rng.uniform(0.2, 1.2) * reach * dir, rng.rotation());
+                const ContactOutput first = contact(zoo[i], pa, zoo[j], start);
+                ASSERT_NE(first.state, ContactState::Failed) << i << " " << j << " " << n;
+                for (const Real push : {Real(-1), Real(0), Real(0.2) * scale}) {
+                    Pose pb = start;
+                    if (push >= 0) pb.position -= (first.signed_distance + push) * first.normal;
+                    const ContactOutput ab = contact(zoo[i], pa, zoo[j], pb);
+                    const ContactOutput ba = contact(zoo[j], pb, zoo[i], pa);
+                    ASSERT_NE(ab.state, ContactState::Failed) << i << " " << j << " " << n;
+                    expectMirror(ab, ba, n);
+                    ASSERT_EQ(collide(zoo[i], pa, zoo[j], pb).state, ab.state)
+                        << i << " " << j << " " << n;
+                    ASSERT_EQ(collide(zoo[j], pb, zoo[i], pa).state, ab.state)
+                        << i << " " << j << " " << n;
+                    ++states[static_cast<std::size_t>(ab.state)];
+                }
+            }
+            EXPECT_GT(states[0], 5) << i << " " << j;
+            EXPECT_GT(states[1], 5) << i << " " << j;
+            EXPECT_GT(states[2], 5) << i << " " << j;
+        }
+    }
+}
+
+// The touching convention of contact.h (Touching iff |signed distance| <= kTouchRelativeTolerance
+// * scale) holds on both sides of each threshold for the closed forms (sphere-sphere,
+// sphere-capsule, capsule-capsule, sphere-box, box-box SAT) and for GJK/EPA (hull-hull,
+// hull-sphere, capsule-box, hull-box): poses built at signed distance k * tolerance, k = +-0.5
+// (Touching) and +-2 (Separated / Penetrating), in both argument orders; the normal is the face
+// normal. Regression: the face-to-face hull pairs got EPA normals 40 to 110 degrees off it (EPA
+// from a GJK simplex that did not hold the origin, or GJK's direction through a 1e-14 gap).
+TEST(Contact, TouchingConventionOnBothSidesOfTheBand) {
+    const Quat q = axisAngle(0.7, Vec3(1, 2, 3));
+    const Vec3 origin(0.3, -0.2, 0.1);
+    const Vec3 x = q * Vec3::UnitX();  // gap direction, A towards B
+    struct Case {
+        const char* name;
+        Shape a;
+        Shape b;
+        Real contact_offset;  ///< centre distance along x at signed distance 0
+    };
+    const std::vector<Case> cases{
+        {"sphere-sphere", Shape::sphere(0.5), Shape::sphere(0.75), 1.25},
+        {"sphere-capsule", Shape::sphere(0.5), Shape::capsule(0.25, 0.5), 0.75},
+        {"capsule-capsule", Shape::capsule(0.25, 0.5), Shape::capsule(0.375, 0.75), 0.625},
+        {"sphere-box", Shape::sphere(0.5), Shape::box(Vec3(0.25, 0.5, 0.75)), 0.75},
+        {"box-box", Shape::box(Vec3(0.5, 0.5, 0.5)), Shape::box(Vec3(0.25, 0.75, 0.5)), 0.75},
+        {"hull-hull", boxHull(Vec3(0.5, 0.5, 0.5)), boxHull(Vec3(0.25, 0.75, 0.5)), 0.75},
+        {"hull-sphere", boxHull(Vec3(0.5, 0.5, 0.5)), Shape::sphere(0.25), 0.75},
+        {"capsule-box", Shape::capsule(0.25, 0.5), Shape::box(Vec3(0.25, 0.75, 0.5)), 0.5},
+        {"hull-box", boxHull(Vec3(0.5, 0.5, 0.5)), Shape::box(Vec3(0.25, 0.75, 0.5)), 0.75},
+    };
+    for (const Case& c : cases) {
+        const Real scale = std::max(boundingRadius(c.a), boundingRadius(c.b));
+        const Real tol = collision::kTouchRelativeTolerance * scale;
+        for (const Real k : {Real(-2), Real(-0.5), Real(0), Real(0.5), Real(2)}) {
+            const ContactState expected = k > 1    ? ContactState::Separated
+                                          : k < -1 ? ContactState::Penetrating
+                                                   : ContactState::Touching;
+            const Pose pa = at(origin, q);
+            const Pose pb = at(origin + (c.contact_offset + k * tol) * x, q);
+            const ContactOutput ab = contact(c.a, pa, c.b, pb);
+            const ContactOutput ba = contact(c.b, pb, c.a, pa);
+            EXPECT_EQ(ab.state, expected) << c.name << " k=" << k;
+            EXPECT_EQ(ba.state, expected) << c.name << " k=" << k;
+            EXPECT_EQ(collide(c.a, pa, c.b, pb).state, expected) << c.name << " k=" << k;
+            EXPECT_EQ(collide(c.b, pb, c.a, pa).state, expected) << c.name << " k=" << k;
+            // The signed distance is in the state's range and within rounding of k * tol.
+            EXPECT_NEAR(ab.signed_distance, k * tol, 0.25 * tol) << c.name << " k=" << k;
+            EXPECT_LE((ab.normal - x).norm(), 1e-9) << c.name << " k=" << k;
         }
     }
 }
@@ -736,6 +853,42 @@ TEST(Contact, RegressionExactlyTouchingBoxesFailedInEpaDecision) {
     const ContactOutput out = contact(a, pa, b, pb);
     EXPECT_EQ(out.state, ContactState::Touching);
     EXPECT_GE(out.manifold_size, 1);
+    expectMirror(out, contact(b, pb, a, pa), 0);
+}
+
+// Regression (EPA from a separated simplex): a box hull A 8.6e-9 * size away from a box B. GJK
+// stopped Separated below kNormalRelative * size, where its direction was not trusted, and EPA
+// was started from GJK's final simplex, which does not hold the origin. EPA then "converged" on a
+// face the origin lies outside of: depth -8.5e-9 (negative), with that face's witnesses, so
+// point_b - point_a was not signed_distance * normal (off by 9e-9 * size, more than the gap).
+// A non-positive EPA depth now falls back to GJK's distance and witnesses.
+//
+//     +-------+   gap 8.6e-9 * size
+//     |   A   | <->  <> B (box)       A: an 8-point hull, so the pair takes GJK/EPA
+//     +-------+
+TEST(Contact, RegressionEpaFromSeparatedSimplexGaveNegativeDepth) {
+    const Vec3 ha(0x1.34b0050cfde5p-2, 0x1.81c1670cefe8p-2, 0x1.1bd878665e554p-2);
+    const Shape a = boxHull(ha);
+    const Shape b =
+        Shape::box(Vec3(0x1.ddf9afb7e2caep-3, 0x1.cc6190ffd6d96p-1, 0x1.19ad3ebf020b4p+0));
+    const Pose pa{Vec3(-0x1.fc2a30e661f09p-1, 0x1.75be030e48164p-2, 0x1.12a05f29b35ep-1),
+                  Quat(-0x1.e72fe1f4f53e5p-2, -0x1.a0bbb00d97b9ap-1, -0x1.2038211725a73p-4,
+                       -0x1.4db776233406ep-2)};
+    const Pose pb{Vec3(0x1.fd6abc6cdfed8p-4, 0x1.c73e4c1a02124p-2, 0x1.39e22085acbd6p+0),
+                  Quat(0x1.fdd9c67251902p-5, 0x1.a2f2d49e31db5p-1, -0x1.d0fe0504664cap-2,
+                       0x1.63480fd5a33d4p-2)};
+    const Real scale = std::max(boundingRadius(a), boundingRadius(b));
+    const ContactOutput out = contact(a, pa, b, pb);
+    ASSERT_EQ(out.state, ContactState::Separated);
+    EXPECT_GT(out.signed_distance, 1e-9 * scale);
+    EXPECT_LT(out.signed_distance, 1e-8 * scale);
+    EXPECT_LE((out.point_b - out.point_a - out.signed_distance * out.normal).norm(), 1e-12 * scale);
+    // Independent of GJK/EPA: the largest separation over 20000 sampled directions and every SAT
+    // axis is a lower bound on the distance (1.2319e-8 here; GJK's 1.2360e-8 is an upper one).
+    const Real lower = -collision::minimumOverlapReference(a, pa, b, pb, 20000).overlap;
+    EXPECT_GE(out.signed_distance, lower - 1e-12 * scale);
+    EXPECT_LE(out.signed_distance, lower + 1e-2 * out.signed_distance);
+    expectConsistent(a, pa, b, pb, out, 1e-12, "epa-separated", 0);
     expectMirror(out, contact(b, pb, a, pa), 0);
 }
 

@@ -36,10 +36,17 @@ struct ManifoldPoint {
     Real depth = 0;               ///< >= 0 penetration along the normal (0 when touching)
 };
 
+/// Touching convention (the one of collide(), narrow_phase.h, for every pair and every path:
+/// closed forms, SAT, GJK, EPA): with tol = kTouchRelativeTolerance * scale, scale the larger
+/// bounding radius of the two shapes (sphere: radius; box: |half_extents|; capsule:
+/// half_height + radius; hull: farthest vertex from its origin),
+///   Separated    iff signed distance >  tol,
+///   Touching     iff |signed distance| <= tol  (a gap or an overlap of rounding size),
+///   Penetrating  iff signed distance < -tol.
 struct ContactOutput {
     ContactState state = ContactState::Failed;
-    /// Separated: the distance (> touching tolerance). Touching/Penetrating: minus the
-    /// penetration depth (<= 0). Failed: 0.
+    /// Separated: the distance (> tol). Penetrating: minus the penetration depth (< -tol).
+    /// Touching: in [-tol, tol], either sign. Failed: 0.
     Real signed_distance = 0;
     /// Unit, world frame, pointing from A towards B: moving B by -signed_distance * normal
     /// (penetrating) separates the shapes; for separated shapes (point_b - point_a) / distance.
@@ -73,15 +80,19 @@ struct ContactOutput {
 /// - Accuracy: closed forms to rounding; GJK distance to kGjkRelativeTolerance (gjk.h) or
 ///   rounding; EPA depth to 1e-11 * size; box-box SAT exact up to rounding, except that a face
 ///   axis is preferred over an edge axis less than 1e-9 * size deeper (stable manifolds).
+/// - GJK/EPA pairs within 1e-8 * size of touching: the normal comes from EPA on the pair shifted
+///   4e-8 * size into contact when that normal is stable under the shift (face contacts), else
+///   from GJK's closest points (separated) or EPA (overlapping), whose direction is then only as
+///   good as rounding allows (~1e-16 * size / gap radians, worse when GJK stalls).
 /// - State: within 1e-6 * size of the touching band the state is collide()'s own and the signed
 ///   distance is moved into that state's range (by at most that much). For meshes (their hull
 ///   here, triangles in collide()) the states may differ.
 /// Full convex query of `a` at `pose_a` against `b` at `pose_b`. Convex shapes only (a Mesh
 /// is treated as its convex hull here; triangle-level mesh contact goes through the BVH).
-/// Guarantees: never NaN, never hangs (iteration caps -> Failed); the same touching convention
-/// as `collide` (narrow_phase.h: |signed distance| <= kTouchRelativeTolerance * scale is
-/// Touching), and `contact(a, b).state == collide(a, b).state`; swapping A and B mirrors the
-/// answer (normal negated, points and features swapped).
+/// Guarantees: never NaN, never hangs (iteration caps -> Failed); the touching convention above
+/// (ContactOutput), and `contact(a, b).state == collide(a, b).state`; swapping A and B mirrors
+/// the answer (same state and signed distance, normal negated, points, features and manifold
+/// sides swapped).
 ContactOutput contact(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b);
 
 }  // namespace collision
