@@ -8,7 +8,6 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <vector>
 
 #include "collision/half_space.h"
 #include "collision/narrow_phase.h"
@@ -82,12 +81,17 @@ Feature boxSupportFeature(const Vec3& half, const Vec3& n, Real tol) {
     }
 }
 
-// The hull's support feature: its vertices within tol of the deepest height `lowest`.
-Feature hullSupportFeature(const ConvexPolytope& hull, const std::vector<Real>& heights,
-                           Real lowest, std::int32_t deepest, Real tol) {
-    auto low = [&](std::int32_t v) { return heights[static_cast<std::size_t>(v)] <= lowest + tol; };
+// The hull's support feature: its vertices within tol of the deepest height `lowest` (heights
+// n . v, recomputed with the same expression as the caller's, so the same values).
+Feature hullSupportFeature(const ConvexPolytope& hull, const Vec3& n, Real lowest,
+                           std::int32_t deepest, Real tol) {
+    auto low = [&](std::int32_t v) {
+        return n.dot(hull.vertices[static_cast<std::size_t>(v)]) <= lowest + tol;
+    };
     int count = 0;
-    for (std::size_t i = 0; i < heights.size(); ++i) count += low(static_cast<std::int32_t>(i));
+    for (std::size_t i = 0; i < hull.vertices.size() && count < 3; ++i) {
+        count += low(static_cast<std::int32_t>(i)) ? 1 : 0;
+    }
     if (count >= 3) {
         for (std::size_t f = 0; f < hull.faces.size(); ++f) {
             const auto& face = hull.faces[f];
@@ -101,9 +105,9 @@ Feature hullSupportFeature(const ConvexPolytope& hull, const std::vector<Real>& 
         for (std::size_t f = 0; f < hull.faces.size(); ++f) {
             const auto& face = hull.faces[f];
             for (std::size_t k = 0; k < 3; ++k) {
-                const std::int32_t s = face[k];
-                const std::int32_t t = face[(k + 1) % 3];
-                if ((s == deepest && low(t)) || (t == deepest && low(s))) {
+                const std::int32_t v0 = face[k];
+                const std::int32_t v1 = face[(k + 1) % 3];
+                if ((v0 == deepest && low(v1)) || (v1 == deepest && low(v0))) {
                     return {FeatureType::Edge, static_cast<std::int32_t>(3 * f + k)};
                 }
             }
@@ -112,36 +116,51 @@ Feature hullSupportFeature(const ConvexPolytope& hull, const std::vector<Real>& 
     return {FeatureType::Vertex, deepest};
 }
 
-// Up to four manifold points from the candidates in the touching band or below: the deepest,
-// then the extremes along two directions u, v of the plane (shape frame), without repeats.
-int selectManifold(std::vector<Candidate>& c, const Vec3& n, std::array<Candidate, 4>& out) {
-    if (c.empty()) return 0;
-    std::sort(c.begin(), c.end(), [](const Candidate& x, const Candidate& y) {
-        return x.height < y.height || (x.height == y.height && x.index < y.index);
-    });
-    if (c.size() <= 4) {
-        std::copy(c.begin(), c.end(), out.begin());
-        return static_cast<int>(c.size());
+// Up to four manifold points among the points offered (in the touching band or below), chosen
+// as they stream past without storing them (no allocation per query): all of them when there
+// are at most four, else the deepest, then the extremes along two directions u, v of the plane
+// (shape frame), without repeats. Ties keep the first offered.
+class ManifoldPicker {
+public:
+    ManifoldPicker(const Vec3& n, Real h0, Real band)
+        : n_(n), u_(n.unitOrthogonal()), v_(n.cross(u_)), h0_(h0), band_(band) {}
+
+    void offer(const Vec3& y, std::int32_t index) {
+        const Candidate c{y, n_.dot(y) + h0_, index};
+        if (!(c.height <= band_)) return;
+        if (count_ < 4) first_[static_cast<std::size_t>(count_)] = c;
+        if (count_ == 0 || c.height < pick_[0].height) pick_[0] = c;
+        if (count_ == 0 || u_.dot(y) > u_.dot(pick_[1].local)) pick_[1] = c;
+        if (count_ == 0 || u_.dot(y) < u_.dot(pick_[2].local)) pick_[2] = c;
+        if (count_ == 0 || v_.dot(y) > v_.dot(pick_[3].local)) pick_[3] = c;
+        if (count_ == 0 || v_.dot(y) < v_.dot(pick_[4].local)) pick_[4] = c;
+        ++count_;
     }
-    const Vec3 u = n.unitOrthogonal();
-    const Vec3 v = n.cross(u);
-    std::array<std::size_t, 5> pick{0, 0, 0, 0, 0};
-    for (std::size_t i = 1; i < c.size(); ++i) {
-        if (u.dot(c[i].local) > u.dot(c[pick[1]].local)) pick[1] = i;
-        if (u.dot(c[i].local) < u.dot(c[pick[2]].local)) pick[2] = i;
-        if (v.dot(c[i].local) > v.dot(c[pick[3]].local)) pick[3] = i;
-        if (v.dot(c[i].local) < v.dot(c[pick[4]].local)) pick[4] = i;
+
+    int finish(std::array<Candidate, 4>& out) const {
+        if (count_ <= 4) {
+            std::copy(first_.begin(), first_.begin() + count_, out.begin());
+            return count_;
+        }
+        int n = 0;
+        for (const Candidate& c : pick_) {
+            if (n == 4) break;
+            bool seen = false;
+            for (int k = 0; k < n; ++k)
+                seen = seen || out[static_cast<std::size_t>(k)].index == c.index;
+            if (!seen) out[static_cast<std::size_t>(n++)] = c;
+        }
+        return n;
     }
-    int count = 0;
-    for (const std::size_t p : pick) {
-        if (count == 4) break;
-        bool seen = false;
-        for (int k = 0; k < count; ++k)
-            seen = seen || out[static_cast<std::size_t>(k)].index == c[p].index;
-        if (!seen) out[static_cast<std::size_t>(count++)] = c[p];
-    }
-    return count;
-}
+
+private:
+    Vec3 n_, u_, v_;
+    Real h0_;
+    Real band_;
+    int count_ = 0;
+    std::array<Candidate, 4> first_{};
+    std::array<Candidate, 5> pick_{};  // deepest, max u, min u, max v, min v
+};
 
 bool finiteShape(const Shape& shape, const Pose& pose) {
     return std::isfinite(shape.radius) && std::isfinite(shape.half_height) &&
@@ -168,11 +187,8 @@ ContactOutput contact(const HalfSpace& a, const Shape& b, const Pose& pose_b) {
 
     // The deepest point of b (its support along -n), its feature, and the manifold candidates.
     Vec3 deepest = Vec3::Zero();
-    std::vector<Candidate> low;  // in the touching band or below
-    auto consider = [&](const Vec3& y, std::int32_t index) {
-        const Real h = n_l.dot(y) + h0;
-        if (h <= touch_tol) low.push_back({y, h, index});
-    };
+    ManifoldPicker manifold(n_l, h0, touch_tol);
+    auto consider = [&](const Vec3& y, std::int32_t index) { manifold.offer(y, index); };
     switch (b.type) {
         case ShapeType::Sphere: {
             deepest = supportPoint(b, -n_l);
@@ -214,19 +230,18 @@ ContactOutput contact(const HalfSpace& a, const Shape& b, const Pose& pose_b) {
         case ShapeType::Mesh: {
             const ConvexPolytope& hull = *b.hull;
             if (hull.vertices.empty()) return out;
-            std::vector<Real> heights(hull.vertices.size());
             Real lowest = std::numeric_limits<Real>::infinity();
             std::int32_t arg = 0;
             for (std::size_t i = 0; i < hull.vertices.size(); ++i) {
-                heights[i] = n_l.dot(hull.vertices[i]);
-                if (heights[i] < lowest) {
-                    lowest = heights[i];
+                const Real height = n_l.dot(hull.vertices[i]);
+                if (height < lowest) {
+                    lowest = height;
                     arg = static_cast<std::int32_t>(i);
                 }
                 consider(hull.vertices[i], static_cast<std::int32_t>(i));
             }
             deepest = hull.vertices[static_cast<std::size_t>(arg)];
-            out.feature_b = hullSupportFeature(hull, heights, lowest, arg, feature_tol);
+            out.feature_b = hullSupportFeature(hull, n_l, lowest, arg, feature_tol);
             break;
         }
     }
@@ -238,7 +253,7 @@ ContactOutput contact(const HalfSpace& a, const Shape& b, const Pose& pose_b) {
     out.feature_a = {FeatureType::Face, 0};
     if (isColliding(out.state)) {
         std::array<Candidate, 4> picked;
-        out.manifold_size = selectManifold(low, n_l, picked);
+        out.manifold_size = manifold.finish(picked);
         for (int k = 0; k < out.manifold_size; ++k) {
             const Candidate& c = picked[static_cast<std::size_t>(k)];
             ManifoldPoint& m = out.manifold[static_cast<std::size_t>(k)];
