@@ -24,7 +24,7 @@ sweep coursework scenes/coursework.yaml \
   --vary broadphase=brute,sphere,sap,hgrid,tree,obb --vary world.time_step=0.004167,0.008333,0.033333
 # Mesh hierarchies: the node volume of the mesh bodies' BVHs (Nv, Np and time per step).
 sweep coursework_mesh_bvh scenes/coursework.yaml \
-  --vary world.mesh_bvh=sphere,aabb,obb,kdop6,kdop14,kdop18,kdop26,rss
+  --vary world.mesh_bvh=sphere,aabb,obb,kdop6,kdop14,kdop18,kdop26,rss,lss
 sweep crowd scenes/crowd.yaml --vary broadphase=sap,sap1,grid,hash,hgrid,tree,octree,obb
 # CCD against the time step: missed contacts and time-of-impact error against an exact-CCD
 # reference.

@@ -80,7 +80,7 @@ struct Builder {
     // triangle's own frame (a flat, tight box); the extents are measured from the corners either
     // way, so every volume contains its triangles whatever the axes.
     BV fitNode(std::int32_t first, std::int32_t count) {
-        if constexpr (std::is_same_v<BV, Obb> || std::is_same_v<BV, Rss>) {
+        if constexpr (kFitsWithAxes<BV>) {
             Mat3 axes;
             if (count == 1 && triangleAxes(scratch[0], scratch[1], scratch[2], &axes)) {
                 return BvTraits<BV>::fitWithAxes(scratch, axes);
@@ -377,7 +377,7 @@ bool traverseVolume(const Bvh<BV>& a, const BV& volume, const BvhTransform& x, B
 }
 
 // The closed surface of the box [lo, hi] as 12 triangles (36 corners): the fits that weight by
-// triangle area (OBB, RSS) see a box, not a point cloud.
+// triangle area (OBB, RSS, LSS) see a box, not a point cloud.
 const std::vector<Vec3>& boxSurfaceCorners(const Vec3& lo, const Vec3& hi) {
     auto corner = [&](int bits) {
         return Vec3((bits & 1) ? hi.x() : lo.x(), (bits & 2) ? hi.y() : lo.y(),
@@ -502,7 +502,7 @@ Bvh<BV>::Bvh(const TriangleMesh& mesh, const BvhBuildOptions& options) {
     opts.max_leaf_triangles = std::max(1, opts.max_leaf_triangles);
     nodes_.reserve(2 * n);
     std::vector<TriangleMoments> moments;
-    if constexpr (std::is_same_v<BV, Obb> || std::is_same_v<BV, Rss>) {
+    if constexpr (kFitsWithAxes<BV>) {
         // About the centre of the mesh's box, so the sums stay small far from the origin.
         const Vec3 origin = (lo + hi) * Real(0.5);
         moments.resize(n);
@@ -704,7 +704,7 @@ BoxView boxView(const Rss& s) {
 // projections on a unit axis (projection onto a unit axis shortens no distance) over A's axes,
 // B's axes and the line of centres, minus the rounding slack x.tol. May be negative.
 template <class BV>
-Real distanceLowerBound(const BV& va, const BV& vb, const BvhTransform& x) {
+Real projectedGapLowerBound(const BV& va, const BV& vb, const BvhTransform& x) {
     const BoxView a = boxView(va);
     BoxView b = boxView(vb);
     b.center = x.apply(b.center);
@@ -722,6 +722,17 @@ Real distanceLowerBound(const BV& va, const BV& vb, const BvhTransform& x) {
     const Real len = d.norm();
     if (len > 0) best = std::max(best, gap(d / len));
     return best - x.tol;
+}
+
+// The distance lower bound of the distance query: the volume's own when its traits give one
+// (LSS: the segments' distance minus the radii), else the projected gap.
+template <class BV>
+Real distanceLowerBound(const BV& va, const BV& vb, const BvhTransform& x) {
+    if constexpr (requires { BvTraits<BV>::distanceLowerBound(va, vb, x); }) {
+        return BvTraits<BV>::distanceLowerBound(va, vb, x);
+    } else {
+        return projectedGapLowerBound(va, vb, x);
+    }
 }
 
 }  // namespace
@@ -1092,6 +1103,7 @@ CDLAB_BVH_INSTANTIATE(Kdop<14>)
 CDLAB_BVH_INSTANTIATE(Kdop<18>)
 CDLAB_BVH_INSTANTIATE(Kdop<26>)
 CDLAB_BVH_INSTANTIATE(Rss)
+CDLAB_BVH_INSTANTIATE(Lss)
 #undef CDLAB_BVH_INSTANTIATE
 
 }  // namespace collision

@@ -281,4 +281,55 @@ Rss BvTraits<Rss>::fitWithAxes(const std::vector<Vec3>& corners, const Mat3& axe
     return s;
 }
 
+Lss BvTraits<Lss>::fit(const std::vector<Vec3>& corners) {
+    CDLAB_ASSERT(!corners.empty(), "fitting a volume to no points");
+    return fitWithAxes(corners, principalAxes(corners));
+}
+
+Lss BvTraits<Lss>::fitWithAxes(const std::vector<Vec3>& corners, const Mat3& axes) {
+    CDLAB_ASSERT(!corners.empty(), "fitting a volume to no points");
+    // Larsen et al. 2000 §4 for the line: the segment runs along the largest principal axis
+    // through the centre of the points' box across it; the radius is the largest distance across
+    // the axis. The segment is then shrunk as far as every point's own slack sqrt(r^2 - d^2)
+    // allows (as for the RSS), and the radius re-measured as the exact largest distance of a
+    // point from the final segment, so the volume contains every corner by construction
+    // (conservative whatever the axis; the axis only decides how tight it is).
+    const Vec3 origin = corners[0];
+    std::vector<Vec3> local;
+    local.reserve(corners.size());
+    Vec3 lo = Vec3::Zero();
+    Vec3 hi = Vec3::Zero();
+    for (const Vec3& p : corners) {
+        local.push_back(axes.transpose() * (p - origin));
+        lo = lo.cwiseMin(local.back());
+        hi = hi.cwiseMax(local.back());
+    }
+    const Real cy = (lo.y() + hi.y()) * Real(0.5);
+    const Real cz = (lo.z() + hi.z()) * Real(0.5);
+    auto across2 = [&](const Vec3& q) {
+        return (q.y() - cy) * (q.y() - cy) + (q.z() - cz) * (q.z() - cz);
+    };
+    Real r2 = 0;
+    for (const Vec3& q : local) r2 = std::max(r2, across2(q));
+    Real x0 = std::numeric_limits<Real>::infinity();
+    Real x1 = -x0;
+    for (const Vec3& q : local) {
+        const Real s = std::sqrt(std::max(Real(0), r2 - across2(q)));
+        x0 = std::min(x0, q.x() + s);
+        x1 = std::max(x1, q.x() - s);
+    }
+    if (x0 > x1) x0 = x1 = (x0 + x1) * Real(0.5);
+    Real radius = 0;
+    for (const Vec3& q : local) {
+        const Real dx = std::max({Real(0), x0 - q.x(), q.x() - x1});
+        radius = std::max(radius, std::sqrt(dx * dx + across2(q)));
+    }
+    Lss s;
+    s.axis = axes.col(0);
+    s.center = origin + axes * Vec3((x0 + x1) * Real(0.5), cy, cz);
+    s.half_length = (x1 - x0) * Real(0.5);
+    s.radius = radius + kFitSlack * magnitude(corners);
+    return s;
+}
+
 }  // namespace collision

@@ -5,10 +5,12 @@
 // never separation for volumes that share a point.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <concepts>
 #include <numbers>
+#include <type_traits>
 #include <vector>
 
 #include "collision/bvh.h"
@@ -313,5 +315,96 @@ struct BvTraits<Rss> {
         return lx * ly * 2 * r + (lx + ly) * pi * r * r + Real(4) / Real(3) * pi * r * r * r;
     }
 };
+
+// ---- LSS (Larsen et al. 2000): a segment along the largest principal axis swept by a sphere.
+// The overlap test is the exact segment-segment distance against the sum of the radii. ----
+
+/// Distance between the segments { ca + s ua : |s| <= ha } and { cb + t ub : |t| <= hb } (ua, ub
+/// unit to rounding; ha, hb >= 0, zero for a point): RTCD 5.1.9 with centred parameters (a = e =
+/// 1), so a zero-length segment needs no branch. The value is the distance of a pair of points
+/// of the two segments (up to rounding), so it never undercuts the true distance by more than
+/// rounding; it can exceed it where the parameters are ill-conditioned (near-parallel segments):
+/// by at most segmentDistanceSlack(ha, hb, ca, cb).
+inline Real distanceSegmentSegment(const Vec3& ca, const Vec3& ua, Real ha, const Vec3& cb,
+                                   const Vec3& ub, Real hb) {
+    const Vec3 r = ca - cb;
+    const Real b = ua.dot(ub);
+    const Real c = ua.dot(r);
+    const Real f = ub.dot(r);
+    const Real denom = Real(1) - b * b;  // sin^2 of the angle between the segments
+    // Minimise |r + s ua - t ub|^2: s = (b f - c) / denom on the lines. Parallel up to rounding
+    // (denom <= 16 eps): any s is a minimiser of the lines; take the centre, and the clamps below
+    // find the right pair (RTCD 5.1.9's s = 0 branch).
+    Real s = 0;
+    if (denom > Real(16) * kEpsilon) s = std::clamp((b * f - c) / denom, -ha, ha);
+    Real t = b * s + f;  // closest point of B's line to A's point s
+    if (t < -hb) {
+        t = -hb;
+        s = std::clamp(t * b - c, -ha, ha);
+    } else if (t > hb) {
+        t = hb;
+        s = std::clamp(t * b - c, -ha, ha);
+    }
+    return (r + ua * s - ub * t).norm();
+}
+
+/// How much distanceSegmentSegment can overestimate, relative to ha + hb + |ca - cb|: above the
+/// parallel threshold the error of s is ~2 eps (|r| + ha) / denom and moves the distance by
+/// sqrt(denom) times that, <= eps^(1/2) (|r| + ha) / 2 for denom > 16 eps; below it, treating
+/// the segments as parallel costs at most ~sin(angle) (ha + hb) <= 4 eps^(1/2) (ha + hb).
+/// 16 eps^(1/2) covers both with margin (2.4e-7 in double: a negligible loss of pruning).
+inline const Real kSegmentDistanceSlack = Real(16) * std::sqrt(kEpsilon);
+inline Real segmentDistanceSlack(Real ha, Real hb, const Vec3& ca, const Vec3& cb) {
+    return kSegmentDistanceSlack * (ha + hb + (ca - cb).norm());
+}
+
+template <>
+struct BvTraits<Lss> {
+    static Lss fit(const std::vector<Vec3>& corners);
+    /// The LSS whose segment runs along axes.col(0) (axes orthonormal).
+    static Lss fitWithAxes(const std::vector<Vec3>& corners, const Mat3& axes);
+    static bool overlaps(const Lss& a, const Lss& b, const BvhTransform& x) {
+        return overlapsMoved(a, move(b, x), x);
+    }
+    /// B's volume in A's frame: computed once per B node while the traversal descends A under it.
+    static Lss move(const Lss& b, const BvhTransform& x) {
+        return Lss{x.apply(b.center), x.r * b.axis, b.half_length, b.radius};
+    }
+    /// Touching counts: distance of the segments <= r_a + r_b, the distance's possible
+    /// overestimate and the transform's rounding slack added, so never a false separation.
+    static bool overlapsMoved(const Lss& a, const Lss& moved, const BvhTransform& x) {
+        const Real d = distanceSegmentSegment(a.center, a.axis, a.half_length, moved.center,
+                                              moved.axis, moved.half_length);
+        return d <=
+               a.radius + moved.radius + x.tol +
+                   segmentDistanceSlack(a.half_length, moved.half_length, a.center, moved.center);
+    }
+    /// A lower bound of the distance between the two volumes (B's moved by x): the segments'
+    /// distance minus the radii and the slacks. May be negative.
+    static Real distanceLowerBound(const Lss& a, const Lss& b, const BvhTransform& x) {
+        const Lss moved = move(b, x);
+        const Real d = distanceSegmentSegment(a.center, a.axis, a.half_length, moved.center,
+                                              moved.axis, moved.half_length);
+        return d - a.radius - moved.radius - x.tol -
+               segmentDistanceSlack(a.half_length, moved.half_length, a.center, moved.center);
+    }
+    static bool contains(const Lss& s, const Vec3& p, Real tol) {
+        const Vec3 d = p - s.center;
+        const Real t = std::clamp(d.dot(s.axis), -s.half_length, s.half_length);
+        return (d - s.axis * t).norm() <= s.radius + tol;
+    }
+    static Real cost(const Lss& s) {
+        // Cylinder + the two half-balls at its ends.
+        const Real pi = std::numbers::pi_v<Real>;
+        const Real r = s.radius;
+        return pi * r * r * (2 * s.half_length) + Real(4) / Real(3) * pi * r * r * r;
+    }
+};
+
+/// Volume types fitted along given axes (fitWithAxes): the build takes their axes from summed
+/// triangle moments, or a one-triangle leaf's own frame.
+template <class BV>
+inline constexpr bool kFitsWithAxes =
+    std::is_same_v<BV, Obb> || std::is_same_v<BV, Rss> || std::is_same_v<BV, Lss>;
 
 }  // namespace collision

@@ -507,8 +507,8 @@ TYPED_TEST(BvhTyped, LargeToriMatchTheAabbTree) {
 }
 
 TEST(Bvh, LookupByNameCoversTheTypeList) {
-    const std::vector<std::string_view> expected = {"sphere", "aabb",   "obb",    "kdop6",
-                                                    "kdop14", "kdop18", "kdop26", "rss"};
+    const std::vector<std::string_view> expected = {"sphere", "aabb",   "obb", "kdop6", "kdop14",
+                                                    "kdop18", "kdop26", "rss", "lss"};
     EXPECT_EQ(collision::bvhVolumeNames(), expected);
     EXPECT_EQ(collision::buildMeshBvh("lss?", torusA()), nullptr);
     const Pose pose = differentialPoses()[0];

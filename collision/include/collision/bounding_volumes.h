@@ -29,7 +29,9 @@ struct Aabb {
     Vec3 extents() const { return max - min; }
 };
 
-/// Bounding sphere. Closed ball.
+/// Bounding sphere. Closed ball. As a mesh-BVH node volume (`sphere`) it is the point swept
+/// sphere (PSS) of Larsen, Gottschalk, Lin, Manocha 2000, the simplest of their swept sphere
+/// volumes beside the line (Lss) and rectangle (Rss) swept spheres in collision/bvh.h.
 struct BoundingSphere {
     Vec3 center = Vec3::Zero();
     Real radius = 0;

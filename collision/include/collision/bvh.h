@@ -42,10 +42,21 @@ struct Rss {
     Real radius = 0;
 };
 
+/// Line swept sphere (Larsen, Gottschalk, Lin, Manocha 2000): the points within `radius` of the
+/// segment { center + s axis : |s| <= half_length } (a capsule). axis is a unit vector; a
+/// zero half_length makes it a sphere. Fitted along the node's principal axis, with the radius
+/// measured as the largest distance of the node's corners from the segment, so it contains them.
+struct Lss {
+    Vec3 center = Vec3::Zero();
+    Vec3 axis = Vec3::UnitX();
+    Real half_length = 0;
+    Real radius = 0;
+};
+
 /// Every node-volume type of the generic BVH, in display order. Append here (plus a BvName
 /// specialisation and the traits in collision/src/bvh_volumes.h) to add a volume type.
 using BvhVolumeTypes =
-    std::tuple<BoundingSphere, Aabb, Obb, Kdop<6>, Kdop<14>, Kdop<18>, Kdop<26>, Rss>;
+    std::tuple<BoundingSphere, Aabb, Obb, Kdop<6>, Kdop<14>, Kdop<18>, Kdop<26>, Rss, Lss>;
 
 /// The name of a volume type, as the CLI and scene files spell it.
 template <class BV>
@@ -81,6 +92,10 @@ struct BvName<Kdop<26>> {
 template <>
 struct BvName<Rss> {
     static constexpr std::string_view value = "rss";
+};
+template <>
+struct BvName<Lss> {
+    static constexpr std::string_view value = "lss";
 };
 
 /// How the top-down build splits a node's triangles (along the longest axis of the bounding box
@@ -302,7 +317,8 @@ public:
 /// in `cdlab bench narrowphase` on the two-tori workload.
 inline constexpr std::string_view kDefaultMeshBvh = "obb";
 
-/// The names of BvhVolumeTypes, in order: sphere, aabb, obb, kdop6, kdop14, kdop18, kdop26, rss.
+/// The names of BvhVolumeTypes, in order: sphere, aabb, obb, kdop6, kdop14, kdop18, kdop26,
+/// rss, lss.
 const std::vector<std::string_view>& bvhVolumeNames();
 
 /// Builds the tree of the named volume type; nullptr for an unknown name.
