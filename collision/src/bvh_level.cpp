@@ -19,6 +19,10 @@ namespace collision {
 
 namespace {
 
+// A triangle whose doubled area is below this fraction of its squared edge lengths has no
+// normal (rounding of the cross product).
+constexpr Real kDegenerateAreaFraction = Real(64) * kEpsilon;
+
 void raise(BvhLevel& level, std::size_t i, BvhNodeState state) {
     if (i < level.states.size() && level.states[i] < state) level.states[i] = state;
 }
@@ -48,13 +52,12 @@ Vec3 toWorld(const Pose& pose, const Vec3& local) {
     return pose.orientation * local + pose.position;
 }
 
-// Unit normal of triangle (p, q, r) by the right-hand rule, zero when it is degenerate (its
-// doubled area below rounding of the squared edge lengths).
+// Unit normal of triangle (p, q, r) by the right-hand rule, zero when it is degenerate.
 Vec3 faceNormal(const Vec3& p, const Vec3& q, const Vec3& r) {
     const Vec3 n = (q - p).cross(r - p);
     const Real len = n.norm();
     const Real ref = (q - p).squaredNorm() + (r - p).squaredNorm();
-    return len > 64 * kEpsilon * ref ? Vec3(n / len) : Vec3(Vec3::Zero());
+    return len > kDegenerateAreaFraction * ref ? Vec3(n / len) : Vec3(Vec3::Zero());
 }
 
 std::array<Vec3, 3> corners(const TriangleMesh& mesh, std::int32_t t) {
