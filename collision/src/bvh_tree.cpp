@@ -398,6 +398,94 @@ const std::vector<Vec3>& boxSurfaceCorners(const Vec3& lo, const Vec3& hi) {
     return out;
 }
 
+// What levelNodes() draws for a node volume (bvh.h, BvhLevelNode): the sphere itself, or a box
+// containing the volume.
+void setLevelShape(const BoundingSphere& v, BvhLevelNode& out) {
+    out.is_sphere = true;
+    out.sphere = v;
+}
+void setLevelShape(const Aabb& v, BvhLevelNode& out) {
+    out.box.center = v.center();
+    out.box.half_extents = (v.max - v.min) * Real(0.5);
+}
+void setLevelShape(const Obb& v, BvhLevelNode& out) { out.box = v; }
+template <int K>
+void setLevelShape(const Kdop<K>& v, BvhLevelNode& out) {
+    // Slabs 0..2 are the unit axes (kKdopDirections): their box contains the k-DOP.
+    const Vec3 lo(v.min[0], v.min[1], v.min[2]);
+    const Vec3 hi(v.max[0], v.max[1], v.max[2]);
+    out.box.center = (lo + hi) * Real(0.5);
+    out.box.half_extents = (hi - lo) * Real(0.5);
+}
+void setLevelShape(const Rss& v, BvhLevelNode& out) {
+    out.box.center = v.center;
+    out.box.axes = v.axes;
+    out.box.half_extents =
+        Vec3(v.half_lengths[0] + v.radius, v.half_lengths[1] + v.radius, v.radius);
+}
+
+// The cut of `tree` at `depth` (MeshBvh::levelNodes), in depth-first order.
+template <class BV>
+std::vector<BvhLevelNode> levelNodesOf(const Bvh<BV>& tree, int depth) {
+    std::vector<BvhLevelNode> out;
+    const auto& nodes = tree.nodes();
+    if (depth < 0 || nodes.empty()) return out;
+    std::vector<std::pair<std::int32_t, int>> stack{{0, 0}};
+    std::vector<std::int32_t> subtree;
+    while (!stack.empty()) {
+        const auto [index, d] = stack.back();
+        stack.pop_back();
+        const auto& node = nodes[static_cast<std::size_t>(index)];
+        if (d < depth && !node.isLeaf()) {
+            stack.push_back({node.right, d + 1});  // left (index + 1) pops first
+            stack.push_back({index + 1, d + 1});
+            continue;
+        }
+        BvhLevelNode level;
+        level.node = index;
+        level.depth = d;
+        setLevelShape(node.volume, level);
+        subtree.assign(1, index);
+        while (!subtree.empty()) {
+            const std::int32_t i = subtree.back();
+            subtree.pop_back();
+            const auto& n = nodes[static_cast<std::size_t>(i)];
+            if (n.isLeaf()) {
+                for (std::int32_t k = n.first; k < n.first + n.count; ++k) {
+                    level.triangles.push_back(tree.leafTriangleId(k));
+                }
+            } else {
+                subtree.push_back(i + 1);
+                subtree.push_back(n.right);
+            }
+        }
+        std::sort(level.triangles.begin(), level.triangles.end());
+        out.push_back(std::move(level));
+    }
+    return out;
+}
+
+// Depth-first indices of the cut (levelNodesOf without the triangle lists).
+template <class BV>
+std::vector<std::int32_t> levelIndices(const Bvh<BV>& tree, int depth) {
+    std::vector<std::int32_t> out;
+    const auto& nodes = tree.nodes();
+    if (depth < 0 || nodes.empty()) return out;
+    std::vector<std::pair<std::int32_t, int>> stack{{0, 0}};
+    while (!stack.empty()) {
+        const auto [index, d] = stack.back();
+        stack.pop_back();
+        const auto& node = nodes[static_cast<std::size_t>(index)];
+        if (d < depth && !node.isLeaf()) {
+            stack.push_back({node.right, d + 1});
+            stack.push_back({index + 1, d + 1});
+        } else {
+            out.push_back(index);
+        }
+    }
+    return out;
+}
+
 template <class BV>
 class MeshBvhOf final : public MeshBvh {
 public:
@@ -466,6 +554,48 @@ public:
                               [&](std::int32_t i, const std::array<Vec3, 3>& corners) {
                                   return visitor.visit(tree_.leafTriangleId(i), corners);
                               });
+    }
+    std::vector<BvhLevelNode> levelNodes(int depth) const override {
+        return levelNodesOf(tree_, depth);
+    }
+    std::vector<BvhLevelPair> levelOverlaps(int depth, const MeshBvh& b, const Mat3& rotation,
+                                            const Vec3& translation) const override {
+        const auto* other = dynamic_cast<const MeshBvhOf<BV>*>(&b);
+        CDLAB_ASSERT(other != nullptr, "BVH query between different volume types");
+        std::vector<BvhLevelPair> out;
+        if (other == nullptr) return out;
+        const Bvh<BV>& tb = other->tree_;
+        const BvhTransform x = makeBvhTransform(rotation, translation, tree_.scale(), tb.scale());
+        const std::vector<std::int32_t> cut_a = levelIndices(tree_, depth);
+        const std::vector<std::int32_t> cut_b = levelIndices(tb, depth);
+        for (std::size_t i = 0; i < cut_a.size(); ++i) {
+            const BV& va = tree_.nodes()[static_cast<std::size_t>(cut_a[i])].volume;
+            for (std::size_t j = 0; j < cut_b.size(); ++j) {
+                const BV& vb = tb.nodes()[static_cast<std::size_t>(cut_b[j])].volume;
+                if (BvTraits<BV>::overlaps(va, vb, x)) {
+                    out.push_back({static_cast<std::int32_t>(i), static_cast<std::int32_t>(j)});
+                }
+            }
+        }
+        return out;
+    }
+    std::vector<std::int32_t> levelOverlapsBox(int depth, const Vec3& box_min, const Vec3& box_max,
+                                               const Mat3& rotation,
+                                               const Vec3& translation) const override {
+        std::vector<std::int32_t> out;
+        if (tree_.nodes().empty()) return out;
+        // The volume and transform of visitNearBox.
+        const Real box_scale =
+            (box_max - box_min).maxCoeff() +
+            std::max(box_min.cwiseAbs().maxCoeff(), box_max.cwiseAbs().maxCoeff());
+        const BV volume = BvTraits<BV>::fit(boxSurfaceCorners(box_min, box_max));
+        const BvhTransform x = makeBvhTransform(rotation, translation, tree_.scale(), box_scale);
+        const std::vector<std::int32_t> cut = levelIndices(tree_, depth);
+        for (std::size_t i = 0; i < cut.size(); ++i) {
+            const BV& v = tree_.nodes()[static_cast<std::size_t>(cut[i])].volume;
+            if (BvTraits<BV>::overlaps(v, volume, x)) out.push_back(static_cast<std::int32_t>(i));
+        }
+        return out;
     }
 
 private:

@@ -215,10 +215,12 @@ Box3 triangleBox(const Vec3& p, const Vec3& q, const Vec3& r) {
 // (culling only drops triangles farther than the tolerance from B).
 class MeshConvexScan final : public TriangleVisitor {
 public:
+    /// With `hits`, every touching or penetrating triangle's mesh index is appended to it and
+    /// the scan never stops early (collidingTriangles).
     MeshConvexScan(const ConvexCore& core_b, const RelativePose& b_in_a, const PairContext& ctx,
-                   const Box3& box_b)
-        : core_b_(core_b), b_in_a_(b_in_a), ctx_(ctx), box_b_(box_b) {}
-    bool visit(std::int32_t, const std::array<Vec3, 3>& t) override {
+                   const Box3& box_b, std::vector<std::int32_t>* hits = nullptr)
+        : core_b_(core_b), b_in_a_(b_in_a), ctx_(ctx), box_b_(box_b), hits_(hits) {}
+    bool visit(std::int32_t id, const std::array<Vec3, 3>& t) override {
         if (!triangleBox(t[0], t[1], t[2]).overlaps(box_b_)) return false;
         ++tests_;
         const CollideOutput res = collideConvexCores(ConvexCore::triangle(t[0], t[1], t[2]),
@@ -227,6 +229,10 @@ public:
         penetrating_ = res.state == ContactState::Penetrating;
         touching_ = touching_ || res.state == ContactState::Touching;
         failed_ = failed_ || res.state == ContactState::Failed;
+        if (hits_ != nullptr) {
+            if (isColliding(res.state)) hits_->push_back(id);
+            return false;
+        }
         return penetrating_;
     }
     CollideOutput result() const {
@@ -245,6 +251,7 @@ private:
     const RelativePose& b_in_a_;
     const PairContext& ctx_;
     const Box3& box_b_;  // B's grown AABB in A's frame: the last cull before GJK
+    std::vector<std::int32_t>* hits_;
     std::int32_t tests_ = 0;
     std::int32_t iterations_ = 0;
     bool penetrating_ = false;
@@ -258,8 +265,8 @@ private:
 // (support points along B's axes, grown the same way) are looked at; without one (the
 // brute-force reference) every triangle is. Both cullings keep every triangle within the
 // tolerance of B, so the state is the same.
-CollideOutput collideMeshConvex(const Shape& a, const Shape& b, const RelativePose& b_in_a,
-                                const PairContext& ctx) {
+CollideOutput scanMeshConvex(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                             const PairContext& ctx, std::vector<std::int32_t>* hits) {
     CDLAB_ASSERT(a.mesh, "mesh shape without triangles");
     const TriangleMesh& mesh = *a.mesh;
     const ConvexCore core_b = ConvexCore::fromShape(b);
@@ -273,7 +280,7 @@ CollideOutput collideMeshConvex(const Shape& a, const Shape& b, const RelativePo
         box_b.max[k] = hi;
     }
     box_b.inflate(grow);
-    MeshConvexScan scan(core_b, b_in_a, ctx, box_b);
+    MeshConvexScan scan(core_b, b_in_a, ctx, box_b, hits);
     if (a.bvh) {
         Vec3 lo;
         Vec3 hi;
@@ -295,6 +302,11 @@ CollideOutput collideMeshConvex(const Shape& a, const Shape& b, const RelativePo
         if (scan.visit(static_cast<std::int32_t>(i), t)) break;
     }
     return scan.result();
+}
+
+CollideOutput collideMeshConvex(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                                const PairContext& ctx) {
+    return scanMeshConvex(a, b, b_in_a, ctx, nullptr);
 }
 
 // Does triangle (p, q, r) have corners farther than `tolerance` on both sides of the plane of
@@ -483,6 +495,13 @@ Real boundingRadius(const Shape& shape) {
     return 0;
 }
 
+PairContext pairContext(const Shape& a, const Shape& b) {
+    PairContext ctx;
+    ctx.scale = std::max(boundingRadius(a), boundingRadius(b));
+    ctx.tolerance = kTouchRelativeTolerance * ctx.scale;
+    return ctx;
+}
+
 bool isFinite(const Shape& shape, const Pose& pose) {
     return std::isfinite(shape.radius) && std::isfinite(shape.half_height) &&
            shape.half_extents.allFinite() && pose.position.allFinite() &&
@@ -542,15 +561,68 @@ CollideOutput collide(const Shape& a, const Pose& pose_a, const Shape& b, const 
     const Pose& pose_first = swap ? pose_b : pose_a;
     const Pose& pose_second = swap ? pose_a : pose_b;
 
-    PairContext ctx;
-    ctx.scale = std::max(boundingRadius(a), boundingRadius(b));
-    ctx.tolerance = kTouchRelativeTolerance * ctx.scale;
+    const PairContext ctx = pairContext(a, b);
     CollideOutput out = entry.fn(first, second, relativePose(pose_first, pose_second), ctx);
     if (!std::isfinite(out.distance)) {
         out.state = ContactState::Failed;
         out.distance = 0;
     }
     return out;
+}
+
+std::vector<std::int32_t> collidingTriangles(const Shape& mesh, const Pose& pose_mesh,
+                                             const Shape& convex, const Pose& pose_convex) {
+    std::vector<std::int32_t> hits;
+    if (mesh.type != ShapeType::Mesh || !mesh.mesh || !convex.isConvex() ||
+        !isFinite(mesh, pose_mesh) || !isFinite(convex, pose_convex)) {
+        return hits;
+    }
+    // collide(mesh, convex) runs collideMeshConvex with the mesh first (the table's unswapped
+    // entry): the same context and relative pose here.
+    scanMeshConvex(mesh, convex, relativePose(pose_mesh, pose_convex), pairContext(mesh, convex),
+                   &hits);
+    std::sort(hits.begin(), hits.end());
+    hits.erase(std::unique(hits.begin(), hits.end()), hits.end());
+    return hits;
+}
+
+namespace {
+
+class PairCollector final : public TrianglePairVisitor {
+public:
+    explicit PairCollector(std::vector<TrianglePair>& out) : out_(out) {}
+    bool visit(std::int32_t a, const std::array<Vec3, 3>&, std::int32_t b,
+               const std::array<Vec3, 3>&) override {
+        out_.push_back({a, b});
+        return false;
+    }
+
+private:
+    std::vector<TrianglePair>& out_;
+};
+
+}  // namespace
+
+std::vector<TrianglePair> collidingTrianglePairs(const Shape& a, const Pose& pose_a, const Shape& b,
+                                                 const Pose& pose_b) {
+    std::vector<TrianglePair> pairs;
+    if (a.type != ShapeType::Mesh || b.type != ShapeType::Mesh || !a.mesh || !b.mesh ||
+        !isFinite(a, pose_a) || !isFinite(b, pose_b)) {
+        return pairs;
+    }
+    const RelativePose b_in_a = relativePose(pose_a, pose_b);
+    if (a.bvh && b.bvh && a.bvh->sameVolumeType(*b.bvh)) {
+        PairCollector collect(pairs);
+        a.bvh->visitIntersecting(*b.bvh, b_in_a.rotation, b_in_a.position, collect);
+    } else {
+        Pose pose;
+        pose.position = b_in_a.position;
+        pose.orientation = Quat(b_in_a.rotation);
+        return intersectMeshMeshBruteForce(*a.mesh, *b.mesh, pose);
+    }
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    return pairs;
 }
 
 }  // namespace collision

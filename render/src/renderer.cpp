@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "collision/bounding_volumes.h"
+#include "collision/narrow_phase.h"
 #include "collision/shape.h"
 #include "font.h"
 
@@ -37,6 +38,10 @@ constexpr Real kPi = Real(3.14159265358979323846);
 constexpr Real kParallelSine = Real(1e-6);
 /// Near plane never closer than this fraction of the far plane (24-bit depth stays useful).
 constexpr Real kNearFarRatio = Real(1e-4);
+/// Contact marks, as fractions of the smaller bounding radius of the pair: the half size of a
+/// witness cross and the length of the normal segment.
+constexpr Real kContactCrossFraction = Real(0.06);
+constexpr Real kContactNormalFraction = Real(0.5);
 
 // ---------------------------------------------------------------------------------------------
 // Camera: gluLookAt / gluPerspective conventions, computed here (no GLU) so tests can mirror it.
@@ -419,6 +424,18 @@ Real gridStep(Real extent, Real target) {
 
 // ---------------------------------------------------------------------------------------------
 
+collision::Color nodeColor(collision::BvhNodeState state) {
+    switch (state) {
+        case collision::BvhNodeState::Apart:
+            return stateColor(engine::BodyState::Apart);
+        case collision::BvhNodeState::Overlapping:
+            return stateColor(engine::BodyState::Flagged);
+        case collision::BvhNodeState::Confirmed:
+            return stateColor(engine::BodyState::Colliding);
+    }
+    return kContactColor;
+}
+
 collision::Color stateColor(engine::BodyState state) {
     switch (state) {
         case engine::BodyState::Apart:
@@ -444,6 +461,8 @@ struct Renderer::Impl {
     LineBuffer structure_lines;  ///< the broad phase's own drawing
     LineBuffer volume_lines;     ///< bounding volumes
     LineBuffer outline_lines;    ///< bounding spheres' silhouettes
+    LineBuffer bvh_lines;        ///< mesh hierarchy levels (draw.bvh_depth)
+    LineBuffer contact_lines;    ///< contact witnesses and normals (draw.contacts)
     std::vector<GLubyte> readback;
 
     const UnitSphereGrid& sphereGrid(int slices) {
@@ -457,6 +476,8 @@ struct Renderer::Impl {
     CameraFrame setUpCamera(const engine::World& world, const engine::CameraSettings& camera);
     void setUpGl(const CameraFrame& cam);
     void buildBodies(const engine::World& world, const CameraFrame& cam);
+    void buildHierarchyLevels(const engine::World& world, int depth, GlDebugDraw& debug);
+    void buildContacts(const engine::World& world, GlDebugDraw& debug);
     void buildLines(const engine::World& world, const CameraFrame& cam,
                     const FrameOptions& options);
     void drawTriangles();
@@ -592,6 +613,8 @@ void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& c
     structure_lines.clear();
     volume_lines.clear();
     outline_lines.clear();
+    bvh_lines.clear();
+    contact_lines.clear();
     GlDebugDraw debug(cam, frame_lines);
 
     if (options.draw.bounds) {
@@ -648,6 +671,112 @@ void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& c
             }
         }
         debug.drawLine(e.point, e.point + e.normal * size, kToiColor);
+    }
+
+    if (options.draw.bvh_depth >= 0) {
+        debug.setTarget(bvh_lines);
+        buildHierarchyLevels(world, options.draw.bvh_depth, debug);
+    }
+    if (options.draw.contacts) {
+        debug.setTarget(contact_lines);
+        buildContacts(world, debug);
+    }
+}
+
+namespace {
+
+bool finitePose(const engine::Body& body) {
+    return body.position.allFinite() && body.orientation.coeffs().allFinite();
+}
+
+// The body's hierarchy when it is a mesh that has one (the scene loader always builds one).
+const collision::MeshBvh* meshTree(const engine::Body& body) {
+    const collision::Shape& s = body.shape;
+    return s.type == collision::ShapeType::Mesh && s.mesh && s.bvh && finitePose(body) ? s.bvh.get()
+                                                                                       : nullptr;
+}
+
+}  // namespace
+
+// Each mesh body's cut at `depth`, marked over the broad phase's flagged pairs (a pair the broad
+// phase does not flag has disjoint bounding volumes, but a node volume may reach outside its
+// body's bounding volume: such near misses stay green). Confirmed triangles come from the narrow
+// phase's own queries, run again here on the colliding pairs only.
+void Renderer::Impl::buildHierarchyLevels(const engine::World& world, int depth,
+                                          GlDebugDraw& debug) {
+    const auto bodies = world.bodies();
+    std::vector<collision::BvhLevel> levels(bodies.size());
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+        if (const collision::MeshBvh* tree = meshTree(bodies[i])) {
+            levels[i] = collision::makeBvhLevel(*tree, depth);
+        }
+    }
+    const auto colliding = world.collidingPairs();
+    for (const collision::ProxyPair& p : world.flaggedPairs()) {
+        const auto ia = static_cast<std::size_t>(p.a);
+        const auto ib = static_cast<std::size_t>(p.b);
+        if (ia >= bodies.size() || ib >= bodies.size()) continue;
+        const engine::Body& a = bodies[ia];
+        const engine::Body& b = bodies[ib];
+        if (!finitePose(a) || !finitePose(b)) continue;
+        const bool confirmed = std::binary_search(colliding.begin(), colliding.end(), p);
+        const collision::MeshBvh* tree_a = meshTree(a);
+        const collision::MeshBvh* tree_b = meshTree(b);
+        if (tree_a && tree_b) {
+            if (!tree_a->sameVolumeType(*tree_b)) continue;
+            const std::vector<collision::TrianglePair> pairs =
+                confirmed ? collision::collidingTrianglePairs(a.shape, a.pose(), b.shape, b.pose())
+                          : std::vector<collision::TrianglePair>{};
+            collision::markBvhLevels(levels[ia], *tree_a, a.pose(), levels[ib], *tree_b, b.pose(),
+                                     pairs);
+        } else if (tree_a && b.shape.isConvex()) {
+            const std::vector<std::int32_t> tris =
+                confirmed ? collision::collidingTriangles(a.shape, a.pose(), b.shape, b.pose())
+                          : std::vector<std::int32_t>{};
+            collision::markBvhLevel(levels[ia], *tree_a, a.pose(), b.shape, b.pose(), tris);
+        } else if (tree_b && a.shape.isConvex()) {
+            const std::vector<std::int32_t> tris =
+                confirmed ? collision::collidingTriangles(b.shape, b.pose(), a.shape, a.pose())
+                          : std::vector<std::int32_t>{};
+            collision::markBvhLevel(levels[ib], *tree_b, b.pose(), a.shape, a.pose(), tris);
+        }
+    }
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+        const Pose pose = bodies[i].pose();
+        for (std::size_t k = 0; k < levels[i].nodes.size(); ++k) {
+            collision::drawBvhLevelNode(debug, levels[i].nodes[k], pose,
+                                        nodeColor(levels[i].states[k]));
+        }
+    }
+}
+
+// Every colliding pair's witnesses (collision::contactWitnesses): a cross at each witness point
+// and the normal from A's witness, sized by the smaller body so marks stay on the pair.
+void Renderer::Impl::buildContacts(const engine::World& world, GlDebugDraw& debug) {
+    const auto bodies = world.bodies();
+    for (const collision::ProxyPair& p : world.collidingPairs()) {
+        const auto ia = static_cast<std::size_t>(p.a);
+        const auto ib = static_cast<std::size_t>(p.b);
+        if (ia >= bodies.size() || ib >= bodies.size()) continue;
+        const engine::Body& a = bodies[ia];
+        const engine::Body& b = bodies[ib];
+        if (!finitePose(a) || !finitePose(b)) continue;
+        const Real size = std::min(a.local_bounds.sphere.radius, b.local_bounds.sphere.radius);
+        const Real cross = kContactCrossFraction * size;
+        for (const collision::ContactWitness& w :
+             collision::contactWitnesses(a.shape, a.pose(), b.shape, b.pose())) {
+            for (const Vec3& point : {w.point_a, w.point_b}) {
+                if (!point.allFinite()) continue;
+                for (int axis = 0; axis < 3; ++axis) {
+                    const Vec3 d = Vec3::Unit(axis) * cross;
+                    debug.drawLine(point - d, point + d, kContactColor);
+                }
+            }
+            if (w.point_a.allFinite() && w.normal.allFinite()) {
+                debug.drawLine(w.point_a, w.point_a + w.normal * (kContactNormalFraction * size),
+                               kContactColor);
+            }
+        }
     }
 }
 
@@ -750,7 +879,8 @@ void Renderer::Impl::drawOverlays(Image& image, const FrameOptions& options) con
                         plate, 0.45f);
         font::drawText(image, margin, margin, options.hud_text, scale, text_color);
     }
-    const bool any_volume = options.draw.sphere || options.draw.aabb || options.draw.obb;
+    const bool any_volume =
+        options.draw.sphere || options.draw.aabb || options.draw.obb || options.draw.bvh_depth >= 0;
     if (options.draw.hud && any_volume) {
         struct Entry {
             engine::BodyState state;
@@ -803,6 +933,8 @@ Image Renderer::render(const engine::World& world, const engine::CameraSettings&
     im.drawLines(im.structure_lines, 1.0f);
     im.drawLines(im.outline_lines, 1.0f);
     im.drawLines(im.volume_lines, 2.0f);
+    im.drawLines(im.bvh_lines, 1.0f);
+    im.drawLines(im.contact_lines, 2.0f);
     const GLenum error = glGetError();
     if (error != GL_NO_ERROR) {
         throw RenderError("OpenGL error " + std::to_string(error) + " while rendering a frame");

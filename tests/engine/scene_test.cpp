@@ -188,6 +188,8 @@ TEST(Scene, Defaults) {
     EXPECT_TRUE(s.draw.bounds);
     EXPECT_TRUE(s.draw.hud);
     EXPECT_FALSE(s.draw.structure);
+    EXPECT_EQ(s.draw.bvh_depth, -1);
+    EXPECT_FALSE(s.draw.contacts);
     ASSERT_EQ(s.bodies.size(), 1u);
     const Body& b = s.bodies[0];
     EXPECT_EQ(b.name, "sphere0");
@@ -197,6 +199,20 @@ TEST(Scene, Defaults) {
     EXPECT_EQ(b.angular_momentum, Vec3::Zero());
     // Bodies are optional.
     EXPECT_TRUE(parse(kHeader).bodies.empty());
+}
+
+// draw.bvh_depth: the hierarchy level to draw (-1: off, as when absent); draw.contacts.
+TEST(Scene, DrawBvhDepthAndContacts) {
+    const Scene on = parse(kHeader + "draw: {bvh_depth: 4, contacts: true}\n");
+    EXPECT_EQ(on.draw.bvh_depth, 4);
+    EXPECT_TRUE(on.draw.contacts);
+    const Scene root = parse(kHeader + "draw: {bvh_depth: 0, contacts: false}\n");
+    EXPECT_EQ(root.draw.bvh_depth, 0);
+    EXPECT_FALSE(root.draw.contacts);
+    EXPECT_EQ(parse(kHeader + "draw: {bvh_depth: -1}\n").draw.bvh_depth, -1);
+    // The other draw keys keep their defaults.
+    EXPECT_TRUE(on.draw.sphere);
+    EXPECT_FALSE(on.draw.structure);
 }
 
 // --- errors: every class, with its exact position ----------------------------------------------
@@ -299,6 +315,22 @@ TEST(SceneErrors, OutOfRangeValues) {
                        "4:14: camera.up: ", "up must not be zero");
     EXPECT_SCENE_ERROR(kHeader + "draw: {volumes: [sphere, kdop]}\n", "4:26: draw.volumes[1]: ",
                        "unknown volume 'kdop' (expected one of: sphere, aabb, obb)");
+}
+
+TEST(SceneErrors, DrawBvhDepthAndContactsAreValidated) {
+    EXPECT_EQ(errorOf(kHeader + "draw: {bvh_depth: -2}\n"),
+              "test.yaml:4:19: draw.bvh_depth: must be >= 0, or -1 for off");
+    EXPECT_EQ(errorOf(kHeader + "draw: {bvh_depth: 2.5}\n"),
+              "test.yaml:4:19: draw.bvh_depth: expected an integer, got '2.5'");
+    EXPECT_EQ(errorOf(kHeader + "draw: {bvh_depth: deep}\n"),
+              "test.yaml:4:19: draw.bvh_depth: expected an integer, got 'deep'");
+    EXPECT_EQ(errorOf(kHeader + "draw: {bvh_depth: [3]}\n"),
+              "test.yaml:4:19: draw.bvh_depth: expected an integer");
+    EXPECT_EQ(errorOf(kHeader + "draw: {contacts: 1.5}\n"),
+              "test.yaml:4:18: draw.contacts: expected true or false, got '1.5'");
+    EXPECT_EQ(errorOf(kHeader + "draw: {contact: true}\n"),
+              "test.yaml:4:8: draw.contact: unknown key 'contact' (expected one of: bodies, "
+              "volumes, bounds, hud, structure, bvh_depth, contacts)");
 }
 
 TEST(SceneErrors, UnknownNamesListTheChoices) {

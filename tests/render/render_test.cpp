@@ -12,7 +12,10 @@
 #include <string>
 #include <vector>
 
+#include "../collision/test_meshes.h"
+#include "collision/bvh_level.h"
 #include "collision/convex_hull.h"
+#include "collision/narrow_phase.h"
 #include "collision/shape.h"
 #include "engine/body.h"
 #include "engine/scene.h"
@@ -579,6 +582,139 @@ TEST(Video, AnFfmpegThatDiesBecomesARenderError) {
 }
 
 }  // namespace
+
+namespace {
+
+// Two interlocked tori, A in the xy plane at the origin and B standing in the xz plane with its
+// centre at x = 1.3, so B's inner tube cuts A's tube near x = 0.65..0.8 (both sides of z = 0):
+//
+//        y                    camera at (0.4, 0.3, 7) looking at (0.4, 0, 0)
+//        |  ___A___
+//        | /   |B  \          B seen edge-on: the vertical bar |B, from x = 0.5 to 2.1
+//   -----+-----|----+-------- x
+//
+engine::World makeTwoTorusWorld() {
+    engine::WorldSettings settings;
+    settings.bounds = collision::Aabb{Vec3::Constant(-20), Vec3::Constant(20)};
+    engine::World world(settings);
+    auto meshShape = [](collision::TriangleMesh m) {
+        auto mesh = std::make_shared<collision::TriangleMesh>(std::move(m));
+        const collision::ConvexHullOutput hull = collision::computeConvexHull(mesh->vertices);
+        return collision::Shape::triangleMesh(
+            mesh, std::make_shared<const collision::ConvexPolytope>(hull.hull));
+    };
+    world.addBody(
+        makeShapeBody("a", meshShape(cdlab_test::makeTorusMesh(1.0, 0.35, 48, 16)), Vec3::Zero()));
+    const Quat b_rot = Quat(Eigen::AngleAxis<Real>(0.12, Vec3::UnitZ())) *
+                       Quat(Eigen::AngleAxis<Real>(kPi / 2, Vec3::UnitX()));
+    world.addBody(makeShapeBody("b", meshShape(cdlab_test::makeTorusMesh(0.8, 0.3, 40, 15)),
+                                Vec3(1.3, 0, 0), b_rot));
+    world.detect();
+    return world;
+}
+
+engine::CameraSettings torusCamera() {
+    engine::CameraSettings camera;
+    camera.position = Vec3(0.4, 0.3, 7);
+    camera.look_at = Vec3(0.4, 0, 0);
+    return camera;
+}
+
+int countColor(const render::Image& image, const Rgb& color, int tolerance = 40) {
+    int n = 0;
+    for (int y = 0; y < image.height; ++y) {
+        for (int x = 0; x < image.width; ++x) n += close(pixelAt(image, x, y), color, tolerance);
+    }
+    return n;
+}
+
+}  // namespace
+
+// draw.bvh_depth: every node of the cut is drawn as its box in its state's colour. The states
+// come from collision::markBvhLevels (tested against brute force in bvh_level_test); here the
+// pixels at each node's box corners must take that colour, for nodes of all three states.
+TEST(Renderer, HierarchyLevelNodesTakeTheirStateColour) {
+    const engine::World world = makeTwoTorusWorld();
+    ASSERT_EQ(world.collidingPairs().size(), 1u);
+    constexpr int kW = 320;
+    constexpr int kH = 240;
+    render::Renderer renderer(kW, kH);
+    render::FrameOptions options = plainOptions();
+    options.draw.bodies = false;
+    options.draw.sphere = false;
+    options.draw.bvh_depth = 2;
+    const render::Image image = renderer.render(world, torusCamera(), options);
+
+    const auto bodies = world.bodies();
+    collision::BvhLevel la = collision::makeBvhLevel(*bodies[0].shape.bvh, 2);
+    collision::BvhLevel lb = collision::makeBvhLevel(*bodies[1].shape.bvh, 2);
+    collision::markBvhLevels(la, *bodies[0].shape.bvh, bodies[0].pose(), lb, *bodies[1].shape.bvh,
+                             bodies[1].pose(),
+                             collision::collidingTrianglePairs(bodies[0].shape, bodies[0].pose(),
+                                                               bodies[1].shape, bodies[1].pose()));
+    int seen[3] = {0, 0, 0};
+    for (const auto& [level, body] : {std::pair{&la, &bodies[0]}, std::pair{&lb, &bodies[1]}}) {
+        for (std::size_t k = 0; k < level->nodes.size(); ++k) {
+            const collision::BvhNodeState state = level->states[k];
+            const Rgb color = toRgb(render::nodeColor(state));
+            const collision::Obb box = collision::transformObb(level->nodes[k].box, body->pose());
+            Vec3 corners[8];
+            box.corners(corners);
+            int hits = 0;
+            for (const Vec3& c : corners) {
+                hits += colorNear(image, project(torusCamera(), kW, kH, c), color, 2, 60);
+            }
+            // Corners can be covered by other nodes' lines; most of them show the colour.
+            EXPECT_GE(hits, 5) << "node " << k << " state " << int(state);
+            ++seen[int(state)];
+        }
+    }
+    EXPECT_GT(seen[0], 0);  // apart
+    EXPECT_GT(seen[1], 0);  // overlapping at that level only
+    EXPECT_GT(seen[2], 0);  // holding a confirmed triangle
+    EXPECT_EQ(countColor(image, toRgb(render::kContactColor)), 0);
+
+    // Off: no node is drawn, so none of the state colours appears (bodies and volumes are off).
+    options.draw.bvh_depth = -1;
+    const render::Image off = renderer.render(world, torusCamera(), options);
+    for (const auto s : {collision::BvhNodeState::Apart, collision::BvhNodeState::Overlapping,
+                         collision::BvhNodeState::Confirmed}) {
+        EXPECT_EQ(countColor(off, toRgb(render::nodeColor(s))), 0);
+    }
+}
+
+// draw.contacts: a magenta cross at the witness points of the confirmed triangle pairs, none
+// without the key; the same state renders bit-identical frames with both overlays on.
+TEST(Renderer, ContactWitnessesAreDrawnInMagentaAndFramesAreDeterministic) {
+    const engine::World world = makeTwoTorusWorld();
+    constexpr int kW = 320;
+    constexpr int kH = 240;
+    render::Renderer renderer(kW, kH);
+    render::FrameOptions options = plainOptions();
+    options.draw.sphere = false;
+    options.draw.contacts = true;
+    const Rgb magenta = toRgb(render::kContactColor);
+    const render::Image image = renderer.render(world, torusCamera(), options);
+    const auto bodies = world.bodies();
+    const auto witnesses = collision::contactWitnesses(bodies[0].shape, bodies[0].pose(),
+                                                       bodies[1].shape, bodies[1].pose());
+    ASSERT_FALSE(witnesses.empty());
+    int near = 0;
+    for (const auto& w : witnesses) {
+        near += colorNear(image, project(torusCamera(), kW, kH, w.point_a), magenta, 2, 60);
+    }
+    // Witnesses on the far side of a body are drawn faintly (x-ray): most are in front.
+    EXPECT_GT(near, int(witnesses.size()) / 2);
+    EXPECT_GT(countColor(image, magenta), 20);
+    options.draw.contacts = false;
+    EXPECT_EQ(countColor(renderer.render(world, torusCamera(), options), magenta), 0);
+
+    options.draw.contacts = true;
+    options.draw.bvh_depth = 3;
+    const render::Image first = renderer.render(world, torusCamera(), options);
+    const render::Image second = renderer.render(makeTwoTorusWorld(), torusCamera(), options);
+    EXPECT_EQ(first.rgb, second.rgb);
+}
 
 // CCD: the pose at the time of impact is drawn in blue in the frame of the step that acted on
 // it, and nothing is blue in a frame without events. The bar of tunnel_bar_ccd.yaml first hits

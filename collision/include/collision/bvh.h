@@ -268,6 +268,27 @@ public:
     virtual bool visit(std::int32_t id, const std::array<Vec3, 3>& corners) = 0;
 };
 
+/// One node of a tree's cut at a depth (MeshBvh::levelNodes): read-only, for drawing the
+/// hierarchy and inspecting one level of it.
+struct BvhLevelNode {
+    std::int32_t node = 0;  ///< depth-first index in the tree (root 0)
+    int depth = 0;          ///< root 0; less than the cut's depth only for a leaf above it
+    std::vector<std::int32_t> triangles;  ///< mesh indices of the subtree's triangles, sorted
+    /// What to draw, in the mesh's frame: sphere volumes are `sphere` (is_sphere); every other
+    /// type is `box`: exact for aabb and obb, the box of the three axis slabs for k-DOPs (contains
+    /// the k-DOP), and the rectangle's box grown by the radius on all three axes for rss.
+    bool is_sphere = false;
+    BoundingSphere sphere;
+    Obb box;
+};
+
+/// An overlapping pair of nodes of two cuts: indices into the two levelNodes() lists.
+struct BvhLevelPair {
+    std::int32_t a = 0;
+    std::int32_t b = 0;
+    auto operator<=>(const BvhLevelPair&) const = default;
+};
+
 /// A Bvh of a volume type chosen at run time by name (CLI, scenes, benchmarks, mesh shapes).
 class MeshBvh {
 public:
@@ -311,6 +332,23 @@ public:
     virtual bool visitNearBox(const Vec3& box_min, const Vec3& box_max, const Mat3& rotation,
                               const Vec3& translation, TriangleVisitor& visitor,
                               BvhQueryStats* stats = nullptr) const = 0;
+    /// The cut of the tree at `depth` (root 0): every node at that depth and every leaf above
+    /// it, in depth-first order, so their subtrees partition the triangles. Empty for depth < 0
+    /// or an empty tree; a depth beyond the leaves gives the leaves. O(n).
+    virtual std::vector<BvhLevelNode> levelNodes(int depth) const = 0;
+    /// Every pair (i, j) of levelNodes(depth) of this tree and of `b` (same volume type,
+    /// asserted; empty if not) whose volumes overlap with B placed by p_a = rotation p_b +
+    /// translation: the node-pair test of the tandem traversal, with its slack. Sorted.
+    /// O(n_a n_b) in the sizes of the cuts (a drawing aid, not a query).
+    virtual std::vector<BvhLevelPair> levelOverlaps(int depth, const MeshBvh& b,
+                                                    const Mat3& rotation,
+                                                    const Vec3& translation) const = 0;
+    /// Indices into levelNodes(depth) whose volumes overlap the volume visitNearBox fits around
+    /// the box [box_min, box_max] of a frame placed by p_a = rotation p_b + translation, with
+    /// visitNearBox's test. Sorted.
+    virtual std::vector<std::int32_t> levelOverlapsBox(int depth, const Vec3& box_min,
+                                                       const Vec3& box_max, const Mat3& rotation,
+                                                       const Vec3& translation) const = 0;
 };
 
 /// The volume type mesh shapes use unless a scene chooses another (`world.mesh_bvh`): the fastest

@@ -35,6 +35,11 @@ struct DrawSettings {
     bool bounds = true;
     bool hud = true;
     bool structure = false;  ///< the broad phase's own structure (cells, intervals, nodes)
+    /// Each mesh body's hierarchy cut at this depth (root 0), nodes coloured by contact state;
+    /// -1 = off. Scene key `draw.bvh_depth` (an integer >= 0, or -1: off).
+    int bvh_depth = -1;
+    /// Witness points and normals of the confirmed contacts. Scene key `draw.contacts`.
+    bool contacts = false;
 };
 
 // BEGIN expect (self-grading scenes)

@@ -5,6 +5,7 @@
 #include <memory>
 #include <string>
 
+#include "collision/bvh_level.h"
 #include "collision/debug_draw.h"
 #include "engine/scene.h"
 #include "engine/world.h"
@@ -24,7 +25,15 @@ inline constexpr collision::Color kBodyColor{0.56f, 0.63f, 0.74f, 1.0f};
 /// (World::toiEvents), and the contact normal there: blue.
 inline constexpr collision::Color kToiColor{0.25f, 0.5f, 1.0f, 1.0f};
 
-/// What one frame shows. With draw.hud and any volume drawn, a colour legend
+/// Witness points (small crosses) and normals (short segments from A's witness) of the confirmed
+/// contacts, with draw.contacts: magenta, a colour no state uses.
+inline constexpr collision::Color kContactColor{1.0f, 0.0f, 1.0f, 1.0f};
+
+/// Colour of a hierarchy node drawn with draw.bvh_depth: the state colours, Overlapping as
+/// flagged (yellow) and Confirmed as colliding (red).
+collision::Color nodeColor(collision::BvhNodeState state);
+
+/// What one frame shows. With draw.hud and any volume (or hierarchy level) drawn, a colour legend
 /// (apart / flagged / colliding) goes bottom-left.
 struct FrameOptions {
     engine::DrawSettings draw;
