@@ -424,6 +424,18 @@ void setLevelShape(const Rss& v, BvhLevelNode& out) {
         Vec3(v.half_lengths[0] + v.radius, v.half_lengths[1] + v.radius, v.radius);
 }
 
+void setLevelShape(const Lss& v, BvhLevelNode& out) {
+    // The capsule's box: the segment's axis first, any two unit vectors across it.
+    const Vec3 u = v.axis.normalized();
+    const Vec3 helper = std::abs(u.x()) < Real(0.9) ? Vec3(Vec3::UnitX()) : Vec3(Vec3::UnitY());
+    const Vec3 w1 = u.cross(helper).normalized();
+    out.box.center = v.center;
+    out.box.axes.col(0) = u;
+    out.box.axes.col(1) = w1;
+    out.box.axes.col(2) = u.cross(w1);
+    out.box.half_extents = Vec3(v.half_length + v.radius, v.radius, v.radius);
+}
+
 // The cut of `tree` at `depth` (MeshBvh::levelNodes), in depth-first order.
 template <class BV>
 std::vector<BvhLevelNode> levelNodesOf(const Bvh<BV>& tree, int depth) {

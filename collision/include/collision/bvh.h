@@ -276,7 +276,8 @@ struct BvhLevelNode {
     std::vector<std::int32_t> triangles;  ///< mesh indices of the subtree's triangles, sorted
     /// What to draw, in the mesh's frame: sphere volumes are `sphere` (is_sphere); every other
     /// type is `box`: exact for aabb and obb, the box of the three axis slabs for k-DOPs (contains
-    /// the k-DOP), and the rectangle's box grown by the radius on all three axes for rss.
+    /// the k-DOP), the rectangle's box grown by the radius on all three axes for rss, and the
+    /// capsule's box for lss.
     bool is_sphere = false;
     BoundingSphere sphere;
     Obb box;
