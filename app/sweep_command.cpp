@@ -6,6 +6,7 @@
 // two time steps). Everything but the wall-clock times is deterministic.
 #include "sweep_command.h"
 
+#include <malloc.h>
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -76,8 +77,33 @@ double totalEnergy(const engine::World& world, double& scale) {
     return e;
 }
 
+// Linux /proc/self/status fields in kB (VmRSS: resident now; VmHWM: peak since the last reset),
+// -1 when not available.
+double procStatusKb(const char* field) {
+    std::ifstream f("/proc/self/status");
+    std::string line;
+    const std::string key = std::string(field) + ":";
+    while (std::getline(f, line)) {
+        if (line.rfind(key, 0) == 0) return std::strtod(line.c_str() + key.size(), nullptr);
+    }
+    return -1;
+}
+
+// Resets VmHWM to the present resident set (Linux >= 4.0: "5" to clear_refs), after handing the
+// heap's free pages back (glibc malloc_trim), so that a run does not grow into pages an earlier
+// run left resident.
+bool resetPeakResident() {
+    malloc_trim(0);
+    std::ofstream f("/proc/self/clear_refs");
+    f << "5";
+    f.flush();
+    return bool(f);
+}
+
 SweepRun measure(const engine::Scene& scene, double duration, FirstContacts& first) {
     SweepRun run;
+    const bool peak_reset = resetPeakResident();
+    const double resident_kb = procStatusKb("VmRSS");
     engine::World world = engine::makeWorld(scene);
     run.time_step = scene.world.time_step;
     run.steps = std::max<std::int64_t>(1, std::llround(duration / run.time_step));
@@ -157,6 +183,10 @@ SweepRun measure(const engine::Scene& scene, double duration, FirstContacts& fir
     run.ms_per_simulated_s = run.ms_step / run.time_step;
     run.pairs_confirmed_total = static_cast<std::int64_t>(first.size());
     run.state_hash = world.stateHash();
+    const double peak_kb = procStatusKb("VmHWM");
+    if (peak_reset && resident_kb >= 0 && peak_kb >= 0) {
+        run.memory_mib = std::max(0.0, peak_kb - resident_kb) / 1024;
+    }
     return run;
 }
 
@@ -204,7 +234,7 @@ std::string csvTable(const std::vector<SweepRun>& runs) {
            "total,"
            "missed_pairs,extra_pairs,"
            "max_first_contact_error_s,mean_first_contact_error_s,max_energy_drift,"
-           "max_angular_momentum_drift,state_hash\n";
+           "max_angular_momentum_drift,memory_mib,state_hash\n";
     for (const SweepRun& r : runs) {
         csv << csvField(r.label) << ',' << fmt(r.time_step, "%.17g") << ',' << r.steps;
         for (double v :
@@ -219,7 +249,7 @@ std::string csvTable(const std::vector<SweepRun>& runs) {
                          r.max_angular_momentum_drift}) {
             csv << ',' << fmt(v, "%.6g");
         }
-        csv << ',' << r.state_hash << '\n';
+        csv << ',' << fmt(r.memory_mib, "%.4g") << ',' << r.state_hash << '\n';
     }
     return csv.str();
 }
@@ -299,22 +329,23 @@ std::string markdownReport(const SweepOptions& options, const engine::Scene& bas
           "angular momentum.\n";
     if (options.report_timing) {
         md << "- Times are wall-clock, this machine, this build; they vary from run to run "
-              "(results.csv keeps every stage).\n";
+              "(results.csv keeps every stage). Memory: the process's peak resident set during "
+              "the run less its resident set at the start (Linux VmHWM, reset per run).\n";
     }
     md << "\n| run | dt (s) | steps |";
-    if (options.report_timing) md << " ms/step | ms per sim. s |";
+    if (options.report_timing) md << " ms/step | ms per sim. s | memory (MiB) |";
     md << " flagged/step | confirmed/step | BP false pos./step | Nv/step | mesh Nv/step | Np/step "
           "| "
           "CCD stops | "
           "missed | extra | max TOI err (s) | max depth (m) | energy drift | abs L drift "
           "|\n|---|---|---|";
-    if (options.report_timing) md << "---|---|";
+    if (options.report_timing) md << "---|---|---|";
     md << "---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     auto row = [&](const SweepRun& r) {
         md << "| " << r.label << " | " << fmt(r.time_step) << " | " << r.steps << " |";
         if (options.report_timing) {
             md << ' ' << fmt(r.ms_step, "%.3f") << " | " << fmt(r.ms_per_simulated_s, "%.1f")
-               << " |";
+               << " | " << fmt(r.memory_mib, "%.3g") << " |";
         }
         md << ' ' << fmt(r.flagged, "%.2f") << " | " << fmt(r.confirmed, "%.2f") << " | "
            << fmt(r.broad_false_positives, "%.2f") << " | " << fmt(r.bv_tests, "%.0f") << " | "

@@ -67,6 +67,11 @@ struct SweepRun {
     double mean_first_contact_error = 0;  ///< s
     double max_energy_drift = 0;  ///< max over steps |E - E0| / (sum of |energy terms| at 0)
     double max_angular_momentum_drift = 0;  ///< max over bodies and steps | |L| - |L0| | / |L0|
+    /// MiB: the process's peak resident set during the run (Linux VmHWM, reset at the run's
+    /// start) less its resident set at the start: what building and stepping this world took.
+    /// Process-wide, so allocator reuse between runs makes it a lower bound; 0 where /proc is
+    /// not available.
+    double memory_mib = 0;
     std::uint64_t state_hash = 0;
 };
 

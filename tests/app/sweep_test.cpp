@@ -173,6 +173,30 @@ TEST(Sweep, ReportWithoutTimingIsBitIdentical) {
     fs::remove_all(o.out_dir);
 }
 
+// Memory per run: the peak resident set a run adds (Linux VmHWM). 1500 bodies need their own
+// pages (bodies, volumes, broad-phase structures), so each run reports a positive figure; the
+// markdown table carries it beside the times.
+TEST(Sweep, MemoryPerRunIsMeasured) {
+    app::SweepOptions o;
+    o.scene = std::filesystem::path(CDLAB_SOURCE_DIR) / "scenes/crowd.yaml";
+    o.vary = {"broadphase=sap,octree"};
+    o.duration = 0.1;
+    o.out_dir = tempDir("memory");
+    const Outcome r = sweep(o);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto rows = readCsv(o.out_dir / "results.csv");
+    ASSERT_EQ(rows.size(), 2u);
+    for (const auto& row : rows) {
+        const double mib = std::stod(row.at("memory_mib"));
+        EXPECT_TRUE(std::isfinite(mib) && mib >= 0) << row.at("run");
+#if !defined(__SANITIZE_ADDRESS__)  // ASan's allocator keeps freed pages in quarantine
+        EXPECT_GT(mib, 0) << row.at("run");
+#endif
+    }
+    EXPECT_NE(slurp(o.out_dir / "report.md").find("memory (MiB)"), std::string::npos);
+    fs::remove_all(o.out_dir);
+}
+
 TEST(Sweep, ParseVaryKeepsBracketedValuesWhole) {
     std::string key, error;
     std::vector<std::string> values;
