@@ -277,10 +277,10 @@ Vec3 SceneParser::readVec3(const YAML::Node& n, const std::string& path) const {
 
 void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
     const std::string path = "world";
-    const std::vector<Entry> es =
-        entries(n, path,
-                {"bounds", "gravity", "time_step", "steps_per_frame", "frames", "mesh_bvh",
-                 "integrator", "ccd", "response", "restitution", "friction"});
+    const std::vector<Entry> es = entries(
+        n, path,
+        {"bounds", "gravity", "time_step", "steps_per_frame", "frames", "mesh_bvh", "integrator",
+         "ccd", "ccd_tolerance", "ccd_target_gap", "response", "restitution", "friction"});
     {
         const Entry& b = require(es, "bounds", n, path);
         const std::string bp = childPath(path, "bounds");
@@ -343,6 +343,20 @@ void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
                      "unknown ccd method '" + name + "' (expected one of: " + ccdMethodNames() +
                          ")");
             }
+        } else if (e.key == "ccd_tolerance") {
+            // Fractions of the pair's smaller bounding radius (WorldSettings). 0 would ask the
+            // advancement for exact contact, which it only approaches (Failed at the cap).
+            const Real v = readReal(e.value, p);
+            if (!(v > 0 && v <= 1)) {
+                fail(e.value, p, "must be > 0 and <= 1 (fraction of the smaller bounding radius)");
+            }
+            scene.world.ccd_tolerance = v;
+        } else if (e.key == "ccd_target_gap") {
+            const Real v = readReal(e.value, p);
+            if (!(v >= 0 && v <= 1)) {
+                fail(e.value, p, "must be in [0, 1] (fraction of the smaller bounding radius)");
+            }
+            scene.world.ccd_target_gap = v;
         } else if (e.key == "integrator") {
             const std::string name = readString(e.value, p);
             if (!findIntegrator(name, scene.world.integrator)) {
