@@ -264,11 +264,68 @@ TEST(Sweep, FloatComparisonAgainstTheSameBuildFindsNoDifference) {
         EXPECT_EQ(row.count("error") ? row.at("error") : "", "");
     }
     EXPECT_NE(slurp(o.out_dir / "report.md").find("## Float against double"), std::string::npos);
+    EXPECT_NE(
+        slurp(o.out_dir / "report.md")
+            .find("- Float and double trajectories are identical in every frame of every run."),
+        std::string::npos);
     EXPECT_FALSE(fs::exists(o.out_dir / "traces"));  // removed unless --keep-traces
     fs::remove_all(o.out_dir);
 
     o.float_binary = fs::path("/nonexistent/cdlab");
     EXPECT_EQ(sweep(o).code, 2);
+}
+
+// Regression: the reading called float "the same" from confirmed pairs alone while
+// docs/sweeps/tunnel_bar/float_vs_double.csv showed 8.43 m and 3.14 rad of divergence with no
+// pair differing. The reading now always names the largest deviations and their runs. Figures
+// from that file.
+TEST(Sweep, FloatReadingStatesTheLargestDeviationEvenWhenPairsAgree) {
+    auto run = [](const std::string& label, int first, int differing, double dp, double dq) {
+        app::FloatRun f;
+        f.label = label;
+        f.comparison.frames = 150;
+        f.comparison.first_pair_difference = first;
+        f.comparison.pair_frames_differing = differing;
+        f.comparison.max_position_deviation = dp;
+        f.comparison.max_orientation_deviation = dq;
+        return f;
+    };
+    std::vector<app::FloatRun> floats = {
+        run("world.ccd=off", -1, 0, 0.0025882, 0.0211288),
+        run("world.ccd=conservative_advancement", -1, 0, 8.43303, 3.13846),
+        run("world.ccd=off world.time_step=0.000521", -1, 0, 1.10413e-05, 8.50651e-07)};
+    std::string text = app::floatReading(floats, 20.4);
+    EXPECT_NE(text.find("Float confirms the same pairs as double in every frame of every run."),
+              std::string::npos)
+        << text;
+    EXPECT_NE(text.find("Largest trajectory divergence of float from double: position 8.43 m "
+                        "(4.13e-01 of the scene size) in **world.ccd=conservative_advancement**; "
+                        "orientation 3.14 rad in **world.ccd=conservative_advancement**."),
+              std::string::npos)
+        << text;
+    // Position and orientation maxima in different runs are named separately; a run whose
+    // pairs differ keeps its own line; an errored comparison is left out of the maxima.
+    floats[0].comparison.max_orientation_deviation = 4;
+    floats[2].comparison.first_pair_difference = 14;
+    floats[2].comparison.pair_frames_differing = 4;
+    floats.push_back(run("broken", -1, 0, 99, 99));
+    floats.back().comparison.error = "unreadable";
+    text = app::floatReading(floats, 20.4);
+    EXPECT_NE(text.find("- Float changes the answers of **world.ccd=off "
+                        "world.time_step=0.000521** from frame 14 on (4 of 150 frames)."),
+              std::string::npos)
+        << text;
+    EXPECT_EQ(text.find("same pairs"), std::string::npos) << text;
+    EXPECT_NE(text.find("position 8.43 m (4.13e-01 of the scene size) in "
+                        "**world.ccd=conservative_advancement**; orientation 4 rad in "
+                        "**world.ccd=off**."),
+              std::string::npos)
+        << text;
+    // Identical builds: said so, no deviation line.
+    const std::vector<app::FloatRun> same = {run("a", -1, 0, 0, 0), run("b", -1, 0, 0, 0)};
+    text = app::floatReading(same, 1);
+    EXPECT_NE(text.find("identical in every frame of every run"), std::string::npos) << text;
+    EXPECT_EQ(text.find("Largest"), std::string::npos) << text;
 }
 
 TEST(Sweep, CompareTracesFindsTheFirstDifferingFrameAndTheLargestDeviation) {
