@@ -241,7 +241,8 @@ TEST(Extremes, NearlyParallelBoxFacesAndEdgesAtEverySizeAndOffset) {
                     // offset where that is more, so the stored poses still hold the gap);
                     // overlaps the same.
                     const Real tiny = std::max(Real(1e-7) * s, 64 * ulpAt(o));
-                    for (Real gap : {0.1 * s, 1e-3 * s, tiny, -tiny, -1e-3 * s, -0.1 * s}) {
+                    for (const Real gap : {Real(0.1) * s, Real(1e-3) * s, tiny, -tiny,
+                                           Real(-1e-3) * s, Real(-0.1) * s}) {
                         const Real lift = static_cast<Real>(up_a + down_b) + gap;
                         const Vec3 pa = base;
                         const Vec3 pb = base + Vec3(edges ? 0 : 0.25 * s, lift, 0);
