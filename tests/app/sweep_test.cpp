@@ -158,6 +158,36 @@ TEST(Sweep, CcdStopsCountAsContactsWithTheirTimeOfImpact) {
     fs::remove_all(o.out_dir);
 }
 
+// The CCD tolerance as a sweep choice (docs/sweeps.sh runs the same on the full scene): the
+// spinning bar of tunnel_bar_ccd.yaml against a 1e-6 reference at dt / 10. The first-contact
+// error grows with the tolerance, and stays within what the tolerance allows: a stop leaves at
+// most (tolerance + target gap 1e-3) of the bar's 1 m bounding radius, closed at >= 45 m/s.
+TEST(Sweep, CcdToleranceIsSweepableAndLooserIsLessAccurate) {
+    app::SweepOptions o;
+    o.scene = fs::path(CDLAB_SOURCE_DIR) / "scenes/tunnel_bar_ccd.yaml";
+    o.vary = {"world.ccd_tolerance=1e-6,1e-3,1e-1"};
+    o.reference = {"world.ccd_tolerance=1e-6"};
+    o.duration = 0.1;  // the first stop is at 0.0721 s
+    o.report_timing = false;
+    o.out_dir = tempDir("ccd_tolerance");
+    const Outcome r = sweep(o);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto rows = readCsv(o.out_dir / "results.csv");
+    ASSERT_EQ(rows.size(), 3u);
+    double previous = -1;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+        const double tolerance =
+            std::stod(rows[i].at("run").substr(rows[i].at("run").find('=') + 1));
+        EXPECT_EQ(rows[i].at("missed_pairs"), "0") << i;
+        EXPECT_GE(std::stoi(rows[i].at("toi_events")), 1) << i;
+        const double error = std::stod(rows[i].at("max_first_contact_error_s"));
+        EXPECT_GT(error, previous) << i;
+        EXPECT_LE(error, (tolerance + 1e-3) / 45 + 1e-6) << i;
+        previous = error;
+    }
+    fs::remove_all(o.out_dir);
+}
+
 TEST(Sweep, ReportWithoutTimingIsBitIdentical) {
     app::SweepOptions o;
     o.scene = kScene;
