@@ -40,11 +40,6 @@ struct Vec3Like {
     double x, y, z;
 };
 
-// One combination's float-against-double comparison (sweep --float-binary).
-struct FloatRun {
-    TraceComparison comparison;
-    std::string label;
-};
 using FirstContacts = std::map<PairKey, double>;
 
 std::string trim(const std::string& s) {
@@ -432,36 +427,8 @@ std::string markdownReport(const SweepOptions& options, const engine::Scene& bas
            << fmt(most_tri->mesh_bv_tests, "%.0f") << "): a tighter volume costs more per node "
            << "test and saves triangle tests.\n";
     }
-    // Float: one line when every run diverges the same way.
-    std::vector<const FloatRun*> differing;
-    for (const FloatRun& f : floats) {
-        if (f.comparison.error.empty() && f.comparison.first_pair_difference >= 0) {
-            differing.push_back(&f);
-        }
-    }
-    const bool float_alike =
-        !differing.empty() && differing.size() == floats.size() &&
-        std::all_of(differing.begin(), differing.end(), [&](const FloatRun* f) {
-            return f->comparison.first_pair_difference ==
-                       differing[0]->comparison.first_pair_difference &&
-                   f->comparison.pair_frames_differing ==
-                       differing[0]->comparison.pair_frames_differing;
-        });
-    if (float_alike && differing.size() > 1) {
-        md << "- Float changes the answers of every run from frame "
-           << differing[0]->comparison.first_pair_difference << " on ("
-           << differing[0]->comparison.pair_frames_differing << " of "
-           << differing[0]->comparison.frames << " frames).\n";
-    } else {
-        for (const FloatRun* f : differing) {
-            md << "- Float changes the answers of **" << f->label << "** from frame "
-               << f->comparison.first_pair_difference << " on ("
-               << f->comparison.pair_frames_differing << " of " << f->comparison.frames
-               << " frames).\n";
-        }
-    }
-    if (!floats.empty() && differing.empty()) {
-        md << "- Float gives the same confirmed pairs as double in every frame of every run.\n";
+    if (!floats.empty()) {
+        md << floatReading(floats, (base.world.bounds.max - base.world.bounds.min).norm());
     }
     std::int64_t worst_missed = 0;
     const SweepRun* worst = nullptr;
@@ -536,6 +503,65 @@ FloatRun compareFloat(const SweepOptions& options, const std::vector<engine::Sce
 }
 
 }  // namespace
+
+std::string floatReading(const std::vector<FloatRun>& floats, double scene_size) {
+    std::ostringstream md;
+    // Answers: one line when every run diverges the same way.
+    std::vector<const FloatRun*> differing;
+    std::vector<const FloatRun*> compared;
+    for (const FloatRun& f : floats) {
+        if (!f.comparison.error.empty()) continue;
+        compared.push_back(&f);
+        if (f.comparison.first_pair_difference >= 0) differing.push_back(&f);
+    }
+    const bool float_alike =
+        !differing.empty() && differing.size() == floats.size() &&
+        std::all_of(differing.begin(), differing.end(), [&](const FloatRun* f) {
+            return f->comparison.first_pair_difference ==
+                       differing[0]->comparison.first_pair_difference &&
+                   f->comparison.pair_frames_differing ==
+                       differing[0]->comparison.pair_frames_differing;
+        });
+    if (float_alike && differing.size() > 1) {
+        md << "- Float changes the answers of every run from frame "
+           << differing[0]->comparison.first_pair_difference << " on ("
+           << differing[0]->comparison.pair_frames_differing << " of "
+           << differing[0]->comparison.frames << " frames).\n";
+    } else {
+        for (const FloatRun* f : differing) {
+            md << "- Float changes the answers of **" << f->label << "** from frame "
+               << f->comparison.first_pair_difference << " on ("
+               << f->comparison.pair_frames_differing << " of " << f->comparison.frames
+               << " frames).\n";
+        }
+    }
+    if (compared.empty()) return md.str();
+    if (differing.empty()) {
+        md << "- Float confirms the same pairs as double in every frame of every run";
+        md << (compared.size() < floats.size() ? " that could be compared" : "") << ".\n";
+    }
+    // Trajectories, whatever the pairs did: a float run can confirm every pair of the double
+    // run while its bodies end metres and radians away (a stop or bounce decided by the last
+    // bits sends a body elsewhere), so the largest deviations are always stated, with the run.
+    const auto by_position = [](const FloatRun* a, const FloatRun* b) {
+        return a->comparison.max_position_deviation < b->comparison.max_position_deviation;
+    };
+    const auto by_orientation = [](const FloatRun* a, const FloatRun* b) {
+        return a->comparison.max_orientation_deviation < b->comparison.max_orientation_deviation;
+    };
+    const FloatRun& far = **std::max_element(compared.begin(), compared.end(), by_position);
+    const FloatRun& turned = **std::max_element(compared.begin(), compared.end(), by_orientation);
+    const double dp = far.comparison.max_position_deviation;
+    const double dq = turned.comparison.max_orientation_deviation;
+    if (dp == 0 && dq == 0) {
+        md << "- Float and double trajectories are identical in every frame of every run.\n";
+        return md.str();
+    }
+    md << "- Largest trajectory divergence of float from double: position " << fmt(dp, "%.3g")
+       << " m (" << fmt(dp / scene_size, "%.2e") << " of the scene size) in **" << far.label
+       << "**; orientation " << fmt(dq, "%.3g") << " rad in **" << turned.label << "**.\n";
+    return md.str();
+}
 
 TraceComparison compareTraces(const fs::path& a, const fs::path& b) {
     TraceComparison out;

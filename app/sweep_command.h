@@ -86,6 +86,18 @@ struct TraceComparison {
     std::string error;                     ///< non-empty: the traces could not be compared
 };
 
+/// One combination's float-against-double comparison (sweep --float-binary).
+struct FloatRun {
+    TraceComparison comparison;
+    std::string label;  ///< the combination, as in SweepRun::label
+};
+
+/// The float-against-double lines of report.md's reading (Markdown list items): which runs
+/// confirm different pairs from which frame, and always the largest position deviation (also
+/// relative to `scene_size`, m, the bounds diagonal) and the largest orientation deviation,
+/// each with the run it occurs in. Runs whose comparison has an error are left out.
+std::string floatReading(const std::vector<FloatRun>& floats, double scene_size);
+
 /// Reads two trace files and compares them; `error` says why when they cannot be compared
 /// (unreadable, malformed, different body counts).
 TraceComparison compareTraces(const std::filesystem::path& a, const std::filesystem::path& b);

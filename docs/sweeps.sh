@@ -32,6 +32,9 @@ sweep tunnel_sphere scenes/tunnel_sphere.yaml --reference world.ccd=conservative
   --vary world.ccd=off,conservative_advancement --vary world.time_step=0.033333,0.004167,0.000521
 sweep tunnel_bar scenes/tunnel_bar.yaml --reference world.ccd=conservative_advancement \
   --vary world.ccd=off,conservative_advancement --vary world.time_step=0.033333,0.004167,0.000521
+# CCD tolerance (world.ccd_tolerance): time-of-impact error against a 1e-6 reference at dt / 10.
+sweep tunnel_bar_ccd_tolerance scenes/tunnel_bar_ccd.yaml --reference world.ccd_tolerance=1e-6 \
+  --vary world.ccd_tolerance=1e-6,1e-4,1e-3,1e-2,1e-1
 # Integrators and time step with contact response: energy drift and contacts.
 sweep bounce scenes/bounce.yaml \
   --vary world.integrator=explicit_euler,semi_implicit_euler,rk4 \

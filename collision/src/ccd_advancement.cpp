@@ -188,7 +188,8 @@ ToiOutput timeOfImpact(const ToiInput& input) {
     if (input.a == nullptr || input.b == nullptr || !finiteSweep(input.sweep_a) ||
         !finiteSweep(input.sweep_b) || !std::isfinite(input.t_max) ||
         !std::isfinite(input.target_gap) || !std::isfinite(input.tolerance) ||
-        input.target_gap < 0 || input.tolerance < 0) {
+        !std::isfinite(input.relative_tolerance) || input.target_gap < 0 || input.tolerance < 0 ||
+        input.relative_tolerance < 0) {
         return out;
     }
     const Shape& a = *input.a;
@@ -199,7 +200,7 @@ ToiOutput timeOfImpact(const ToiInput& input) {
     const Real rb = core_b.boundingRadius();
     const Real scale = std::max(ra, rb);
     const Real tolerance =
-        input.tolerance > 0 ? input.tolerance : kToiRelativeTolerance * std::min(ra, rb);
+        input.tolerance > 0 ? input.tolerance : input.relative_tolerance * std::min(ra, rb);
     const Real t_max = std::clamp(input.t_max, Real(0), Real(1));
     const Vec3 rel_translation = input.sweep_a.translation - input.sweep_b.translation;
     const Real spin_speed = spinSpeed(a, input.sweep_a.spin) + spinSpeed(b, input.sweep_b.spin);

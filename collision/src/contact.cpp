@@ -34,10 +34,13 @@ constexpr Real kDirectionRelative = Real(16) * kEpsilon;
 constexpr Real kFeatureRelative = std::max(Real(1e-9), Real(64) * kEpsilon);
 // Width of the band around the touching thresholds where collide() decides the state.
 constexpr Real kReconcileBand = Real(1e-6);
-// SAT: a cross-product axis of near-parallel edges (|e_a x e_b| < kParallelSin) is skipped, as in
-// collideBoxBox; an edge axis must beat the best face axis by kEdgeBias * scale to be chosen
-// (faces give stable multi-point manifolds; Box2D / Bullet do the same).
+// Capsule axes closer to parallel than sin = kParallelSin have no common perpendicular to use.
 constexpr Real kParallelSin = Real(1e-6);
+// Box SAT: only the cross-product axes of exactly parallel edges (|e_a x e_b|^2 below
+// kSatAxisMin, the smallest normal number) are skipped, as in collideBoxBox (which says why);
+// an edge axis must beat the best face axis by kEdgeBias * scale to be chosen (faces give
+// stable multi-point manifolds; Box2D / Bullet do the same).
+constexpr Real kSatAxisMin = std::numeric_limits<Real>::min();
 constexpr Real kEdgeBias = std::max(Real(1e-9), Real(64) * kEpsilon);
 
 Real signOrPlus(Real x) { return x < 0 ? Real(-1) : Real(1); }
@@ -629,8 +632,9 @@ bool boxBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& 
     for (int i = 0; i < 3; ++i) {
         for (int j = 0; j < 3; ++j) {
             const Vec3 axis = Vec3::Unit(i).cross(rot.col(j));
-            const Real len = axis.norm();
-            if (len < kParallelSin) continue;
+            const Real len2 = axis.squaredNorm();
+            if (!(len2 >= kSatAxisMin)) continue;
+            const Real len = std::sqrt(len2);
             const Vec3 unit = axis / len;
             const Real sep = std::abs(t.dot(unit)) - ea.dot(unit.cwiseAbs()) -
                              eb.dot((rot.transpose() * unit).cwiseAbs());

@@ -132,11 +132,16 @@ CollideOutput collideConvexGeneric(const Shape& a, const Shape& b, const Relativ
 // normal of the Minkowski difference), and a positive maximum gap is a lower bound on the
 // distance. Each axis carries a rounding bound (gap error <= 8 eps (|t.L| + ra + rb) / |L|), and
 // only verdicts that survive it are taken here; the rest, and every Separated distance, go to GJK.
-// Cross axes of (nearly) parallel edges, |L|^2 < kParallelCross, are skipped: their planes are
-// covered by face axes up to the rounding the bound would report anyway.
+// Only cross axes of exactly parallel edges (|L|^2 below the smallest normal number, so 1/|L| stays
+// exact) are skipped: those are covered by the face axes. Nearly parallel edges are not: at an
+// angle theta the face axes miss the edge axis's gap by up to |e| sin(theta) (two cube ridges of
+// half size s, theta = 1e-7, 1e-7 s apart were Penetrating while the old 1e-6 cut-off skipped
+// their axis; tests/collision/extremes_test.cpp). A tiny |L| costs no accuracy: L = e_i x r_j
+// only permutes entries of r_j, and dist, ra, rb all scale with |L|, so the bound stays
+// 8 eps (|t.L| + ra + rb) / |L|; r's own rounding perturbs B by ~eps * size, as on every axis.
 CollideOutput collideBoxBox(const Shape& a, const Shape& b, const RelativePose& b_in_a,
                             const PairContext& ctx) {
-    constexpr Real kParallelCross = Real(1e-12);
+    constexpr Real kParallelCross = std::numeric_limits<Real>::min();
     const Mat3& rot = b_in_a.rotation;
     const Vec3& t = b_in_a.position;
     const Vec3& ea = a.half_extents;

@@ -129,7 +129,7 @@ private:
                                           const Entry& file_entry, const std::string& path,
                                           const std::string& bvh_name);
     /// `expect:` (after the bodies, whose names it refers to).
-    void parseExpect(const YAML::Node& n, Scene& scene) const;
+    void parseExpect(const Entry& entry, Scene& scene) const;
     template <typename Place>
     std::vector<Body> repeatBody(const Body& base, const Entry& entry, const std::string& path,
                                  const Scene& scene, Place&& place) const;
@@ -277,10 +277,10 @@ Vec3 SceneParser::readVec3(const YAML::Node& n, const std::string& path) const {
 
 void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
     const std::string path = "world";
-    const std::vector<Entry> es =
-        entries(n, path,
-                {"bounds", "gravity", "time_step", "steps_per_frame", "frames", "mesh_bvh",
-                 "integrator", "ccd", "response", "restitution", "friction"});
+    const std::vector<Entry> es = entries(
+        n, path,
+        {"bounds", "gravity", "time_step", "steps_per_frame", "frames", "mesh_bvh", "integrator",
+         "ccd", "ccd_tolerance", "ccd_target_gap", "response", "restitution", "friction"});
     {
         const Entry& b = require(es, "bounds", n, path);
         const std::string bp = childPath(path, "bounds");
@@ -343,6 +343,20 @@ void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
                      "unknown ccd method '" + name + "' (expected one of: " + ccdMethodNames() +
                          ")");
             }
+        } else if (e.key == "ccd_tolerance") {
+            // Fractions of the pair's smaller bounding radius (WorldSettings). 0 would ask the
+            // advancement for exact contact, which it only approaches (Failed at the cap).
+            const Real v = readReal(e.value, p);
+            if (!(v > 0 && v <= 1)) {
+                fail(e.value, p, "must be > 0 and <= 1 (fraction of the smaller bounding radius)");
+            }
+            scene.world.ccd_tolerance = v;
+        } else if (e.key == "ccd_target_gap") {
+            const Real v = readReal(e.value, p);
+            if (!(v >= 0 && v <= 1)) {
+                fail(e.value, p, "must be in [0, 1] (fraction of the smaller bounding radius)");
+            }
+            scene.world.ccd_target_gap = v;
         } else if (e.key == "integrator") {
             const std::string name = readString(e.value, p);
             if (!findIntegrator(name, scene.world.integrator)) {
@@ -853,12 +867,20 @@ std::vector<Body> SceneParser::repeatBody(const Body& base, const Entry& entry,
 // BEGIN expect (self-grading scenes)
 // `expect:` states outcomes `cdlab check` verifies. Everything that can be checked without
 // running is checked here: frames inside the run, body names that exist and are unique, broad
-// phase names in the registry, colour names, contradictory pair states.
-void SceneParser::parseExpect(const YAML::Node& n, Scene& scene) const {
+// phase names in the registry, colour names, contradictory pair states, and that the section
+// states at least one expectation (an empty one would pass `cdlab check` having checked
+// nothing).
+void SceneParser::parseExpect(const Entry& entry, Scene& scene) const {
+    const YAML::Node& n = entry.value;
     const std::string path = "expect";
     Expectations& ex = scene.expect;
     ex.present = true;
-    if (n.IsNull()) return;  // "expect:" with nothing after it: nothing to check
+    const std::string kinds =
+        "min_bodies, min_moving_rotating, broadphases, energy_drift_max, energy_rise_max, "
+        "pause_dumps, pairs, colors, tunnelling, toi, rest";
+    if (n.IsNull() || (n.IsMap() && n.size() == 0)) {
+        fail(entry.key_node, path, "states no expectation (give at least one of: " + kinds + ")");
+    }
     const std::vector<Entry> es =
         entries(n, path,
                 {"frames", "min_bodies", "min_moving_rotating", "broadphases", "energy_drift_max",
@@ -896,8 +918,11 @@ void SceneParser::parseExpect(const YAML::Node& n, Scene& scene) const {
         if (c < 0) fail(v, p, "must be >= 0");
         return c;
     };
-    auto readList = [&](const YAML::Node& v, const std::string& p) {
+    // A list of expectations that is empty states nothing, which is taken for a mistake; the
+    // colour lists inside one expectation may be empty (`needs 'present' or 'absent'` guards).
+    auto readList = [&](const YAML::Node& v, const std::string& p, bool may_be_empty = false) {
         if (!v.IsSequence()) fail(v, p, "expected a list");
+        if (v.size() == 0 && !may_be_empty) fail(v, p, "empty list: states no expectation");
         std::vector<YAML::Node> out;
         for (std::size_t i = 0; i < v.size(); ++i) out.push_back(v[i]);
         return out;
@@ -1068,7 +1093,7 @@ void SceneParser::parseExpect(const YAML::Node& n, Scene& scene) const {
                 for (const Entry& c : ce) {
                     const std::string cp = childPath(ip, c.key);
                     if (c.key == "present" || c.key == "absent") {
-                        const std::vector<YAML::Node> names = readList(c.value, cp);
+                        const std::vector<YAML::Node> names = readList(c.value, cp, true);
                         for (std::size_t k = 0; k < names.size(); ++k) {
                             const BodyState st = readState(names[k], indexPath(cp, k));
                             (c.key == "present" ? color.present : color.absent).push_back(st);
@@ -1091,6 +1116,14 @@ void SceneParser::parseExpect(const YAML::Node& n, Scene& scene) const {
                 ex.colors.push_back(std::move(color));
             }
         }
+    }
+    // `frames` alone sets the run length and checks nothing.
+    const bool states_something =
+        ex.min_bodies || ex.min_moving_rotating || !ex.broad_phases.empty() ||
+        ex.energy_drift_max || ex.energy_rise_max || !ex.pause_dumps.empty() || !ex.pairs.empty() ||
+        !ex.colors.empty() || !ex.tunnelling.empty() || !ex.toi.empty() || !ex.rest.empty();
+    if (!states_something) {
+        fail(entry.key_node, path, "states no expectation (give at least one of: " + kinds + ")");
     }
 }
 // END expect (self-grading scenes)
@@ -1141,7 +1174,7 @@ Scene SceneParser::parse(const std::string& text) {
             }
         }
     }
-    if (const Entry* e = find(es, "expect")) parseExpect(e->value, scene);
+    if (const Entry* e = find(es, "expect")) parseExpect(*e, scene);
     return scene;
 }
 

@@ -293,10 +293,6 @@ void World::integrateRk4(Real dt, const Vec3& gravity) {
 
 namespace {
 
-// Target gap of the continuous stage, relative to the smaller bounding radius of the pair: a
-// pair stopped at its time of impact is left this far apart (plus the query's tolerance,
-// collision::kToiRelativeTolerance of the same radius), so the next step starts separated.
-constexpr Real kCcdTargetGapFraction = Real(1e-3);
 // Iteration cap of one time-of-impact query (Failed -> the pair is stopped at the safe time).
 constexpr int kCcdMaxIterations = 64;
 // Restitution of the impulse that resolves a time of impact while `response` is none: elastic
@@ -389,8 +385,13 @@ void World::resolveContinuous() {
         in.b = &b.shape;
         in.sweep_a = swept_[pair.a].sweep;
         in.sweep_b = swept_[pair.b].sweep;
+        // Target gap (settings_.ccd_target_gap of the smaller bounding radius of the pair): a
+        // pair stopped at its time of impact is left this far apart, plus the query's tolerance
+        // (settings_.ccd_tolerance of the smaller shape radius), so the next step starts
+        // separated.
         in.target_gap =
-            kCcdTargetGapFraction * std::min(swept_[pair.a].radius, swept_[pair.b].radius);
+            settings_.ccd_target_gap * std::min(swept_[pair.a].radius, swept_[pair.b].radius);
+        in.relative_tolerance = settings_.ccd_tolerance;
         in.max_iterations = kCcdMaxIterations;
         collision::ToiOutput out = collision::timeOfImpact(in);
         ++stats_.toi_queries;

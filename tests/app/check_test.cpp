@@ -185,6 +185,13 @@ TEST(Check, ShortRunsAndMissingSectionsFail) {
     ASSERT_EQ(rows.size(), 1u);
     EXPECT_FALSE(rows[0].pass);
     EXPECT_EQ(rows[0].reason, "the scene has no 'expect:' section");
+    // Expectations built in code with nothing in them: checking nothing is no pass.
+    engine::Scene nothing = parse(kTwoSpheres);
+    nothing.expect.present = true;
+    rows = checkScene(nothing, 25, dir);
+    ASSERT_EQ(rows.size(), 1u);
+    EXPECT_FALSE(rows[0].pass);
+    EXPECT_EQ(rows[0].reason, "states no expectation");
 
     rows = checkScene(parse(kTwoSpheres + "expect:\n  pairs:\n"
                                           "    - {a: a, b: b, frames: [11, 20], colliding: true}\n"
@@ -256,6 +263,8 @@ TEST(CheckCli, ExitCodesAndTable) {
                           "    - {a: a, b: b, frames: [9, 20], colliding: true}\n";
     std::ofstream(broken) << kTwoSpheres << "expect:\n  pairs:\n"
                           << "    - {a: a, b: zz, frames: 1, colliding: true}\n";
+    const fs::path empty = work / "empty.yaml";
+    std::ofstream(empty) << kTwoSpheres << "expect:\n";
 
     Result r = runCdlab("check " + good.string(), work);
     EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
@@ -277,6 +286,14 @@ TEST(CheckCli, ExitCodesAndTable) {
     r = runCdlab("check " + good.string() + " " + broken.string(), work);
     EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
     EXPECT_NE(r.err.find("broken.yaml:11:17: expect.pairs[0].b: no body is named 'zz'"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(r.out, "");
+    // An `expect:` that states nothing would pass having checked nothing: bad input too.
+    r = runCdlab("check " + good.string() + " " + empty.string(), work);
+    EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+    EXPECT_NE(r.err.find("empty.yaml:9:1: expect: states no expectation (give at least one of: "
+                         "min_bodies,"),
               std::string::npos)
         << r.err;
     EXPECT_EQ(r.out, "");

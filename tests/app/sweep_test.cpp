@@ -158,6 +158,36 @@ TEST(Sweep, CcdStopsCountAsContactsWithTheirTimeOfImpact) {
     fs::remove_all(o.out_dir);
 }
 
+// The CCD tolerance as a sweep choice (docs/sweeps.sh runs the same on the full scene): the
+// spinning bar of tunnel_bar_ccd.yaml against a 1e-6 reference at dt / 10. The first-contact
+// error grows with the tolerance, and stays within what the tolerance allows: a stop leaves at
+// most (tolerance + target gap 1e-3) of the bar's 1 m bounding radius, closed at >= 45 m/s.
+TEST(Sweep, CcdToleranceIsSweepableAndLooserIsLessAccurate) {
+    app::SweepOptions o;
+    o.scene = fs::path(CDLAB_SOURCE_DIR) / "scenes/tunnel_bar_ccd.yaml";
+    o.vary = {"world.ccd_tolerance=1e-6,1e-3,1e-1"};
+    o.reference = {"world.ccd_tolerance=1e-6"};
+    o.duration = 0.1;  // the first stop is at 0.0721 s
+    o.report_timing = false;
+    o.out_dir = tempDir("ccd_tolerance");
+    const Outcome r = sweep(o);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto rows = readCsv(o.out_dir / "results.csv");
+    ASSERT_EQ(rows.size(), 3u);
+    double previous = -1;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+        const double tolerance =
+            std::stod(rows[i].at("run").substr(rows[i].at("run").find('=') + 1));
+        EXPECT_EQ(rows[i].at("missed_pairs"), "0") << i;
+        EXPECT_GE(std::stoi(rows[i].at("toi_events")), 1) << i;
+        const double error = std::stod(rows[i].at("max_first_contact_error_s"));
+        EXPECT_GT(error, previous) << i;
+        EXPECT_LE(error, (tolerance + 1e-3) / 45 + 1e-6) << i;
+        previous = error;
+    }
+    fs::remove_all(o.out_dir);
+}
+
 TEST(Sweep, ReportWithoutTimingIsBitIdentical) {
     app::SweepOptions o;
     o.scene = kScene;
@@ -264,11 +294,68 @@ TEST(Sweep, FloatComparisonAgainstTheSameBuildFindsNoDifference) {
         EXPECT_EQ(row.count("error") ? row.at("error") : "", "");
     }
     EXPECT_NE(slurp(o.out_dir / "report.md").find("## Float against double"), std::string::npos);
+    EXPECT_NE(
+        slurp(o.out_dir / "report.md")
+            .find("- Float and double trajectories are identical in every frame of every run."),
+        std::string::npos);
     EXPECT_FALSE(fs::exists(o.out_dir / "traces"));  // removed unless --keep-traces
     fs::remove_all(o.out_dir);
 
     o.float_binary = fs::path("/nonexistent/cdlab");
     EXPECT_EQ(sweep(o).code, 2);
+}
+
+// Regression: the reading called float "the same" from confirmed pairs alone while
+// docs/sweeps/tunnel_bar/float_vs_double.csv showed 8.43 m and 3.14 rad of divergence with no
+// pair differing. The reading now always names the largest deviations and their runs. Figures
+// from that file.
+TEST(Sweep, FloatReadingStatesTheLargestDeviationEvenWhenPairsAgree) {
+    auto run = [](const std::string& label, int first, int differing, double dp, double dq) {
+        app::FloatRun f;
+        f.label = label;
+        f.comparison.frames = 150;
+        f.comparison.first_pair_difference = first;
+        f.comparison.pair_frames_differing = differing;
+        f.comparison.max_position_deviation = dp;
+        f.comparison.max_orientation_deviation = dq;
+        return f;
+    };
+    std::vector<app::FloatRun> floats = {
+        run("world.ccd=off", -1, 0, 0.0025882, 0.0211288),
+        run("world.ccd=conservative_advancement", -1, 0, 8.43303, 3.13846),
+        run("world.ccd=off world.time_step=0.000521", -1, 0, 1.10413e-05, 8.50651e-07)};
+    std::string text = app::floatReading(floats, 20.4);
+    EXPECT_NE(text.find("Float confirms the same pairs as double in every frame of every run."),
+              std::string::npos)
+        << text;
+    EXPECT_NE(text.find("Largest trajectory divergence of float from double: position 8.43 m "
+                        "(4.13e-01 of the scene size) in **world.ccd=conservative_advancement**; "
+                        "orientation 3.14 rad in **world.ccd=conservative_advancement**."),
+              std::string::npos)
+        << text;
+    // Position and orientation maxima in different runs are named separately; a run whose
+    // pairs differ keeps its own line; an errored comparison is left out of the maxima.
+    floats[0].comparison.max_orientation_deviation = 4;
+    floats[2].comparison.first_pair_difference = 14;
+    floats[2].comparison.pair_frames_differing = 4;
+    floats.push_back(run("broken", -1, 0, 99, 99));
+    floats.back().comparison.error = "unreadable";
+    text = app::floatReading(floats, 20.4);
+    EXPECT_NE(text.find("- Float changes the answers of **world.ccd=off "
+                        "world.time_step=0.000521** from frame 14 on (4 of 150 frames)."),
+              std::string::npos)
+        << text;
+    EXPECT_EQ(text.find("same pairs"), std::string::npos) << text;
+    EXPECT_NE(text.find("position 8.43 m (4.13e-01 of the scene size) in "
+                        "**world.ccd=conservative_advancement**; orientation 4 rad in "
+                        "**world.ccd=off**."),
+              std::string::npos)
+        << text;
+    // Identical builds: said so, no deviation line.
+    const std::vector<app::FloatRun> same = {run("a", -1, 0, 0, 0), run("b", -1, 0, 0, 0)};
+    text = app::floatReading(same, 1);
+    EXPECT_NE(text.find("identical in every frame of every run"), std::string::npos) << text;
+    EXPECT_EQ(text.find("Largest"), std::string::npos) << text;
 }
 
 TEST(Sweep, CompareTracesFindsTheFirstDifferingFrameAndTheLargestDeviation) {

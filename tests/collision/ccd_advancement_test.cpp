@@ -96,6 +96,63 @@ TEST(ConservativeAdvancement, RotatingBarAgainstWallMatchesClosedForm) {
     EXPECT_EQ(timeOfImpact(away).state, CcdState::Separated);
 }
 
+// The acceptance tolerance trades iterations for an earlier stop, never for a late one: the
+// advancement visits the same sequence of conservative times whatever the tolerance and stops
+// at the first within target_gap + tolerance, so a looser tolerance stops at an earlier (or the
+// same) iterate. Same bar and wall as above (closed-form contact time `exact`).
+TEST(ConservativeAdvancement, LooserToleranceStopsEarlierWithFewerIterations) {
+    const Shape bar = Shape::box(Vec3(1, 0.02, 0.02));
+    const Shape wall = Shape::box(Vec3(0.05, 5, 5));
+    const Real turn = 1.2;
+    Sweep sa;
+    sa.start.orientation = Quat(Eigen::AngleAxis<Real>(M_PI / 2, Vec3::UnitZ()));
+    sa.rotation = Vec3(0, 0, -turn);
+    ToiInput in = makeInput(bar, sa, wall, linear(Vec3(0.85, 0, 0), Vec3::Zero()));
+    const Real big_r = std::sqrt(1 + 0.02 * 0.02);
+    const Real alpha = std::atan(0.02) + std::acos(0.8 / big_r);
+    const Real exact = (M_PI / 2 - alpha) / turn;
+    // The gap to the wall is g(t) = 0.8 - R cos(phi), phi = alpha - atan(0.02) + turn (t* - t):
+    // convex in t* - t with slope R sin(phi*) turn = 0.6 * 1.2 R at contact, so g <= tol means
+    // t >= t* - tol / (0.72 R). The tolerance is relative to the bar's bounding radius
+    // |half_extents| (the smaller of the two shapes).
+    const Real bar_radius = Vec3(1, 0.02, 0.02).norm();
+    const Real rate = 0.6 * turn * big_r;
+    Real previous_t = std::numeric_limits<Real>::infinity();
+    int previous_iterations = std::numeric_limits<int>::max();
+    ToiOutput tightest, loosest;
+    for (const Real rel : {1e-6, 1e-4, 1e-3, 1e-2, 1e-1}) {
+        in.relative_tolerance = rel;
+        const ToiOutput out = timeOfImpact(in);
+        ASSERT_EQ(out.state, CcdState::Hit) << rel;
+        EXPECT_LE(out.t, exact) << rel;  // never later than the true time of impact
+        // Early by at most the tolerance over the closing rate (1e-9 relative: rounding of g).
+        EXPECT_GE(out.t, exact - rel * bar_radius / rate * (1 + 1e-9)) << rel;
+        EXPECT_LE(out.t, previous_t) << rel;
+        EXPECT_LE(out.iterations, previous_iterations) << rel;
+        previous_t = out.t;
+        previous_iterations = out.iterations;
+        if (rel == Real(1e-6)) tightest = out;
+        loosest = out;
+        RecordProperty("iterations_at_" + std::to_string(rel), out.iterations);
+    }
+    // The setting acts: five decades looser is strictly earlier and strictly cheaper.
+    EXPECT_LT(loosest.t, tightest.t);
+    EXPECT_LT(loosest.iterations, tightest.iterations);
+    // The default is kToiRelativeTolerance, and an absolute `tolerance` overrides the relative.
+    in.relative_tolerance = kToiRelativeTolerance;
+    const ToiOutput by_default = timeOfImpact(makeInput(bar, sa, wall, in.sweep_b));
+    EXPECT_EQ(timeOfImpact(in).t, by_default.t);
+    in.relative_tolerance = 1e-1;
+    in.tolerance = 1e-6 * bar_radius;
+    EXPECT_EQ(timeOfImpact(in).t, tightest.t);
+    // Bad values are bad input: Failed at t = 0.
+    in.tolerance = 0;
+    in.relative_tolerance = -1;
+    EXPECT_EQ(timeOfImpact(in).state, CcdState::Failed);
+    in.relative_tolerance = std::numeric_limits<Real>::quiet_NaN();
+    EXPECT_EQ(timeOfImpact(in).state, CcdState::Failed);
+}
+
 TEST(ConservativeAdvancement, InvariantUnderOffsetScaleAndSwap) {
     const Shape bar = Shape::box(Vec3(1, 0.05, 0.1));
     const Shape pill = Shape::capsule(0.2, 0.5);

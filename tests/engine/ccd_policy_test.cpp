@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "engine/scene.h"
 #include "engine/world.h"
@@ -108,6 +109,45 @@ TEST(CcdPolicy, SpinningBarNeverPassesTheWallWithConservativeAdvancement) {
     }
     EXPECT_GE(hits, 2);
     RecordProperty("wall_hits", hits);
+}
+
+// world.ccd_tolerance and world.ccd_target_gap reach the stage: the spinning bar's first stop
+// (closed form 0.0721186 s, see tunnel_bar_ccd.yaml) comes earlier with a looser tolerance or a
+// larger target gap, never after first contact; the defaults reproduce the scene as shipped.
+TEST(CcdPolicy, ToleranceAndTargetGapMoveTheFirstStopEarlier) {
+    const Real exact = 0.0721186;  // s, by bisection (6 digits)
+    auto firstStop = [](const std::vector<SceneOverride>& overrides) {
+        World world = makeWorld(loadScene(kScenes / "tunnel_bar_ccd.yaml", overrides));
+        for (int i = 0; i < 10; ++i) {
+            world.step();
+            if (!world.toiEvents().empty()) {
+                EXPECT_FALSE(world.toiEvents()[0].failed);
+                return world.settings().time_step * (i + world.toiEvents()[0].t);
+            }
+        }
+        ADD_FAILURE() << "no stop in 10 steps";
+        return Real(0);
+    };
+    const Real shipped = firstStop({});
+    EXPECT_EQ(firstStop({{"world.ccd_tolerance", "0.001"}, {"world.ccd_target_gap", "0.001"}}),
+              shipped);
+    const Real tight = firstStop({{"world.ccd_tolerance", "1e-6"}});
+    const Real loose = firstStop({{"world.ccd_tolerance", "0.1"}});
+    const Real far = firstStop({{"world.ccd_target_gap", "0.1"}});
+    RecordProperty("first_stop_tight", std::to_string(tight));
+    RecordProperty("first_stop_shipped", std::to_string(shipped));
+    RecordProperty("first_stop_loose", std::to_string(loose));
+    RecordProperty("first_stop_far", std::to_string(far));
+    // Never later than first contact (5e-7 s: the 6 digits of the closed form).
+    EXPECT_LE(tight, exact + 5e-7);
+    EXPECT_LE(shipped, tight);
+    EXPECT_LT(loose, shipped);
+    EXPECT_LT(far, shipped);
+    // And earlier by no more than the gap left over the slowest closing speed: every point of
+    // the bar moves towards the wall at >= 75 - 30 * 1 = 45 m/s, and the stop leaves at most
+    // (0.1 + 0.001) of the bar's bounding radius (1 m), so it is at most 0.101 / 45 s early.
+    EXPECT_GE(loose, exact - 0.101 / 45 - 5e-7);
+    EXPECT_GE(far, exact - 0.101 / 45 - 5e-7);
 }
 
 TEST(CcdPolicy, RunsAreBitIdentical) {

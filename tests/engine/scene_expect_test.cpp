@@ -42,9 +42,34 @@ TEST(SceneExpect, AbsentMeansNotPresent) {
     const Scene s = parseScene("world: {bounds: {min: [-1, -1, -1], max: [1, 1, 1]}}\nbodies:\n",
                                "x.yaml", ".");
     EXPECT_FALSE(s.expect.present);
-    const Scene empty = parseScene(kScene, "x.yaml", ".");
-    EXPECT_TRUE(empty.expect.present);
-    EXPECT_TRUE(empty.expect.pairs.empty());
+    const Scene one = parseScene(kScene + "  min_bodies: 1\n", "x.yaml", ".");
+    EXPECT_TRUE(one.expect.present);
+    EXPECT_EQ(one.expect.min_bodies, 1);
+}
+
+// An `expect:` that states nothing passed `cdlab check` having checked nothing (a shipped scene
+// could grade itself with no grade); now it is an error at the section's key.
+TEST(SceneExpect, EmptyExpectationsAreAnError) {
+    const std::string what =
+        "states no expectation (give at least one of: min_bodies, "
+        "min_moving_rotating, broadphases, energy_drift_max, "
+        "energy_rise_max, pause_dumps, pairs, colors, tunnelling, toi, rest)";
+    EXPECT_SCENE_ERROR(kScene, "7:1: expect: ", what);
+    EXPECT_SCENE_ERROR(kScene.substr(0, kScene.size() - 1) + " {}\n", "7:1: expect: ", what);
+    EXPECT_SCENE_ERROR(kScene.substr(0, kScene.size() - 1) + " ~\n", "7:1: expect: ", what);
+    // `frames` sets the run length and expects nothing.
+    EXPECT_SCENE_ERROR(kScene + "  frames: 5\n", "7:1: expect: ", what);
+    // An empty list states nothing either, even beside other expectations.
+    EXPECT_SCENE_ERROR(kScene + "  min_bodies: 1\n  pairs: []\n",
+                       "9:10: expect.pairs: ", "empty list: states no expectation");
+    for (const char* key : {"broadphases", "pause_dumps", "colors", "tunnelling", "toi", "rest"}) {
+        EXPECT_SCENE_ERROR(
+            kScene + "  " + key + ": []\n",
+            "8:" + std::to_string(std::string(key).size() + 5) + ": expect." + key + ": ",
+            "empty list: states no expectation");
+    }
+    // One colour list may be empty when the other is not.
+    EXPECT_EQ(errorOf(kScene + "  colors:\n    - {frame: 1, present: [red], absent: []}\n"), "");
 }
 
 TEST(SceneExpect, ParsesEveryKey) {

@@ -43,6 +43,16 @@ TEST(SceneOverride, LaterOverridesWinAndMissingMapsAreCreated) {
     EXPECT_FALSE(s.draw.hud);
 }
 
+TEST(SceneOverride, CcdToleranceAndTargetGapAreSweepable) {
+    // What `cdlab sweep --vary world.ccd_tolerance=...` sets; validated like the file's keys.
+    const engine::Scene s = engine::loadScene(
+        kScene, {{"world.ccd_tolerance", "0.02"}, {"world.ccd_target_gap", "0.005"}});
+    EXPECT_EQ(s.world.ccd_tolerance, engine::Real(0.02));
+    EXPECT_EQ(s.world.ccd_target_gap, engine::Real(0.005));
+    const std::string err = errorOf({{"world.ccd_tolerance", "0"}});
+    EXPECT_NE(err.find("world.ccd_tolerance: must be > 0 and <= 1"), std::string::npos) << err;
+}
+
 TEST(SceneOverride, BadOverridesAreRejectedWithTheKeyPath) {
     // Validation is the file's own: range, unknown keys, types.
     EXPECT_NE(errorOf({{"world.time_step", "0"}}).find("world.time_step"), std::string::npos);

@@ -374,6 +374,47 @@ TEST(Scene, MeshBvhIsChosenByTheWorld) {
     }
 }
 
+TEST(Scene, CcdToleranceAndTargetGapReachTheWorld) {
+    // Defaults: the constants the continuous stage had before the keys existed, so scenes that
+    // do not set them keep their results.
+    const Scene d = parse(kHeader);
+    EXPECT_EQ(d.world.ccd_tolerance, collision::kToiRelativeTolerance);
+    EXPECT_EQ(d.world.ccd_target_gap, Real(1e-3));
+    const Scene s = parse(
+        "world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n"
+        "  ccd: conservative_advancement\n  ccd_tolerance: 0.05\n"
+        "  ccd_target_gap: 0\nbodies:\n");
+    EXPECT_EQ(s.world.ccd_tolerance, Real(0.05));
+    EXPECT_EQ(s.world.ccd_target_gap, Real(0));
+    const World w = makeWorld(s);
+    EXPECT_EQ(w.settings().ccd_tolerance, Real(0.05));
+    EXPECT_EQ(w.settings().ccd_target_gap, Real(0));
+    // The upper ends of the ranges are accepted.
+    EXPECT_EQ(errorOf("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  ccd_tolerance: 1\n"
+                      "  ccd_target_gap: 1\n"),
+              "");
+}
+
+TEST(SceneErrors, CcdToleranceAndTargetGapAreValidated) {
+    const std::string head = "world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n";
+    EXPECT_SCENE_ERROR(head + "  ccd_tolerance: 0\n", "3:18: world.ccd_tolerance: ",
+                       "must be > 0 and <= 1 (fraction of the smaller bounding radius)");
+    EXPECT_SCENE_ERROR(head + "  ccd_tolerance: 1.5\n",
+                       "3:18: world.ccd_tolerance: ", "must be > 0 and <= 1");
+    EXPECT_SCENE_ERROR(head + "  ccd_tolerance: -1e-3\n",
+                       "3:18: world.ccd_tolerance: ", "must be > 0 and <= 1");
+    EXPECT_SCENE_ERROR(head + "  ccd_tolerance: .nan\n",
+                       "3:18: world.ccd_tolerance: ", "must be finite");
+    EXPECT_SCENE_ERROR(head + "  ccd_tolerance: loose\n",
+                       "3:18: world.ccd_tolerance: ", "expected a number, got 'loose'");
+    EXPECT_SCENE_ERROR(head + "  ccd_target_gap: -0.1\n", "3:19: world.ccd_target_gap: ",
+                       "must be in [0, 1] (fraction of the smaller bounding radius)");
+    EXPECT_SCENE_ERROR(head + "  ccd_target_gap: 2\n",
+                       "3:19: world.ccd_target_gap: ", "must be in [0, 1]");
+    EXPECT_SCENE_ERROR(head + "  ccd_target_gap: [1]\n",
+                       "3:19: world.ccd_target_gap: ", "expected a number");
+}
+
 TEST(SceneErrors, UnknownMeshBvh) {
     EXPECT_SCENE_ERROR("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  mesh_bvh: kdop7\n",
                        "3:13: world.mesh_bvh: ",

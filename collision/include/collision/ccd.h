@@ -121,6 +121,9 @@ struct Sweep {
     Pose at(Real t) const;
 };
 
+/// Default acceptance tolerance of timeOfImpact, relative to the smaller shape's bounding radius.
+inline constexpr Real kToiRelativeTolerance = Real(1e-3);
+
 /// Input of timeOfImpact.
 struct ToiInput {
     const Shape* a = nullptr;  ///< convex shapes (a Mesh stands for its convex hull: conservative)
@@ -130,13 +133,18 @@ struct ToiInput {
     Real t_max = 1;       ///< search [0, t_max] of the step, t_max in [0, 1]
     Real target_gap = 0;  ///< m, >= 0: report the time the gap first closes to this distance
     /// m, >= 0: a Hit is accepted once the gap is within target_gap + tolerance. 0 picks
-    /// kToiRelativeTolerance times the smaller bounding radius of the two shapes.
+    /// relative_tolerance times the smaller bounding radius of the two shapes.
     Real tolerance = 0;
+    /// Dimensionless, >= 0: the tolerance when `tolerance` is 0, as a fraction of the smaller
+    /// bounding radius of the two shapes. Every advance is conservative whatever its value, so a
+    /// looser tolerance stops at an earlier iterate of the same sequence (never later than the
+    /// tighter one, never later than first contact) after fewer iterations; the pair is then
+    /// left up to target_gap + tolerance apart. 0: the gap must reach target_gap itself,
+    /// which the advancement approaches only step by step unless the motion is a pure
+    /// translation (then Failed at the iteration cap).
+    Real relative_tolerance = kToiRelativeTolerance;
     int max_iterations = 64;  ///< cap on distance queries; reaching it returns Failed
 };
-
-/// Default acceptance tolerance of timeOfImpact, relative to the smaller shape's bounding radius.
-inline constexpr Real kToiRelativeTolerance = Real(1e-3);
 
 /// Result of the rigid-body time-of-impact queries, world frame.
 struct ToiOutput {

@@ -77,6 +77,15 @@ struct WorldSettings {
     std::string mesh_bvh{collision::kDefaultMeshBvh};
     Integrator integrator = Integrator::SemiImplicitEuler;
     CcdMethod ccd = CcdMethod::Off;
+    /// Acceptance tolerance of the continuous stage's time-of-impact queries, dimensionless: a
+    /// fraction of the smaller bounding radius (about the local origin) of the pair's shapes.
+    /// A pair is stopped once its gap is within target gap + this; looser stops earlier (never
+    /// after first contact) with fewer iterations. Scene key `world.ccd_tolerance`, in (0, 1].
+    Real ccd_tolerance = collision::kToiRelativeTolerance;
+    /// Gap the continuous stage leaves between a pair stopped at its time of impact,
+    /// dimensionless: a fraction of the smaller bounding radius of the two bodies, so the next
+    /// step starts separated. Scene key `world.ccd_target_gap`, in [0, 1].
+    Real ccd_target_gap = Real(1e-3);
     Response response = Response::None;
     Real restitution = Real(0.5);  ///< default of bodies that do not set theirs (scene files)
     Real friction = Real(0.5);     ///< default of bodies that do not set theirs (scene files)
