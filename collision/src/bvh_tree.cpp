@@ -521,6 +521,13 @@ public:
         return intersectBvhBvh(tree_, other->tree_, b_in_a, stats);
     }
     std::int32_t triangleCount() const override { return tree_.triangleCount(); }
+    const Bvh<Obb>* obbTree() const override {
+        if constexpr (std::is_same_v<BV, Obb>) {
+            return &tree_;
+        } else {
+            return nullptr;
+        }
+    }
     std::int32_t refit(const TriangleMesh& mesh) override { return tree_.refit(mesh); }
     MeshDistance distance(const MeshBvh& b, const Pose& b_in_a,
                           BvhQueryStats* stats) const override {

@@ -12,6 +12,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "collision/bvh.h"
+#include "collision/ccd.h"
 #include "collision/narrow_phase.h"
 #include "contact_solver.h"
 
@@ -139,9 +141,12 @@ std::string integratorNames() {
 
 std::string_view bodyStateName(BodyState state) {
     switch (state) {
-        case BodyState::Apart: return "apart";
-        case BodyState::Flagged: return "flagged";
-        case BodyState::Colliding: return "colliding";
+        case BodyState::Apart:
+            return "apart";
+        case BodyState::Flagged:
+            return "flagged";
+        case BodyState::Colliding:
+            return "colliding";
     }
     return "apart";
 }
@@ -161,10 +166,10 @@ BodyId World::addBody(Body body) {
     states_.push_back(BodyState::Apart);
     const Body& b = bodies_.back();
     const Pose pose = b.pose();
-    volumes_.push_back(collision::ProxyVolumes{
-        collision::computeWorldAabb(b.shape, pose),
-        collision::transformSphere(b.local_bounds.sphere, pose),
-        collision::transformObb(b.local_bounds.obb, pose)});
+    volumes_.push_back(
+        collision::ProxyVolumes{collision::computeWorldAabb(b.shape, pose),
+                                collision::transformSphere(b.local_bounds.sphere, pose),
+                                collision::transformObb(b.local_bounds.obb, pose)});
     if (proxies_inserted_) broad_phase_->insert(id, volumes_.back());
     return id;
 }
@@ -177,9 +182,15 @@ void World::setBroadPhase(const std::string& name) {
 
 void World::integrate(Real dt, const Vec3& gravity) {
     switch (settings_.integrator) {
-        case Integrator::ExplicitEuler: integrateExplicitEuler(dt, gravity); break;
-        case Integrator::SemiImplicitEuler: integrateSemiImplicitEuler(dt, gravity); break;
-        case Integrator::Rk4: integrateRk4(dt, gravity); break;
+        case Integrator::ExplicitEuler:
+            integrateExplicitEuler(dt, gravity);
+            break;
+        case Integrator::SemiImplicitEuler:
+            integrateSemiImplicitEuler(dt, gravity);
+            break;
+        case Integrator::Rk4:
+            integrateRk4(dt, gravity);
+            break;
     }
 }
 
@@ -244,9 +255,9 @@ void World::integrateSemiImplicitEuler(Real dt, const Vec3& gravity) {
             // q1 = R(L, iso) q0 S with S the body-frame part of the flows: the CCD sweep
             // (collision::Sweep: world rotation and body spin), exact for symmetric bodies.
             const std::size_t i = static_cast<std::size_t>(&b - bodies_.data());
-            const Quat body_part =
-                b.principal_frame * (qp0.conjugate() * qp) *
-                Quat(Eigen::AngleAxis<Real>(-iso, l / l.norm())) * b.principal_frame.conjugate();
+            const Quat body_part = b.principal_frame * (qp0.conjugate() * qp) *
+                                   Quat(Eigen::AngleAxis<Real>(-iso, l / l.norm())) *
+                                   b.principal_frame.conjugate();
             const Eigen::AngleAxis<Real> aa(body_part);
             step_rotation_[i] = b.angular_momentum * (iso / l_norm);
             step_spin_[i] = aa.axis() * aa.angle();
@@ -353,9 +364,9 @@ void World::resolveContinuous() {
         s.box.min = step_start_[i].position.cwiseMin(b.position) - Vec3::Constant(s.radius);
         s.box.max = step_start_[i].position.cwiseMax(b.position) + Vec3::Constant(s.radius);
         s.clamp_t = 1;
-        s.moving = !b.is_static && (s.sweep.translation.squaredNorm() > 0 ||
-                                    s.sweep.rotation.squaredNorm() > 0 ||
-                                    s.sweep.spin.squaredNorm() > 0);
+        s.moving =
+            !b.is_static && (s.sweep.translation.squaredNorm() > 0 ||
+                             s.sweep.rotation.squaredNorm() > 0 || s.sweep.spin.squaredNorm() > 0);
         sweep_order_.push_back(static_cast<BodyId>(i));
     }
     std::sort(sweep_order_.begin(), sweep_order_.end(), [this](BodyId x, BodyId y) {
@@ -393,7 +404,26 @@ void World::resolveContinuous() {
             settings_.ccd_target_gap * std::min(swept_[pair.a].radius, swept_[pair.b].radius);
         in.relative_tolerance = settings_.ccd_tolerance;
         in.max_iterations = kCcdMaxIterations;
-        collision::ToiOutput out = collision::timeOfImpact(in);
+        // Two meshes with OBB trees: their surfaces, triangle pair by triangle pair under the
+        // continuous OBB test's culling (a ring may pass around a rod). Any other pair: the
+        // convex shapes, a mesh standing for its convex hull (conservative: may stop early).
+        const collision::Bvh<collision::Obb>* tree_a =
+            a.shape.bvh != nullptr ? a.shape.bvh->obbTree() : nullptr;
+        const collision::Bvh<collision::Obb>* tree_b =
+            b.shape.bvh != nullptr ? b.shape.bvh->obbTree() : nullptr;
+        auto query = [&]() {
+            if (tree_a == nullptr || tree_b == nullptr) return collision::timeOfImpact(in);
+            collision::MeshToiInput mi;
+            mi.a = tree_a;
+            mi.b = tree_b;
+            mi.sweep_a = in.sweep_a;
+            mi.sweep_b = in.sweep_b;
+            mi.target_gap = in.target_gap;
+            mi.tolerance = in.tolerance;
+            mi.max_iterations = in.max_iterations;
+            return collision::timeOfImpactMeshes(mi).toi;
+        };
+        collision::ToiOutput out = query();
         ++stats_.toi_queries;
         if (out.state == collision::CcdState::Hit && out.t == 0 && out.distance > 0) {
             // Already within the target gap (typically: stopped here by the previous step).
@@ -401,7 +431,7 @@ void World::resolveContinuous() {
             // approaching one still stops before contact.
             in.target_gap = out.distance / 2;
             in.tolerance = out.distance / 4;
-            out = collision::timeOfImpact(in);
+            out = query();
             ++stats_.toi_queries;
         }
         if (out.state != collision::CcdState::Hit && out.state != collision::CcdState::Failed) {
@@ -424,8 +454,9 @@ void World::resolveContinuous() {
         } else {
             e.point = (out.point_a + out.point_b) / 2;
         }
-        const Real approach = (pointVelocity(b, e.pose_b, e.point) -
-                               pointVelocity(a, e.pose_a, e.point)).dot(e.normal);
+        const Real approach =
+            (pointVelocity(b, e.pose_b, e.point) - pointVelocity(a, e.pose_a, e.point))
+                .dot(e.normal);
         if (e.t == 0 && !(approach < 0)) continue;
         toi_events_.push_back(e);
     }
@@ -560,7 +591,8 @@ void World::runCollisionPipeline() {
     for (const collision::ProxyPair& pair : flagged_) {
         const Body& a = bodies_[pair.a];
         const Body& b = bodies_[pair.b];
-        const collision::CollideOutput out = collision::collide(a.shape, a.pose(), b.shape, b.pose());
+        const collision::CollideOutput out =
+            collision::collide(a.shape, a.pose(), b.shape, b.pose());
         ++stats_.narrow_tests;
         stats_.triangle_tests += out.triangle_tests;
         stats_.bv_tests += out.bv_tests;

@@ -192,5 +192,40 @@ TEST(CcdPolicy, SceneErrors) {
     }
 }
 
+// Mesh-mesh pairs run the continuous stage on their surfaces (timeOfImpactMeshes on the OBB
+// trees), not on their convex hulls. tests/data/ring_rod_ccd.yaml:
+//
+//      ring (axis y, 300 m/s up)   ( O )  -> passes around the bead in its hole
+//      bead on the tube (x = 1)    ( o)   -> the ring is stopped at the bead
+//
+TEST(CcdPolicy, MeshRingPassesAroundABeadInItsHoleButStopsAtOneOnItsTube) {
+    const std::filesystem::path file =
+        std::filesystem::path(CDLAB_SOURCE_DIR) / "tests" / "data" / "ring_rod_ccd.yaml";
+    {
+        World world = makeWorld(loadScene(file));
+        ASSERT_EQ(world.bodies()[0].shape.type, collision::ShapeType::Mesh);
+        world.step();
+        EXPECT_GT(world.lastStats().toi_queries, 0);  // the pair was asked
+        EXPECT_TRUE(world.toiEvents().empty());
+        EXPECT_NEAR(world.bodies()[0].position.y(), 5, 1e-9);  // a whole step: through the hole
+    }
+    {
+        Scene scene = loadScene(file);
+        scene.bodies[1].position = Vec3(1, 0, 0);
+        World world = makeWorld(scene);
+        world.step();
+        ASSERT_EQ(world.toiEvents().size(), 1u);
+        // Contact when the tube's top (ring y + 0.35) meets the bead's bottom (-0.07), at ring
+        // y = -0.42 for the smooth shapes; the faceted meshes (12 segments around the tube) meet
+        // up to ~0.015 later. Stopped a target gap short, never past it.
+        const Real y = world.bodies()[0].position.y();
+        EXPECT_LT(y, -0.42 + 0.015);
+        EXPECT_GT(y, -0.42 - 0.01);
+        const ToiEvent& e = world.toiEvents()[0];
+        EXPECT_NEAR(e.point.x(), 1, 0.05);  // at the bead
+        EXPECT_GT(e.normal.y(), 0.9);       // from the ring (a) up to the bead (b)
+    }
+}
+
 }  // namespace
 }  // namespace engine

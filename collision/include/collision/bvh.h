@@ -314,6 +314,9 @@ public:
     /// Bvh::refit (a deforming mesh): returns the nodes updated. Not for a tree shared by shapes
     /// that other threads query.
     virtual std::int32_t refit(const TriangleMesh& mesh) = 0;
+    /// The typed tree when this hierarchy's volume type is `obb`, else null (mesh-mesh CCD,
+    /// timeOfImpactMeshes in ccd.h, runs on OBB trees).
+    virtual const Bvh<Obb>* obbTree() const { return nullptr; }
     /// True when `b` holds the same volume type (the tandem queries need it).
     virtual bool sameVolumeType(const MeshBvh& b) const = 0;
     /// The tandem traversal with a visitor: every intersecting triangle pair (exact triangle test,

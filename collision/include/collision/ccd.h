@@ -153,15 +153,15 @@ struct ToiOutput {
     /// Overlapped: penetrating at t = 0 (t = 0). Failed: iteration cap or bad input; the gap
     /// stays above target_gap on [0, t] (a safe time), the caller must treat the pair as hit.
     CcdState state = CcdState::Failed;
-    Real t = 0;           ///< fraction of the step
-    Real distance = 0;    ///< lower bound on the gap at t (m); 0 when Overlapped or Failed early
-    Vec3 normal = Vec3::Zero();   ///< unit, from A towards B at t (Hit, Failed after 1 query)
+    Real t = 0;         ///< fraction of the step
+    Real distance = 0;  ///< lower bound on the gap at t (m); 0 when Overlapped or Failed early
+    Vec3 normal = Vec3::Zero();  ///< unit, from A towards B at t (Hit, Failed after 1 query)
     /// Witnesses at t, world: the support point of one shape along the normal and the point of
     /// the other shape closest to it (exact closest points for sphere/box/capsule vertex or
     /// round contacts; for face-face contact one corner of the contact region).
     Vec3 point_a = Vec3::Zero();
     Vec3 point_b = Vec3::Zero();
-    int iterations = 0;           ///< distance queries made
+    int iterations = 0;  ///< distance queries made
 };
 
 /// Conservative advancement (Mirtich 1996, "Impulse-based dynamic simulation of rigid body
@@ -193,5 +193,45 @@ struct Obb;
 /// often on long intervals (callers bisect). O(1). Non-finite input or t0 > t1 -> true.
 bool testObbSweep(const Obb& box_a, const Sweep& sweep_a, const Obb& box_b, const Sweep& sweep_b,
                   Real t0, Real t1);
+
+// ---- Meshes: conservative advancement on triangle pairs, culled by the continuous OBB test
+// (ccd_mesh.cpp). ----
+
+template <class BV>
+class Bvh;
+
+/// Input of timeOfImpactMeshes: two OBB trees (Gottschalk's OBBTree, bvh.h) in their meshes'
+/// local frames, each moving by its sweep.
+struct MeshToiInput {
+    const Bvh<Obb>* a = nullptr;
+    const Bvh<Obb>* b = nullptr;
+    Sweep sweep_a;
+    Sweep sweep_b;
+    Real t_max = 1;           ///< search [0, t_max] of the step, t_max in [0, 1]
+    Real target_gap = 0;      ///< m, >= 0, as ToiInput::target_gap
+    Real tolerance = 0;       ///< m, >= 0, as ToiInput::tolerance (0: relative to each pair)
+    int max_iterations = 64;  ///< per triangle pair, as ToiInput::max_iterations
+};
+
+/// Result of timeOfImpactMeshes, with its witness features and cost counters.
+struct MeshToiOutput {
+    ToiOutput toi;                 ///< the earliest triangle-pair result (state, t, normal, points)
+    std::int32_t triangle_a = -1;  ///< witness: mesh index of A's triangle (Hit, Overlapped)
+    std::int32_t triangle_b = -1;  ///< witness: mesh index of B's triangle
+    std::int64_t node_tests = 0;   ///< continuous OBB tests (testObbSweep)
+    std::int64_t triangle_queries = 0;  ///< conservative advancements on triangle pairs
+};
+
+/// Time of impact of two moving triangle meshes (surfaces): the tandem traversal of the two OBB
+/// trees drops every node pair that the continuous OBB test (Redon et al. 2002, testObbSweep)
+/// proves apart on [0, t_best], t_best the earliest time found so far, and runs conservative
+/// advancement (timeOfImpact) on each surviving triangle pair, each triangle a flat convex set.
+/// Guarantee: conservative, as timeOfImpact: never later than the first time any triangle pair
+/// comes within target_gap (the culling is conservative, every triangle pair's advancement is).
+/// Separated: no pair comes within target_gap on [0, t_max] (t = t_max). Overlapped: some
+/// triangle pair penetrates at t = 0. Failed: a triangle pair hit its iteration cap; t is still
+/// safe. Unlike timeOfImpact on the meshes' convex hulls, a body passing through a hole of the
+/// other is not stopped. Null trees -> Failed.
+MeshToiOutput timeOfImpactMeshes(const MeshToiInput& input);
 
 }  // namespace collision
