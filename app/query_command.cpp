@@ -158,10 +158,14 @@ int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err) 
         j["volumes_agree"] = agree;
         nlohmann::json results = nlohmann::json::array();
         for (const Row& r : rows) {
+            // Every type writes its own list (sorted by (a, b)), so a reader can compare them.
+            nlohmann::json pairs = nlohmann::json::array();
+            for (const collision::TrianglePair& p : r.pairs) pairs.push_back({p.a, p.b});
             results.push_back({
                 {"bv", std::string(r.bv)},
                 {"colliding", r.colliding},
-                {"triangle_pairs", r.pairs.size()},
+                {"triangle_pair_count", r.pairs.size()},
+                {"triangle_pairs", std::move(pairs)},
                 {"nodes", r.nodes},
                 {"build_ms", r.build_ms},
                 {"first_contact",

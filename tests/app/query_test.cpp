@@ -10,7 +10,10 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
+#include "collision/bvh.h"
+#include "engine/mesh_import.h"
 #include "query_command.h"
 
 namespace {
@@ -55,11 +58,23 @@ TEST(Query, JsonHasEveryVolumeTypeAndTheyAgree) {
     const nlohmann::json j = nlohmann::json::parse(r.out);
     EXPECT_TRUE(j["volumes_agree"].get<bool>());
     ASSERT_EQ(j["results"].size(), 9u);
-    const std::size_t pairs = j["results"][0]["triangle_pairs"].get<std::size_t>();
-    EXPECT_GT(pairs, 0u);
+
+    // The reference: the brute-force triangle loop on the same mesh, as the CLI imports it.
+    const engine::MeshImportOutput torus =
+        engine::importMesh(fs::path(CDLAB_SOURCE_DIR) / "assets/torus.obj", 1.0);
+    ASSERT_TRUE(torus.ok) << torus.error;
+    const collision::Pose pose{collision::Vec3(0.5, 0, 0.1), collision::Quat::Identity()};
+    const std::vector<collision::TrianglePair> brute =
+        collision::intersectMeshMeshBruteForce(torus.mesh, torus.mesh, pose);
+    ASSERT_FALSE(brute.empty());
+    nlohmann::json expected = nlohmann::json::array();
+    for (const collision::TrianglePair& p : brute) expected.push_back({p.a, p.b});
+
+    const std::size_t pairs = brute.size();
     for (const auto& row : j["results"]) {
         EXPECT_TRUE(row["colliding"].get<bool>()) << row["bv"];
-        EXPECT_EQ(row["triangle_pairs"].get<std::size_t>(), pairs) << row["bv"];
+        EXPECT_EQ(row["triangle_pair_count"].get<std::size_t>(), pairs) << row["bv"];
+        EXPECT_EQ(row["triangle_pairs"], expected) << row["bv"];
         EXPECT_GT(row["all_pairs"]["bv_tests"].get<std::int64_t>(), 0);
         EXPECT_GE(row["all_pairs"]["triangle_tests"].get<std::int64_t>(),
                   static_cast<std::int64_t>(pairs));
