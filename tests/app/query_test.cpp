@@ -80,6 +80,14 @@ TEST(Query, JsonHasEveryVolumeTypeAndTheyAgree) {
                   static_cast<std::int64_t>(pairs));
         EXPECT_LE(row["first_contact"]["triangle_tests"].get<std::int64_t>(),
                   row["all_pairs"]["triangle_tests"].get<std::int64_t>());
+        // Cv and Cp timed on batches of the query's own tests (at least 2e5 and 1e5).
+        const auto& unit = row["unit_costs"];
+        EXPECT_GT(unit["bv_test_ns"].get<double>(), 0) << row["bv"];
+        EXPECT_GT(unit["triangle_test_ns"].get<double>(), 0) << row["bv"];
+        EXPECT_GE(unit["bv_tests_timed"].get<std::int64_t>(), 200000) << row["bv"];
+        EXPECT_GE(unit["triangle_tests_timed"].get<std::int64_t>(), 100000) << row["bv"];
+        EXPECT_TRUE(unit["triangle_tests_from_query"].get<bool>()) << row["bv"];
+        EXPECT_GT(unit["all_pairs_model_us"].get<double>(), 0) << row["bv"];
     }
     EXPECT_EQ(j["results"][7]["bv"], "rss");
     EXPECT_EQ(j["results"][8]["bv"], "lss");
@@ -93,6 +101,10 @@ TEST(Query, FarApartIsNotCollidingAndTableIsPrinted) {
     EXPECT_NE(r.out.find("obb"), std::string::npos);
     EXPECT_NE(r.out.find("apart"), std::string::npos);
     EXPECT_EQ(r.out.find("colliding"), std::string::npos);
+    // Apart at the root volumes: no triangle test to replay, so Cp comes from random pairs and
+    // the table says so.
+    EXPECT_NE(r.out.find("Cv ns"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("Cp on random triangle pairs"), std::string::npos) << r.out;
 }
 
 TEST(Query, BadInputExitsTwoWithAMessage) {

@@ -666,6 +666,45 @@ TEST(Bvh, LookupByNameCoversTheTypeList) {
     }
 }
 
+// The sample behind the measured Cv and Cp is the query's own work: recordTests gives as many
+// node and triangle pairs as the query's counters, and replaying them finds what the query found.
+// With one triangle per leaf every overlapping node pair either pushes two children or is a leaf
+// pair with one triangle test, so the overlaps are (Nv - 1) / 2 + Np exactly.
+TEST(Bvh, RecordedTestsReplayAsTheQueryMadeThem) {
+    int colliding = 0;
+    for (const std::string_view name : collision::bvhVolumeNames()) {
+        const auto a = collision::buildMeshBvh(name, torusA());
+        const auto b = collision::buildMeshBvh(name, torusB());
+        for (std::size_t k = 0; k < 6; ++k) {
+            const Pose& pose = differentialPoses()[k];
+            BvhQueryStats stats;
+            const auto pairs = a->intersect(*b, pose, &stats);
+            const collision::BvhTestSample sample = a->recordTests(*b, pose);
+            const auto nv = static_cast<std::int64_t>(sample.node_pairs.size());
+            const auto np = static_cast<std::int64_t>(sample.triangle_pairs.size());
+            EXPECT_EQ(nv, stats.bv_tests) << name << " pose " << k;
+            EXPECT_EQ(np, stats.triangle_tests) << name << " pose " << k;
+            EXPECT_EQ(a->replayVolumeTests(*b, pose, sample, 1), (nv - 1) / 2 + np)
+                << name << " pose " << k;
+            EXPECT_EQ(a->replayVolumeTests(*b, pose, sample, 3), 3 * ((nv - 1) / 2 + np));
+            EXPECT_EQ(a->replayTriangleTests(*b, pose, sample, 1),
+                      static_cast<std::int64_t>(pairs.size()))
+                << name << " pose " << k;
+            EXPECT_EQ(a->replayTriangleTests(*b, pose, sample, 2),
+                      2 * static_cast<std::int64_t>(pairs.size()));
+            colliding += pairs.empty() ? 0 : 1;
+        }
+        // A sample of other trees (an index past this tree's nodes) is refused, not read.
+        collision::BvhTestSample bad;
+        bad.node_pairs.push_back({a->nodeCount(), 0});
+        EXPECT_EQ(a->replayVolumeTests(*b, Pose{}, bad, 1), -1);
+        bad.triangle_pairs.push_back({0, b->triangleCount()});
+        EXPECT_EQ(a->replayTriangleTests(*b, Pose{}, bad, 1), -1);
+    }
+    EXPECT_GT(colliding, 0);
+    EXPECT_LT(colliding, 6 * 9);
+}
+
 TEST(Bvh, SweepReferenceEqualsBruteForce) {
     // Random poses of the tori, and grid cubes touching face to face, edge to edge and corner to
     // corner (exact coordinates): the sweep returns the brute force's list, with as many tests.
