@@ -19,6 +19,7 @@
 #include <ostream>
 #include <random>
 
+#include "bvh_unit_costs.h"
 #include "collision/bvh.h"
 
 #ifdef CDLAB_HAVE_FCL
@@ -83,6 +84,9 @@ public:
     /// Number of intersecting triangle pairs; `pairs` (may be null) gets them when available.
     virtual std::size_t all(const Pose& b_in_a, collision::BvhQueryStats* stats,
                             std::vector<collision::TrianglePair>* pairs) = 0;
+    /// cdlab only: the trees A and B of the last build (nullptr for other libraries).
+    virtual collision::MeshBvh* treeA() { return nullptr; }
+    virtual const collision::MeshBvh* treeB() const { return nullptr; }
 };
 
 class CdlabMethod final : public NarrowMethod {
@@ -108,6 +112,8 @@ public:
         if (pairs) *pairs = std::move(found);
         return n;
     }
+    collision::MeshBvh* treeA() override { return a_.get(); }
+    const collision::MeshBvh* treeB() const override { return b_.get(); }
 
 private:
     std::string_view bv_;
@@ -199,7 +205,26 @@ struct Row {
     int bool_mismatches = 0;
     int count_mismatches = 0;
     bool counters = false;
+    BvhUnitCosts unit;    // Cv, Cp (cdlab only)
+    double refit_ms = 0;  // one tree refitted to the deformed torus (cdlab only)
+    std::int32_t refit_nu = 0;
+    bool refit_ok = true;  // the refitted tree's pairs equal the reference on the deformed torus
 };
+
+// The torus deformed for the refit row: radial waves around the ring and a twist about z, moving
+// vertices by up to ~20 % of the ring radius (more than a triangle's size, so leaves move).
+TriangleMesh deformedTorus(const TriangleMesh& mesh) {
+    TriangleMesh m = mesh;
+    for (Vec3& v : m.vertices) {
+        const Real angle = std::atan2(v.y(), v.x());
+        const Real k = 1 + Real(0.15) * std::sin(3 * angle);
+        const Real twist = Real(0.3) * v.z();
+        const Vec3 w(v.x() * k, v.y() * k, v.z());
+        v = Vec3(w.x() * std::cos(twist) - w.y() * std::sin(twist),
+                 w.x() * std::sin(twist) + w.y() * std::cos(twist), w.z());
+    }
+    return m;
+}
 
 // Poses of B in A's frame from a fixed stream: B's centre uniform in [-1.6, 1.6]^3 (the tori's
 // bounding boxes overlap), uniform rotation; the first poses/2 that collide and the first
@@ -294,6 +319,11 @@ int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& ou
         << " poses (" << colliding << " colliding), fastest of " << options.reps
         << " repetitions per pose\n";
 
+    // The refit workload: the deformed torus as A, the reference its sweep answer at pose 0.
+    const TriangleMesh deformed = deformedTorus(mesh);
+    const std::vector<collision::TrianglePair> deformed_answer =
+        collision::intersectMeshMeshSweep(deformed, mesh, w.poses.front());
+
     std::vector<Row> rows;
     bool cdlab_wrong = false;
     for (const std::string& n : names) {
@@ -342,7 +372,24 @@ int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& ou
                 ++row.count_mismatches;  // same count but another list: still wrong
             }
         }
-        if (row.counters && (row.bool_mismatches > 0 || row.count_mismatches > 0)) {
+        if (row.counters) {
+            // Cv and Cp from the tests the all-pairs queries made at these poses, replayed
+            // outside the timed queries above.
+            row.unit = measureBvhUnitCosts(*method->treeA(), *method->treeB(), w.poses);
+            // Refit A to the deformed torus (fastest of the repetitions; a refit of an already
+            // refitted tree does the same work), then check its answer at the first pose.
+            double best_refit = std::numeric_limits<double>::infinity();
+            for (int r = 0; r < std::min(options.reps, 3); ++r) {
+                const Clock::time_point t = Clock::now();
+                row.refit_nu = method->treeA()->refit(deformed);
+                best_refit = std::min(best_refit, secondsSince(t));
+            }
+            row.refit_ms = 1e3 * best_refit;
+            row.refit_ok =
+                method->treeA()->intersect(*method->treeB(), w.poses.front()) == deformed_answer;
+        }
+        if (row.counters &&
+            (row.bool_mismatches > 0 || row.count_mismatches > 0 || !row.refit_ok)) {
             cdlab_wrong = true;
         }
         rows.push_back(row);
@@ -351,7 +398,9 @@ int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& ou
     out << std::left << std::setw(12) << "method" << std::right << std::setw(10) << "build_ms"
         << std::setw(11) << "first_us" << std::setw(11) << "all_us" << std::setw(11) << "first_Nv"
         << std::setw(10) << "first_Np" << std::setw(11) << "all_Nv" << std::setw(10) << "all_Np"
-        << std::setw(11) << "bool_diff" << std::setw(11) << "pair_diff" << '\n';
+        << std::setw(8) << "Cv_ns" << std::setw(8) << "Cp_ns" << std::setw(10) << "refit_ms"
+        << std::setw(8) << "Nu" << std::setw(11) << "bool_diff" << std::setw(11) << "pair_diff"
+        << '\n';
     out << std::fixed;
     for (const Row& r : rows) {
         out << std::left << std::setw(12) << r.method << std::right << std::setprecision(2)
@@ -359,14 +408,21 @@ int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& ou
             << std::setw(11) << r.all_us;
         if (r.counters) {
             out << std::setprecision(0) << std::setw(11) << r.first_nv << std::setw(10)
-                << r.first_np << std::setw(11) << r.all_nv << std::setw(10) << r.all_np;
+                << r.first_np << std::setw(11) << r.all_nv << std::setw(10) << r.all_np
+                << std::setprecision(1) << std::setw(8) << r.unit.bv_test_ns << std::setw(8)
+                << r.unit.triangle_test_ns << std::setprecision(2) << std::setw(10) << r.refit_ms
+                << std::setw(8) << r.refit_nu;
         } else {
             out << std::setw(11) << "-" << std::setw(10) << "-" << std::setw(11) << "-"
-                << std::setw(10) << "-";
+                << std::setw(10) << "-" << std::setw(8) << "-" << std::setw(8) << "-"
+                << std::setw(10) << "-" << std::setw(8) << "-";
         }
         out << std::setw(11) << r.bool_mismatches << std::setw(11) << r.count_mismatches << '\n';
     }
     out.unsetf(std::ios::fixed);
+    out << "(Cv, Cp: ns per BV test and per triangle test, timed by replaying the tests the "
+           "all-pairs"
+           " queries made; refit: one tree to a deformed torus, Nu nodes updated)\n";
 
     if (options.json) {
         nlohmann::json j;
@@ -389,6 +445,14 @@ int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& ou
                 o["first_np"] = r.first_np;
                 o["all_nv"] = r.all_nv;
                 o["all_np"] = r.all_np;
+                o["bv_test_ns"] = r.unit.bv_test_ns;
+                o["triangle_test_ns"] = r.unit.triangle_test_ns;
+                o["bv_tests_timed"] = r.unit.bv_tests_timed;
+                o["triangle_tests_timed"] = r.unit.triangle_tests_timed;
+                o["triangle_tests_from_queries"] = r.unit.triangles_from_queries;
+                o["refit_ms"] = r.refit_ms;
+                o["refit_nu"] = r.refit_nu;
+                o["refit_ok"] = r.refit_ok;
             }
             arr.push_back(o);
         }

@@ -9,9 +9,11 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <ostream>
+#include <span>
 #include <sstream>
 #include <vector>
 
+#include "bvh_unit_costs.h"
 #include "collision/bvh.h"
 #include "engine/mesh_import.h"
 
@@ -31,6 +33,7 @@ struct Row {
     double build_ms = 0;  // both trees
     double first_us = 0;  // per query
     double all_us = 0;    // per query
+    BvhUnitCosts unit;    // Cv, Cp: measured after the timed queries
 };
 
 // Mean time per call of `fn`, repeated until ~20 ms have passed (at most 1000 calls).
@@ -136,6 +139,8 @@ int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err) 
         row.pairs = a->intersect(*b, pose_b, &row.all);
         row.first_us = 1e6 * timePerCall([&] { (void)a->testOverlap(*b, pose_b); });
         row.all_us = 1e6 * timePerCall([&] { (void)a->intersect(*b, pose_b); });
+        // Cv and Cp: the all-pairs query's own tests replayed in batches, outside its timing.
+        row.unit = measureBvhUnitCosts(*a, *b, std::span<const collision::Pose>(&pose_b, 1));
         rows.push_back(std::move(row));
     }
     bool agree = true;
@@ -158,10 +163,14 @@ int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err) 
         j["volumes_agree"] = agree;
         nlohmann::json results = nlohmann::json::array();
         for (const Row& r : rows) {
+            // Every type writes its own list (sorted by (a, b)), so a reader can compare them.
+            nlohmann::json pairs = nlohmann::json::array();
+            for (const collision::TrianglePair& p : r.pairs) pairs.push_back({p.a, p.b});
             results.push_back({
                 {"bv", std::string(r.bv)},
                 {"colliding", r.colliding},
-                {"triangle_pairs", r.pairs.size()},
+                {"triangle_pair_count", r.pairs.size()},
+                {"triangle_pairs", std::move(pairs)},
                 {"nodes", r.nodes},
                 {"build_ms", r.build_ms},
                 {"first_contact",
@@ -172,6 +181,16 @@ int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err) 
                  {{"bv_tests", r.all.bv_tests},
                   {"triangle_tests", r.all.triangle_tests},
                   {"time_us", r.all_us}}},
+                {"unit_costs",
+                 {{"bv_test_ns", r.unit.bv_test_ns},
+                  {"triangle_test_ns", r.unit.triangle_test_ns},
+                  {"bv_tests_timed", r.unit.bv_tests_timed},
+                  {"triangle_tests_timed", r.unit.triangle_tests_timed},
+                  {"triangle_tests_from_query", r.unit.triangles_from_queries},
+                  // F = Nv Cv + Np Cp for the all-pairs query, beside its measured time_us.
+                  {"all_pairs_model_us",
+                   1e-3 * (static_cast<double>(r.all.bv_tests) * r.unit.bv_test_ns +
+                           static_cast<double>(r.all.triangle_tests) * r.unit.triangle_test_ns)}}},
             });
         }
         j["results"] = results;
@@ -183,7 +202,8 @@ int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err) 
         out << std::left << std::setw(8) << "bv" << std::right << std::setw(10) << "answer"
             << std::setw(8) << "pairs" << std::setw(10) << "first Nv" << std::setw(10) << "first Np"
             << std::setw(10) << "all Nv" << std::setw(10) << "all Np" << std::setw(11) << "build ms"
-            << std::setw(11) << "first us" << std::setw(11) << "all us"
+            << std::setw(11) << "first us" << std::setw(11) << "all us" << std::setw(8) << "Cv ns"
+            << std::setw(8) << "Cp ns"
             << "\n";
         out << std::fixed;
         for (const Row& r : rows) {
@@ -192,9 +212,16 @@ int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err) 
                 << std::setw(10) << r.first.bv_tests << std::setw(10) << r.first.triangle_tests
                 << std::setw(10) << r.all.bv_tests << std::setw(10) << r.all.triangle_tests
                 << std::setprecision(2) << std::setw(11) << r.build_ms << std::setw(11)
-                << r.first_us << std::setw(11) << r.all_us << "\n";
+                << r.first_us << std::setw(11) << r.all_us << std::setprecision(1) << std::setw(8)
+                << r.unit.bv_test_ns << std::setw(8) << r.unit.triangle_test_ns
+                << (r.unit.triangles_from_queries ? "" : "*") << "\n";
         }
-        out << "(Nv: BV tests, Np: triangle tests; build: both trees)\n";
+        out << "(Nv: BV tests, Np: triangle tests; build: both trees; Cv, Cp: ns per BV test and\n"
+               " per triangle test, timed by replaying the all-pairs query's own tests";
+        bool random_cp = false;
+        for (const Row& r : rows) random_cp = random_cp || !r.unit.triangles_from_queries;
+        if (random_cp) out << ";\n * the query tested no triangles: Cp on random triangle pairs";
+        out << ")\n";
     }
     if (!agree) {
         err << "error: the volume types disagree on the triangle pairs (a BVH bug)\n";

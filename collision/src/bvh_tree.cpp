@@ -266,13 +266,27 @@ private:
     std::size_t size_ = 0;
 };
 
+// The traversal's test recorder: the queries pass this one, which records nothing (its empty
+// inline calls compile away, so the timed queries are unchanged).
+struct NoTestRecord {
+    void node(std::int32_t, std::int32_t) {}
+    void triangle(std::int32_t, std::int32_t) {}
+};
+// Records every node pair and triangle pair the traversal tests, in order (MeshBvh::recordTests).
+struct SampleTestRecord {
+    BvhTestSample* sample;
+    void node(std::int32_t ia, std::int32_t ib) { sample->node_pairs.push_back({ia, ib}); }
+    void triangle(std::int32_t i, std::int32_t j) { sample->triangle_pairs.push_back({i, j}); }
+};
+
 // The tandem traversal (Gottschalk 1996 §5): pop a node pair, test the volumes, and at two leaves
 // test their triangles; otherwise descend the node with the larger volume (a leaf never
 // descends). Every intersecting triangle pair goes to on_pair(i, j, ta, tb) (leaf-order indices,
-// corners in A's frame), which returns true to stop. Returns true when stopped.
-template <class BV, class OnPair>
+// corners in A's frame), which returns true to stop. Returns true when stopped. `record` sees
+// every node pair and triangle pair tested.
+template <class BV, class OnPair, class Record = NoTestRecord>
 bool traverse(const Bvh<BV>& a, const Bvh<BV>& b, const BvhTransform& x, BvhQueryStats* stats,
-              OnPair&& on_pair) {
+              OnPair&& on_pair, Record record = {}) {
     const auto& na = a.nodes();
     const auto& nb = b.nodes();
     if (na.empty() || nb.empty()) return false;
@@ -294,6 +308,7 @@ bool traverse(const Bvh<BV>& a, const Bvh<BV>& b, const BvhTransform& x, BvhQuer
         const auto& node_a = na[static_cast<std::size_t>(ia)];
         const auto& node_b = nb[static_cast<std::size_t>(ib)];
         ++bv_tests;
+        record.node(ia, ib);
         if constexpr (MovableVolume<BV>) {
             if (ib != moved_id) {
                 moved_b = BvTraits<BV>::move(node_b.volume, x);
@@ -310,6 +325,7 @@ bool traverse(const Bvh<BV>& a, const Bvh<BV>& b, const BvhTransform& x, BvhQuer
                 for (std::int32_t i = node_a.first; i < node_a.first + node_a.count; ++i) {
                     const auto& ta = a.leafTriangle(i);
                     ++tri_tests;
+                    record.triangle(i, j);
                     if (!testTriangleTriangle(ta[0], ta[1], ta[2], moved[0], moved[1], moved[2])) {
                         continue;
                     }
@@ -498,6 +514,53 @@ std::vector<std::int32_t> levelIndices(const Bvh<BV>& tree, int depth) {
     return out;
 }
 
+// The volume tests of `sample` as traverse() does them: B's node volume moved into A's frame
+// once per run of pairs with the same B node (movable types), then the overlap test. Returns how
+// many overlap, `repeats` times over.
+template <class BV>
+std::int64_t replayVolumeTestsOf(const Bvh<BV>& a, const Bvh<BV>& b, const BvhTransform& x,
+                                 const BvhTestSample& sample, int repeats) {
+    const auto& na = a.nodes();
+    const auto& nb = b.nodes();
+    std::int64_t overlapping = 0;
+    for (int r = 0; r < repeats; ++r) {
+        [[maybe_unused]] BV moved_b{};
+        [[maybe_unused]] std::int32_t moved_id = -1;
+        for (const auto& [ia, ib] : sample.node_pairs) {
+            const auto& node_a = na[static_cast<std::size_t>(ia)];
+            const auto& node_b = nb[static_cast<std::size_t>(ib)];
+            if constexpr (MovableVolume<BV>) {
+                if (ib != moved_id) {
+                    moved_b = BvTraits<BV>::move(node_b.volume, x);
+                    moved_id = ib;
+                }
+                overlapping += BvTraits<BV>::overlapsMoved(node_a.volume, moved_b, x) ? 1 : 0;
+            } else {
+                overlapping += BvTraits<BV>::overlaps(node_a.volume, node_b.volume, x) ? 1 : 0;
+            }
+        }
+    }
+    return overlapping;
+}
+
+// The triangle tests of `sample` as traverse() does them at a leaf pair of one triangle each:
+// B's triangle moved into A's frame, then the exact test. Returns how many intersect.
+template <class BV>
+std::int64_t replayTriangleTestsOf(const Bvh<BV>& a, const Bvh<BV>& b, const BvhTransform& x,
+                                   const BvhTestSample& sample, int repeats) {
+    std::int64_t intersecting = 0;
+    for (int r = 0; r < repeats; ++r) {
+        for (const auto& [i, j] : sample.triangle_pairs) {
+            const auto& tb = b.leafTriangle(j);
+            const std::array<Vec3, 3> moved{x.apply(tb[0]), x.apply(tb[1]), x.apply(tb[2])};
+            const auto& ta = a.leafTriangle(i);
+            intersecting +=
+                testTriangleTriangle(ta[0], ta[1], ta[2], moved[0], moved[1], moved[2]) ? 1 : 0;
+        }
+    }
+    return intersecting;
+}
+
 template <class BV>
 class MeshBvhOf final : public MeshBvh {
 public:
@@ -574,6 +637,38 @@ public:
                                   return visitor.visit(tree_.leafTriangleId(i), corners);
                               });
     }
+    BvhTestSample recordTests(const MeshBvh& b, const Pose& b_in_a) const override {
+        const auto* other = dynamic_cast<const MeshBvhOf<BV>*>(&b);
+        CDLAB_ASSERT(other != nullptr, "BVH query between different volume types");
+        BvhTestSample sample;
+        if (other == nullptr) return sample;
+        const BvhTransform x = makeBvhTransform(b_in_a, tree_.scale(), other->tree_.scale());
+        traverse(
+            tree_, other->tree_, x, nullptr,
+            [](std::int32_t, std::int32_t, const std::array<Vec3, 3>&, const std::array<Vec3, 3>&) {
+                return false;
+            },
+            SampleTestRecord{&sample});
+        return sample;
+    }
+    std::int64_t replayVolumeTests(const MeshBvh& b, const Pose& b_in_a,
+                                   const BvhTestSample& sample, int repeats) const override {
+        const auto* other = dynamic_cast<const MeshBvhOf<BV>*>(&b);
+        CDLAB_ASSERT(other != nullptr, "BVH query between different volume types");
+        if (other == nullptr) return 0;
+        if (!sampleFits(sample, other->tree_)) return -1;
+        const BvhTransform x = makeBvhTransform(b_in_a, tree_.scale(), other->tree_.scale());
+        return replayVolumeTestsOf(tree_, other->tree_, x, sample, repeats);
+    }
+    std::int64_t replayTriangleTests(const MeshBvh& b, const Pose& b_in_a,
+                                     const BvhTestSample& sample, int repeats) const override {
+        const auto* other = dynamic_cast<const MeshBvhOf<BV>*>(&b);
+        CDLAB_ASSERT(other != nullptr, "BVH query between different volume types");
+        if (other == nullptr) return 0;
+        if (!sampleFits(sample, other->tree_)) return -1;
+        const BvhTransform x = makeBvhTransform(b_in_a, tree_.scale(), other->tree_.scale());
+        return replayTriangleTestsOf(tree_, other->tree_, x, sample, repeats);
+    }
     std::vector<BvhLevelNode> levelNodes(int depth) const override {
         return levelNodesOf(tree_, depth);
     }
@@ -618,6 +713,21 @@ public:
     }
 
 private:
+    // Every index of `sample` names a node or leaf triangle of this tree (A) and of `b`.
+    bool sampleFits(const BvhTestSample& sample, const Bvh<BV>& b) const {
+        const auto nodes_a = static_cast<std::int32_t>(tree_.nodes().size());
+        const auto nodes_b = static_cast<std::int32_t>(b.nodes().size());
+        for (const auto& [ia, ib] : sample.node_pairs) {
+            if (ia < 0 || ia >= nodes_a || ib < 0 || ib >= nodes_b) return false;
+        }
+        for (const auto& [i, j] : sample.triangle_pairs) {
+            if (i < 0 || i >= tree_.triangleCount() || j < 0 || j >= b.triangleCount()) {
+                return false;
+            }
+        }
+        return true;
+    }
+
     Bvh<BV> tree_;
 };
 

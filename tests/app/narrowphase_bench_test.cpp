@@ -59,6 +59,8 @@ TEST(NarrowphaseBench, SmallToriTableAndJsonAgreeWithBruteForce) {
         "bench narrowphase --triangles 600 --poses 6 --reps 1 --json " + json.string(), work);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("first_us"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("Cv_ns"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("Nu"), std::string::npos) << r.out;
     const nlohmann::json j = nlohmann::json::parse(slurp(json));
     EXPECT_EQ(j["poses"], 6);
     EXPECT_EQ(j["colliding_poses"], 3);
@@ -75,6 +77,19 @@ TEST(NarrowphaseBench, SmallToriTableAndJsonAgreeWithBruteForce) {
             EXPECT_EQ(row["pair_mismatches"], 0) << row["method"];
             EXPECT_GT(row["all_nv"].get<double>(), 0) << row["method"];
             EXPECT_GT(row["all_np"].get<double>(), 0) << row["method"];
+            // Cv and Cp measured on batches of at least 2e5 and 1e5 tests drawn from the
+            // queries' own tests (some poses collide, so triangle tests exist).
+            EXPECT_GT(row["bv_test_ns"].get<double>(), 0) << row["method"];
+            EXPECT_GT(row["triangle_test_ns"].get<double>(), 0) << row["method"];
+            EXPECT_GE(row["bv_tests_timed"].get<std::int64_t>(), 200000) << row["method"];
+            EXPECT_GE(row["triangle_tests_timed"].get<std::int64_t>(), 100000) << row["method"];
+            EXPECT_TRUE(row["triangle_tests_from_queries"].get<bool>()) << row["method"];
+            // Refit updates every node of a one-triangle-leaf tree (2 n - 1) and still answers
+            // as the brute force on the deformed torus.
+            EXPECT_EQ(row["refit_nu"].get<int>(), 2 * j["triangles"].get<int>() - 1)
+                << row["method"];
+            EXPECT_TRUE(row["refit_ok"].get<bool>()) << row["method"];
+            EXPECT_GT(row["refit_ms"].get<double>(), 0) << row["method"];
         }
     }
     EXPECT_EQ(cdlab_rows, static_cast<int>(collision::bvhVolumeNames().size()));

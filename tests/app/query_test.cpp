@@ -10,7 +10,10 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
+#include "collision/bvh.h"
+#include "engine/mesh_import.h"
 #include "query_command.h"
 
 namespace {
@@ -55,16 +58,36 @@ TEST(Query, JsonHasEveryVolumeTypeAndTheyAgree) {
     const nlohmann::json j = nlohmann::json::parse(r.out);
     EXPECT_TRUE(j["volumes_agree"].get<bool>());
     ASSERT_EQ(j["results"].size(), 9u);
-    const std::size_t pairs = j["results"][0]["triangle_pairs"].get<std::size_t>();
-    EXPECT_GT(pairs, 0u);
+
+    // The reference: the brute-force triangle loop on the same mesh, as the CLI imports it.
+    const engine::MeshImportOutput torus =
+        engine::importMesh(fs::path(CDLAB_SOURCE_DIR) / "assets/torus.obj", 1.0);
+    ASSERT_TRUE(torus.ok) << torus.error;
+    const collision::Pose pose{collision::Vec3(0.5, 0, 0.1), collision::Quat::Identity()};
+    const std::vector<collision::TrianglePair> brute =
+        collision::intersectMeshMeshBruteForce(torus.mesh, torus.mesh, pose);
+    ASSERT_FALSE(brute.empty());
+    nlohmann::json expected = nlohmann::json::array();
+    for (const collision::TrianglePair& p : brute) expected.push_back({p.a, p.b});
+
+    const std::size_t pairs = brute.size();
     for (const auto& row : j["results"]) {
         EXPECT_TRUE(row["colliding"].get<bool>()) << row["bv"];
-        EXPECT_EQ(row["triangle_pairs"].get<std::size_t>(), pairs) << row["bv"];
+        EXPECT_EQ(row["triangle_pair_count"].get<std::size_t>(), pairs) << row["bv"];
+        EXPECT_EQ(row["triangle_pairs"], expected) << row["bv"];
         EXPECT_GT(row["all_pairs"]["bv_tests"].get<std::int64_t>(), 0);
         EXPECT_GE(row["all_pairs"]["triangle_tests"].get<std::int64_t>(),
                   static_cast<std::int64_t>(pairs));
         EXPECT_LE(row["first_contact"]["triangle_tests"].get<std::int64_t>(),
                   row["all_pairs"]["triangle_tests"].get<std::int64_t>());
+        // Cv and Cp timed on batches of the query's own tests (at least 2e5 and 1e5).
+        const auto& unit = row["unit_costs"];
+        EXPECT_GT(unit["bv_test_ns"].get<double>(), 0) << row["bv"];
+        EXPECT_GT(unit["triangle_test_ns"].get<double>(), 0) << row["bv"];
+        EXPECT_GE(unit["bv_tests_timed"].get<std::int64_t>(), 200000) << row["bv"];
+        EXPECT_GE(unit["triangle_tests_timed"].get<std::int64_t>(), 100000) << row["bv"];
+        EXPECT_TRUE(unit["triangle_tests_from_query"].get<bool>()) << row["bv"];
+        EXPECT_GT(unit["all_pairs_model_us"].get<double>(), 0) << row["bv"];
     }
     EXPECT_EQ(j["results"][7]["bv"], "rss");
     EXPECT_EQ(j["results"][8]["bv"], "lss");
@@ -78,6 +101,10 @@ TEST(Query, FarApartIsNotCollidingAndTableIsPrinted) {
     EXPECT_NE(r.out.find("obb"), std::string::npos);
     EXPECT_NE(r.out.find("apart"), std::string::npos);
     EXPECT_EQ(r.out.find("colliding"), std::string::npos);
+    // Apart at the root volumes: no triangle test to replay, so Cp comes from random pairs and
+    // the table says so.
+    EXPECT_NE(r.out.find("Cv ns"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("Cp on random triangle pairs"), std::string::npos) << r.out;
 }
 
 TEST(Query, BadInputExitsTwoWithAMessage) {

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -13,6 +14,7 @@
 #include <tuple>
 #include <vector>
 
+#include "test_meshes.h"
 #include "test_random.h"
 
 namespace {
@@ -467,7 +469,8 @@ TYPED_TEST(BvhTyped, TouchingAndCoplanarPosesMatchBruteForce) {
 TYPED_TEST(BvhTyped, TranslatedAndScaledScenesGiveTheSameAnswer) {
     const TriangleMesh small_a = makeTorus(1.0, 0.35, 24, 12);
     const TriangleMesh small_b = makeTorus(0.8, 0.3, 20, 10);
-    const std::vector<Pose> poses = randomPoses(99, 4, 1.2);
+    const std::vector<Pose> poses = randomPoses(100, 6, 1.6);
+    int colliding = 0;
     for (const Real scale : {Real(1), Real(1e-4), Real(1e4)}) {
         const Vec3 offset = Vec3(1e6, -2e6, 0.5e6) * scale;
         const TriangleMesh ma = transformed(small_a, scale, offset);
@@ -481,29 +484,166 @@ TYPED_TEST(BvhTyped, TranslatedAndScaledScenesGiveTheSameAnswer) {
                 << "scale " << scale;
             EXPECT_EQ(pairs, collision::intersectMeshMeshBruteForce(small_a, small_b, pose))
                 << "scale " << scale;
+            colliding += pairs.empty() ? 0 : 1;
         }
     }
+    // Both outcomes at every scale (the pair lists are equal across scales, so 3 times the
+    // count at scale 1), or equal empty lists could pass.
+    EXPECT_GE(colliding, 3 * 2);
+    EXPECT_LE(colliding, 3 * 4);
 }
 
-// 10k-triangle tori: brute force would be 1e8 tests, so every volume type is checked against the
-// AABB tree instead (itself checked against brute force above).
-TYPED_TEST(BvhTyped, LargeToriMatchTheAabbTree) {
-    static const TriangleMesh big_a = makeTorus(1.0, 0.35, 100, 50);
-    static const TriangleMesh big_b = makeTorus(0.9, 0.3, 100, 50);
-    static const Bvh<Aabb> ref_a(big_a);
-    static const Bvh<Aabb> ref_b(big_b);
-    ASSERT_EQ(big_a.triangles.size(), 10000u);
-    const Bvh<TypeParam> a(big_a);
-    const Bvh<TypeParam> b(big_b);
-    EXPECT_TRUE(a.validate());
+// Real-size meshes (10k+ triangles): two 10k-triangle tori and a grid cube of 32 x 32 squares a
+// face (12288 triangles). The reference is the sweep form of the brute force
+// (intersectMeshMeshSweep: the same boxes and exact tests, so the same list; checked equal to the
+// brute force on these kinds of pose in SweepReferenceEqualsBruteForce), computed once per pose
+// and shared by every volume type.
+const TriangleMesh& bigTorusA() {
+    static const TriangleMesh m = cdlab_test::makeTorusMesh(1.0, 0.35, 100, 50);
+    return m;
+}
+const TriangleMesh& bigTorusB() {
+    static const TriangleMesh m = cdlab_test::makeTorusMesh(0.9, 0.3, 100, 50);
+    return m;
+}
+const TriangleMesh& bigCube() {
+    static const TriangleMesh m = cdlab_test::makeGridCubeMesh(32);
+    return m;
+}
+
+// A rotation by `angle` about x: it keeps x exact (R row 0 is (1, 0, 0) in floating point too),
+// so a face x = const stays exactly in its plane.
+Quat aboutX(Real angle) { return Quat(std::cos(angle / 2), std::sin(angle / 2), 0, 0); }
+
+enum class LargeMeshes { Tori, Cubes };
+struct LargeCase {
+    LargeMeshes meshes;
+    Pose pose;
+    std::vector<TrianglePair> expected;
+};
+struct LargeGroup {
+    std::string name;
+    std::vector<LargeCase> cases;
     int colliding = 0;
-    for (const Pose& pose : randomPoses(7, 6, 1.5)) {
-        const auto expected = collision::intersectBvhBvh(ref_a, ref_b, pose);
-        EXPECT_EQ(collision::intersectBvhBvh(a, b, pose), expected);
-        EXPECT_EQ(collision::testBvhBvh(a, b, pose), !expected.empty());
-        colliding += expected.empty() ? 0 : 1;
+};
+
+// Four groups of poses:
+//   random:   the tori, B's centre uniform in [-1.8, 1.8]^3, uniform rotation;
+//   cubes:    the cube against itself, centre uniform in [-3, 3]^3, uniform rotation;
+//   touching: the cubes face to face at x = 1 (grids aligned; offset by half a cell; B turned a
+//             quarter about x), edge to edge, corner to corner, and a hair apart;
+//   coplanar: face x = 1 of A against face x = -1 of B moved to x = 1, B turned about x by a
+//             random angle and slid in the face's plane by up to 3.5 in y and z.
+const std::vector<LargeGroup>& largeGroups() {
+    static const std::vector<LargeGroup> groups = [] {
+        std::vector<LargeGroup> g(4);
+        g[0].name = "random tori";
+        for (const Pose& p : randomPoses(7, 6, 1.8))
+            g[0].cases.push_back({LargeMeshes::Tori, p, {}});
+        g[1].name = "random cubes";
+        for (const Pose& p : randomPoses(8, 4, 3.0))
+            g[1].cases.push_back({LargeMeshes::Cubes, p, {}});
+        g[2].name = "touching cubes";
+        const Real half_cell = Real(1) / 32;  // cells are 2/32 wide: exact offsets
+        for (const Pose& p :
+             {Pose{Vec3(2, 0, 0), Quat::Identity()},
+              Pose{Vec3(2, half_cell, half_cell), Quat::Identity()},
+              Pose{Vec3(2, 0, 0), aboutX(std::numbers::pi_v<Real> / 2)},
+              Pose{Vec3(2, 2, 0), Quat::Identity()}, Pose{Vec3(2, 2, 2), Quat::Identity()},
+              Pose{Vec3(2 + 1e-9, 0, 0), Quat::Identity()}}) {
+            g[2].cases.push_back({LargeMeshes::Cubes, p, {}});
+        }
+        g[3].name = "coplanar cubes";
+        cdlab_test::Rng rng(31);
+        for (int i = 0; i < 6; ++i) {
+            const Vec3 slide(2, rng.uniform(-3.5, 3.5), rng.uniform(-3.5, 3.5));
+            const Real angle = rng.uniform(0, 2 * std::numbers::pi_v<Real>);
+            g[3].cases.push_back({LargeMeshes::Cubes, Pose{slide, aboutX(angle)}, {}});
+        }
+        for (LargeGroup& group : g) {
+            for (LargeCase& c : group.cases) {
+                c.expected =
+                    c.meshes == LargeMeshes::Tori
+                        ? collision::intersectMeshMeshSweep(bigTorusA(), bigTorusB(), c.pose)
+                        : collision::intersectMeshMeshSweep(bigCube(), bigCube(), c.pose);
+                group.colliding += c.expected.empty() ? 0 : 1;
+            }
+        }
+        return g;
+    }();
+    return groups;
+}
+
+TYPED_TEST(BvhTyped, LargeMeshesMatchBruteForceAtRandomTouchingAndCoplanarPoses) {
+    ASSERT_EQ(bigTorusA().triangles.size(), 10000u);
+    ASSERT_EQ(bigTorusB().triangles.size(), 10000u);
+    ASSERT_EQ(bigCube().triangles.size(), 12288u);
+    const Bvh<TypeParam> torus_a(bigTorusA());
+    const Bvh<TypeParam> torus_b(bigTorusB());
+    const Bvh<TypeParam> cube(bigCube());
+    EXPECT_TRUE(torus_a.validate());
+    EXPECT_TRUE(cube.validate());
+    for (const LargeGroup& group : largeGroups()) {
+        for (std::size_t k = 0; k < group.cases.size(); ++k) {
+            const LargeCase& c = group.cases[k];
+            const Bvh<TypeParam>& a = c.meshes == LargeMeshes::Tori ? torus_a : cube;
+            const Bvh<TypeParam>& b = c.meshes == LargeMeshes::Tori ? torus_b : cube;
+            EXPECT_EQ(collision::intersectBvhBvh(a, b, c.pose), c.expected)
+                << group.name << " pose " << k;
+            EXPECT_EQ(collision::testBvhBvh(a, b, c.pose), !c.expected.empty())
+                << group.name << " pose " << k;
+        }
     }
-    EXPECT_GE(colliding, 2);
+    // Each random group hits both outcomes (or the comparison could pass on empty lists); the
+    // touching poses all touch except the last, a hair apart.
+    const auto& g = largeGroups();
+    EXPECT_GE(g[0].colliding, 2);
+    EXPECT_LE(g[0].colliding, 4);
+    EXPECT_GE(g[1].colliding, 1);
+    EXPECT_LE(g[1].colliding, 3);
+    EXPECT_EQ(g[2].colliding, 5);
+    EXPECT_TRUE(g[2].cases.back().expected.empty());
+    EXPECT_GE(g[3].colliding, 2);
+    EXPECT_LE(g[3].colliding, 4);
+}
+
+// Swapping A and B mirrors the answer: the pairs of (b, a) under the inverse pose, each swapped,
+// are the pairs of (a, b). Generic random poses (no contact within rounding of touching) and
+// exactly representable touching poses, where the inverse pose is exact too.
+TYPED_TEST(BvhTyped, SwappingTheMeshesMirrorsThePairs) {
+    const Bvh<TypeParam> a(torusA());
+    const Bvh<TypeParam> b(torusB());
+    auto mirrored = [](std::vector<TrianglePair> pairs) {
+        for (TrianglePair& p : pairs) std::swap(p.a, p.b);
+        std::sort(pairs.begin(), pairs.end());
+        return pairs;
+    };
+    int colliding = 0;
+    for (std::size_t k = 0; k < differentialPoses().size(); ++k) {
+        const Pose& pose = differentialPoses()[k];
+        const std::vector<TrianglePair> swapped =
+            mirrored(collision::intersectBvhBvh(b, a, pose.inverse()));
+        EXPECT_EQ(swapped, bruteAnswer(k)) << "pose " << k;
+        EXPECT_EQ(collision::testBvhBvh(b, a, pose.inverse()), !bruteAnswer(k).empty())
+            << "pose " << k;
+        colliding += bruteAnswer(k).empty() ? 0 : 1;
+    }
+    EXPECT_GE(colliding, 4);
+    EXPECT_LE(colliding, 12);
+    // Touching grid cubes of different sizes (exact coordinates): face, edge and corner contact.
+    const TriangleMesh big = transformed(makeGridCube(4), 2, Vec3::Zero());
+    const TriangleMesh small = makeGridCube(8);
+    const Bvh<TypeParam> tree_big(big);
+    const Bvh<TypeParam> tree_small(small);
+    for (const Vec3& d : {Vec3(3, 0.5, 0.25), Vec3(3, 3, 0), Vec3(3, 3, 3), Vec3(0, -3, 0.5)}) {
+        const Pose pose{d, Quat::Identity()};
+        const auto expected = collision::intersectMeshMeshBruteForce(big, small, pose);
+        EXPECT_FALSE(expected.empty()) << d.transpose();
+        EXPECT_EQ(collision::intersectBvhBvh(tree_big, tree_small, pose), expected);
+        EXPECT_EQ(mirrored(collision::intersectBvhBvh(tree_small, tree_big, pose.inverse())),
+                  expected)
+            << d.transpose();
+    }
 }
 
 TEST(Bvh, LookupByNameCoversTheTypeList) {
@@ -524,6 +664,45 @@ TEST(Bvh, LookupByNameCoversTheTypeList) {
         EXPECT_EQ(a->testOverlap(*b, pose), !bruteAnswer(0).empty()) << name;
         EXPECT_GT(stats.bv_tests, 0);
     }
+}
+
+// The sample behind the measured Cv and Cp is the query's own work: recordTests gives as many
+// node and triangle pairs as the query's counters, and replaying them finds what the query found.
+// With one triangle per leaf every overlapping node pair either pushes two children or is a leaf
+// pair with one triangle test, so the overlaps are (Nv - 1) / 2 + Np exactly.
+TEST(Bvh, RecordedTestsReplayAsTheQueryMadeThem) {
+    int colliding = 0;
+    for (const std::string_view name : collision::bvhVolumeNames()) {
+        const auto a = collision::buildMeshBvh(name, torusA());
+        const auto b = collision::buildMeshBvh(name, torusB());
+        for (std::size_t k = 0; k < 6; ++k) {
+            const Pose& pose = differentialPoses()[k];
+            BvhQueryStats stats;
+            const auto pairs = a->intersect(*b, pose, &stats);
+            const collision::BvhTestSample sample = a->recordTests(*b, pose);
+            const auto nv = static_cast<std::int64_t>(sample.node_pairs.size());
+            const auto np = static_cast<std::int64_t>(sample.triangle_pairs.size());
+            EXPECT_EQ(nv, stats.bv_tests) << name << " pose " << k;
+            EXPECT_EQ(np, stats.triangle_tests) << name << " pose " << k;
+            EXPECT_EQ(a->replayVolumeTests(*b, pose, sample, 1), (nv - 1) / 2 + np)
+                << name << " pose " << k;
+            EXPECT_EQ(a->replayVolumeTests(*b, pose, sample, 3), 3 * ((nv - 1) / 2 + np));
+            EXPECT_EQ(a->replayTriangleTests(*b, pose, sample, 1),
+                      static_cast<std::int64_t>(pairs.size()))
+                << name << " pose " << k;
+            EXPECT_EQ(a->replayTriangleTests(*b, pose, sample, 2),
+                      2 * static_cast<std::int64_t>(pairs.size()));
+            colliding += pairs.empty() ? 0 : 1;
+        }
+        // A sample of other trees (an index past this tree's nodes) is refused, not read.
+        collision::BvhTestSample bad;
+        bad.node_pairs.push_back({a->nodeCount(), 0});
+        EXPECT_EQ(a->replayVolumeTests(*b, Pose{}, bad, 1), -1);
+        bad.triangle_pairs.push_back({0, b->triangleCount()});
+        EXPECT_EQ(a->replayTriangleTests(*b, Pose{}, bad, 1), -1);
+    }
+    EXPECT_GT(colliding, 0);
+    EXPECT_LT(colliding, 6 * 9);
 }
 
 TEST(Bvh, SweepReferenceEqualsBruteForce) {
@@ -548,6 +727,23 @@ TEST(Bvh, SweepReferenceEqualsBruteForce) {
         EXPECT_FALSE(brute.empty());
         EXPECT_EQ(collision::intersectMeshMeshSweep(cube, cube, p), brute);
     }
+    // The kinds of pose the large-mesh test uses: faces flush with the grids offset by half a
+    // cell, B turned about x (a quarter and a random angle: coplanar faces, crossing edges), and
+    // the random cube poses.
+    const TriangleMesh fine = makeGridCube(8);
+    std::vector<Pose> poses = {Pose{Vec3(2, 0.125, 0.125), Quat::Identity()},
+                               Pose{Vec3(2, 0, 0), aboutX(std::numbers::pi_v<Real> / 2)},
+                               Pose{Vec3(2, 0.7, -1.1), aboutX(Real(0.83))},
+                               Pose{Vec3(2, 2.2, 0.4), aboutX(Real(2.1))}};
+    for (const Pose& p : randomPoses(8, 4, 3.0)) poses.push_back(p);
+    int touching = 0;
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+        const auto brute = collision::intersectMeshMeshBruteForce(fine, fine, poses[k]);
+        EXPECT_EQ(collision::intersectMeshMeshSweep(fine, fine, poses[k]), brute) << "pose " << k;
+        touching += brute.empty() ? 0 : 1;
+    }
+    EXPECT_GE(touching, 4);
+    EXPECT_LE(touching, 7);
 }
 
 TEST(Bvh, EmptyMeshHasNoContacts) {

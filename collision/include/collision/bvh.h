@@ -290,6 +290,16 @@ struct BvhLevelPair {
     auto operator<=>(const BvhLevelPair&) const = default;
 };
 
+/// The node pairs and triangle pairs one all-pairs query tests, in the order it tests them
+/// (MeshBvh::recordTests): a sample of the real work of a query, for measuring the cost model's
+/// unit costs Cv and Cp by replaying it (MeshBvh::replayVolumeTests, replayTriangleTests).
+struct BvhTestSample {
+    std::vector<std::array<std::int32_t, 2>> node_pairs;  ///< (node of A, node of B), node indices
+    /// (triangle of A, triangle of B) as leaf-order positions (Bvh::leafTriangle), in [0,
+    /// triangleCount()) of each tree
+    std::vector<std::array<std::int32_t, 2>> triangle_pairs;
+};
+
 /// A Bvh of a volume type chosen at run time by name (CLI, scenes, benchmarks, mesh shapes).
 class MeshBvh {
 public:
@@ -336,6 +346,22 @@ public:
     virtual bool visitNearBox(const Vec3& box_min, const Vec3& box_max, const Mat3& rotation,
                               const Vec3& translation, TriangleVisitor& visitor,
                               BvhQueryStats* stats = nullptr) const = 0;
+    /// Every node pair and triangle pair that intersect(b, b_in_a) tests, in its order
+    /// (node_pairs.size() is its Nv, triangle_pairs.size() its Np). The same traversal with a
+    /// recorder; the queries themselves record nothing. `b` must hold the same volume type
+    /// (asserted; empty if not). Memory O(Nv + Np).
+    virtual BvhTestSample recordTests(const MeshBvh& b, const Pose& b_in_a) const = 0;
+    /// Runs the node-volume tests of `sample`, `repeats` times, exactly as the traversal does them
+    /// (B's node volume moved into A's frame once per run of pairs with the same B node, then the
+    /// overlap test, with its slack) and nothing else, for timing Cv. Returns the number of tests
+    /// that found an overlap (all repeats); -1 when an index of `sample` is out of range.
+    virtual std::int64_t replayVolumeTests(const MeshBvh& b, const Pose& b_in_a,
+                                           const BvhTestSample& sample, int repeats) const = 0;
+    /// Runs the triangle tests of `sample`, `repeats` times, as the traversal does them (B's
+    /// triangle moved into A's frame, then the exact triangle-triangle test), for timing Cp.
+    /// Returns the number of intersecting pairs (all repeats); -1 when an index is out of range.
+    virtual std::int64_t replayTriangleTests(const MeshBvh& b, const Pose& b_in_a,
+                                             const BvhTestSample& sample, int repeats) const = 0;
     /// The cut of the tree at `depth` (root 0): every node at that depth and every leaf above
     /// it, in depth-first order, so their subtrees partition the triangles. Empty for depth < 0
     /// or an empty tree; a depth beyond the leaves gives the leaves. O(n).
