@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "engine/scene.h"
 #include "engine/world.h"
@@ -108,6 +109,50 @@ TEST(CcdPolicy, SpinningBarNeverPassesTheWallWithConservativeAdvancement) {
     }
     EXPECT_GE(hits, 2);
     RecordProperty("wall_hits", hits);
+}
+
+// More than two bodies: the 5 cm sphere at 1000 m/s (33 m per step) sweeps through two 1 cm
+// plates, 0.5 m apart, within one step. The earliest time of impact is the first plate's, so
+// the sphere must stop there and bounce back; it must never reach either plate.
+//
+//      -20 m         x = 0     x = 0.5
+//   ball o -->        |         |
+//                  plate 1   plate 2
+// Both orders of insertion (the first plate added before or after the second) are run, so the
+// outcome does not hinge on body ids.
+TEST(CcdPolicy, FastSphereStopsAtTheFirstOfTwoPlates) {
+    for (const bool near_first : {true, false}) {
+        Scene scene = loadScene(kScenes / "tunnel_sphere_ccd.yaml");
+        ASSERT_EQ(scene.bodies.size(), 2u);
+        Body near_plate = scene.bodies[0];
+        Body far_plate = scene.bodies[0];
+        far_plate.name = "plate2";
+        far_plate.position.x() = 0.5;
+        const Body ball = scene.bodies[1];
+        scene.bodies = near_first ? std::vector<Body>{near_plate, far_plate, ball}
+                                  : std::vector<Body>{far_plate, near_plate, ball};
+        const BodyId near_id = near_first ? 0 : 1;
+        World world = makeWorld(scene);
+        const Real speed = world.bodies()[2].velocity().norm();
+        ASSERT_EQ(speed, 1000);
+        int hits = 0;
+        for (int i = 0; i < 300; ++i) {
+            world.step();
+            const Body& b = world.bodies()[2];
+            // The sphere's surface never crosses the first plate's face at x = -0.005.
+            ASSERT_LT(b.position.x() + 0.05, -0.005)
+                << "step " << i << " near_first " << near_first;
+            if (!world.toiEvents().empty()) {
+                // The earliest event of the step is with the first plate.
+                const ToiEvent& e = world.toiEvents()[0];
+                EXPECT_EQ(e.a, near_id) << "step " << i;
+                EXPECT_EQ(e.b, 2) << "step " << i;
+                ++hits;
+            }
+            EXPECT_NEAR(b.velocity().norm(), speed, 1e-9 * speed) << "step " << i;
+        }
+        EXPECT_GE(hits, 5) << near_first;
+    }
 }
 
 TEST(CcdPolicy, RunsAreBitIdentical) {
