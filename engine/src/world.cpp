@@ -447,7 +447,11 @@ void World::resolveContinuous() {
     // + n.((I_a^-1 (r_a x n)) x r_a) + n.((I_b^-1 (r_b x n)) x r_b)) (Mirtich & Canny 1995;
     // Baraff, SIGGRAPH course notes, "Rigid body simulation II", §8).
     for (const ToiEvent& e : toi_events_) {
-        if (e.t != swept_[e.a].clamp_t && e.t != swept_[e.b].clamp_t) continue;
+        // The earliest event of a moving body: a static body's clamp_t is just its own first
+        // event, and a body stopped earlier by another event is not at this one's pose.
+        const bool earliest_a = swept_[e.a].moving && e.t == swept_[e.a].clamp_t;
+        const bool earliest_b = swept_[e.b].moving && e.t == swept_[e.b].clamp_t;
+        if (!earliest_a && !earliest_b) continue;
         Body& a = bodies_[e.a];
         Body& b = bodies_[e.b];
         const Vec3 ra = e.point - a.position;

@@ -2,7 +2,8 @@
 // scenes: with ccd off the fast sphere and the spinning bar pass through their static plate /
 // wall, with conservative advancement they never do; the first time of impact matches the
 // closed form; elastic resolution keeps the speed; runs are bit-identical; ccd off does no
-// CCD work at all.
+// CCD work at all. With three bodies: the first of two plates stops a fast sphere, and a body
+// stopped early gets no impulse from its later impacts.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -153,6 +154,56 @@ TEST(CcdPolicy, FastSphereStopsAtTheFirstOfTwoPlates) {
         }
         EXPECT_GE(hits, 5) << near_first;
     }
+}
+
+// A body the stage stopped at an early time of impact is not at its later ones: they must not
+// push it. Regression: the impulse loop took an event as "the earliest for one of its bodies"
+// when it was the earliest for the *static* body, whose stop time is just its own event's. The
+// ball (5 cm, 600 m/s along x and y, 20 m per step each) is stopped at the wall at t = 0.497 of
+// the step; its straight sweep also meets the ceiling, which lies past the wall, at t = 0.747,
+// 5 m away from where it stopped. That event still got an elastic impulse with a 5 m lever arm:
+// -240 rad/s of spin about z and v_y 600 -> 599.952 m/s from a ceiling it never touched.
+//
+//            ceiling (y = 5, x in [0.5, 20.5])
+//     |    ==========
+//     |   /
+//     |  /  (straight sweep, cut at the wall)
+//     | /
+//   wall x = 0
+//    o ball from (-10, -10)
+TEST(CcdPolicy, StoppedBodyGetsNoImpulseFromALaterImpactWithAStaticBody) {
+    WorldSettings settings;
+    settings.bounds = collision::Aabb{Vec3::Constant(-60), Vec3::Constant(60)};
+    settings.time_step = Real(1) / 30;
+    settings.ccd = CcdMethod::ConservativeAdvancement;
+    MassProperties slab_mass;
+    slab_mass.mass = 1;
+    Body wall = makeBody("wall", collision::Shape::box(Vec3(0.005, 40, 40)), slab_mass);
+    setStatic(wall);
+    Body ceiling = makeBody("ceiling", collision::Shape::box(Vec3(10, 0.005, 10)), slab_mass);
+    ceiling.position = Vec3(10.5, 5, 0);
+    setStatic(ceiling);
+    MassProperties ball_mass;
+    ball_mass.mass = 4;
+    ball_mass.inertia = Mat3::Identity() * (Real(0.4) * 4 * 0.05 * 0.05);
+    Body ball = makeBody("ball", collision::Shape::sphere(0.05), ball_mass);
+    ball.position = Vec3(-10, -10, 0);
+    ball.linear_momentum = ball.mass * Vec3(600, 600, 0);
+    World world(settings);
+    world.addBody(wall);
+    world.addBody(ceiling);
+    world.addBody(ball);
+    world.detect();
+    world.step();
+    ASSERT_EQ(world.toiEvents().size(), 2u);
+    EXPECT_EQ(world.toiEvents()[0].a, 0);  // the wall first
+    EXPECT_EQ(world.toiEvents()[1].a, 1);  // the ceiling later, on the uncut sweep
+    const Body& b = world.bodies()[2];
+    EXPECT_NEAR(b.position.x(), -0.055, 1e-3);  // stopped at the wall
+    // Only the wall's impulse: v_x reversed, v_y and the (zero) spin untouched.
+    EXPECT_NEAR(b.velocity().x(), -600, 1e-9 * 600);
+    EXPECT_NEAR(b.velocity().y(), 600, 1e-9 * 600);
+    EXPECT_LE(b.angularVelocity().norm() * 0.05, 1e-9 * 600);
 }
 
 TEST(CcdPolicy, RunsAreBitIdentical) {
