@@ -333,8 +333,9 @@ void World::resolveContinuous() {
     //    that still hits at t = 0 while its witness points separate (stopping it would freeze
     //    it).
     // 3. Each body is stopped at its earliest accepted time of impact (the rest of its step is
-    //    dropped), then each event that is the earliest for one of its bodies gets an impulse
-    //    (restitution kCcdRestitution, frictionless) at the witness midpoint, in (t, a, b) order.
+    //    dropped), then each event that is the earliest for one of its moving bodies gets an
+    //    impulse (restitution kCcdRestitution with response none, else the pair's;
+    //    frictionless) at the witness midpoint, in (t, a, b) order.
     // Limitation: one round. A body stopped early is not re-tested against the bodies whose
     // sweeps it no longer blocks, and a third body's sweep is not re-tested against the stopped
     // pose (the discrete pipeline still sees any overlap that results).
