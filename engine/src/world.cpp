@@ -340,8 +340,9 @@ void World::resolveContinuous() {
     //    that still hits at t = 0 while its witness points separate (stopping it would freeze
     //    it).
     // 3. Each body is stopped at its earliest accepted time of impact (the rest of its step is
-    //    dropped), then each event that is the earliest for one of its bodies gets an impulse
-    //    (restitution kCcdRestitution, frictionless) at the witness midpoint, in (t, a, b) order.
+    //    dropped), then each event that is the earliest for one of its moving bodies gets an
+    //    impulse (restitution kCcdRestitution with response none, else the pair's;
+    //    frictionless) at the witness midpoint, in (t, a, b) order.
     // Limitation: one round. A body stopped early is not re-tested against the bodies whose
     // sweeps it no longer blocks, and a third body's sweep is not re-tested against the stopped
     // pose (the discrete pipeline still sees any overlap that results).
@@ -479,7 +480,11 @@ void World::resolveContinuous() {
     // + n.((I_a^-1 (r_a x n)) x r_a) + n.((I_b^-1 (r_b x n)) x r_b)) (Mirtich & Canny 1995;
     // Baraff, SIGGRAPH course notes, "Rigid body simulation II", §8).
     for (const ToiEvent& e : toi_events_) {
-        if (e.t != swept_[e.a].clamp_t && e.t != swept_[e.b].clamp_t) continue;
+        // The earliest event of a moving body: a static body's clamp_t is just its own first
+        // event, and a body stopped earlier by another event is not at this one's pose.
+        const bool earliest_a = swept_[e.a].moving && e.t == swept_[e.a].clamp_t;
+        const bool earliest_b = swept_[e.b].moving && e.t == swept_[e.b].clamp_t;
+        if (!earliest_a && !earliest_b) continue;
         Body& a = bodies_[e.a];
         Body& b = bodies_[e.b];
         const Vec3 ra = e.point - a.position;

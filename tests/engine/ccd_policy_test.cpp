@@ -2,7 +2,8 @@
 // scenes: with ccd off the fast sphere and the spinning bar pass through their static plate /
 // wall, with conservative advancement they never do; the first time of impact matches the
 // closed form; elastic resolution keeps the speed; runs are bit-identical; ccd off does no
-// CCD work at all.
+// CCD work at all. With three bodies: the first of two plates stops a fast sphere, and a body
+// stopped early gets no impulse from its later impacts.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -148,6 +149,98 @@ TEST(CcdPolicy, ToleranceAndTargetGapMoveTheFirstStopEarlier) {
     // (0.1 + 0.001) of the bar's bounding radius (1 m), so it is at most 0.101 / 45 s early.
     EXPECT_GE(loose, exact - 0.101 / 45 - 5e-7);
     EXPECT_GE(far, exact - 0.101 / 45 - 5e-7);
+// More than two bodies: the 5 cm sphere at 1000 m/s (33 m per step) sweeps through two 1 cm
+// plates, 0.5 m apart, within one step. The earliest time of impact is the first plate's, so
+// the sphere must stop there and bounce back; it must never reach either plate.
+//
+//      -20 m         x = 0     x = 0.5
+//   ball o -->        |         |
+//                  plate 1   plate 2
+// Both orders of insertion (the first plate added before or after the second) are run, so the
+// outcome does not hinge on body ids.
+TEST(CcdPolicy, FastSphereStopsAtTheFirstOfTwoPlates) {
+    for (const bool near_first : {true, false}) {
+        Scene scene = loadScene(kScenes / "tunnel_sphere_ccd.yaml");
+        ASSERT_EQ(scene.bodies.size(), 2u);
+        Body near_plate = scene.bodies[0];
+        Body far_plate = scene.bodies[0];
+        far_plate.name = "plate2";
+        far_plate.position.x() = 0.5;
+        const Body ball = scene.bodies[1];
+        scene.bodies = near_first ? std::vector<Body>{near_plate, far_plate, ball}
+                                  : std::vector<Body>{far_plate, near_plate, ball};
+        const BodyId near_id = near_first ? 0 : 1;
+        World world = makeWorld(scene);
+        const Real speed = world.bodies()[2].velocity().norm();
+        ASSERT_EQ(speed, 1000);
+        int hits = 0;
+        for (int i = 0; i < 300; ++i) {
+            world.step();
+            const Body& b = world.bodies()[2];
+            // The sphere's surface never crosses the first plate's face at x = -0.005.
+            ASSERT_LT(b.position.x() + 0.05, -0.005)
+                << "step " << i << " near_first " << near_first;
+            if (!world.toiEvents().empty()) {
+                // The earliest event of the step is with the first plate.
+                const ToiEvent& e = world.toiEvents()[0];
+                EXPECT_EQ(e.a, near_id) << "step " << i;
+                EXPECT_EQ(e.b, 2) << "step " << i;
+                ++hits;
+            }
+            EXPECT_NEAR(b.velocity().norm(), speed, 1e-9 * speed) << "step " << i;
+        }
+        EXPECT_GE(hits, 5) << near_first;
+    }
+}
+
+// A body the stage stopped at an early time of impact is not at its later ones: they must not
+// push it. Regression: the impulse loop took an event as "the earliest for one of its bodies"
+// when it was the earliest for the *static* body, whose stop time is just its own event's. The
+// ball (5 cm, 600 m/s along x and y, 20 m per step each) is stopped at the wall at t = 0.497 of
+// the step; its straight sweep also meets the ceiling, which lies past the wall, at t = 0.747,
+// 5 m away from where it stopped. That event still got an elastic impulse with a 5 m lever arm:
+// -240 rad/s of spin about z and v_y 600 -> 599.952 m/s from a ceiling it never touched.
+//
+//            ceiling (y = 5, x in [0.5, 20.5])
+//     |    ==========
+//     |   /
+//     |  /  (straight sweep, cut at the wall)
+//     | /
+//   wall x = 0
+//    o ball from (-10, -10)
+TEST(CcdPolicy, StoppedBodyGetsNoImpulseFromALaterImpactWithAStaticBody) {
+    WorldSettings settings;
+    settings.bounds = collision::Aabb{Vec3::Constant(-60), Vec3::Constant(60)};
+    settings.time_step = Real(1) / 30;
+    settings.ccd = CcdMethod::ConservativeAdvancement;
+    MassProperties slab_mass;
+    slab_mass.mass = 1;
+    Body wall = makeBody("wall", collision::Shape::box(Vec3(0.005, 40, 40)), slab_mass);
+    setStatic(wall);
+    Body ceiling = makeBody("ceiling", collision::Shape::box(Vec3(10, 0.005, 10)), slab_mass);
+    ceiling.position = Vec3(10.5, 5, 0);
+    setStatic(ceiling);
+    MassProperties ball_mass;
+    ball_mass.mass = 4;
+    ball_mass.inertia = Mat3::Identity() * (Real(0.4) * 4 * 0.05 * 0.05);
+    Body ball = makeBody("ball", collision::Shape::sphere(0.05), ball_mass);
+    ball.position = Vec3(-10, -10, 0);
+    ball.linear_momentum = ball.mass * Vec3(600, 600, 0);
+    World world(settings);
+    world.addBody(wall);
+    world.addBody(ceiling);
+    world.addBody(ball);
+    world.detect();
+    world.step();
+    ASSERT_EQ(world.toiEvents().size(), 2u);
+    EXPECT_EQ(world.toiEvents()[0].a, 0);  // the wall first
+    EXPECT_EQ(world.toiEvents()[1].a, 1);  // the ceiling later, on the uncut sweep
+    const Body& b = world.bodies()[2];
+    EXPECT_NEAR(b.position.x(), -0.055, 1e-3);  // stopped at the wall
+    // Only the wall's impulse: v_x reversed, v_y and the (zero) spin untouched.
+    EXPECT_NEAR(b.velocity().x(), -600, 1e-9 * 600);
+    EXPECT_NEAR(b.velocity().y(), 600, 1e-9 * 600);
+    EXPECT_LE(b.angularVelocity().norm() * 0.05, 1e-9 * 600);
 }
 
 TEST(CcdPolicy, RunsAreBitIdentical) {

@@ -1,10 +1,12 @@
 // tests/engine/dynamics_test.cpp -- the integrators against closed forms and conservation laws:
 // projectile positions, |L| of a free tumbling asymmetric box, energy and orientation error
-// orders (explicit Euler 1, semi-implicit Euler with split rotation 2, RK4 4), thin-rod stability.
+// orders (explicit Euler 1, semi-implicit Euler with split rotation 2, RK4 4), thin-rod stability,
+// and the torque-free symmetric top's body-frame precession against its closed form.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 #include "engine/scene.h"
@@ -15,8 +17,8 @@ namespace {
 
 using collision::Shape;
 
-constexpr Integrator kAllIntegrators[] = {Integrator::ExplicitEuler,
-                                          Integrator::SemiImplicitEuler, Integrator::Rk4};
+constexpr Integrator kAllIntegrators[] = {Integrator::ExplicitEuler, Integrator::SemiImplicitEuler,
+                                          Integrator::Rk4};
 
 MassProperties boxMass(const Vec3& h, Real mass) {
     MassProperties m;
@@ -83,10 +85,10 @@ TEST(Integrators, ProjectileFollowsEachClosedForm) {
         world.detect();
         for (int i = 0; i < n; ++i) world.step();
         const Real nn = n;
-        const Real expected_y = integ == Integrator::ExplicitEuler ? 500 + g * dt * dt * nn * (nn - 1) / 2
-                                : integ == Integrator::SemiImplicitEuler
-                                    ? 500 + g * dt * dt * nn * (nn + 1) / 2
-                                    : 500 + g * (nn * dt) * (nn * dt) / 2;
+        const Real expected_y =
+            integ == Integrator::ExplicitEuler       ? 500 + g * dt * dt * nn * (nn - 1) / 2
+            : integ == Integrator::SemiImplicitEuler ? 500 + g * dt * dt * nn * (nn + 1) / 2
+                                                     : 500 + g * (nn * dt) * (nn * dt) / 2;
         const Body& r = world.bodies()[0];
         SCOPED_TRACE(std::string(integratorName(integ)));
         EXPECT_NEAR(r.position.y(), expected_y, 1e-9);
@@ -154,8 +156,9 @@ TEST(Integrators, ErrorOrders) {
                                                                     : 4;
         const Real expected = std::pow(Real(2), order);
         SCOPED_TRACE(std::string(integratorName(integ)));
-        RecordProperty(std::string(integratorName(integ)) + "_ratios",
-                       std::to_string(err[0] / err[1]) + " " + std::to_string(energy[0] / energy[1]));
+        RecordProperty(
+            std::string(integratorName(integ)) + "_ratios",
+            std::to_string(err[0] / err[1]) + " " + std::to_string(energy[0] / energy[1]));
         EXPECT_NEAR(err[0] / err[1], expected, 0.15 * expected);
         EXPECT_NEAR(energy[0] / energy[1], expected, 0.15 * expected);
     }
@@ -182,6 +185,111 @@ TEST(Integrators, ThinRodSpinningFastKeepsItsEnergyWithSemiImplicitEuler) {
         }
         EXPECT_LT(drift, 1e-9) << l_long;
         EXPECT_EQ(world.bodies()[0].angular_momentum, b.angular_momentum);
+    }
+}
+
+// The torque-free symmetric top (I1 = I2 != I3, symmetry axis = body z): Euler's equations
+// I1 w1' = (I1 - I3) w2 w3, I1 w2' = (I3 - I1) w3 w1, I3 w3' = 0 give, in the body frame,
+//   w3 = const,  (w1 + i w2)(t) = (w1 + i w2)(0) exp(i Omega t),  Omega = (I3 - I1) / I1 * w3
+// (Landau & Lifshitz, Mechanics §33; Goldstein, Classical Mechanics §5.6). The stored world L
+// never changes without torque, so the existing |L| checks hold by construction; this one reads
+// w in the body frame, I^-1 R^T L, which only follows the closed form if the integrator turns R
+// the right way (the gyroscopic term): a wrong-sign, frozen or body/world-swapped update is off
+// by O(|w|) after |Omega| T = 3.6 (oblate) or 4.8 (prolate) rad.
+struct TopCase {
+    const char* name;
+    Vec3 half_extents;  // h.x = h.y: I1 = I2
+    Vec3 w_body;        // rad/s, body frame at t = 0
+};
+
+Vec3 bodyOmega(const Body& b) {
+    return b.inv_inertia_body * (b.orientation.conjugate() * b.angular_momentum);
+}
+
+TEST(Integrators, TorqueFreeSymmetricTopPrecessesAtTheClosedFormRate) {
+    const TopCase cases[] = {{"oblate", Vec3(0.5, 0.5, 0.2), Vec3(1, 0, 2.5)},
+                             {"prolate", Vec3(0.2, 0.2, 0.6), Vec3(1, 0.5, 3)}};
+    const Real t_end = 2;
+    const Real eps = std::numeric_limits<Real>::epsilon();
+    const Quat q0(Eigen::AngleAxis<Real>(0.7, Vec3(1, -2, 0.5).normalized()));
+    for (const TopCase& tc : cases) {
+        for (const Integrator integ : kAllIntegrators) {
+            // Explicit Euler runs at a smaller step so that its bound stays well below the
+            // O(1) error of a wrong update; the others at 1/240 s (RK4 at 1/960 would reach
+            // rounding, and its error ratio would mean nothing).
+            const int base_steps_per_s = integ == Integrator::ExplicitEuler ? 960 : 240;
+            Real err[2];
+            Real energy_err[2];
+            Real l3_err[2];
+            Real tol[2];
+            Vec3 expected = Vec3::Zero();
+            Vec3 reversed = Vec3::Zero();  // the closed form with -Omega
+            for (int k = 0; k < 2; ++k) {
+                const int steps_per_s = base_steps_per_s << k;
+                const Real dt = Real(1) / steps_per_s;
+                World world(openSpace(integ, dt));
+                Body b = makeBody("top", Shape::box(tc.half_extents), boxMass(tc.half_extents, 3));
+                const Real i1 = b.inertia_body(0, 0);
+                const Real i3 = b.inertia_body(2, 2);
+                ASSERT_EQ(b.inertia_body(1, 1), i1);
+                ASSERT_TRUE(b.inertia_body.isDiagonal(0));
+                ASSERT_GT(std::abs(i3 - i1), 0.1 * i1);
+                b.orientation = q0;
+                b.angular_momentum = q0 * (b.inertia_body * tc.w_body);
+                world.addBody(b);
+                world.detect();
+                const Vec3 l_body0 = b.inertia_body * tc.w_body;
+                const Real e0 = Real(0.5) * tc.w_body.dot(l_body0);
+                const int n = steps_per_s * static_cast<int>(t_end);
+                for (int i = 0; i < n; ++i) world.step();
+                const Body& r = world.bodies()[0];
+                const Real big_omega = (i3 - i1) / i1 * tc.w_body.z();
+                const Real c = std::cos(big_omega * t_end), s = std::sin(big_omega * t_end);
+                expected = Vec3(c * tc.w_body.x() - s * tc.w_body.y(),
+                                s * tc.w_body.x() + c * tc.w_body.y(), tc.w_body.z());
+                reversed = Vec3(c * tc.w_body.x() + s * tc.w_body.y(),
+                                -s * tc.w_body.x() + c * tc.w_body.y(), tc.w_body.z());
+                const Vec3 w = bodyOmega(r);
+                const Vec3 l_body = r.inertia_body * w;
+                err[k] = (w - expected).norm() / tc.w_body.norm();
+                energy_err[k] = std::abs(Real(0.5) * w.dot(l_body) - e0) / e0;
+                l3_err[k] = std::abs(l_body.z() - l_body0.z()) / l_body0.norm();
+                // |L| in the body frame: R^T is a rotation, so only rounding.
+                EXPECT_NEAR(l_body.norm(), l_body0.norm(), 64 * eps * l_body0.norm());
+                // Tolerance from the order p and the step: K (rate dt)^p (rate T), rate = the
+                // fastest rate of the motion (|w| or the body's turn about L, |L| / I1), K the
+                // local error constant of one step: 1/2 for forward Euler (the y'' dt^2 / 2
+                // Taylor remainder), 1/120 for RK4 (the dt^5 / 5! remainder; the method's own
+                // constant is smaller). Semi-implicit Euler's splitting is exact for a symmetric
+                // body (one principal flow vanishes, the other and the turn about L are the
+                // exact solution: world.cpp), so only rounding: 16 eps per step.
+                const Real rate = std::max(tc.w_body.norm(), l_body0.norm() / i1);
+                tol[k] = integ == Integrator::ExplicitEuler ? Real(0.5) * (rate * dt) * rate * t_end
+                         : integ == Integrator::Rk4 ? std::pow(rate * dt, 4) * rate * t_end / 120
+                                                    : 16 * eps * n;
+            }
+            SCOPED_TRACE(std::string(tc.name) + " " + std::string(integratorName(integ)));
+            char text[160];
+            std::snprintf(text, sizeof text,
+                          "w %.3e %.3e  E %.3e %.3e  L3 %.3e %.3e  tol %.3e %.3e", err[0], err[1],
+                          energy_err[0], energy_err[1], l3_err[0], l3_err[1], tol[0], tol[1]);
+            RecordProperty(std::string(tc.name) + "_" + std::string(integratorName(integ)), text);
+            for (int k = 0; k < 2; ++k) {
+                EXPECT_LE(err[k], tol[k]) << "dt 1/" << (base_steps_per_s << k);
+                EXPECT_LE(energy_err[k], tol[k]) << "dt 1/" << (base_steps_per_s << k);
+                EXPECT_LE(l3_err[k], tol[k]) << "dt 1/" << (base_steps_per_s << k);
+            }
+            // The test can fail: no precession (w frozen at w0) or precession the wrong way
+            // round is off by far more than the tolerance.
+            EXPECT_GT((tc.w_body - expected).norm() / tc.w_body.norm(), 4 * tol[0]);
+            EXPECT_GT((reversed - expected).norm() / tc.w_body.norm(), 4 * tol[0]);
+            // Halving the step divides the error by 2^p (explicit 1, RK4 4): the integrators
+            // converge to the closed form, not to some other motion.
+            if (integ != Integrator::SemiImplicitEuler) {
+                const Real expected_ratio = integ == Integrator::ExplicitEuler ? 2 : 16;
+                EXPECT_NEAR(err[0] / err[1], expected_ratio, 0.15 * expected_ratio);
+            }
+        }
     }
 }
 

@@ -2,7 +2,8 @@
 // spheres exchange velocities with momentum exact and energy kept; kinetic energy never grows
 // for restitution <= 1 in a long random box pile; the shipped 5-box stack rests without drift
 // or jitter; a 1:1000 mass-ratio stack holds; runs are bit-identical; response none costs
-// nothing (no solver).
+// nothing (no solver); a dropped ball rebounds at e times its impact speed and a sliding box
+// stops at the Coulomb distance v0^2 / (2 mu g) (closed forms).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -247,6 +248,149 @@ TEST(Response, RunsAreBitIdenticalAndNoneMeansNoSolver) {
     for (int i = 0; i < 10; ++i) c.step();
     EXPECT_EQ(c.lastStats().contact_points, 0);
     EXPECT_EQ(c.lastStats().response_s, 0);
+}
+
+// A static floor slab whose top face is y = 0 (the shape scenes/bounce.yaml and stack.yaml use).
+Body staticFloor(Real restitution, Real friction) {
+    const Vec3 h(20, 0.25, 20);
+    Body floor = makeBody("floor", Shape::box(h), boxMass(h, 1));
+    floor.position = Vec3(0, -0.25, 0);
+    floor.restitution = restitution;
+    floor.friction = friction;
+    setStatic(floor);
+    return floor;
+}
+
+// Restitution, closed form: a ball dropped from rest with its bottom h above the floor meets it
+// at v = sqrt(2 g h) and leaves at e v (Newton's law of restitution; the solver's velocity target
+// -e v_n, Catto 2006), then rises to e^2 h. The pair uses the larger restitution, so the floor has
+// 0 and the ball e. Tolerances, from the step (semi-implicit Euler, dt = 1/240 s):
+// - rebound = e * the approach speed the solver saw, to 1e-12: one contact point, no tangential
+//   motion, so the sequential impulses converge exactly;
+// - that approach speed = sqrt(2 g h) within 2 g dt: the contact is found up to one step late
+//   (at most v dt deep: the ball gains at most g dt more), semi-implicit Euler arrives g dt / 2
+//   slow, and the solver sees the velocity after this step's gravity kick (+ g dt);
+// - apex = e^2 h within 2 e^2 h (2 g dt / v) (the squared speed error) + e v dt (the bounce
+//   starts up to one step of travel off the floor);
+// - the ball never sinks deeper than one step of travel at the impact speed, v dt (the
+//   speculative margin, 2 % of the radius, is less than the 1.8 cm a step covers here).
+// Measured: approach 4.455375 m/s against 4.429447 (0.63 g dt); rebound ratio exactly e;
+// apex 0.25543 (e = 0.5) and 0.65279 (e = 0.8) m; deepest 2.5 mm before the first bounce.
+TEST(Response, DroppedBallReboundsAtRestitutionTimesImpactSpeed) {
+    const Real g = 9.81;
+    const Real h = 1;
+    const Real r = 0.2;
+    for (const Real e : {Real(0), Real(0.5), Real(0.8)}) {
+        SCOPED_TRACE("e = " + std::to_string(e));
+        WorldSettings s = impulseWorld(50);
+        s.gravity = Vec3(0, -g, 0);
+        s.time_step = Real(1) / 240;
+        const Real dt = s.time_step;
+        World world(s);
+        world.addBody(staticFloor(0, 0.5));
+        Body ball = makeBody("ball", Shape::sphere(r), sphereMass(r, 1));
+        ball.position = Vec3(0, r + h, 0);
+        ball.restitution = e;
+        ball.friction = 0.5;
+        world.addBody(ball);
+        world.detect();
+        const Real v_exact = std::sqrt(2 * g * h);
+        Real v_before = 0;  // velocity at the end of the step before the bounce
+        Real v_after = 0;
+        int bounce_step = -1;
+        Real apex = 0;    // highest bottom after the first bounce, before the second
+        Real lowest = h;  // lowest bottom over the whole run
+        for (int i = 0; i < 600; ++i) {
+            const Real v_prev = world.bodies()[1].velocity().y();
+            world.step();
+            const Body& b = world.bodies()[1];
+            if (bounce_step < 0 && b.velocity().y() > v_prev) {
+                bounce_step = i;
+                v_before = v_prev;
+                v_after = b.velocity().y();
+            }
+            if (bounce_step >= 0 && (e == 0 || b.velocity().y() > -v_after)) {
+                apex = std::max(apex, b.position.y() - r);
+            }
+            lowest = std::min(lowest, b.position.y() - r);
+        }
+        ASSERT_GE(bounce_step, 0);
+        const Real v_impact = -(v_before - g * dt);  // what the solver saw (after the kick)
+        char text[128];
+        std::snprintf(text, sizeof text,
+                      "impact %.6f exact %.6f rebound %.9f apex %.5f lowest %.5f", v_impact,
+                      v_exact, v_after, apex, lowest);
+        RecordProperty("e_" + std::to_string(e), text);
+        EXPECT_NEAR(v_impact, v_exact, 2 * g * dt);
+        EXPECT_NEAR(v_after, e * v_impact, 1e-12 * v_impact);
+        EXPECT_NEAR(apex, e * e * h, 2 * e * e * h * (2 * g * dt / v_exact) + e * v_exact * dt);
+        EXPECT_GT(lowest, -v_exact * dt);
+        if (e == 0) {
+            // Perfectly inelastic: it stays on the floor.
+            EXPECT_LT(world.bodies()[1].velocity().norm(), 1e-3);
+            EXPECT_LT(apex, 0.005 * r);  // at most the solver's slop above the face
+        }
+    }
+}
+
+// Coulomb friction, closed form: a box sliding at v0 on a level floor decelerates at a = mu g and
+// stops after d = v0^2 / (2 mu g), t = v0 / (mu g); with mu = 0 it keeps v0. The pair uses
+// sqrt(mu_a mu_b), so floor and box both have mu. Semi-implicit Euler moves by the already
+// decelerated velocity, so its distance is d - v0 dt / 2 exactly, up to the last partial step
+// (a dt^2). Tolerances: d within v0 dt (one step of travel); the discrete form within a dt^2; the
+// stopping step within one step of t / dt. Measured at dt = 1/240 s, v0 = 3 m/s: d - v0^2/(2 mu g)
+// = -6.25e-3 m for mu = 0.2, 0.5, 1 (= -v0 dt / 2); mu = 0 slides 9.000000 m in 3 s.
+TEST(Response, SlidingBoxStopsAtTheCoulombDistance) {
+    const Real g = 9.81;
+    const Real v0 = 3;
+    const Vec3 hb(0.3, 0.1, 0.3);
+    const Real t_end = 3;
+    for (const Real mu : {Real(0), Real(0.2), Real(0.5), Real(1)}) {
+        SCOPED_TRACE("mu = " + std::to_string(mu));
+        WorldSettings s = impulseWorld(50);
+        s.gravity = Vec3(0, -g, 0);
+        s.time_step = Real(1) / 240;
+        const Real dt = s.time_step;
+        World world(s);
+        world.addBody(staticFloor(0, mu));
+        Body box = makeBody("box", Shape::box(hb), boxMass(hb, 2));
+        box.position = Vec3(-10, hb.y(), 0);
+        box.linear_momentum = box.mass * Vec3(v0, 0, 0);
+        box.restitution = 0;
+        box.friction = mu;
+        world.addBody(box);
+        world.detect();
+        const int n = static_cast<int>(std::lround(t_end / dt));
+        int stop_step = -1;
+        Real max_tilt = 0;
+        for (int i = 0; i < n; ++i) {
+            world.step();
+            const Body& b = world.bodies()[1];
+            max_tilt = std::max(max_tilt, b.orientation.angularDistance(Quat::Identity()));
+            if (stop_step < 0 && b.velocity().x() < 1e-6) stop_step = i;
+        }
+        const Body& b = world.bodies()[1];
+        const Real d = b.position.x() + 10;
+        char text[128];
+        std::snprintf(text, sizeof text, "d %.6f stop step %d v %.3e tilt %.2e y %.6f", d,
+                      stop_step, b.velocity().norm(), max_tilt, b.position.y());
+        RecordProperty("mu_" + std::to_string(mu), text);
+        EXPECT_LT(max_tilt, 1e-9);                               // it slides, it does not tip
+        EXPECT_NEAR(b.position.y(), hb.y(), 0.005 * hb.norm());  // on the floor (slop)
+        if (mu == 0) {
+            EXPECT_EQ(stop_step, -1);
+            EXPECT_NEAR(b.velocity().x(), v0, 1e-12 * v0);
+            EXPECT_NEAR(d, v0 * t_end, 1e-9 * v0 * t_end);
+            continue;
+        }
+        const Real a = mu * g;
+        const Real d_exact = v0 * v0 / (2 * a);
+        ASSERT_LT(v0 / a, t_end);  // it has time to stop
+        EXPECT_NEAR(d, d_exact, v0 * dt);
+        EXPECT_NEAR(d, d_exact - v0 * dt / 2, a * dt * dt);
+        EXPECT_NEAR(stop_step + 1, v0 / a / dt, 1.0);
+        EXPECT_LT(b.velocity().norm(), 1e-9);  // and stays stopped (static friction)
+    }
 }
 
 TEST(Response, SceneKeys) {

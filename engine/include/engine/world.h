@@ -44,8 +44,15 @@ std::string ccdMethodNames();
 
 /// Contact response of the step (world.response in scene files).
 enum class Response : std::uint8_t {
-    None,     ///< detection only: bodies pass through each other (the bounds still reflect)
-    Impulse,  ///< sequential impulses at contact() manifolds: restitution, friction, resting
+    /// No contact solver: discrete contacts are detected only, so overlapping bodies pass
+    /// through each other (the bounds still reflect). With ccd on, a pair the CCD stage stops
+    /// at its time of impact while approaching still gets one elastic, frictionless impulse
+    /// (restitution 1, the pair's own restitution ignored), so it bounces back instead of
+    /// passing.
+    None,
+    /// Sequential impulses at contact() manifolds: restitution, friction, resting; the CCD
+    /// stage's impulse uses the pair's restitution (the larger of the two), frictionless.
+    Impulse,
 };
 std::string_view responseName(Response response);  ///< "none", "impulse"
 bool findResponse(std::string_view name, Response& out);
