@@ -59,7 +59,8 @@ struct FrameStats {
     std::int64_t narrow_tests = 0;
     std::int64_t triangle_tests = 0;
     std::int64_t bv_tests = 0;
-    double integrate_s = 0, volumes_s = 0, broad_s = 0, narrow_s = 0, total_s = 0;
+    double integrate_s = 0, volumes_s = 0, broad_s = 0, narrow_s = 0, ccd_s = 0, response_s = 0,
+           total_s = 0;
 
     void add(const engine::StepStats& s) {
         broad.volume_tests += s.broad.volume_tests;
@@ -73,25 +74,29 @@ struct FrameStats {
         volumes_s += s.volumes_s;
         broad_s += s.broad_phase_s;
         narrow_s += s.narrow_phase_s;
+        ccd_s += s.ccd_s;
+        response_s += s.response_s;
         total_s += s.total_s;
     }
 };
 
 constexpr const char* kStatsHeader =
     "frame,time,broadphase,bodies,flagged,colliding,volume_tests,volumes_updated,swaps,"
-    "narrow_tests,triangle_tests,bv_tests,integrate_ms,volumes_ms,broadphase_ms,narrowphase_ms,step_ms\n";
+    "narrow_tests,triangle_tests,bv_tests,integrate_ms,volumes_ms,broadphase_ms,narrowphase_ms,"
+    "ccd_ms,response_ms,step_ms\n";
 
 std::string statsRow(int frame, const engine::World& world, const FrameStats& f) {
     char line[512];
     std::snprintf(line, sizeof line,
-                  "%d,%.9g,%s,%zu,%zu,%zu,%lld,%lld,%lld,%lld,%lld,%lld,%.6f,%.6f,%.6f,%.6f,%.6f\n",
+                  "%d,%.9g,%s,%zu,%zu,%zu,%lld,%lld,%lld,%lld,%lld,%lld,%.6f,%.6f,%.6f,%.6f,%.6f,"
+                  "%.6f,%.6f\n",
                   frame, double(world.time()), std::string(world.broadPhase().name()).c_str(),
                   world.bodies().size(), world.flaggedPairs().size(),
                   world.collidingPairs().size(), (long long)f.broad.volume_tests,
                   (long long)f.broad.volumes_updated, (long long)f.broad.swaps,
                   (long long)f.narrow_tests, (long long)f.triangle_tests, (long long)f.bv_tests,
-                  1e3 * f.integrate_s,
-                  1e3 * f.volumes_s, 1e3 * f.broad_s, 1e3 * f.narrow_s, 1e3 * f.total_s);
+                  1e3 * f.integrate_s, 1e3 * f.volumes_s, 1e3 * f.broad_s, 1e3 * f.narrow_s,
+                  1e3 * f.ccd_s, 1e3 * f.response_s, 1e3 * f.total_s);
     return line;
 }
 

@@ -1,5 +1,6 @@
-// End-to-end: the cdlab binary writes frames, the video, pause dumps and a summary; bad input
-// gets a precise message and exit code 2; output failures a message and a non-zero exit.
+// End-to-end: the cdlab binary writes frames, the video (checked by ffprobe), pause dumps and a
+// summary; bad input gets a precise message and exit code 2; output failures (an unwritable
+// directory, ffmpeg missing) a message and a non-zero exit.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -8,9 +9,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
+
+#include "render/image.h"
 
 namespace {
 
@@ -37,11 +42,13 @@ fs::path tempDir(const std::string& name) {
     return d;
 }
 
-Result runCdlab(const std::string& args, const fs::path& work) {
+// `env` is prepended to the cdlab command line ("PATH=/x" sets the variable for cdlab only).
+Result runCdlab(const std::string& args, const fs::path& work, const std::string& env = "") {
     const fs::path out = work / "stdout.txt";
     const fs::path err = work / "stderr.txt";
-    const std::string cmd = std::string("cd ") + CDLAB_SOURCE_DIR + " && " + CDLAB_BINARY + " " +
-                            args + " > " + out.string() + " 2> " + err.string() + " < /dev/null";
+    const std::string cmd = std::string("cd ") + CDLAB_SOURCE_DIR + " && " + env + " " +
+                            CDLAB_BINARY + " " + args + " > " + out.string() + " 2> " +
+                            err.string() + " < /dev/null";
     const int status = std::system(cmd.c_str());
     Result r;
     r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -50,17 +57,49 @@ Result runCdlab(const std::string& args, const fs::path& work) {
     return r;
 }
 
-bool haveFfmpeg() { return std::system("ffmpeg -version > /dev/null 2>&1") == 0; }
+bool haveFfprobe() { return std::system("ffprobe -version > /dev/null 2>&1") == 0; }
+
+// ffprobe's key=value lines for the first video stream, frames decoded and counted.
+std::map<std::string, std::string> probeVideo(const fs::path& video, const fs::path& work) {
+    const fs::path out = work / "ffprobe.txt";
+    const std::string cmd =
+        "ffprobe -v error -select_streams v:0 -count_frames -show_entries "
+        "stream=codec_name,pix_fmt,width,height,nb_read_frames "
+        "-of default=noprint_wrappers=1 " +
+        video.string() + " > " + out.string() + " 2>&1";
+    std::map<std::string, std::string> fields;
+    if (std::system(cmd.c_str()) != 0) {
+        fields["error"] = slurp(out);
+        return fields;
+    }
+    std::istringstream lines(slurp(out));
+    for (std::string line; std::getline(lines, line);) {
+        const std::size_t eq = line.find('=');
+        if (eq != std::string::npos) fields[line.substr(0, eq)] = line.substr(eq + 1);
+    }
+    return fields;
+}
+
+// Pixels that differ between two images of the same size, counting rows from `first_row` on.
+int differingPixels(const render::Image& a, const render::Image& b, int first_row) {
+    int n = 0;
+    for (int y = first_row; y < a.height; ++y) {
+        for (int x = 0; x < a.width; ++x) {
+            const std::uint8_t* p = a.pixel(x, y);
+            const std::uint8_t* q = b.pixel(x, y);
+            n += p[0] != q[0] || p[1] != q[1] || p[2] != q[2];
+        }
+    }
+    return n;
+}
 
 const std::string kTiny = "tests/data/tiny.yaml";
 
-TEST(Cli, RunWritesFramesVideoPauseDumpsAndSummary) {
+TEST(Cli, RunWritesFramesPauseDumpsAndSummary) {
     const fs::path work = tempDir("run");
     const fs::path out = work / "out";
-    const bool video = haveFfmpeg();
-    const Result r = runCdlab("run " + kTiny + " --out " + out.string() +
-                                  " --pause-at 0 --pause-at 3" + (video ? "" : " --no-video"),
-                              work);
+    const Result r = runCdlab(
+        "run " + kTiny + " --out " + out.string() + " --pause-at 0 --pause-at 3 --no-video", work);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     for (int f = 0; f < 6; ++f) {
         char name[32];
@@ -68,11 +107,22 @@ TEST(Cli, RunWritesFramesVideoPauseDumpsAndSummary) {
         EXPECT_GT(fs::file_size(out / name), 100u) << name;
     }
     EXPECT_FALSE(fs::exists(out / "frame_00006.png"));
-    if (video) {
-        EXPECT_GT(fs::file_size(out / "tiny.mp4"), 1000u);
+    EXPECT_FALSE(fs::exists(out / "tiny.mp4"));
+    // The pause picture draws every volume kind; tiny.yaml draws spheres and AABBs only, so the
+    // OBBs of the turned crate and of the torus appear in it and not in the frame. Rows from 40
+    // on, below the HUD text (which differs anyway: "PAUSED", no step time).
+    for (const int f : {0, 3}) {
+        const fs::path pause = out / ("pause_" + std::to_string(f) + ".png");
+        ASSERT_TRUE(fs::exists(pause)) << pause;
+        char name[32];
+        std::snprintf(name, sizeof name, "frame_%05d.png", f);
+        const render::Image frame_image = render::readPng(out / name);
+        const render::Image pause_image = render::readPng(pause);
+        ASSERT_EQ(pause_image.width, frame_image.width);
+        ASSERT_EQ(pause_image.height, frame_image.height);
+        ASSERT_GT(frame_image.height, 40);
+        EXPECT_GE(differingPixels(frame_image, pause_image, 40), 30) << pause;
     }
-    EXPECT_TRUE(fs::exists(out / "pause_0.png"));
-    EXPECT_TRUE(fs::exists(out / "pause_3.png"));
 
     const nlohmann::json p0 = nlohmann::json::parse(slurp(out / "pause_0.json"));
     EXPECT_EQ(p0["frame"], 0);
@@ -105,6 +155,53 @@ TEST(Cli, RunWritesFramesVideoPauseDumpsAndSummary) {
     const nlohmann::json summary = nlohmann::json::parse(slurp(out / "summary.json"));
     EXPECT_EQ(summary["frames"], 6);
     EXPECT_EQ(summary["bodies"], 5);
+    EXPECT_EQ(summary["video"], "");
+    fs::remove_all(work);
+}
+
+// The video as a browser needs it (H.264 in yuv420p) with one picture per frame, read back by
+// ffprobe, which the ffmpeg package always brings along.
+TEST(Cli, RunWritesAnH264Yuv420pVideoWithEveryFrame) {
+    if (!haveFfprobe()) GTEST_SKIP() << "ffprobe not on PATH (Debian package ffmpeg)";
+    const fs::path work = tempDir("video");
+    const fs::path out = work / "out";
+    const Result r = runCdlab("run " + kTiny + " --out " + out.string(), work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const fs::path video = out / "tiny.mp4";
+    ASSERT_TRUE(fs::exists(video));
+    EXPECT_FALSE(fs::exists(out / "tiny.partial.mp4"));
+    const std::map<std::string, std::string> probe = probeVideo(video, work);
+    ASSERT_EQ(probe.count("error"), 0u) << probe.at("error");
+    const render::Image first = render::readPng(out / "frame_00000.png");
+    EXPECT_EQ(probe.count("codec_name") ? probe.at("codec_name") : "?", "h264");
+    EXPECT_EQ(probe.count("pix_fmt") ? probe.at("pix_fmt") : "?", "yuv420p");
+    EXPECT_EQ(probe.count("width") ? probe.at("width") : "?", std::to_string(first.width));
+    EXPECT_EQ(probe.count("height") ? probe.at("height") : "?", std::to_string(first.height));
+    EXPECT_EQ(probe.count("nb_read_frames") ? probe.at("nb_read_frames") : "?", "6");
+    const nlohmann::json summary = nlohmann::json::parse(slurp(out / "summary.json"));
+    EXPECT_EQ(summary["video"], video.string());
+    fs::remove_all(work);
+}
+
+// ffmpeg missing: found before any output is written, a message that says what to do, exit 1.
+// cdlab looks for ffmpeg on PATH, so an empty directory as PATH hides it; the same run with
+// --no-video succeeds, so it is the missing encoder and nothing else that stops the first run.
+TEST(Cli, MissingFfmpegIsAClearFailureBeforeAnyOutput) {
+    const fs::path work = tempDir("noffmpeg");
+    const fs::path empty = work / "empty_path";
+    fs::create_directories(empty);
+    const fs::path out = work / "out";
+    const std::string env = "PATH=" + empty.string();
+    Result r = runCdlab("run " + kTiny + " --out " + out.string(), work, env);
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_NE(r.err.find("ffmpeg not found on PATH"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("--no-video"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out / "summary.json"));
+    EXPECT_FALSE(fs::exists(out)) << "output written before the check";
+
+    r = runCdlab("run " + kTiny + " --out " + out.string() + " --no-video", work, env);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(out / "summary.json"));
     fs::remove_all(work);
 }
 
@@ -188,37 +285,98 @@ TEST(Cli, BroadPhaseFlagOverridesTheScene) {
     fs::remove_all(work);
 }
 
-TEST(Cli, StatsCsvHasOneRowPerFrameAndCheckBroadphasePasses) {
-    const fs::path work = tempDir("stats");
-    const fs::path csv = work / "stats" / "run.csv";
-    const Result r = runCdlab("run " + kTiny + " --no-video --check-broadphase --draw-structure "
-                              "--broadphase hgrid --pause-at 5 --stats " + csv.string() +
-                                  " --out " + (work / "o").string(),
-                              work);
-    ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_NE(r.out.find("every step checked"), std::string::npos) << r.out;
+// The --stats CSV: header, then one row of cells per frame, columns named by the header.
+struct StatsCsv {
+    std::vector<std::string> header;
+    std::vector<std::vector<std::string>> rows;
+    std::size_t column(const std::string& name) const {
+        const auto it = std::find(header.begin(), header.end(), name);
+        return it == header.end() ? header.size() : std::size_t(it - header.begin());
+    }
+    double sum(const std::string& name) const {
+        const std::size_t c = column(name);
+        double total = 0;
+        for (const auto& row : rows) total += c < row.size() ? std::stod(row[c]) : 0.0;
+        return total;
+    }
+};
+
+std::vector<std::string> splitCsv(const std::string& line) {
+    std::vector<std::string> cells;
+    std::stringstream row(line);
+    for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+    return cells;
+}
+
+StatsCsv readStats(const fs::path& csv) {
+    StatsCsv stats;
     std::istringstream lines(slurp(csv));
     std::string line;
     std::getline(lines, line);
-    EXPECT_EQ(line.rfind("frame,time,broadphase,bodies,flagged,colliding,volume_tests", 0), 0u);
-    int rows = 0;
-    std::string last;
-    while (std::getline(lines, line)) {
-        EXPECT_EQ(std::count(line.begin(), line.end(), ','), 16) << line;
-        last = line;
-        ++rows;
-    }
-    EXPECT_EQ(rows, 6);
+    stats.header = splitCsv(line);
+    while (std::getline(lines, line)) stats.rows.push_back(splitCsv(line));
+    return stats;
+}
+
+const std::vector<std::string> kStatsColumns = {
+    "frame",          "time",         "broadphase",      "bodies",     "flagged",
+    "colliding",      "volume_tests", "volumes_updated", "swaps",      "narrow_tests",
+    "triangle_tests", "bv_tests",     "integrate_ms",    "volumes_ms", "broadphase_ms",
+    "narrowphase_ms", "ccd_ms",       "response_ms",     "step_ms"};
+
+TEST(Cli, StatsCsvHasOneRowPerFrameAndCheckBroadphasePasses) {
+    const fs::path work = tempDir("stats");
+    const fs::path csv = work / "stats" / "run.csv";
+    const Result r = runCdlab("run " + kTiny +
+                                  " --no-video --check-broadphase --draw-structure "
+                                  "--broadphase hgrid --pause-at 5 --stats " +
+                                  csv.string() + " --out " + (work / "o").string(),
+                              work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("every step checked"), std::string::npos) << r.out;
+    const StatsCsv stats = readStats(csv);
+    EXPECT_EQ(stats.header, kStatsColumns);
+    ASSERT_EQ(stats.rows.size(), 6u);
+    for (const auto& row : stats.rows) EXPECT_EQ(row.size(), kStatsColumns.size());
     // The last row's flagged/colliding counts are those of the frame-5 pause dump.
     const nlohmann::json p = nlohmann::json::parse(slurp(work / "o" / "pause_5.json"));
-    std::vector<std::string> cells;
-    std::stringstream row(last);
-    for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
-    ASSERT_EQ(cells.size(), 17u);
-    EXPECT_EQ(cells[0], "5");
-    EXPECT_EQ(cells[2], "hgrid");
-    EXPECT_EQ(std::stoul(cells[4]), p["flagged_pairs"].size());
-    EXPECT_EQ(std::stoul(cells[5]), p["colliding_pairs"].size());
+    const std::vector<std::string>& last = stats.rows.back();
+    ASSERT_EQ(last.size(), kStatsColumns.size());
+    EXPECT_EQ(last[stats.column("frame")], "5");
+    EXPECT_EQ(last[stats.column("broadphase")], "hgrid");
+    EXPECT_EQ(std::stoul(last[stats.column("flagged")]), p["flagged_pairs"].size());
+    EXPECT_EQ(std::stoul(last[stats.column("colliding")]), p["colliding_pairs"].size());
+    // tiny.yaml runs without CCD and without contact response: those stages cost nothing.
+    EXPECT_EQ(stats.sum("ccd_ms"), 0.0);
+    EXPECT_EQ(stats.sum("response_ms"), 0.0);
+    EXPECT_GT(stats.sum("step_ms"), 0.0);
+    fs::remove_all(work);
+}
+
+// With CCD and impulse response switched on, their stages get times of their own, and each
+// stays within the step's total.
+TEST(Cli, StatsCsvTimesTheCcdAndResponseStages) {
+    const fs::path work = tempDir("stats_stages");
+    const fs::path csv = work / "run.csv";
+    const Result r = runCdlab("run " + kTiny +
+                                  " --no-video --no-frames "
+                                  "--set world.ccd=conservative_advancement "
+                                  "--set world.response=impulse --stats " +
+                                  csv.string() + " --out " + (work / "o").string(),
+                              work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const StatsCsv stats = readStats(csv);
+    EXPECT_EQ(stats.header, kStatsColumns);
+    ASSERT_EQ(stats.rows.size(), 6u);
+    EXPECT_GT(stats.sum("ccd_ms"), 0.0);
+    EXPECT_GT(stats.sum("response_ms"), 0.0);
+    for (const auto& row : stats.rows) {
+        ASSERT_EQ(row.size(), kStatsColumns.size());
+        const double step = std::stod(row[stats.column("step_ms")]);
+        // Rounded to 1e-6 ms in the file.
+        EXPECT_LE(std::stod(row[stats.column("ccd_ms")]), step + 1e-6) << row[0];
+        EXPECT_LE(std::stod(row[stats.column("response_ms")]), step + 1e-6) << row[0];
+    }
     fs::remove_all(work);
 }
 

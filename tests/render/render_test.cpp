@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
@@ -15,6 +16,7 @@
 #include "../collision/test_meshes.h"
 #include "collision/bvh_level.h"
 #include "collision/convex_hull.h"
+#include "collision/debug_draw.h"
 #include "collision/narrow_phase.h"
 #include "collision/shape.h"
 #include "engine/body.h"
@@ -206,6 +208,49 @@ TEST(Renderer, SphereOutlinesTakeTheirStateColour) {
     }
 }
 
+// A pair the broad phase flags but the narrow phase rejects is drawn yellow. Two spheres whose
+// AABBs overlap on every axis (|dx| = |dy| = 1.2 < 2r = 1.6) while their centres are 1.2 sqrt(2)
+// = 1.70 > 1.6 apart: `sap` (on AABBs) flags them, the exact sphere test does not confirm them.
+//
+//        y
+//        |        ( E )               E (0, 0.6), D (-1.2, -0.6), r = 0.8
+//   -----+----( D )---------( F )---- x      F (2.8, 0) alone: green
+TEST(Renderer, FlaggedButNotTouchingPairIsYellow) {
+    engine::WorldSettings settings;
+    settings.bounds = collision::Aabb{Vec3::Constant(-20), Vec3::Constant(20)};
+    settings.broad_phase = "sap";
+    engine::World world(settings);
+    world.addBody(sphereBody("d", 0.8, Vec3(-1.2, -0.6, 0)));
+    world.addBody(sphereBody("e", 0.8, Vec3(0, 0.6, 0)));
+    world.addBody(sphereBody("f", 0.8, Vec3(2.8, 0, 0)));
+    world.detect();
+    ASSERT_EQ(world.states().size(), 3u);
+    ASSERT_EQ(world.states()[0], engine::BodyState::Flagged);
+    ASSERT_EQ(world.states()[1], engine::BodyState::Flagged);
+    ASSERT_EQ(world.states()[2], engine::BodyState::Apart);
+
+    render::Renderer renderer(kWidth, kHeight);
+    const engine::CameraSettings cam = headOnCamera();
+    const render::Image image = renderer.render(world, cam, plainOptions());
+    const Rgb yellow = toRgb(render::stateColor(engine::BodyState::Flagged));
+    const Rgb red = toRgb(render::stateColor(engine::BodyState::Colliding));
+    const Rgb green = toRgb(render::stateColor(engine::BodyState::Apart));
+    // Outline points of D and E seen from +z, away from where the two outlines come close.
+    const std::vector<Vec3> yellow_points = {{-2.0, -0.6, 0}, {-1.2, -1.4, 0}, {-1.2, 0.2, 0},
+                                             {0.8, 0.6, 0},   {0, 1.4, 0},     {-0.8, 0.6, 0}};
+    for (const Vec3& p : yellow_points) {
+        const PixelPos px = project(cam, kWidth, kHeight, p);
+        EXPECT_TRUE(colorNear(image, px, yellow)) << "no yellow near " << px.x << "," << px.y;
+        EXPECT_FALSE(colorNear(image, px, red)) << "red near " << px.x << "," << px.y;
+        EXPECT_FALSE(colorNear(image, px, green)) << "green near " << px.x << "," << px.y;
+    }
+    for (const Vec3& p : {Vec3(2.0, 0, 0), Vec3(3.6, 0, 0), Vec3(2.8, 0.8, 0)}) {
+        const PixelPos px = project(cam, kWidth, kHeight, p);
+        EXPECT_TRUE(colorNear(image, px, green)) << "no green near " << px.x << "," << px.y;
+        EXPECT_FALSE(colorNear(image, px, yellow)) << "yellow near " << px.x << "," << px.y;
+    }
+}
+
 TEST(Renderer, BackgroundIsTheBackgroundColour) {
     render::Renderer renderer(kWidth, kHeight);
     const render::Image image = renderThreeSpheres(renderer);
@@ -360,11 +405,81 @@ TEST(Renderer, VolumeSelectionControlsWhichWireframesAppear) {
     EXPECT_TRUE(colorNear(renderThreeSpheres(renderer, options), corner, green, 1));
 }
 
-TEST(Renderer, DrawStructureRendersWithoutError) {
+// Records what a broad phase draws, to know which colours its structure uses.
+class RecordingDraw final : public collision::DebugDraw {
+public:
+    void drawLine(const Vec3& /*a*/, const Vec3& /*b*/, const collision::Color& color) override {
+        ++lines;
+        const Rgb c = toRgb(color);
+        if (std::find(colors.begin(), colors.end(), c) == colors.end()) colors.push_back(c);
+    }
+    int lines = 0;
+    std::vector<Rgb> colors;
+};
+
+// True when `seen` is `line` laid over `under` with a coverage of at least 30 %, within 10 per
+// channel: a 1-pixel line falls across two pixels after the supersampling box filter, each then
+// a partial blend, so comparing with the line's colour alone would miss it.
+bool blendedOver(const Rgb& seen, const Rgb& under, const Rgb& line) {
+    double de = 0;
+    double ee = 0;
+    for (int k = 0; k < 3; ++k) {
+        de += double(seen[k] - under[k]) * double(line[k] - under[k]);
+        ee += double(line[k] - under[k]) * double(line[k] - under[k]);
+    }
+    if (ee < 30 * 30) return false;   // the line's colour is (nearly) what was there already
+    const double coverage = de / ee;  // least squares: seen - under = coverage (line - under)
+    if (coverage < 0.3 || coverage > 1.05) return false;
+    for (int k = 0; k < 3; ++k) {
+        const double residual = double(seen[k] - under[k]) - coverage * double(line[k] - under[k]);
+        if (std::abs(residual) > 10) return false;
+    }
+    return true;
+}
+
+// --draw-structure: every broad phase that has a structure to show draws it, so the picture
+// changes, and the change is in the structure's own colours (not, say, a state colour). The
+// three-sphere scene leaves room where nothing else is drawn: the gap between B and C, where
+// SAP's intervals on y and z and the grid cells cross, and the space around the spheres.
+TEST(Renderer, DrawStructureShowsEachBroadPhasesStructure) {
+    const std::vector<std::string> drawing = {"grid", "hash", "hgrid", "sap",
+                                              "sap1", "tree", "octree"};
     render::Renderer renderer(kWidth, kHeight);
-    render::FrameOptions options = plainOptions();
-    options.draw_structure = true;
-    EXPECT_NO_THROW(renderThreeSpheres(renderer, options));
+    for (const std::string& name : drawing) {
+        SCOPED_TRACE(name);
+        engine::World world = makeThreeSphereWorld();
+        world.setBroadPhase(name);
+        world.detect();  // inserts the proxies into the new broad phase
+        ASSERT_EQ(world.broadPhase().name(), name);
+        RecordingDraw recorded;
+        world.broadPhase().draw(recorded);
+        ASSERT_GT(recorded.lines, 0) << "draws nothing";
+
+        render::FrameOptions options = plainOptions();
+        const render::Image without = renderer.render(world, headOnCamera(), options);
+        options.draw_structure = true;
+        const render::Image with = renderer.render(world, headOnCamera(), options);
+        int differing = 0;
+        int structure_coloured = 0;  // pixels that show a blend of one of the structure's colours
+        for (int y = 0; y < kHeight; ++y) {
+            for (int x = 0; x < kWidth; ++x) {
+                const Rgb a = pixelAt(without, x, y);
+                const Rgb b = pixelAt(with, x, y);
+                if (a == b) continue;
+                ++differing;
+                for (const Rgb& c : recorded.colors) {
+                    if (blendedOver(b, a, c)) {
+                        ++structure_coloured;
+                        break;
+                    }
+                }
+            }
+        }
+        EXPECT_GE(differing, 20) << "structure barely visible";
+        EXPECT_GE(structure_coloured, 10)
+            << "of " << differing << " changed pixels, too few in the structure's "
+            << recorded.colors.size() << " colours";
+    }
 }
 
 TEST(Renderer, HudTextChangesTopLeftPixelsOnly) {

@@ -1,0 +1,238 @@
+// `cdlab bench broadphase` end to end at the size of smallBenchOptions(): every default method
+// (cdlab's AABB broad phases and the peers compiled in) appears in the table and the JSON with
+// every field, agrees on the pair count with a brute-force count written here, and is checked
+// frame by frame; bad options exit 2.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include "bench_broadphase.h"
+#include "bench_method.h"
+#include "bench_workload.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+    int exit_code = -1;
+    std::string out;
+    std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+}
+
+fs::path tempDir(const std::string& name) {
+    const fs::path d =
+        fs::temp_directory_path() / ("cdlab_bp_bench_" + name + "_" + std::to_string(::getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
+Result runCdlab(const std::string& args, const fs::path& work) {
+    const fs::path out = work / "stdout.txt";
+    const fs::path err = work / "stderr.txt";
+    const std::string cmd = std::string("cd ") + CDLAB_SOURCE_DIR + " && " + CDLAB_BINARY + " " +
+                            args + " > " + out.string() + " 2> " + err.string() + " < /dev/null";
+    const int status = std::system(cmd.c_str());
+    Result r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+}
+
+// Overlapping pairs of the workload after `frames` steps, by testing every pair of boxes with
+// the closed interval test on each axis (touching counts): independent of every broad phase and
+// of the bench's own reference sweep.
+std::int64_t bruteForcePairs(app::WorkloadKind kind, int n, std::uint64_t seed, int frames) {
+    app::MovingBoxes boxes(kind, n, seed);
+    for (int f = 0; f < frames; ++f) boxes.step();
+    std::int64_t pairs = 0;
+    for (int a = 0; a < n; ++a) {
+        for (int b = a + 1; b < n; ++b) {
+            const collision::Aabb& ba = boxes.aabb(a);
+            const collision::Aabb& bb = boxes.aabb(b);
+            bool overlap = true;
+            for (int k = 0; k < 3; ++k) {
+                overlap = overlap && ba.min[k] <= bb.max[k] && bb.min[k] <= ba.max[k];
+            }
+            pairs += overlap ? 1 : 0;
+        }
+    }
+    return pairs;
+}
+
+std::string joined(const std::vector<int>& values) {
+    std::string out;
+    for (int v : values) {
+        if (!out.empty()) out += ',';
+        out += std::to_string(v);
+    }
+    return out;
+}
+
+TEST(BroadphaseBench, SmallRunReportsEveryMethodWithTheSamePairsInTableAndJson) {
+    const app::BenchOptions small = app::smallBenchOptions();
+    ASSERT_EQ(small.sizes.size(), 1u);
+    ASSERT_EQ(small.workload, "both");
+    const int n = small.sizes.front();
+    const fs::path work = tempDir("small");
+    const fs::path json = work / "bp.json";
+    const Result r =
+        runCdlab("bench broadphase --sizes " + joined(small.sizes) + " --frames " +
+                     std::to_string(small.frames) + " --workload " + small.workload + " --seed " +
+                     std::to_string(small.seed) + " --json " + json.string(),
+                 work);
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    EXPECT_FALSE(fs::exists(json.string() + ".partial"));
+
+    // The default method set is what the binary runs: the same library is linked here.
+    std::set<std::string> expected_methods;
+    std::set<std::string> peers;
+    for (const app::BenchMethodEntry& m : app::benchMethods()) {
+        if (!m.default_set) continue;
+        expected_methods.insert(m.name);
+        if (m.peer) peers.insert(m.name);
+    }
+    for (const char* cdlab : {"brute", "sap", "sap1", "grid", "hash", "hgrid", "tree", "octree"}) {
+        EXPECT_TRUE(expected_methods.count(cdlab)) << cdlab << " missing from the default set";
+    }
+
+    const nlohmann::json doc = nlohmann::json::parse(slurp(json));
+    EXPECT_EQ(doc["frames"], small.frames);
+    EXPECT_EQ(doc["seed"], small.seed);
+    ASSERT_TRUE(doc["rows"].is_array());
+    EXPECT_EQ(doc["rows"].size(), 2 * expected_methods.size());
+
+    std::map<std::string, std::set<std::string>> methods_by_workload;
+    std::map<std::string, int> best_peer_rows;
+    for (const nlohmann::json& row : doc["rows"]) {
+        const std::string method = row.value("method", "");
+        const std::string workload = row.value("workload", "");
+        SCOPED_TRACE(method + " / " + workload);
+        EXPECT_FALSE(row.contains("skipped")) << row.dump();
+        EXPECT_FALSE(row.contains("failed")) << row.dump();
+        bool complete = true;
+        for (const char* key :
+             {"method", "workload", "n", "peer", "insert_ms", "ms_per_frame_median",
+              "ms_per_frame_mean", "ms_per_frame_first100_median", "ms_per_frame_last100_median",
+              "pairs", "ratio_to_best_peer", "peak_mb", "frames", "mismatched_frames"}) {
+            EXPECT_TRUE(row.contains(key)) << key;
+            complete = complete && row.contains(key);
+        }
+        if (!complete) continue;
+        methods_by_workload[workload].insert(method);
+        EXPECT_EQ(row["n"], n);
+        EXPECT_EQ(row["peer"].get<bool>(), peers.count(method) == 1);
+        EXPECT_EQ(row["frames"], small.frames);
+        EXPECT_EQ(row["mismatched_frames"], 0);
+        for (const char* key : {"insert_ms", "ms_per_frame_median", "ms_per_frame_mean"}) {
+            ASSERT_TRUE(row[key].is_number()) << key << ": " << row[key];
+            EXPECT_GE(row[key].get<double>(), 0) << key;
+        }
+        // Fewer than 100 frames: the first-100 and last-100 medians are the whole run's median.
+        ASSERT_LE(small.frames, 100);
+        EXPECT_EQ(row["ms_per_frame_first100_median"], row["ms_per_frame_median"]);
+        EXPECT_EQ(row["ms_per_frame_last100_median"], row["ms_per_frame_median"]);
+        // Isolated runs (the default) fork per method and report the child's peak growth.
+        ASSERT_TRUE(row["peak_mb"].is_number()) << row["peak_mb"];
+        EXPECT_GE(row["peak_mb"].get<double>(), 0);
+        if (peers.empty()) {
+            EXPECT_TRUE(row["ratio_to_best_peer"].is_null()) << row["ratio_to_best_peer"];
+        } else {
+            ASSERT_TRUE(row["ratio_to_best_peer"].is_number()) << row["ratio_to_best_peer"];
+            const double ratio = row["ratio_to_best_peer"].get<double>();
+            EXPECT_GT(ratio, 0);
+            if (row["peer"].get<bool>()) {
+                EXPECT_GE(ratio, 1.0) << "a peer is faster than the best peer";
+                if (ratio == 1.0) ++best_peer_rows[workload];
+            }
+        }
+    }
+
+    // Both workloads, each with exactly the default methods.
+    ASSERT_EQ(methods_by_workload.size(), 2u);
+    for (const auto& [workload, methods] : methods_by_workload) {
+        EXPECT_EQ(methods, expected_methods) << workload;
+        if (!peers.empty()) {
+            EXPECT_GE(best_peer_rows[workload], 1) << workload;
+        }
+    }
+
+    // Every method reports the pairs a brute-force count of the last frame finds, so they all
+    // agree with each other; the workload is calibrated to overlap, so the count is not 0.
+    for (const auto& [name, kind] :
+         {std::pair{"uniform", app::WorkloadKind::Uniform}, {"mixed", app::WorkloadKind::Mixed}}) {
+        const std::int64_t truth = bruteForcePairs(kind, n, small.seed, small.frames);
+        EXPECT_GT(truth, n / 2) << name;
+        for (const nlohmann::json& row : doc["rows"]) {
+            if (row["workload"] != name) continue;
+            EXPECT_EQ(row["pairs"].get<std::int64_t>(), truth) << row["method"] << " / " << name;
+        }
+    }
+
+    // The table: a heading per workload, the column header, one checked row per method.
+    EXPECT_NE(r.out.find("== workload uniform, N = " + std::to_string(n)), std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("== workload mixed, N = " + std::to_string(n)), std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("median_ms"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("peak_MB"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("MISMATCH"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("FAILED"), std::string::npos) << r.out;
+    for (const std::string& method : expected_methods) {
+        const std::string label = method + (peers.count(method) ? " [peer]" : "");
+        int rows = 0;
+        std::istringstream lines(r.out);
+        for (std::string line; std::getline(lines, line);) {
+            if (line.rfind(label + " ", 0) != 0) continue;
+            ++rows;
+            EXPECT_EQ(line.substr(line.size() - 2), "ok") << line;
+        }
+        EXPECT_EQ(rows, 2) << label << " rows in the table\n" << r.out;
+    }
+    EXPECT_NE(r.out.find("fastest cdlab: "), std::string::npos) << r.out;
+    if (!peers.empty()) {
+        EXPECT_NE(r.out.find("; best peer: "), std::string::npos) << r.out;
+    }
+    fs::remove_all(work);
+}
+
+TEST(BroadphaseBench, BadOptionsExitTwoBeforeAnyWork) {
+    const fs::path work = tempDir("bad");
+    Result r = runCdlab("bench broadphase --sizes 1 --frames 2", work);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("--sizes: 1 boxes"), std::string::npos) << r.err;
+    r = runCdlab("bench broadphase --sizes 50 --frames 0", work);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("--frames: 0"), std::string::npos) << r.err;
+    r = runCdlab("bench broadphase --sizes 50 --frames 2 --methods sap,nope", work);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("unknown method 'nope'"), std::string::npos) << r.err;
+    const fs::path unwritable = work / "no" / "such" / "dir.json";
+    r = runCdlab(
+        "bench broadphase --sizes 50 --frames 2 --methods sap --json " + unwritable.string(), work);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("cannot write"), std::string::npos) << r.err;
+    EXPECT_EQ(r.out.find("== workload"), std::string::npos) << "measured before failing";
+    fs::remove_all(work);
+}
+
+}  // namespace
