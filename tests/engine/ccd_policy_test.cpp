@@ -149,6 +149,8 @@ TEST(CcdPolicy, ToleranceAndTargetGapMoveTheFirstStopEarlier) {
     // (0.1 + 0.001) of the bar's bounding radius (1 m), so it is at most 0.101 / 45 s early.
     EXPECT_GE(loose, exact - 0.101 / 45 - 5e-7);
     EXPECT_GE(far, exact - 0.101 / 45 - 5e-7);
+}
+
 // More than two bodies: the 5 cm sphere at 1000 m/s (33 m per step) sweeps through two 1 cm
 // plates, 0.5 m apart, within one step. The earliest time of impact is the first plate's, so
 // the sphere must stop there and bounce back; it must never reach either plate.
