@@ -17,7 +17,8 @@ namespace collision {
 ///    al. 2003); hash collisions only cost extra tests, since entries keep their true cell.
 /// A pair is reported only from the cell holding the lowest corner of the two boxes'
 /// intersection, so no duplicate removal is needed. Proxies that would cover more than
-/// kMaxCellsPerProxy cells (huge size ratios) are kept aside and tested against every proxy.
+/// kMaxCellsPerProxy cells (huge size ratios) are not binned: each visits its cells (or, when
+/// it covers more cells than there are entries, tests every proxy).
 class GridBroadPhase : public BroadPhase {
 public:
     enum class Mode { Dense, Hashed };
@@ -56,6 +57,7 @@ private:
     std::vector<Entry> sorted_;
     std::vector<std::uint32_t> bucket_start_;
     std::vector<ProxyId> big_;
+    std::vector<char> is_big_;  // per proxy id, this frame
 };
 
 }  // namespace collision
