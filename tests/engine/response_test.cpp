@@ -197,39 +197,53 @@ TEST(Response, FiveBoxStackRestsWithoutDriftOrJitter) {
     EXPECT_EQ(world.lastStats().contact_points, 20);  // 4 points per resting face
 }
 
-// Mass ratio 1:1000 with the heavy box below: holds. (The other way round, 1000 kg on 1 kg, the
-// sequential-impulse solver does not converge at 30 iterations: the light box is squeezed into
-// the floor; not handled, see the report.)
-TEST(Response, MassRatioOneToThousandStackHolds) {
-    WorldSettings s = impulseWorld(10);
-    s.gravity = Vec3(0, -9.81, 0);
-    World world(s);
-    const Vec3 floor_h(4, 0.25, 4);
-    Body floor = makeBody("floor", Shape::box(floor_h), boxMass(floor_h, 1));
-    floor.position = Vec3(0, -0.25, 0);
-    setStatic(floor);
-    world.addBody(floor);
-    const Vec3 h(0.5, 0.5, 0.5);
-    for (const Real mass : {Real(1000), Real(1)}) {
-        Body b = makeBody("box", Shape::box(h), boxMass(h, mass));
-        b.position = Vec3(0, mass == 1000 ? 0.5 : 1.5, 0);
-        world.addBody(b);
-    }
-    world.detect();
-    std::vector<Vec3> start;
-    for (const Body& b : world.bodies()) start.push_back(b.position);
-    Real late_speed = 0;
-    for (int i = 0; i < 600; ++i) {
-        world.step();
-        if (i >= 300) {
-            for (const Body& b : world.bodies())
-                late_speed = std::max(late_speed, b.velocity().norm());
+// Mass ratios to 1:1000 and beyond hold both ways round. Regression: with the heavy box on
+// top (1000 kg on 1 kg) the sequential-impulse iterations alone did not converge: the light box
+// was squeezed into the floor and squirted out sideways (x = 1.14 m after 2 s) and the heavy
+// box fell to the floor. Shock propagation (contact_solver.h) holds the lower body fixed in
+// extra passes. Set-ups, boxes of 1 m on a static floor, masses bottom to top:
+//
+//   [1000]   [1]      [1e6]   [1000]
+//   [1]      [1000]   [1]     [1]
+//                             [1000]
+//   ======   ======   ======  [1]  ======
+TEST(Response, MassRatioStacksHoldBothWaysRound) {
+    const std::vector<std::vector<Real>> stacks = {
+        {1000, 1}, {1, 1000}, {1, 1e6}, {1, 1000, 1, 1000}};
+    for (const std::vector<Real>& masses : stacks) {
+        SCOPED_TRACE("bottom mass " + std::to_string(masses[0]) + ", top mass " +
+                     std::to_string(masses.back()) + ", " + std::to_string(masses.size()) +
+                     " boxes");
+        WorldSettings s = impulseWorld(10);
+        s.gravity = Vec3(0, -9.81, 0);
+        World world(s);
+        const Vec3 floor_h(4, 0.25, 4);
+        Body floor = makeBody("floor", Shape::box(floor_h), boxMass(floor_h, 1));
+        floor.position = Vec3(0, -0.25, 0);
+        setStatic(floor);
+        world.addBody(floor);
+        const Vec3 h(0.5, 0.5, 0.5);
+        for (std::size_t k = 0; k < masses.size(); ++k) {
+            Body b = makeBody("box", Shape::box(h), boxMass(h, masses[k]));
+            b.position = Vec3(0, 0.5 + Real(k), 0);
+            world.addBody(b);
         }
+        world.detect();
+        std::vector<Vec3> start;
+        for (const Body& b : world.bodies()) start.push_back(b.position);
+        Real late_speed = 0;
+        for (int i = 0; i < 600; ++i) {
+            world.step();
+            if (i >= 300) {
+                for (const Body& b : world.bodies())
+                    late_speed = std::max(late_speed, b.velocity().norm());
+            }
+        }
+        const Real drift = maxDrift(world, start);
+        RecordProperty("drift_m", std::to_string(drift));
+        EXPECT_LT(drift, 0.01);  // 1 % of a box
+        EXPECT_LT(late_speed, 1e-3);
     }
-    const Real drift = maxDrift(world, start);
-    RecordProperty("drift_m", std::to_string(drift));
-    EXPECT_LT(drift, 0.01);
-    EXPECT_LT(late_speed, 1e-3);
 }
 
 TEST(Response, RunsAreBitIdenticalAndNoneMeansNoSolver) {
