@@ -13,34 +13,16 @@
 #include <utility>
 #include <vector>
 
+#include "cli_run.h"
+
 namespace {
 
 namespace fs = std::filesystem;
-
-struct Result {
-    int exit_code = -1;
-    std::string out;
-    std::string err;
-};
-
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
-}
+using Result = cdlab_test::CliResult;
+using cdlab_test::slurp;
 
 Result runCdlab(const std::string& args, const fs::path& work) {
-    const fs::path out = work / "stdout.txt";
-    const fs::path err = work / "stderr.txt";
-    const std::string cmd = std::string("cd ") + work.string() + " && " + CDLAB_BINARY + " " +
-                            args + " > " + out.string() + " 2> " + err.string() + " < /dev/null";
-    const int status = std::system(cmd.c_str());
-    Result r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
+    return cdlab_test::runCdlab(args, work, "", work);
 }
 
 const std::string kHead =

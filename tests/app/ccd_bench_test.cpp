@@ -12,44 +12,16 @@
 #include <string>
 
 #include "bench_ccd.h"
+#include "cli_run.h"
 
 namespace {
 
 namespace fs = std::filesystem;
+using Result = cdlab_test::CliResult;
+using cdlab_test::runCdlab;
+using cdlab_test::slurp;
 
-struct Result {
-    int exit_code = -1;
-    std::string out;
-    std::string err;
-};
-
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
-}
-
-fs::path tempDir(const std::string& name) {
-    const fs::path d =
-        fs::temp_directory_path() / ("cdlab_ccd_bench_" + name + "_" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-}
-
-Result runCdlab(const std::string& args, const fs::path& work) {
-    const fs::path out = work / "stdout.txt";
-    const fs::path err = work / "stderr.txt";
-    const std::string cmd = std::string("cd ") + CDLAB_SOURCE_DIR + " && " + CDLAB_BINARY + " " +
-                            args + " > " + out.string() + " 2> " + err.string() + " < /dev/null";
-    const int status = std::system(cmd.c_str());
-    Result r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-}
+fs::path tempDir(const std::string& name) { return cdlab_test::tempDir("cdlab_ccd_bench_", name); }
 
 TEST(CcdBench, UnitTestSetTableAndJsonWithNoFalseNegatives) {
     const fs::path work = tempDir("unit");

@@ -17,11 +17,15 @@
 #include <string>
 
 #include "check_command.h"
+#include "cli_run.h"
 
 namespace app {
 namespace {
 
 namespace fs = std::filesystem;
+using Result = cdlab_test::CliResult;
+using cdlab_test::runCdlab;
+using cdlab_test::slurp;
 
 const std::string kTwoSpheres =
     "world: {bounds: {min: [-4, -4, -4], max: [4, 4, 4]}, time_step: 0.1, frames: 25}\n"
@@ -33,13 +37,7 @@ const std::string kTwoSpheres =
     "  - {name: b, shape: sphere, radius: 0.5, position: [1.55, 0, 0], velocity: [-1, 0, 0]}\n"
     "  - {name: c, shape: sphere, radius: 0.5, position: [0, 2.5, -2]}\n";
 
-fs::path tempDir(const std::string& name) {
-    const fs::path d =
-        fs::temp_directory_path() / ("cdlab_check_test_" + name + "_" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-}
+fs::path tempDir(const std::string& name) { return cdlab_test::tempDir("cdlab_check_test_", name); }
 
 engine::Scene parse(const std::string& text) { return engine::parseScene(text, "t.yaml", "."); }
 
@@ -223,32 +221,6 @@ TEST(Check, SameSceneSameRows) {
 }
 
 // --- through the binary ---
-
-struct Result {
-    int exit_code = -1;
-    std::string out;
-    std::string err;
-};
-
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
-}
-
-Result runCdlab(const std::string& args, const fs::path& work) {
-    const fs::path out = work / "stdout.txt";
-    const fs::path err = work / "stderr.txt";
-    const std::string cmd = std::string("cd ") + CDLAB_SOURCE_DIR + " && " + CDLAB_BINARY + " " +
-                            args + " > " + out.string() + " 2> " + err.string() + " < /dev/null";
-    const int status = std::system(cmd.c_str());
-    Result r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-}
 
 TEST(CheckCli, ExitCodesAndTable) {
     const fs::path work = tempDir("cli");

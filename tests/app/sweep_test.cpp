@@ -13,26 +13,16 @@
 
 #include "render/image.h"
 #include "sweep_command.h"
+#include "cli_run.h"
 
 namespace {
 
 namespace fs = std::filesystem;
+using cdlab_test::slurp;
 
 const fs::path kScene = fs::path(CDLAB_SOURCE_DIR) / "tests/data/tunnel_small.yaml";
 
-fs::path tempDir(const std::string& name) {
-    const fs::path d =
-        fs::temp_directory_path() / ("cdlab_sweep_" + name + "_" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    return d;
-}
-
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
-}
+fs::path tempDir(const std::string& name) { return cdlab_test::tempDir("cdlab_sweep_", name); }
 
 // A CSV file as one map per row, column name -> text.
 std::vector<std::map<std::string, std::string>> readCsv(const fs::path& file) {
