@@ -289,29 +289,35 @@ void ContactSolver::solve(std::span<Body> bodies, std::span<const collision::Pro
     auto relative = [&](const Point& p) -> Vec3 {
         return (vel[p.b].v + vel[p.b].w.cross(p.rb)) - (vel[p.a].v + vel[p.a].w.cross(p.ra));
     };
+    // One update of point p, friction first (clamped by the present normal impulse), then the
+    // normal: `mass(d, cached)` is the effective mass along d (`cached` the pair's own),
+    // `push(impulse)` applies an impulse along a -> b.
+    auto solvePoint = [&](Point& p, const auto& mass, const auto& push) {
+        const Vec3 dv = relative(p);
+        const Real max_f = p.friction * p.impulse_n;
+        const Real old1 = p.impulse_t1;
+        const Real old2 = p.impulse_t2;
+        Real new1 = old1 - mass(p.t1, p.mass_t1) * dv.dot(p.t1);
+        Real new2 = old2 - mass(p.t2, p.mass_t2) * dv.dot(p.t2);
+        // Coulomb cone clamped as a disc (isotropic friction).
+        const Real len = std::sqrt(new1 * new1 + new2 * new2);
+        if (len > max_f && len > 0) {
+            new1 *= max_f / len;
+            new2 *= max_f / len;
+        }
+        p.impulse_t1 = new1;
+        p.impulse_t2 = new2;
+        push((new1 - old1) * p.t1 + (new2 - old2) * p.t2);
+
+        const Real vn = relative(p).dot(p.normal);
+        const Real old_n = p.impulse_n;
+        p.impulse_n = std::max(old_n - mass(p.normal, p.mass_n) * (vn - p.velocity_bias), Real(0));
+        push((p.impulse_n - old_n) * p.normal);
+    };
+    const auto cached_mass = [](const Vec3&, Real cached) { return cached; };
     for (int it = 0; it < settings.velocity_iterations; ++it) {
         for (Point& p : points_) {
-            // Friction first (clamped by the present normal impulse), then the normal.
-            const Vec3 dv = relative(p);
-            const Real max_f = p.friction * p.impulse_n;
-            const Real old1 = p.impulse_t1;
-            const Real old2 = p.impulse_t2;
-            Real new1 = old1 - p.mass_t1 * dv.dot(p.t1);
-            Real new2 = old2 - p.mass_t2 * dv.dot(p.t2);
-            // Coulomb cone clamped as a disc (isotropic friction).
-            const Real len = std::sqrt(new1 * new1 + new2 * new2);
-            if (len > max_f && len > 0) {
-                new1 *= max_f / len;
-                new2 *= max_f / len;
-            }
-            p.impulse_t1 = new1;
-            p.impulse_t2 = new2;
-            apply(p, (new1 - old1) * p.t1 + (new2 - old2) * p.t2);
-
-            const Real vn = relative(p).dot(p.normal);
-            const Real old_n = p.impulse_n;
-            p.impulse_n = std::max(old_n - p.mass_n * (vn - p.velocity_bias), Real(0));
-            apply(p, (p.impulse_n - old_n) * p.normal);
+            solvePoint(p, cached_mass, [&](const Vec3& impulse) { apply(p, impulse); });
         }
     }
     // Shock propagation (Guendelman, Bridson, Fedkiw 2003 §5): levels by breadth-first search
@@ -375,25 +381,9 @@ void ContactSolver::solve(std::span<Body> bodies, std::span<const collision::Pro
             const bool a_up = level[p.a] > level[p.b];
             if (bodies[a_up ? p.a : p.b].is_static) continue;
             const BodyId up = a_up ? p.a : p.b;
-            const Vec3 dv = relative(p);
-            const Real max_f = p.friction * p.impulse_n;
-            const Real old1 = p.impulse_t1;
-            const Real old2 = p.impulse_t2;
-            Real new1 = old1 - upperMass(p, a_up, p.t1) * dv.dot(p.t1);
-            Real new2 = old2 - upperMass(p, a_up, p.t2) * dv.dot(p.t2);
-            const Real len = std::sqrt(new1 * new1 + new2 * new2);
-            if (len > max_f && len > 0) {
-                new1 *= max_f / len;
-                new2 *= max_f / len;
-            }
-            p.impulse_t1 = new1;
-            p.impulse_t2 = new2;
-            applyUpper(p, a_up, (new1 - old1) * p.t1 + (new2 - old2) * p.t2, vel[up].v, vel[up].w);
-            const Real vn = relative(p).dot(p.normal);
-            const Real old_n = p.impulse_n;
-            p.impulse_n =
-                std::max(old_n - upperMass(p, a_up, p.normal) * (vn - p.velocity_bias), Real(0));
-            applyUpper(p, a_up, (p.impulse_n - old_n) * p.normal, vel[up].v, vel[up].w);
+            solvePoint(
+                p, [&](const Vec3& d, Real) { return upperMass(p, a_up, d); },
+                [&](const Vec3& impulse) { applyUpper(p, a_up, impulse, vel[up].v, vel[up].w); });
         }
     }
 
@@ -408,24 +398,30 @@ void ContactSolver::solve(std::span<Body> bodies, std::span<const collision::Pro
 
     // Split impulse: pseudo velocities that remove baumgarte * (depth - slop) / dt of each
     // penetration, applied to the positions of this step only (never to the momenta).
+    // One split-impulse update of point p: `mass` the effective mass along the normal,
+    // `push(impulse)` applies a pseudo impulse along a -> b.
+    auto solvePseudo = [&](Point& p, Real mass, const auto& push) {
+        const Vec3 dv = (pseudo_linear[p.b] + pseudo_angular[p.b].cross(p.rb)) -
+                        (pseudo_linear[p.a] + pseudo_angular[p.a].cross(p.ra));
+        const Real target = settings.baumgarte * std::max(p.depth - p.slop, Real(0)) / dt;
+        const Real old = p.pseudo_n;
+        p.pseudo_n = std::max(old - mass * (dv.dot(p.normal) - target), Real(0));
+        push((p.pseudo_n - old) * p.normal);
+    };
     for (int it = 0; it < settings.position_iterations; ++it) {
         for (Point& p : points_) {
-            const Vec3 dv = (pseudo_linear[p.b] + pseudo_angular[p.b].cross(p.rb)) -
-                            (pseudo_linear[p.a] + pseudo_angular[p.a].cross(p.ra));
-            const Real target = settings.baumgarte * std::max(p.depth - p.slop, Real(0)) / dt;
-            const Real old = p.pseudo_n;
-            p.pseudo_n = std::max(old - p.mass_n * (dv.dot(p.normal) - target), Real(0));
-            const Vec3 impulse = (p.pseudo_n - old) * p.normal;
-            const Body& a = bodies[p.a];
-            const Body& b = bodies[p.b];
-            if (!a.is_static) {
-                pseudo_linear[p.a] -= impulse * a.inv_mass;
-                pseudo_angular[p.a] -= inv_inertia[p.a] * p.ra.cross(impulse);
-            }
-            if (!b.is_static) {
-                pseudo_linear[p.b] += impulse * b.inv_mass;
-                pseudo_angular[p.b] += inv_inertia[p.b] * p.rb.cross(impulse);
-            }
+            solvePseudo(p, p.mass_n, [&](const Vec3& impulse) {
+                const Body& a = bodies[p.a];
+                const Body& b = bodies[p.b];
+                if (!a.is_static) {
+                    pseudo_linear[p.a] -= impulse * a.inv_mass;
+                    pseudo_angular[p.a] -= inv_inertia[p.a] * p.ra.cross(impulse);
+                }
+                if (!b.is_static) {
+                    pseudo_linear[p.b] += impulse * b.inv_mass;
+                    pseudo_angular[p.b] += inv_inertia[p.b] * p.rb.cross(impulse);
+                }
+            });
         }
     }
 
@@ -436,14 +432,9 @@ void ContactSolver::solve(std::span<Body> bodies, std::span<const collision::Pro
             const bool a_up = level[p.a] > level[p.b];
             if (bodies[a_up ? p.a : p.b].is_static) continue;
             const BodyId up = a_up ? p.a : p.b;
-            const Vec3 dv = (pseudo_linear[p.b] + pseudo_angular[p.b].cross(p.rb)) -
-                            (pseudo_linear[p.a] + pseudo_angular[p.a].cross(p.ra));
-            const Real target = settings.baumgarte * std::max(p.depth - p.slop, Real(0)) / dt;
-            const Real old = p.pseudo_n;
-            p.pseudo_n =
-                std::max(old - upperMass(p, a_up, p.normal) * (dv.dot(p.normal) - target), Real(0));
-            applyUpper(p, a_up, (p.pseudo_n - old) * p.normal, pseudo_linear[up],
-                       pseudo_angular[up]);
+            solvePseudo(p, upperMass(p, a_up, p.normal), [&](const Vec3& impulse) {
+                applyUpper(p, a_up, impulse, pseudo_linear[up], pseudo_angular[up]);
+            });
         }
     }
 
