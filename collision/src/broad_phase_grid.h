@@ -10,7 +10,9 @@
 namespace collision {
 
 /// Uniform-grid binning (RTCD 7.1; the lecture's "regular grid broad phase") rebuilt each frame
-/// by a counting sort of (cell, proxy) entries. The cell size is twice the median AABB extent.
+/// by a counting sort of (cell, proxy) entries. The cell size starts at twice the median AABB
+/// extent; `Dense` doubles it until the grid has at most ~2n cells, `Hashed` (at most 4 times)
+/// until at most 1/64 of the proxies are oversized.
 ///  - `Dense`: a bounded grid over the union of the AABBs with at most ~2n cells; cell indices
 ///    are clamped, so anything outside the grid lands in a border cell and is still found.
 ///  - `Hashed`: an unbounded grid whose cells are hashed into ~2x(entries) buckets (Teschner et
