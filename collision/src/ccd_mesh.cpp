@@ -60,10 +60,12 @@ MeshToiOutput timeOfImpactMeshes(const MeshToiInput& input) {
     const Real size = std::min(a.nodes()[0].volume.half_extents.minCoeff(),
                                b.nodes()[0].volume.half_extents.minCoeff());
     const Real travel = (input.sweep_a.translation - input.sweep_b.translation).norm();
-    Real slices_wanted = std::max(turn / kSliceAngle, size > 0 ? travel / (size / 4) : Real(1));
+    const Real slices_wanted =
+        std::max(turn / kSliceAngle, size > 0 ? travel / (size / 4) : Real(1));
     constexpr int kMaxSlices = 64;
-    const int slices = std::isfinite(slices_wanted)
-                           ? std::clamp(static_cast<int>(std::ceil(slices_wanted)), 1, kMaxSlices)
+    // Clamped before the cast: a flat mesh (root half extent ~1e-17) would ask for ~1e16.
+    const int slices = slices_wanted <= Real(kMaxSlices)
+                           ? std::max(1, static_cast<int>(std::ceil(slices_wanted)))
                            : kMaxSlices;
 
     std::vector<std::pair<std::int32_t, std::int32_t>> stack;
@@ -85,7 +87,11 @@ MeshToiOutput timeOfImpactMeshes(const MeshToiInput& input) {
             const typename Bvh<Obb>::Node& nb = b.nodes()[static_cast<std::size_t>(ib)];
             ++out.node_tests;
             // Redon et al. 2002: the 15 separating-axis inequalities on [0, s_best] of the slice.
-            if (!testObbSweep(na.volume, sa, nb.volume, sb, 0, s_best)) continue;
+            // A's box grown by the target gap on every axis holds every point within that gap
+            // of the box, so a pair whose gap only closes to target_gap is not dropped.
+            Obb box_a = na.volume;
+            box_a.half_extents.array() += input.target_gap;
+            if (!testObbSweep(box_a, sa, nb.volume, sb, 0, s_best)) continue;
             if (na.isLeaf() && nb.isLeaf()) {
                 for (std::int32_t i = na.first; i < na.first + na.count; ++i) {
                     for (std::int32_t j = nb.first; j < nb.first + nb.count; ++j) {
@@ -97,20 +103,25 @@ MeshToiOutput timeOfImpactMeshes(const MeshToiInput& input) {
                         in.t_max = s_best;
                         in.target_gap = input.target_gap;
                         in.tolerance = input.tolerance;
+                        in.relative_tolerance = input.relative_tolerance;
                         in.max_iterations = input.max_iterations;
                         ++out.triangle_queries;
                         const ToiOutput r = timeOfImpact(in);
                         if (r.state == CcdState::Separated) continue;
-                        // Hit, Overlapped or Failed (a safe time): the earliest one wins.
-                        if (r.t < s_best || out.toi.state == CcdState::Separated) {
+                        // Hit, Overlapped or Failed (a safe time): the earliest one wins, a tie
+                        // the smaller gap (the engine sizes its retry from it); Overlapped (only
+                        // at the slice's start) always, and it ends the search.
+                        if (r.state == CcdState::Overlapped || r.t < s_best ||
+                            out.toi.state == CcdState::Separated ||
+                            (r.t == s_best && r.distance < out.toi.distance)) {
                             s_best = r.t;
                             out.toi = r;
                             out.toi.t = t0 + r.t;
                             out.triangle_a = a.leafTriangleId(i);
                             out.triangle_b = b.leafTriangleId(j);
                         }
-                        // Overlapped only at the slice's start: at t = 0 it is the answer; later
-                        // it means an earlier slice's advancement crossed by rounding: a Hit.
+                        // At t = 0 Overlapped is the answer; later it means an earlier slice's
+                        // advancement crossed by rounding: a Hit at the slice's start.
                         if (r.state == CcdState::Overlapped) {
                             if (t0 > 0) out.toi.state = CcdState::Hit;
                             return out;

@@ -25,7 +25,9 @@ constexpr Real kMatchFraction = Real(0.1);
 // Shock-propagation passes after the iterations (velocity, then position). With the lower body
 // held fixed each contact converges in a few passes; measured on a 1 kg box under 1000 kg (and
 // a 1-1000-1-1000 tower): 1 pass leaves a 2 cm creep over 10 s, 10 passes 0.15 mm, 20 none
-// visible at 0.1 mm; the passes touch only contacts between levels, so they are cheap.
+// visible at 0.1 mm. Cost: the passes visit only contacts between levels, but in a resting
+// pile that is nearly all of them, so they add up to 20/30 to the velocity work and 4x the
+// position work (5 iterations) of the solver.
 constexpr int kShockPasses = 20;
 
 Real boundingRadius(const Body& b) {
@@ -337,16 +339,29 @@ void ContactSolver::solve(std::span<Body> bodies, std::span<const collision::Pro
                 frontier.push_back(static_cast<BodyId>(i));
             }
         }
-        // Points are sorted by (a, b); a few sweeps over them per level suffice for stacks.
-        for (int l = 0; !frontier.empty(); ++l) {
-            frontier.clear();
+        // Breadth-first search over the contact graph (adjacency in compressed rows, built
+        // once: O(points + bodies)).
+        std::vector<std::uint32_t> first(n + 1, 0);
+        for (const Point& p : points_) {
+            ++first[p.a + 1];
+            ++first[p.b + 1];
+        }
+        for (std::size_t i = 0; i < n; ++i) first[i + 1] += first[i];
+        std::vector<BodyId> neighbour(first[n]);
+        {
+            std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
             for (const Point& p : points_) {
-                if (level[p.a] == l && level[p.b] == kUnreached) {
-                    level[p.b] = l + 1;
-                    frontier.push_back(p.b);
-                } else if (level[p.b] == l && level[p.a] == kUnreached) {
-                    level[p.a] = l + 1;
-                    frontier.push_back(p.a);
+                neighbour[fill[p.a]++] = p.b;
+                neighbour[fill[p.b]++] = p.a;
+            }
+        }
+        for (std::size_t head = 0; head < frontier.size(); ++head) {
+            const BodyId u = frontier[head];
+            for (std::uint32_t k = first[u]; k < first[u + 1]; ++k) {
+                const BodyId v = neighbour[k];
+                if (level[v] == kUnreached) {
+                    level[v] = level[u] + 1;
+                    frontier.push_back(v);
                 }
             }
         }

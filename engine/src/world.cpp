@@ -421,6 +421,7 @@ void World::resolveContinuous() {
             mi.sweep_b = in.sweep_b;
             mi.target_gap = in.target_gap;
             mi.tolerance = in.tolerance;
+            mi.relative_tolerance = in.relative_tolerance;
             mi.max_iterations = in.max_iterations;
             return collision::timeOfImpactMeshes(mi).toi;
         };
@@ -480,8 +481,10 @@ void World::resolveContinuous() {
     // + n.((I_a^-1 (r_a x n)) x r_a) + n.((I_b^-1 (r_b x n)) x r_b)) (Mirtich & Canny 1995;
     // Baraff, SIGGRAPH course notes, "Rigid body simulation II", §8).
     for (const ToiEvent& e : toi_events_) {
-        // The earliest event of a moving body: a static body's clamp_t is just its own first
-        // event, and a body stopped earlier by another event is not at this one's pose.
+        // Only an event that is the earliest of one of its moving bodies gets an impulse (a
+        // static body's clamp_t is just its own first event, so it does not count). If the
+        // partner is a moving body stopped earlier by another event, it still takes its share
+        // of the impulse at its own earlier pose: part of the one-round limitation above.
         const bool earliest_a = swept_[e.a].moving && e.t == swept_[e.a].clamp_t;
         const bool earliest_b = swept_[e.b].moving && e.t == swept_[e.b].clamp_t;
         if (!earliest_a && !earliest_b) continue;

@@ -131,6 +131,35 @@ TEST(MeshTimeOfImpact, RingAroundRodIsNotStoppedButItsHullIs) {
     EXPECT_GT(hit.toi.t, 0.3);  // the tube's near face is at z = -0.2 - 0.02: t ~ 0.46
 }
 
+// Regression (review): the node test proved boxes apart without the target gap, so a pair whose
+// gap closed to target_gap without the boxes ever overlapping was dropped: Separated instead of
+// Hit. Two unit quads (flat OBBs), B sliding over A 0.01 above it, target gap 0.05:
+//
+//        B [====]  -->            gap 0.05 reached when B's edge is 0.049 from A's (x)
+//   A [====]                      t = (1 - 0.049) / 6 = 0.1585
+//
+TEST(MeshTimeOfImpact, TargetGapIsReachedWithoutTheBoxesOverlapping) {
+    TriangleMesh quad;
+    quad.vertices = {Vec3(-1, -1, 0), Vec3(1, -1, 0), Vec3(1, 1, 0), Vec3(-1, 1, 0)};
+    quad.triangles = {{0, 1, 2}, {0, 2, 3}};
+    const Bvh<Obb> tree(quad);
+    MeshToiInput in;
+    in.a = &tree;
+    in.b = &tree;
+    in.sweep_b.start.position = Vec3(3, 0, 0.01);
+    in.sweep_b.translation = Vec3(-6, 0, 0);
+    in.target_gap = 0.05;
+    const MeshToiOutput r = timeOfImpactMeshes(in);
+    ASSERT_EQ(r.toi.state, CcdState::Hit);
+    const Real exact = (1 - std::sqrt(0.05 * 0.05 - 0.01 * 0.01)) / 6;
+    EXPECT_LE(r.toi.t, exact + 1e-12);
+    // Accepted within target gap + tolerance (1e-3 of the triangles' radius about the origin,
+    // sqrt(2)), closing at up to 6 m per step.
+    EXPECT_GE(r.toi.t, exact - (1e-3 * std::sqrt(2.0) + 1e-9) / 6 * 2);
+    in.target_gap = 0;  // without a target gap the quads never touch
+    EXPECT_EQ(timeOfImpactMeshes(in).toi.state, CcdState::Separated);
+}
+
 TEST(MeshTimeOfImpact, NullTreesFailAndEmptyStepIsSeparated) {
     MeshToiInput in;
     EXPECT_EQ(timeOfImpactMeshes(in).toi.state, CcdState::Failed);

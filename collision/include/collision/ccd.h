@@ -207,9 +207,11 @@ struct MeshToiInput {
     const Bvh<Obb>* b = nullptr;
     Sweep sweep_a;
     Sweep sweep_b;
-    Real t_max = 1;           ///< search [0, t_max] of the step, t_max in [0, 1]
-    Real target_gap = 0;      ///< m, >= 0, as ToiInput::target_gap
-    Real tolerance = 0;       ///< m, >= 0, as ToiInput::tolerance (0: relative to each pair)
+    Real t_max = 1;       ///< search [0, t_max] of the step, t_max in [0, 1]
+    Real target_gap = 0;  ///< m, >= 0, as ToiInput::target_gap
+    Real tolerance = 0;   ///< m, >= 0, as ToiInput::tolerance (0: relative to each pair)
+    /// As ToiInput::relative_tolerance, used when tolerance is 0.
+    Real relative_tolerance = kToiRelativeTolerance;
     int max_iterations = 64;  ///< per triangle pair, as ToiInput::max_iterations
 };
 
