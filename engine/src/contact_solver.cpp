@@ -390,17 +390,23 @@ void ContactSolver::solve(std::span<Body> bodies, std::span<const collision::Pro
         v += sign * impulse * bodies[id].inv_mass;
         w += sign * (inv_inertia[id] * r.cross(impulse));
     };
-    for (int pass = 0; pass < kShockPasses; ++pass) {
-        for (const std::size_t k : shock_order) {
-            Point& p = points_[k];
-            const bool a_up = level[p.a] > level[p.b];
-            if (bodies[a_up ? p.a : p.b].is_static) continue;
-            const BodyId up = a_up ? p.a : p.b;
-            solvePoint(
-                p, [&](const Vec3& d, Real) { return upperMass(p, a_up, d); },
-                [&](const Vec3& impulse) { applyUpper(p, a_up, impulse, vel[up].v, vel[up].w); });
+    // kShockPasses passes over the contacts between levels, in shock order; `solve(p, a_up, up)`
+    // updates one with its upper body `up` (a_up: it is p.a). The upper body is never static:
+    // static bodies are level 0, below every other.
+    auto shockPasses = [&](const auto& solve) {
+        for (int pass = 0; pass < kShockPasses; ++pass) {
+            for (const std::size_t k : shock_order) {
+                Point& p = points_[k];
+                const bool a_up = level[p.a] > level[p.b];
+                solve(p, a_up, a_up ? p.a : p.b);
+            }
         }
-    }
+    };
+    shockPasses([&](Point& p, bool a_up, BodyId up) {
+        solvePoint(
+            p, [&](const Vec3& d, Real) { return upperMass(p, a_up, d); },
+            [&](const Vec3& impulse) { applyUpper(p, a_up, impulse, vel[up].v, vel[up].w); });
+    });
 
     for (std::size_t i = 0; i < n; ++i) {
         Body& b = bodies[i];
@@ -441,17 +447,11 @@ void ContactSolver::solve(std::span<Body> bodies, std::span<const collision::Pro
     }
 
     // The same shock passes for the split impulse: the lower body's pseudo velocity held fixed.
-    for (int pass = 0; pass < kShockPasses; ++pass) {
-        for (const std::size_t k : shock_order) {
-            Point& p = points_[k];
-            const bool a_up = level[p.a] > level[p.b];
-            if (bodies[a_up ? p.a : p.b].is_static) continue;
-            const BodyId up = a_up ? p.a : p.b;
-            solvePseudo(p, upperMass(p, a_up, p.normal), [&](const Vec3& impulse) {
-                applyUpper(p, a_up, impulse, pseudo_linear[up], pseudo_angular[up]);
-            });
-        }
-    }
+    shockPasses([&](Point& p, bool a_up, BodyId up) {
+        solvePseudo(p, upperMass(p, a_up, p.normal), [&](const Vec3& impulse) {
+            applyUpper(p, a_up, impulse, pseudo_linear[up], pseudo_angular[up]);
+        });
+    });
 
     previous_ = points_;  // already sorted by (a, b): pairs were sorted
 }

@@ -177,19 +177,30 @@ Real maxDrift(const World& world, const std::vector<Vec3>& start) {
     return d;
 }
 
-TEST(Response, FiveBoxStackRestsWithoutDriftOrJitter) {
-    World world = makeWorld(loadScene(kScenes / "stack.yaml"));
+// Runs 600 steps (10 s at dt = 1/60) and measures how far any body moved from where it was at
+// the start and the largest speed over the last 300 steps.
+struct Settling {
+    Real drift = 0;
+    Real late_speed = 0;
+};
+Settling settle(World& world) {
     std::vector<Vec3> start;
     for (const Body& b : world.bodies()) start.push_back(b.position);
-    Real late_speed = 0;
-    for (int i = 0; i < 600; ++i) {  // 10 s at dt = 1/60
+    Settling out;
+    for (int i = 0; i < 600; ++i) {
         world.step();
         if (i >= 300) {
             for (const Body& b : world.bodies())
-                late_speed = std::max(late_speed, b.velocity().norm());
+                out.late_speed = std::max(out.late_speed, b.velocity().norm());
         }
     }
-    const Real drift = maxDrift(world, start);
+    out.drift = maxDrift(world, start);
+    return out;
+}
+
+TEST(Response, FiveBoxStackRestsWithoutDriftOrJitter) {
+    World world = makeWorld(loadScene(kScenes / "stack.yaml"));
+    const auto [drift, late_speed] = settle(world);
     RecordProperty("drift_m", std::to_string(drift));
     RecordProperty("late_max_speed", std::to_string(late_speed));
     EXPECT_LT(drift, 0.01);                           // 1 % of the 1 m box
@@ -229,17 +240,7 @@ TEST(Response, MassRatioStacksHoldBothWaysRound) {
             world.addBody(b);
         }
         world.detect();
-        std::vector<Vec3> start;
-        for (const Body& b : world.bodies()) start.push_back(b.position);
-        Real late_speed = 0;
-        for (int i = 0; i < 600; ++i) {
-            world.step();
-            if (i >= 300) {
-                for (const Body& b : world.bodies())
-                    late_speed = std::max(late_speed, b.velocity().norm());
-            }
-        }
-        const Real drift = maxDrift(world, start);
+        const auto [drift, late_speed] = settle(world);
         RecordProperty("drift_m", std::to_string(drift));
         EXPECT_LT(drift, 0.01);  // 1 % of a box
         EXPECT_LT(late_speed, 1e-3);
