@@ -1,19 +1,26 @@
 // collision/src/broad_phase_hgrid.cpp -- hierarchical grid of sorted columns, rebuilt each frame.
-// Completeness and uniqueness, same level: members' extents are <= the column width w (cells
-// are s_top / 8^k, widened by 2^-20 so rounding of floor((v - o) / w) cannot split two values
-// less than a cell apart by two columns); so overlapping a, b sit in columns at most one apart in
-// y and in z. Each pair of such columns is swept once (sweepLevel), and the box of the pair
-// that comes first in min x finds the other. Across levels: a at a finer level scans, in each coarser level j, the columns
-// within that level's largest extent E_j of its box and the min-x window [min_a.x - E_j,
-// max_a.x], widened by a few ulps; a pair across levels is found only from its finer member.
+// Completeness and uniqueness. Let a, b overlap, with a at level ka, b at level kb, and
+// j = min(ka, kb) the coarser level. Both have an entry at level j (one is its own, the other
+// its own or a guest), in every column of level j their boxes touch. The point
+// p = (max(a.min_y, b.min_y), max(a.min_z, b.min_z)) lies in both boxes' (y, z) projections,
+// and because column(v) is a non-decreasing function of v, p's column is
+// (max of the two min-y columns, max of the two min-z columns): both boxes touch it, and it is
+// the only column where each axis has one of the two entries at its own min column, i.e. where
+// the flags' OR has bits 0 and 1 set. Bit 2 (one of them is at its own level) holds at level j
+// only, since at a coarser level both are guests and at a finer one the coarser box is absent.
+// In that one column the two entries are swept once, from whichever comes first in (min x, id).
 #include "broad_phase_hgrid.h"
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
-#include <numeric>
-#include <type_traits>
+#include <limits>
 #include <sstream>
+#include <type_traits>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "collision/debug_draw.h"
 #include "radix_sort.h"
@@ -24,173 +31,114 @@ using radix::bitsFor;
 using radix::orderedBits;
 using radix::radixSortIndices;
 
-std::int64_t HierarchicalGrid::column(const Level& level, int axis, Real v) const {
-    const Real origin = axis == 1 ? level.origin_y : level.origin_z;
-    const std::int64_t n = axis == 1 ? level.ny : level.nz;
-    const Real c = std::floor((v - origin) / level.cell);
-    return static_cast<std::int64_t>(std::clamp(c, Real(0), Real(n - 1)));
-}
-
-void HierarchicalGrid::buildLevel(Level& level, const std::vector<ProxyId>& members) {
-    const std::size_t n = members.size();
-    level.count = n;
-    Real lo_y = std::numeric_limits<Real>::max(), hi_y = std::numeric_limits<Real>::lowest();
-    Real lo_z = lo_y, hi_z = hi_y;
-    level.top_extent = 0;
-    for (ProxyId id : members) {
-        const Aabb& b = table_.aabb(id);
-        lo_y = std::min(lo_y, b.min.y());
-        hi_y = std::max(hi_y, b.min.y());
-        lo_z = std::min(lo_z, b.min.z());
-        hi_z = std::max(hi_z, b.min.z());
-        level.top_extent = std::max(level.top_extent, b.extents().maxCoeff());
-    }
-    level.origin_y = lo_y;
-    level.origin_z = lo_z;
-    // Widen the columns a little (see the file comment); at most ~2 columns per member, else
-    // coarser columns (still >= every extent, so still correct).
-    level.cell *= Real(1) + std::ldexp(Real(1), -20);
-    const Real limit = std::max<Real>(64, 2 * Real(n));
-    for (;;) {
-        const Real ny = std::floor((hi_y - lo_y) / level.cell) + 1;
-        const Real nz = std::floor((hi_z - lo_z) / level.cell) + 1;
-        if (ny * nz <= limit) {
-            level.ny = static_cast<std::int64_t>(ny);
-            level.nz = static_cast<std::int64_t>(nz);
-            break;
-        }
-        level.cell *= 2;
-    }
-    const std::size_t columns = static_cast<std::size_t>(level.ny * level.nz);
-
-    // Sort by min x (stable over the id order members come in), then stably by column.
-    sort_keys_.resize(n);
-    order_.resize(n);
-    column_of_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-        const Aabb& b = table_.aabb(members[i]);
-        sort_keys_[i] = orderedBits(b.min.x());
-        order_[i] = static_cast<std::uint32_t>(i);
-        column_of_[i] =
-            static_cast<std::uint32_t>(column(level, 2, b.min.z()) * level.ny + column(level, 1, b.min.y()));
-    }
-    radixSortIndices(order_, order_scratch_, sort_keys_);
-    level.start.assign(columns + 1, 0);
-    for (std::size_t i = 0; i < n; ++i) ++level.start[column_of_[i] + 1];
-    for (std::size_t c = 0; c < columns; ++c) level.start[c + 1] += level.start[c];
-    level.id.resize(n);
-    level.box.resize(n);
-    for (std::uint32_t i : order_) {
-        const std::uint32_t slot = level.start[column_of_[i]]++;
-        const Aabb& b = table_.aabb(members[i]);
-        level.id[slot] = members[i];
-        level.box[slot] =
-            PackedBox{b.min.x(), b.max.x(), b.min.y(), b.max.y(), b.min.z(), b.max.z()};
-    }
-    for (std::size_t c = columns; c > 0; --c) level.start[c] = level.start[c - 1];
-    level.start[0] = 0;
-}
-
 namespace {
 
-// The boxes of `from` in [q, end) whose min x lies within `a`'s x interval overlap `a` in x
-// (their min x >= a's, by the sweep order); emit those that also overlap in y and z.
-inline void scanForward(const HierarchicalGrid::PackedBox& a, ProxyId a_id,
-                        const HierarchicalGrid::PackedBox* box, const ProxyId* ids,
-                        std::uint32_t q, std::uint32_t end, int id_shift,
-                        std::vector<std::uint64_t>& keys, std::int64_t& tests) {
-    for (; q < end && box[q].min_x <= a.max_x; ++q) {
-        ++tests;
-        const HierarchicalGrid::PackedBox& b = box[q];
-        const bool hit = (b.min_y <= a.max_y) & (a.min_y <= b.max_y) & (b.min_z <= a.max_z) &
-                         (a.min_z <= b.max_z);
-        if (hit) {
-            const ProxyId b_id = ids[q];
-            const ProxyId lo = std::min(a_id, b_id);
-            const ProxyId hi = std::max(a_id, b_id);
-            keys.push_back((std::uint64_t(lo) << id_shift) | std::uint64_t(hi));
-        }
-    }
+inline Real extentOf(const Aabb& b) { return (b.max - b.min).maxCoeff(); }
+
+// floor(log2(x)) for x >= 1 (and large for x = inf), from the exponent bits.
+inline int floorLog2(Real x) {
+    using Bits = std::conditional_t<sizeof(Real) == 8, std::uint64_t, std::uint32_t>;
+    constexpr int kMantissa = std::numeric_limits<Real>::digits - 1;
+    constexpr int kBias = std::numeric_limits<Real>::max_exponent - 1;
+    constexpr Bits kMask = (Bits(1) << (sizeof(Real) * 8 - 1 - kMantissa)) - 1;
+    return int((std::bit_cast<Bits>(x) >> kMantissa) & kMask) - kBias;
 }
+
+inline bool before(Real xa, std::uint32_t ia, Real xb, std::uint32_t ib) {
+    return xa < xb || (xa == xb && ia < ib);
+}
+
+// Overlap of a fixed entry's (y, z) interval with others'; touching counts. With SSE2 and double
+// coordinates, the four comparisons are two (min y, min z) <= (max y, max z) vector compares.
+#if defined(__SSE2__)
+template <typename T>
+struct YzTestOf;
+template <>
+struct YzTestOf<double> {
+    using Entry = HierarchicalGrid::Entry;
+    explicit YzTestOf(const Entry& a) : lo(_mm_loadu_pd(&a.min_y)), hi(_mm_loadu_pd(&a.max_y)) {}
+    bool overlaps(const Entry& b) const {
+        const __m128d in = _mm_and_pd(_mm_cmple_pd(_mm_loadu_pd(&b.min_y), hi),
+                                      _mm_cmple_pd(lo, _mm_loadu_pd(&b.max_y)));
+        return _mm_movemask_pd(in) == 3;
+    }
+    __m128d lo, hi;
+};
+#endif
+
+template <typename T>
+struct YzTestOf {
+    using Entry = HierarchicalGrid::Entry;
+    explicit YzTestOf(const Entry& a) : a_(a) {}
+    bool overlaps(const Entry& b) const {
+        return (b.min_y <= a_.max_y) & (a_.min_y <= b.max_y) & (b.min_z <= a_.max_z) &
+               (a_.min_z <= b.max_z);
+    }
+    const Entry& a_;
+};
+using YzTest = YzTestOf<Real>;
 
 }  // namespace
 
-void HierarchicalGrid::sweepLevel(const Level& lv, BroadPhaseCounters& counters) {
-    // Each unordered pair of columns at most one apart is visited once: a column with itself
-    // (one sorted list swept forward), then with its four "forward" neighbours (+y; -y+z; +z;
-    // +y+z) by merging the two sorted lists: whichever box comes first in min x (ties: the
-    // column's own) scans the other list forward, so a pair is met exactly once, from the
-    // box that starts first (Baraff 1992 sort and sweep, two lists at a time).
-    const PackedBox* const box = lv.box.data();
-    const ProxyId* const ids = lv.id.data();
-    const std::uint32_t* const start = lv.start.data();
-    std::int64_t tests = 0;  // a local, so the pushes below cannot force it through memory
-    constexpr std::array<std::array<int, 2>, 4> kForward{{{1, 0}, {-1, 1}, {0, 1}, {1, 1}}};
-    for (std::int64_t cz = 0; cz < lv.nz; ++cz) {
-        for (std::int64_t cy = 0; cy < lv.ny; ++cy) {
-            const std::int64_t c = cz * lv.ny + cy;
-            const std::uint32_t c0 = start[c];
-            const std::uint32_t c1 = start[c + 1];
-            if (c0 == c1) continue;
-            for (std::uint32_t i = c0; i < c1; ++i) {
-                scanForward(box[i], ids[i], box, ids, i + 1, c1, id_shift_, keys_, tests);
-            }
-            for (const auto& [oy, oz] : kForward) {
-                const std::int64_t dy = cy + oy;
-                const std::int64_t dz = cz + oz;
-                if (dy < 0 || dy >= lv.ny || dz >= lv.nz) continue;
-                const std::int64_t d = dz * lv.ny + dy;
-                std::uint32_t i = c0;
-                std::uint32_t j = start[d];
-                const std::uint32_t d1 = start[d + 1];
-                while (i < c1 && j < d1) {
-                    if (box[i].min_x <= box[j].min_x) {
-                        scanForward(box[i], ids[i], box, ids, j, d1, id_shift_, keys_, tests);
-                        ++i;
-                    } else {
-                        scanForward(box[j], ids[j], box, ids, i, c1, id_shift_, keys_, tests);
-                        ++j;
-                    }
-                }
-            }
-        }
-    }
-    counters.volume_tests += tests;
+std::int64_t HierarchicalGrid::column(const Level& lv, Real v, Real origin, std::int64_t n) const {
+    if (n == 1) return 0;
+    // v >= origin (the smallest min coordinate of all proxies), so the product is >= 0 and the
+    // truncation is floor: non-decreasing in v, which is all the owner rule needs.
+    const Real c = (v - origin) * lv.inv_cell;
+    return std::min<std::int64_t>(static_cast<std::int64_t>(c), n - 1);
 }
 
-void HierarchicalGrid::queryCoarser(const PackedBox& a, ProxyId a_id, const Level& lv,
-                                    BroadPhaseCounters& counters) {
-    const Real e = lv.top_extent;
-    // A few ulps of the coordinates, so rounding never narrows the scanned window.
-    const Real slack =
-        4 * kEpsilon * (e + std::abs(a.min_x) + std::abs(a.min_y) + std::abs(a.min_z));
-    const std::int64_t y0 = column(lv, 1, a.min_y - e - slack);
-    const std::int64_t y1 = column(lv, 1, a.max_y);
-    const std::int64_t z0 = column(lv, 2, a.min_z - e - slack);
-    const std::int64_t z1 = column(lv, 2, a.max_z);
-    const Real x_from = a.min_x - e - slack;
-    const PackedBox* const box = lv.box.data();
-    for (std::int64_t z = z0; z <= z1; ++z) {
-        for (std::int64_t y = y0; y <= y1; ++y) {
-            const std::int64_t d = z * lv.ny + y;
-            const PackedBox* first = box + lv.start[d];
-            const PackedBox* last = box + lv.start[d + 1];
-            const PackedBox* q = std::partition_point(
-                first, last, [x_from](const PackedBox& b) { return b.min_x < x_from; });
-            for (; q < last && q->min_x <= a.max_x; ++q) {
-                ++counters.volume_tests;
-                const bool hit = (q->min_x <= a.max_x) & (a.min_x <= q->max_x) &
-                                 (q->min_y <= a.max_y) & (a.min_y <= q->max_y) &
-                                 (q->min_z <= a.max_z) & (a.min_z <= q->max_z);
-                if (hit) {
-                    const ProxyId b_id = lv.id[static_cast<std::size_t>(q - box)];
-                    const ProxyId lo = std::min(a_id, b_id);
-                    const ProxyId hi = std::max(a_id, b_id);
-                    keys_.push_back((std::uint64_t(lo) << id_shift_) | std::uint64_t(hi));
-                }
+HierarchicalGrid::Span HierarchicalGrid::span(const Level& lv, const Aabb& b) const {
+    const std::int64_t y0 = column(lv, b.min.y(), origin_y_, lv.ny);
+    const std::int64_t z0 = column(lv, b.min.z(), origin_z_, lv.nz);
+    return Span{y0, z0, column(lv, b.max.y(), origin_y_, lv.ny) - y0,
+                column(lv, b.max.z(), origin_z_, lv.nz) - z0};
+}
+
+void HierarchicalGrid::sortByMinX(BroadPhaseCounters& counters) {
+    const std::size_t n = static_cast<std::size_t>(table_.count());
+    if (!membership_changed_ && order_.size() == n) {
+        // Gather the boxes in last frame's order and repair it by insertion sort; coherent
+        // motion makes few shifts. Past the budget the motion is not coherent, and the radix
+        // sort below is cheaper.
+        box_.resize(n);
+        for (std::size_t p = 0; p < n; ++p) box_[p] = table_.aabb(ProxyId(order_[p]));
+        const std::size_t budget = 8 * n + 1024;
+        std::size_t shifts = 0;
+        bool sorted = true;
+        for (std::size_t i = 1; i < n; ++i) {
+            if (!before(box_[i].min.x(), order_[i], box_[i - 1].min.x(), order_[i - 1])) continue;
+            const Aabb b = box_[i];
+            const std::uint32_t id = order_[i];
+            std::size_t j = i;
+            do {
+                box_[j] = box_[j - 1];
+                order_[j] = order_[j - 1];
+                --j;
+            } while (j > 0 && before(b.min.x(), id, box_[j - 1].min.x(), order_[j - 1]));
+            box_[j] = b;
+            order_[j] = id;
+            shifts += i - j;
+            if (shifts > budget) {
+                sorted = false;
+                break;
             }
         }
+        counters.swaps += static_cast<std::int64_t>(shifts);
+        if (sorted) return;
     }
+    // Full sort: ids ascending, then a stable radix sort by min x, so ties stay in id order.
+    order_.clear();
+    sort_key_.resize(static_cast<std::size_t>(table_.capacity()));
+    for (ProxyId id = 0; id < table_.capacity(); ++id) {
+        if (!table_.contains(id)) continue;
+        order_.push_back(static_cast<std::uint32_t>(id));
+        sort_key_[static_cast<std::size_t>(id)] = orderedBits(table_.aabb(id).min.x());
+    }
+    radixSortIndices(order_, sort_scratch_, sort_key_);
+    box_.resize(n);
+    for (std::size_t p = 0; p < n; ++p) box_[p] = table_.aabb(ProxyId(order_[p]));
+    membership_changed_ = false;
 }
 
 void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) {
@@ -198,98 +146,258 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     moved_ = 0;
     pairs.clear();
     level_count_ = 0;
+    entries_.clear();
     if (table_.count() == 0) return;
+    sortByMinX(counters);
+    const std::size_t n = order_.size();
 
-    // Levels: cells s_top / 8^k, down to the smallest extent (at most kMaxLevels).
-    Real largest = 0;
-    for (ProxyId id = 0; id < table_.capacity(); ++id) {
-        if (table_.contains(id)) largest = std::max(largest, table_.aabb(id).extents().maxCoeff());
+    // The largest extent and the (y, z) bounds of every box.
+    Real top = 0;
+    Real lo_y = std::numeric_limits<Real>::max(), hi_y = std::numeric_limits<Real>::lowest();
+    Real lo_z = lo_y, hi_z = hi_y;
+    for (const Aabb& b : box_) {
+        top = std::max(top, extentOf(b));
+        lo_y = std::min(lo_y, b.min.y());
+        hi_y = std::max(hi_y, b.max.y());
+        lo_z = std::min(lo_z, b.min.z());
+        hi_z = std::max(hi_z, b.max.z());
     }
-    const Real top = largest > 0 ? largest : Real(1);
-    for (auto& m : members_) m.clear();
+    if (!(top > 0)) top = 1;
+    origin_y_ = lo_y;
+    origin_z_ = lo_z;
+
+    // Levels: cells s_top / 8^k; a box at the finest level whose cells hold its extent.
+    // Zero-size boxes fit anywhere; they join the finest level in use (or level 0).
+    constexpr std::uint8_t kZeroSize = 0xff;
+    level_of_.resize(n);
     int finest = 0;
-    for (ProxyId id = 0; id < table_.capacity(); ++id) {
-        if (!table_.contains(id)) continue;
-        const Real e = table_.aabb(id).extents().maxCoeff();
-        int k = kMaxLevels - 1;  // zero-size boxes: the finest level
-        if (e > 0) {
-            int exponent = 0;
-            std::frexp(top / e, &exponent);  // top / e in [2^(exponent-1), 2^exponent)
-            k = std::clamp((exponent - 1) / kLevelBits, 0, kMaxLevels - 1);
-            while (k > 0 && std::ldexp(top, -kLevelBits * k) < e) --k;  // guard: cell >= extent
+    for (std::size_t p = 0; p < n; ++p) {
+        const Real e = extentOf(box_[p]);
+        if (!(e > 0)) {
+            level_of_[p] = kZeroSize;
+            continue;
         }
-        members_[k].push_back(id);
+        int k = std::min(floorLog2(top / e) / kLevelBits, kMaxLevels - 1);
+        while (k > 0 && std::ldexp(top, -kLevelBits * k) < e) --k;  // guard: cell >= extent
+        level_of_[p] = static_cast<std::uint8_t>(k);
         finest = std::max(finest, k);
     }
     level_count_ = finest + 1;
-    for (int k = 0; k < level_count_; ++k) {
-        levels_[k].cell = std::ldexp(top, -kLevelBits * k);
-        levels_[k].count = 0;
-        if (!members_[k].empty()) buildLevel(levels_[k], members_[k]);
+    for (int k = 0; k < level_count_; ++k) levels_[k].members = 0;
+    for (std::size_t p = 0; p < n; ++p) {
+        if (level_of_[p] == kZeroSize) level_of_[p] = static_cast<std::uint8_t>(finest);
+        ++levels_[level_of_[p]].members;
     }
 
-    // Pair keys pack (a, b) into 2 x id_shift_ bits, so the final radix sort makes as few
-    // passes as the ids need (3 passes of 11 bits for up to 2^16 proxies).
-    id_shift_ = bitsFor(static_cast<std::uint64_t>(table_.capacity()));
-    keys_.clear();
-    for (int k = 0; k < level_count_; ++k) {
-        const Level& own = levels_[k];
-        if (own.count == 0) continue;
-        sweepLevel(own, counters);
-        for (int j = k - 1; j >= 0; --j) {
-            if (levels_[j].count == 0) continue;
-            for (std::size_t i = 0; i < own.count; ++i) {
-                queryCoarser(own.box[i], own.id[i], levels_[j], counters);
+    // Column grids: cells widened (doubled) until a level has at most ~2 columns per entry.
+    std::size_t guests = 0;  // entries of finer levels' proxies, as guests of this level
+    for (int k = level_count_ - 1; k >= 0; --k) {
+        Level& lv = levels_[k];
+        const std::size_t entries = lv.members + guests;
+        if (lv.members > 0) guests += lv.members;
+        if (lv.members == 0) continue;
+        const Real limit = std::max<Real>(64, 2 * Real(entries));
+        lv.cell = std::ldexp(top, -kLevelBits * k) * (1 + std::ldexp(Real(1), -20));
+        for (;;) {
+            lv.inv_cell = 1 / lv.cell;
+            const Real sy = (hi_y - lo_y) * lv.inv_cell;
+            const Real sz = (hi_z - lo_z) * lv.inv_cell;
+            if (!std::isfinite(sy) || !std::isfinite(sz) || lv.inv_cell == 0) {
+                lv.ny = lv.nz = 1;  // coordinates beyond the range of a column index
+                break;
+            }
+            const Real ny = std::floor(sy) + 1;
+            const Real nz = std::floor(sz) + 1;
+            if (ny * nz <= limit) {
+                lv.ny = static_cast<std::int64_t>(ny);
+                lv.nz = static_cast<std::int64_t>(nz);
+                break;
+            }
+            lv.cell *= 2;
+        }
+        lv.start.assign(static_cast<std::size_t>(lv.ny * lv.nz) + 1, 0);
+    }
+
+    // Count the entries of every column, then lay the levels out one after the other. A box
+    // touches one or two columns per axis (its extent is at most the cell, widened by 2^-20 so
+    // rounding cannot make it three in double); the common case runs without branches on it.
+    for (std::size_t p = 0; p < n; ++p) {
+        const Aabb& b = box_[p];
+        for (int k = 0; k <= level_of_[p]; ++k) {
+            Level& lv = levels_[k];
+            if (lv.members == 0) continue;
+            const Span s = span(lv, b);
+            std::uint32_t* const count = lv.start.data() + 1;
+            if (s.dy <= 1 && s.dz <= 1) {
+                const std::int64_t c = s.z0 * lv.ny + s.y0;
+                count[c] += 1;
+                count[c + s.dy] += std::uint32_t(s.dy);
+                count[c + s.dz * lv.ny] += std::uint32_t(s.dz);
+                count[c + s.dz * lv.ny + s.dy] += std::uint32_t(s.dy & s.dz);
+                continue;
+            }
+            for (std::int64_t z = s.z0; z <= s.z0 + s.dz; ++z) {
+                for (std::int64_t y = s.y0; y <= s.y0 + s.dy; ++y) ++count[z * lv.ny + y];
             }
         }
     }
-    // (a, b) order: one radix sort of the packed keys.
+    std::size_t total = 0;
+    for (int k = 0; k < level_count_; ++k) {
+        Level& lv = levels_[k];
+        lv.first = total;
+        lv.count = 0;
+        if (lv.members == 0) continue;
+        for (std::size_t c = 1; c < lv.start.size(); ++c) lv.start[c] += lv.start[c - 1];
+        lv.count = lv.start.back();
+        total += lv.count;
+    }
+    entries_.resize(total + 1);  // + 1: where the branch-free scatter writes entries it drops
+
+    // Scatter in min-x order, so every column is sorted by (min x, id).
+    for (std::size_t p = 0; p < n; ++p) {
+        const std::uint32_t id = order_[p];
+        const Aabb& b = box_[p];
+        const int own = level_of_[p];
+        for (int k = 0; k <= own; ++k) {
+            Level& lv = levels_[k];
+            if (lv.members == 0) continue;
+            const Span s = span(lv, b);
+            const std::uint32_t level_bit = k == own ? 4u : 0u;
+            Entry entry{b.min.x(), b.max.x(), b.min.y(), b.min.z(), b.max.y(), b.max.z(), id, 0};
+            Entry* const out = entries_.data() + lv.first;
+            std::uint32_t* const next = lv.start.data();
+            if (s.dy <= 1 && s.dz <= 1) {
+                // Four writes; those for columns the box does not touch go to the spare slot.
+                const std::int64_t c = s.z0 * lv.ny + s.y0;
+                const std::uint32_t dy = std::uint32_t(s.dy), dz = std::uint32_t(s.dz);
+                const std::uint32_t spare = std::uint32_t(total - lv.first);
+                const std::int64_t cells[4] = {c, c + s.dy, c + s.dz * lv.ny,
+                                               c + s.dz * lv.ny + s.dy};
+                const std::uint32_t used[4] = {1, dy, dz, dy & dz};
+                const std::uint32_t flags[4] = {3, 2 | (1 - dy), 1 | (1 - dz) << 1,
+                                                (1 - dy) | (1 - dz) << 1};
+                for (int t = 0; t < 4; ++t) {
+                    const std::uint32_t slot = next[cells[t]];
+                    next[cells[t]] = slot + used[t];
+                    entry.flags = flags[t] | level_bit;
+                    out[used[t] ? slot : spare] = entry;
+                }
+                continue;
+            }
+            for (std::int64_t z = s.z0; z <= s.z0 + s.dz; ++z) {
+                for (std::int64_t y = s.y0; y <= s.y0 + s.dy; ++y) {
+                    entry.flags =
+                        std::uint32_t(y == s.y0) | std::uint32_t(z == s.z0) << 1 | level_bit;
+                    out[next[z * lv.ny + y]++] = entry;
+                }
+            }
+        }
+    }
+    for (int k = 0; k < level_count_; ++k) {
+        Level& lv = levels_[k];
+        if (lv.members == 0) continue;
+        for (std::size_t c = lv.start.size() - 1; c > 0; --c) lv.start[c] = lv.start[c - 1];
+        lv.start[0] = 0;
+    }
+
+    // Sweep every column: each entry scans forward while the next ones start within its x
+    // interval. Keys are written unconditionally and kept when the pair counts (no branch on
+    // the outcome), so the buffer always has room for the rest of the column.
+    id_shift_ = bitsFor(static_cast<std::uint64_t>(table_.capacity()));
+    const int shift = id_shift_;
+    std::size_t count = 0;
+    std::int64_t tests = 0;
+    for (int k = 0; k < level_count_; ++k) {
+        const Level& lv = levels_[k];
+        if (lv.members == 0) continue;
+        const Entry* const e = entries_.data() + lv.first;
+        const std::size_t columns = lv.start.size() - 1;
+        for (std::size_t c = 0; c < columns; ++c) {
+            const std::uint32_t c0 = lv.start[c];
+            const std::uint32_t c1 = lv.start[c + 1];
+            if (c1 - c0 < 2) continue;
+            for (std::uint32_t i = c0; i + 1 < c1; ++i) {
+                if (keys_.size() < count + (c1 - i)) {
+                    keys_.resize(std::max(2 * keys_.size(), count + (c1 - i)) + 1024);
+                }
+                std::uint64_t* const out = keys_.data();
+                const Entry& a = e[i];
+                const YzTest yz(a);
+                std::uint32_t q = i + 1;
+                for (; q < c1 && e[q].min_x <= a.max_x; ++q) {
+                    const Entry& b = e[q];
+                    const bool hit = yz.overlaps(b) & ((a.flags | b.flags) == 7u);
+                    // (min id, max id) by masks: the order of the ids is a coin toss, and a
+                    // branch on it costs more than the rest of the test.
+                    const std::uint64_t x = a.id, y = b.id;
+                    const std::uint64_t swap = (x ^ y) & (std::uint64_t(0) - std::uint64_t(x > y));
+                    out[count] = ((x ^ swap) << shift) | (y ^ swap);
+                    count += hit;
+                }
+                tests += q - i - 1;
+            }
+        }
+    }
+    counters.volume_tests += tests;
+
+    // (a, b) order: one radix sort of the packed keys (3 passes of 11 bits up to 2^16 ids).
+    const std::size_t capacity = keys_.size();
+    keys_.resize(count);
     radix::keysToSortedPairs(keys_, scratch_, id_shift_, pairs);
+    keys_.resize(std::max(capacity, keys_.size()));
     counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
 }
 
 void HierarchicalGrid::draw(DebugDraw& draw) const {
-    // Occupied columns' cells (one cell tall at each member), coloured by level: coarse levels
-    // orange, fine levels blue.
+    // Each proxy's home cell at its own level (one cell tall at its min x), coloured by level:
+    // coarse levels orange, fine levels blue.
     for (int k = 0; k < level_count_; ++k) {
         const Level& lv = levels_[k];
+        if (lv.members == 0) continue;
         const float t = level_count_ > 1 ? float(k) / float(level_count_ - 1) : 0.0f;
         const Color color{1.0f - 0.7f * t, 0.55f, 0.3f + 0.7f * t, 1};
-        for (std::size_t i = 0; i < lv.count; ++i) {
-            const PackedBox& b = lv.box[i];
-            const Real y = lv.origin_y + Real(column(lv, 1, b.min_y)) * lv.cell;
-            const Real z = lv.origin_z + Real(column(lv, 2, b.min_z)) * lv.cell;
-            const Real x = std::floor(b.min_x / lv.cell) * lv.cell;
-            const Vec3 lo(x, y, z);
-            draw.drawAabb(Aabb{lo, lo + Vec3::Constant(lv.cell)}, color);
+        const Entry* const e = entries_.data() + lv.first;
+        for (std::size_t c = 0; c + 1 < lv.start.size(); ++c) {
+            const Real y = origin_y_ + Real(std::int64_t(c) % lv.ny) * lv.cell;
+            const Real z = origin_z_ + Real(std::int64_t(c) / lv.ny) * lv.cell;
+            for (std::uint32_t i = lv.start[c]; i < lv.start[c + 1]; ++i) {
+                if (e[i].flags != 7u) continue;
+                const Vec3 lo(std::floor(e[i].min_x / lv.cell) * lv.cell, y, z);
+                draw.drawAabb(Aabb{lo, lo + Vec3::Constant(lv.cell)}, color);
+            }
         }
     }
 }
 
 std::string HierarchicalGrid::validate() const {
     std::ostringstream out;
-    std::size_t total = 0;
+    std::size_t homes = 0;
     for (int k = 0; k < level_count_; ++k) {
         const Level& lv = levels_[k];
-        total += lv.count;
-        for (std::size_t i = 0; i < lv.count; ++i) {
-            const ProxyId id = lv.id[i];
-            if (!table_.contains(id)) {
-                out << "level " << k << " holds absent proxy " << id << "; ";
-                continue;
-            }
-            if (table_.aabb(id).extents().maxCoeff() > lv.cell) {
-                out << "proxy " << id << " larger than its level's cells; ";
-            }
-            if (i > 0 && lv.box[i].min_x < lv.box[i - 1].min_x &&
-                column(lv, 1, lv.box[i].min_y) == column(lv, 1, lv.box[i - 1].min_y) &&
-                column(lv, 2, lv.box[i].min_z) == column(lv, 2, lv.box[i - 1].min_z)) {
-                out << "level " << k << " column out of x order at " << i << "; ";
+        if (lv.members == 0) continue;
+        const Entry* const e = entries_.data() + lv.first;
+        for (std::size_t c = 0; c + 1 < lv.start.size(); ++c) {
+            for (std::uint32_t i = lv.start[c]; i < lv.start[c + 1]; ++i) {
+                if (!table_.contains(ProxyId(e[i].id))) {
+                    out << "level " << k << " holds absent proxy " << e[i].id << "; ";
+                    continue;
+                }
+                const Aabb& b = table_.aabb(ProxyId(e[i].id));
+                if (e[i].min_x != b.min.x() || e[i].max_y != b.max.y()) {
+                    out << "level " << k << " entry of proxy " << e[i].id << " is stale; ";
+                }
+                if ((e[i].flags & 4u) && extentOf(b) > lv.cell) {
+                    out << "proxy " << e[i].id << " larger than its level's cells; ";
+                }
+                if (e[i].flags == 7u) ++homes;
+                if (i > lv.start[c] && before(e[i].min_x, e[i].id, e[i - 1].min_x, e[i - 1].id)) {
+                    out << "level " << k << " column " << c << " out of x order at " << i << "; ";
+                }
             }
         }
     }
-    if (level_count_ > 0 && total != static_cast<std::size_t>(table_.count())) {
-        out << "levels hold " << total << " proxies of " << table_.count() << "; ";
+    if (level_count_ > 0 && homes != static_cast<std::size_t>(table_.count())) {
+        out << "levels hold " << homes << " home entries for " << table_.count() << " proxies; ";
     }
     return out.str();
 }

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include "collision/broad_phase.h"
@@ -10,24 +11,39 @@
 namespace collision {
 
 /// Hierarchical grid after Mirtich, "Efficient Algorithms for Two-Phase Collision Detection"
-/// (TR-97-23 §2-2.2). Levels have cells of size s_top / 8^k, s_top = the largest AABB extent;
-/// each proxy lives at the finest level whose cells are at least its largest extent, entered
-/// once, by its AABB's minimum corner. Two boxes can overlap only if the one at the finer (or
-/// same) level finds the other within one cell of itself at the coarser level, so the pair is
-/// met exactly once, at the coarser of the two levels (TR-97-23 §2.2).
+/// (TR-97-23 §2-2.2). Level k has cells of size s_top / 8^k, s_top = the largest AABB extent;
+/// each proxy lives at the finest level whose cells are at least its largest extent. A pair is
+/// found once, at the coarser of its two levels (TR-97-23 §2.2): a proxy is also entered, as a
+/// guest, in every coarser level that holds proxies of its own, and guests are paired only with
+/// that level's own members.
 ///
-/// Within a level the cells are columns of a 2-D grid over (y, z), each column sorted by min x
-/// (then id). Pairs inside a level come from merging each column with its 3 x 3 neighbourhood,
-/// one pointer per neighbour sweeping forward in x (sort and sweep, Baraff 1992), each pair
-/// found from the box with the smaller (min x, id); a box looks up coarser levels' columns by
-/// binary search on min x. Rebuilt each frame by radix sorts; pairs put in (a, b) order by one
-/// more radix sort. Cost per frame O(n + candidates + pairs) whatever the size ratio, and no
-/// heap allocation once the buffers have grown.
+/// Within a level the cells are columns of a 2-D grid over (y, z); an entry is written into
+/// every column its box touches (at most 2 x 2, since cells are at least the extents), and each
+/// column is one list sorted by min x, swept forward (sort and sweep, Baraff 1992). A pair
+/// shares several columns when both boxes straddle a boundary; it is reported only in the
+/// column holding the point (max of the min y, max of the min z), which lies in both boxes
+/// (owner rule, as in Ericson, Real-Time Collision Detection §7.1.5), so it is met once. That
+/// column is known from two bits per entry: whether the entry's own min corner is in this
+/// column's row (y) and layer (z).
+///
+/// The global min-x order is kept from frame to frame and repaired by insertion sort, which
+/// costs O(n + swaps) for coherent motion (Cohen et al. 1995); when the motion is not coherent
+/// (or proxies were inserted or removed) it is rebuilt by a radix sort. Entries are scattered
+/// into columns stably in that order, so each column comes out sorted; pairs are put in (a, b)
+/// order by one more radix sort. Cost per frame O(n + swaps + candidates + pairs), whatever the
+/// size ratio, and no heap allocation once the buffers have grown. Exact: every comparison is
+/// on the proxies' own coordinates, touching counts.
 class HierarchicalGrid : public BroadPhase {
 public:
     std::string_view name() const override { return "hgrid"; }
-    void insert(ProxyId id, const ProxyVolumes& v) override { table_.insert(id, v); }
-    void remove(ProxyId id) override { table_.remove(id); }
+    void insert(ProxyId id, const ProxyVolumes& v) override {
+        table_.insert(id, v);
+        membership_changed_ = true;
+    }
+    void remove(ProxyId id) override {
+        table_.remove(id);
+        membership_changed_ = true;
+    }
     void move(ProxyId id, const ProxyVolumes& v) override {
         table_.move(id, v);
         ++moved_;
@@ -38,44 +54,50 @@ public:
 
     static constexpr int kMaxLevels = 40;
     /// Cells shrink by 2^kLevelBits per level. Mirtich uses 2; 8 halves the levels a 1:100 size
-    /// mix spreads over, and each fine box queries every coarser level, which outweighs the
-    /// looser cells (measured: 10k mixed boxes 4.7 vs 6.6 ms/frame; uniform unchanged).
+    /// mix spreads over, and each proxy is a guest in every coarser level.
     static constexpr int kLevelBits = 3;
 
-    /// A member's AABB laid out for the sweep.
-    struct PackedBox {
-        Real min_x, max_x, min_y, max_y, min_z, max_z;
+    /// One box in one column. `flags`: bit 0, its min y is in this column's row; bit 1, its min
+    /// z is in this column's layer; bit 2, the level is its own (not a guest). A pair is
+    /// reported in a column iff the OR of the two flags is 7.
+    struct Entry {
+        Real min_x, max_x, min_y, min_z, max_y, max_z;
+        std::uint32_t id;
+        std::uint32_t flags;
     };
 
 private:
     struct Level {
-        Real cell = 1;            // column width in y and z (>= every member's largest extent)
-        Real top_extent = 0;      // largest extent among the members
-        Real origin_y = 0, origin_z = 0;
+        Real cell = 1;  // column width in y and z
+        Real inv_cell = 1;
         std::int64_t ny = 1, nz = 1;
-        std::vector<std::uint32_t> start;  // column -> first member (prefix sums), size cols+1
-        std::vector<ProxyId> id;           // members sorted by (column, min x, id)
-        std::vector<PackedBox> box;
+        std::size_t members = 0;  // proxies whose own level this is
+        std::size_t first = 0;    // this level's entries are entries_[first, first + count)
         std::size_t count = 0;
+        std::vector<std::uint32_t> start;  // column -> offset of its first entry in the level
     };
-    void buildLevel(Level& level, const std::vector<ProxyId>& members);
-    std::int64_t column(const Level& level, int axis, Real v) const;
-    void sweepLevel(const Level& level, BroadPhaseCounters& counters);
-    void queryCoarser(const PackedBox& a, ProxyId id, const Level& coarse,
-                      BroadPhaseCounters& counters);
+    struct Span {
+        std::int64_t y0, z0, dy, dz;  // first column and how many more, in y and in z
+    };
+    void sortByMinX(BroadPhaseCounters& counters);
+    Span span(const Level& level, const Aabb& box) const;
+    std::int64_t column(const Level& level, Real v, Real origin, std::int64_t n) const;
 
     ProxyTable table_;
     std::int64_t moved_ = 0;
+    bool membership_changed_ = true;
     int level_count_ = 0;
+    Real origin_y_ = 0, origin_z_ = 0;
     std::array<Level, kMaxLevels> levels_;
-    std::array<std::vector<ProxyId>, kMaxLevels> members_;
-    int id_shift_ = 1;                 // bits per id in a packed pair key
+    std::vector<std::uint32_t> order_;     // present proxies by (min x, id)
+    std::vector<std::uint64_t> sort_key_;  // full-sort keys, by id
+    std::vector<std::uint32_t> sort_scratch_;
+    std::vector<Aabb> box_;               // their boxes
+    std::vector<std::uint8_t> level_of_;  // by position in order_
+    std::vector<Entry> entries_;
+    int id_shift_ = 1;  // bits per id in a packed pair key
     std::vector<std::uint64_t> keys_;
     std::vector<std::uint64_t> scratch_;
-    std::vector<std::uint64_t> sort_keys_;
-    std::vector<std::uint32_t> order_;
-    std::vector<std::uint32_t> order_scratch_;
-    std::vector<std::uint32_t> column_of_;
 };
 
 }  // namespace collision
