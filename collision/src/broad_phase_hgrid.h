@@ -56,6 +56,8 @@ public:
     /// Cells shrink by 2^kLevelBits per level. Mirtich uses 2; 8 halves the levels a 1:100 size
     /// mix spreads over, and each proxy is a guest in every coarser level.
     static constexpr int kLevelBits = 3;
+    /// Columns are at least this many times the mean extent of a level's own members.
+    static constexpr Real kCellPerExtent = 2;
 
     /// One box in one column. `flags`: bit 0, its min y is in this column's row; bit 1, its min
     /// z is in this column's layer; bit 2, the level is its own (not a guest). A pair is

@@ -6,6 +6,7 @@
 #include <array>
 #include <bit>
 #include <cstdint>
+#include <span>
 #include <type_traits>
 #include <vector>
 
@@ -26,29 +27,9 @@ inline std::uint64_t orderedBits(T v) {
     return (b >> kTop) ? U(~b) : U(b | (U(1) << kTop));
 }
 
-// LSD radix sort of 64-bit keys, 11 bits per pass, skipping digits that are all equal; stable.
-inline void radixSortKeys(std::vector<std::uint64_t>& keys, std::vector<std::uint64_t>& scratch,
-                   int bits) {
-    scratch.resize(keys.size());
-    std::array<std::uint32_t, kBuckets> count;
-    for (int shift = 0; shift < bits; shift += kDigitBits) {
-        count.fill(0);
-        for (std::uint64_t k : keys) ++count[(k >> shift) & (kBuckets - 1)];
-        if (count[(keys[0] >> shift) & (kBuckets - 1)] == keys.size()) continue;
-        std::uint32_t sum = 0;
-        for (std::uint32_t& c : count) {
-            const std::uint32_t here = c;
-            c = sum;
-            sum += here;
-        }
-        for (std::uint64_t k : keys) scratch[count[(k >> shift) & (kBuckets - 1)]++] = k;
-        keys.swap(scratch);
-    }
-}
-
 // Stable LSD radix sort of `order` (indices) by key[index].
 inline void radixSortIndices(std::vector<std::uint32_t>& order, std::vector<std::uint32_t>& scratch,
-                      const std::vector<std::uint64_t>& key) {
+                             const std::vector<std::uint64_t>& key) {
     scratch.resize(order.size());
     std::array<std::uint32_t, kBuckets> count;
     for (int shift = 0; shift < 64; shift += kDigitBits) {
@@ -73,20 +54,69 @@ inline int bitsFor(std::uint64_t n) {
 }
 
 /// Sorts `keys` (each (a << shift) | b, a < b < 2^shift) and writes them to `pairs` as (a, b):
-/// the sorted, unique pair list every broad phase returns. `scratch` is reused storage.
-inline void keysToSortedPairs(std::vector<std::uint64_t>& keys, std::vector<std::uint64_t>& scratch,
+/// the sorted, unique pair list every broad phase returns. `scratch` is reused storage; `keys`
+/// is left in an unspecified order. An LSD radix sort: the digits are as few as possible of at
+/// most 14 bits (a 64 KiB histogram), all counted in one read pass; a digit that is the same in
+/// every key costs no pass, and the last pass writes the pairs themselves.
+inline void keysToSortedPairs(std::span<std::uint64_t> keys, std::vector<std::uint64_t>& scratch,
                               int shift, std::vector<ProxyPair>& pairs) {
-    if (keys.size() > 64) {
-        radixSortKeys(keys, scratch, 2 * shift);
-    } else {
+    const std::size_t n = keys.size();
+    pairs.resize(n);
+    const std::uint64_t id_mask = (std::uint64_t(1) << shift) - 1;
+    const auto toPair = [shift, id_mask](std::uint64_t k) {
+        return ProxyPair{static_cast<ProxyId>(k >> shift), static_cast<ProxyId>(k & id_mask)};
+    };
+    if (n <= 64) {
         std::sort(keys.begin(), keys.end());
+        for (std::size_t i = 0; i < n; ++i) pairs[i] = toPair(keys[i]);
+        return;
     }
-    pairs.resize(keys.size());
-    const std::uint64_t mask = (std::uint64_t(1) << shift) - 1;
-    for (std::size_t i = 0; i < keys.size(); ++i) {
-        pairs[i] = ProxyPair{static_cast<ProxyId>(keys[i] >> shift),
-                             static_cast<ProxyId>(keys[i] & mask)};
+    constexpr int kMaxDigitBits = 14;
+    constexpr int kMaxDigits = (64 + kMaxDigitBits - 1) / kMaxDigitBits;
+    const int bits = std::clamp(2 * shift, 1, 64);
+    const int digits = (bits + kMaxDigitBits - 1) / kMaxDigitBits;
+    const int width = (bits + digits - 1) / digits;
+    const std::size_t buckets = std::size_t(1) << width;
+    const std::uint64_t mask = buckets - 1;
+    thread_local std::vector<std::uint32_t> histogram;  // reused: no allocation once grown
+    histogram.assign(buckets * std::size_t(digits), 0);
+    std::array<std::uint32_t*, kMaxDigits> count{};
+    for (int d = 0; d < digits; ++d) count[d] = histogram.data() + buckets * std::size_t(d);
+    for (std::uint64_t k : keys) {
+        for (int d = 0; d < digits; ++d) ++count[d][(k >> (d * width)) & mask];
     }
+    std::array<int, kMaxDigits> passes{};
+    int pass_count = 0;
+    for (int d = 0; d < digits; ++d) {
+        if (count[d][(keys[0] >> (d * width)) & mask] != n) passes[pass_count++] = d;
+    }
+    scratch.resize(n);
+    std::uint64_t* from = keys.data();
+    std::uint64_t* to = scratch.data();
+    for (int p = 0; p < pass_count; ++p) {
+        const int d = passes[p];
+        std::uint32_t* const c = count[d];
+        std::uint32_t sum = 0;
+        for (std::size_t i = 0; i < buckets; ++i) {
+            const std::uint32_t here = c[i];
+            c[i] = sum;
+            sum += here;
+        }
+        const int digit_shift = d * width;
+        if (p + 1 == pass_count) {
+            for (std::size_t i = 0; i < n; ++i) {
+                const std::uint64_t k = from[i];
+                pairs[c[(k >> digit_shift) & mask]++] = toPair(k);
+            }
+            return;
+        }
+        for (std::size_t i = 0; i < n; ++i) {
+            const std::uint64_t k = from[i];
+            to[c[(k >> digit_shift) & mask]++] = k;
+        }
+        std::swap(from, to);
+    }
+    for (std::size_t i = 0; i < n; ++i) pairs[i] = toPair(from[i]);  // one key, or all equal
 }
 
 }  // namespace collision::radix
