@@ -29,7 +29,6 @@ namespace collision {
 
 using radix::bitsFor;
 using radix::orderedBits;
-using radix::radixSortIndices;
 
 namespace {
 
@@ -95,50 +94,59 @@ HierarchicalGrid::Span HierarchicalGrid::span(const Level& lv, const Aabb& b) co
                 column(lv, b.max.z(), origin_z_, lv.nz) - z0};
 }
 
-void HierarchicalGrid::sortByMinX(BroadPhaseCounters& counters) {
-    const std::size_t n = static_cast<std::size_t>(table_.count());
-    if (!membership_changed_ && order_.size() == n) {
-        // Gather the boxes in last frame's order and repair it by insertion sort; coherent
-        // motion makes few shifts. Past the budget the motion is not coherent, and the radix
-        // sort below is cheaper.
-        box_.resize(n);
-        for (std::size_t p = 0; p < n; ++p) box_[p] = table_.aabb(ProxyId(order_[p]));
-        const std::size_t budget = 8 * n + 1024;
-        std::size_t shifts = 0;
-        bool sorted = true;
-        for (std::size_t i = 1; i < n; ++i) {
-            if (!before(box_[i].min.x(), order_[i], box_[i - 1].min.x(), order_[i - 1])) continue;
-            const Aabb b = box_[i];
-            const std::uint32_t id = order_[i];
-            std::size_t j = i;
+void HierarchicalGrid::sortByMinX() {
+    // Keys: min x rounded to float (a non-decreasing map, so the order is exact up to ties of
+    // the rounding, which fixColumns undoes), above the id; read in id order, sorted by the key
+    // alone by a stable LSD radix sort, so ties stay in id order.
+    packed_.clear();
+    for (ProxyId id = 0; id < table_.capacity(); ++id) {
+        if (!table_.contains(id)) continue;
+        const float x = static_cast<float>(table_.aabb(id).min.x());
+        packed_.push_back(orderedBits(x) << 32 | std::uint64_t(std::uint32_t(id)));
+    }
+    radix::radixSortHigh32(packed_, packed_scratch_);
+    const std::size_t n = packed_.size();
+    order_.resize(n);
+    box_.resize(n);
+    for (std::size_t p = 0; p < n; ++p) {
+        order_[p] = static_cast<std::uint32_t>(packed_[p]);
+        box_[p] = table_.aabb(ProxyId(order_[p]));
+    }
+}
+
+std::int64_t HierarchicalGrid::fixColumns(const Level& lv) {
+    // Each column is in (float(min x), id) order: restore (min x, id) by insertion sort. Only
+    // boxes whose min x round to the same float can be out of order, so this is one comparison
+    // per entry unless the coordinates are far larger than the boxes (1e6 with 1e-4 boxes);
+    // past a budget of shifts a column is sorted outright, so that case stays O(m log m).
+    Entry* const e = entries_.data() + lv.first;
+    const auto less = [](const Entry& a, const Entry& b) {
+        return before(a.min_x, a.id, b.min_x, b.id);
+    };
+    std::int64_t shifts = 0;
+    for (std::size_t c = 0; c + 1 < lv.start.size(); ++c) {
+        const std::uint32_t c0 = lv.start[c];
+        const std::uint32_t c1 = lv.start[c + 1];
+        const std::size_t budget = 8 * std::size_t(c1 - c0) + 64;
+        std::size_t column_shifts = 0;
+        for (std::uint32_t i = c0 + 1; i < c1; ++i) {
+            if (!less(e[i], e[i - 1])) continue;
+            const Entry moving = e[i];
+            std::uint32_t j = i;
             do {
-                box_[j] = box_[j - 1];
-                order_[j] = order_[j - 1];
+                e[j] = e[j - 1];
                 --j;
-            } while (j > 0 && before(b.min.x(), id, box_[j - 1].min.x(), order_[j - 1]));
-            box_[j] = b;
-            order_[j] = id;
-            shifts += i - j;
-            if (shifts > budget) {
-                sorted = false;
+            } while (j > c0 && less(moving, e[j - 1]));
+            e[j] = moving;
+            column_shifts += i - j;
+            if (column_shifts > budget) {
+                std::sort(e + c0, e + c1, less);
                 break;
             }
         }
-        counters.swaps += static_cast<std::int64_t>(shifts);
-        if (sorted) return;
+        shifts += static_cast<std::int64_t>(column_shifts);
     }
-    // Full sort: ids ascending, then a stable radix sort by min x, so ties stay in id order.
-    order_.clear();
-    sort_key_.resize(static_cast<std::size_t>(table_.capacity()));
-    for (ProxyId id = 0; id < table_.capacity(); ++id) {
-        if (!table_.contains(id)) continue;
-        order_.push_back(static_cast<std::uint32_t>(id));
-        sort_key_[static_cast<std::size_t>(id)] = orderedBits(table_.aabb(id).min.x());
-    }
-    radixSortIndices(order_, sort_scratch_, sort_key_);
-    box_.resize(n);
-    for (std::size_t p = 0; p < n; ++p) box_[p] = table_.aabb(ProxyId(order_[p]));
-    membership_changed_ = false;
+    return shifts;
 }
 
 void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) {
@@ -148,7 +156,7 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     level_count_ = 0;
     entries_.clear();
     if (table_.count() == 0) return;
-    sortByMinX(counters);
+    sortByMinX();
     const std::size_t n = order_.size();
 
     // The largest extent and the (y, z) bounds of every box.
@@ -261,7 +269,7 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     }
     entries_.resize(total + 1);  // + 1: where the branch-free scatter writes entries it drops
 
-    // Scatter in min-x order, so every column is sorted by (min x, id).
+    // Scatter in (float(min x), id) order, so every column is nearly sorted by (min x, id).
     for (std::size_t p = 0; p < n; ++p) {
         const std::uint32_t id = order_[p];
         const Aabb& b = box_[p];
@@ -306,6 +314,7 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
         if (lv.members == 0) continue;
         for (std::size_t c = lv.start.size() - 1; c > 0; --c) lv.start[c] = lv.start[c - 1];
         lv.start[0] = 0;
+        counters.swaps += fixColumns(lv);
     }
 
     // Sweep every column: each entry scans forward while the next ones start within its x

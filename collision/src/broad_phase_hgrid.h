@@ -36,14 +36,8 @@ namespace collision {
 class HierarchicalGrid : public BroadPhase {
 public:
     std::string_view name() const override { return "hgrid"; }
-    void insert(ProxyId id, const ProxyVolumes& v) override {
-        table_.insert(id, v);
-        membership_changed_ = true;
-    }
-    void remove(ProxyId id) override {
-        table_.remove(id);
-        membership_changed_ = true;
-    }
+    void insert(ProxyId id, const ProxyVolumes& v) override { table_.insert(id, v); }
+    void remove(ProxyId id) override { table_.remove(id); }
     void move(ProxyId id, const ProxyVolumes& v) override {
         table_.move(id, v);
         ++moved_;
@@ -81,19 +75,19 @@ private:
     struct Span {
         std::int64_t y0, z0, dy, dz;  // first column and how many more, in y and in z
     };
-    void sortByMinX(BroadPhaseCounters& counters);
+    void sortByMinX();
+    std::int64_t fixColumns(const Level& level);
     Span span(const Level& level, const Aabb& box) const;
     std::int64_t column(const Level& level, Real v, Real origin, std::int64_t n) const;
 
     ProxyTable table_;
     std::int64_t moved_ = 0;
-    bool membership_changed_ = true;
     int level_count_ = 0;
     Real origin_y_ = 0, origin_z_ = 0;
     std::array<Level, kMaxLevels> levels_;
-    std::vector<std::uint32_t> order_;     // present proxies by (min x, id)
-    std::vector<std::uint64_t> sort_key_;  // full-sort keys, by id
-    std::vector<std::uint32_t> sort_scratch_;
+    std::vector<std::uint32_t> order_;   // present proxies by (min x, id)
+    std::vector<std::uint64_t> packed_;  // (float min x, id) sort keys
+    std::vector<std::uint64_t> packed_scratch_;
     std::vector<Aabb> box_;               // their boxes
     std::vector<std::uint8_t> level_of_;  // by position in order_
     std::vector<Entry> entries_;

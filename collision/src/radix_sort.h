@@ -47,6 +47,34 @@ inline void radixSortIndices(std::vector<std::uint32_t>& order, std::vector<std:
     }
 }
 
+// Stable LSD radix sort of 64-bit values by their upper 32 bits (11 + 11 + 10 bits, all
+// histograms in one read; a digit equal in every value costs no pass).
+inline void radixSortHigh32(std::vector<std::uint64_t>& values,
+                            std::vector<std::uint64_t>& scratch) {
+    constexpr int kShifts[3] = {32, 43, 54};
+    constexpr std::size_t kSize = std::size_t(1) << 11;
+    const std::size_t n = values.size();
+    if (n < 2) return;
+    std::array<std::array<std::uint32_t, kSize>, 3> count{};
+    for (std::uint64_t v : values) {
+        for (int d = 0; d < 3; ++d) ++count[d][(v >> kShifts[d]) & (kSize - 1)];
+    }
+    scratch.resize(n);
+    for (int d = 0; d < 3; ++d) {
+        std::array<std::uint32_t, kSize>& c = count[d];
+        const int shift = kShifts[d];
+        if (c[(values[0] >> shift) & (kSize - 1)] == n) continue;
+        std::uint32_t sum = 0;
+        for (std::uint32_t& slot : c) {
+            const std::uint32_t here = slot;
+            slot = sum;
+            sum += here;
+        }
+        for (std::uint64_t v : values) scratch[c[(v >> shift) & (kSize - 1)]++] = v;
+        values.swap(scratch);
+    }
+}
+
 inline int bitsFor(std::uint64_t n) {
     int b = 1;
     while ((std::uint64_t(1) << b) < n) ++b;
