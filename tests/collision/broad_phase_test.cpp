@@ -190,11 +190,12 @@ INSTANTIATE_TEST_SUITE_P(Layouts, BroadPhaseDifferential,
                          });
 
 // The differential scenes above insert or remove proxies on almost every frame. Here the
-// membership stays fixed for long runs, so broad phases that keep state between frames (the
-// sorted orders of sap and hgrid, repaired by insertion sort) run on it: coherent motion, then
-// frames where every box jumps (an insertion sort past its budget falls back to a full sort),
-// then all boxes on a few min-x values (ties), then coherent motion again.
-TEST(BroadPhaseDifferential, KeptOrdersSurviveCoherentJumpingAndTiedMotion) {
+// membership stays fixed for long runs, so state kept between frames (SAP's sorted endpoint
+// lists) and orders that only a float key decides (hgrid sorts by float(min x), then fixes its
+// columns) are exercised: coherent motion, then frames where every box jumps, then all boxes on
+// a few min-x values (exact ties), then 1e-3 boxes within 0.01 of (1e6, 1e6, 1e6), where
+// float(min x) ties for most of them, then coherent motion again.
+TEST(BroadPhaseDifferential, FixedMembershipThroughJumpsTiesAndFloatTies) {
     constexpr int kBoxes = 400;
     for (const BroadPhaseEntry& entry : broadPhaseRegistry()) {
         SCOPED_TRACE(std::string(entry.name));
@@ -210,9 +211,18 @@ TEST(BroadPhaseDifferential, KeptOrdersSurviveCoherentJumpingAndTiedMotion) {
         }
         std::vector<ProxyPair> fast_pairs, ref_pairs;
         std::int64_t total_pairs = 0;
-        for (int frame = 0; frame < 90; ++frame) {
-            const int phase = frame / 20;  // 0 coherent, 1 jumps, 2 ties, 3-4 coherent
-            if (phase == 1) {
+        for (int frame = 0; frame < 110; ++frame) {
+            const int phase = frame / 20;  // 0 coherent, 1 jumps, 2 ties, 3 far, 4-5 coherent
+            if (phase == 3) {
+                for (MovingBox& b : boxes) {
+                    // Half the frames within 0.002: some columns hold ~100 float-tied boxes.
+                    const Real spread = frame < 70 ? Real(0.01) : Real(0.002);
+                    b.center = Vec3::Constant(Real(1e6)) + rng.vec(-spread, spread);
+                    b.half_extents = rng.vec(Real(1e-4), Real(1e-3));
+                }
+            } else if (frame == 80) {
+                boxes = makeScene(Layout::Uniform, kBoxes, rng);  // back near the origin
+            } else if (phase == 1) {
                 for (MovingBox& b : boxes) b.center = rng.vec(-10, 10);
             } else if (phase == 2) {
                 for (MovingBox& b : boxes) {  // min x = an integer, exactly
@@ -234,7 +244,7 @@ TEST(BroadPhaseDifferential, KeptOrdersSurviveCoherentJumpingAndTiedMotion) {
             ASSERT_EQ(fast->validate(), "") << "frame " << frame;
             total_pairs += static_cast<std::int64_t>(ref_pairs.size());
         }
-        EXPECT_GT(total_pairs, 90 * kBoxes / 4);  // the scene is dense enough to test something
+        EXPECT_GT(total_pairs, 110 * kBoxes / 4);  // the scene is dense enough to test something
     }
 }
 
