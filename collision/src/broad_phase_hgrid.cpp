@@ -237,23 +237,28 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     // Count the entries of every column, then lay the levels out one after the other. A box
     // touches one or two columns per axis (its extent is at most the cell, widened by 2^-20 so
     // rounding cannot make it three in double); the common case runs without branches on it.
+    placements_.clear();
     for (std::size_t p = 0; p < n; ++p) {
         const Aabb& b = box_[p];
-        for (int k = 0; k <= level_of_[p]; ++k) {
+        const int own = level_of_[p];
+        for (int k = 0; k <= own; ++k) {
             Level& lv = levels_[k];
             if (lv.members == 0) continue;
             const Span s = span(lv, b);
+            const std::int64_t c = s.z0 * lv.ny + s.y0;
+            placements_.push_back(Placement{std::uint32_t(c), std::uint16_t(s.dy),
+                                            std::uint16_t(s.dz), std::uint8_t(k),
+                                            std::uint8_t(k == own)});
             std::uint32_t* const count = lv.start.data() + 1;
             if (s.dy <= 1 && s.dz <= 1) {
-                const std::int64_t c = s.z0 * lv.ny + s.y0;
                 count[c] += 1;
                 count[c + s.dy] += std::uint32_t(s.dy);
                 count[c + s.dz * lv.ny] += std::uint32_t(s.dz);
                 count[c + s.dz * lv.ny + s.dy] += std::uint32_t(s.dy & s.dz);
                 continue;
             }
-            for (std::int64_t z = s.z0; z <= s.z0 + s.dz; ++z) {
-                for (std::int64_t y = s.y0; y <= s.y0 + s.dy; ++y) ++count[z * lv.ny + y];
+            for (std::int64_t z = 0; z <= s.dz; ++z) {
+                for (std::int64_t y = 0; y <= s.dy; ++y) ++count[c + z * lv.ny + y];
             }
         }
     }
@@ -270,25 +275,25 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     entries_.resize(total + 1);  // + 1: where the branch-free scatter writes entries it drops
 
     // Scatter in (float(min x), id) order, so every column is nearly sorted by (min x, id).
+    const Placement* placement = placements_.data();
     for (std::size_t p = 0; p < n; ++p) {
         const std::uint32_t id = order_[p];
         const Aabb& b = box_[p];
-        const int own = level_of_[p];
-        for (int k = 0; k <= own; ++k) {
-            Level& lv = levels_[k];
-            if (lv.members == 0) continue;
-            const Span s = span(lv, b);
-            const std::uint32_t level_bit = k == own ? 4u : 0u;
-            Entry entry{b.min.x(), b.max.x(), b.min.y(), b.min.z(), b.max.y(), b.max.z(), id, 0};
+        const Entry proto{b.min.x(), b.max.x(), b.min.y(), b.min.z(), b.max.y(), b.max.z(), id, 0};
+        for (bool last = false; !last; ++placement) {
+            const Placement& pl = *placement;
+            last = pl.own;  // a box's own level comes last, after the coarser ones it visits
+            Level& lv = levels_[pl.level];
+            Entry entry = proto;
+            const std::uint32_t level_bit = pl.own << 2;
             Entry* const out = entries_.data() + lv.first;
             std::uint32_t* const next = lv.start.data();
-            if (s.dy <= 1 && s.dz <= 1) {
+            const std::uint32_t c = pl.column, dy = pl.dy, dz = pl.dz;
+            if (dy <= 1 && dz <= 1) {
                 // Four writes; those for columns the box does not touch go to the spare slot.
-                const std::int64_t c = s.z0 * lv.ny + s.y0;
-                const std::uint32_t dy = std::uint32_t(s.dy), dz = std::uint32_t(s.dz);
                 const std::uint32_t spare = std::uint32_t(total - lv.first);
-                const std::int64_t cells[4] = {c, c + s.dy, c + s.dz * lv.ny,
-                                               c + s.dz * lv.ny + s.dy};
+                const std::uint32_t row = dz * std::uint32_t(lv.ny);
+                const std::uint32_t cells[4] = {c, c + dy, c + row, c + row + dy};
                 const std::uint32_t used[4] = {1, dy, dz, dy & dz};
                 const std::uint32_t flags[4] = {3, 2 | (1 - dy), 1 | (1 - dz) << 1,
                                                 (1 - dy) | (1 - dz) << 1};
@@ -300,11 +305,10 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
                 }
                 continue;
             }
-            for (std::int64_t z = s.z0; z <= s.z0 + s.dz; ++z) {
-                for (std::int64_t y = s.y0; y <= s.y0 + s.dy; ++y) {
-                    entry.flags =
-                        std::uint32_t(y == s.y0) | std::uint32_t(z == s.z0) << 1 | level_bit;
-                    out[next[z * lv.ny + y]++] = entry;
+            for (std::uint32_t z = 0; z <= dz; ++z) {
+                for (std::uint32_t y = 0; y <= dy; ++y) {
+                    entry.flags = std::uint32_t(y == 0) | std::uint32_t(z == 0) << 1 | level_bit;
+                    out[next[c + z * std::uint32_t(lv.ny) + y]++] = entry;
                 }
             }
         }
@@ -344,11 +348,7 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
                 for (; q < c1 && e[q].min_x <= a.max_x; ++q) {
                     const Entry& b = e[q];
                     const bool hit = yz.overlaps(b) & ((a.flags | b.flags) == 7u);
-                    // (min id, max id) by masks: the order of the ids is a coin toss, and a
-                    // branch on it costs more than the rest of the test.
-                    const std::uint64_t x = a.id, y = b.id;
-                    const std::uint64_t swap = (x ^ y) & (std::uint64_t(0) - std::uint64_t(x > y));
-                    out[count] = ((x ^ swap) << shift) | (y ^ swap);
+                    out[count] = (std::uint64_t(a.id) << shift) | b.id;  // ordered later
                     count += hit;
                 }
                 tests += q - i - 1;
@@ -358,7 +358,8 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     counters.volume_tests += tests;
 
     // (a, b) order: one radix sort of the packed keys (3 passes of 11 bits up to 2^16 ids).
-    radix::keysToSortedPairs(std::span(keys_.data(), count), scratch_, id_shift_, pairs);
+    radix::keysToSortedPairs(std::span(keys_.data(), count), scratch_, id_shift_, pairs,
+                             /*order_ids=*/true);
     counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
 }
 

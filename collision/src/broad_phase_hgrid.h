@@ -75,6 +75,13 @@ private:
     struct Span {
         std::int64_t y0, z0, dy, dz;  // first column and how many more, in y and in z
     };
+    /// Where one box goes in one level: its first column and how many more in y and z (at
+    /// most 2: a box's extent is at most the cell of its level and of every coarser one).
+    struct Placement {
+        std::uint32_t column;
+        std::uint16_t dy, dz;
+        std::uint8_t level, own;
+    };
     void sortByMinX();
     std::int64_t fixColumns(const Level& level);
     Span span(const Level& level, const Aabb& box) const;
@@ -90,6 +97,7 @@ private:
     std::vector<std::uint64_t> packed_scratch_;
     std::vector<Aabb> box_;               // their boxes
     std::vector<std::uint8_t> level_of_;  // by position in order_
+    std::vector<Placement> placements_;   // by position in order_, then level
     std::vector<Entry> entries_;
     int id_shift_ = 1;  // bits per id in a packed pair key
     std::vector<std::uint64_t> keys_;

@@ -86,14 +86,23 @@ inline int bitsFor(std::uint64_t n) {
 /// is left in an unspecified order. An LSD radix sort: the digits are as few as possible of at
 /// most 14 bits (a 64 KiB histogram), all counted in one read pass; a digit that is the same in
 /// every key costs no pass, and the last pass writes the pairs themselves.
+/// With `order_ids` the keys may hold their two ids either way round ((b << shift) | a); they
+/// are put as (a, b) in the counting pass, so a caller need not order them per candidate.
 inline void keysToSortedPairs(std::span<std::uint64_t> keys, std::vector<std::uint64_t>& scratch,
-                              int shift, std::vector<ProxyPair>& pairs) {
+                              int shift, std::vector<ProxyPair>& pairs, bool order_ids = false) {
     const std::size_t n = keys.size();
     pairs.resize(n);
     const std::uint64_t id_mask = (std::uint64_t(1) << shift) - 1;
     const auto toPair = [shift, id_mask](std::uint64_t k) {
         return ProxyPair{static_cast<ProxyId>(k >> shift), static_cast<ProxyId>(k & id_mask)};
     };
+    if (order_ids) {
+        for (std::uint64_t& k : keys) {
+            const std::uint64_t x = k >> shift, y = k & id_mask;
+            const std::uint64_t swap = (x ^ y) & (std::uint64_t(0) - std::uint64_t(x > y));
+            k = ((x ^ swap) << shift) | (y ^ swap);  // (min, max) by masks: no branch
+        }
+    }
     if (n <= 64) {
         std::sort(keys.begin(), keys.end());
         for (std::size_t i = 0; i < n; ++i) pairs[i] = toPair(keys[i]);
