@@ -41,10 +41,17 @@ constexpr int kExitFailure = 1;
 constexpr int kExitBadInput = 2;
 constexpr int kEdgeFrames = 100;  // frames in the "first" and "last" medians
 
-double threadCpuSeconds() {
+double clockSeconds(clockid_t clock) {
     timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    clock_gettime(clock, &ts);
     return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+double threadCpuSeconds() { return clockSeconds(CLOCK_THREAD_CPUTIME_ID); }
+
+/// The clock frames are timed by: --clock thread or wall.
+clockid_t frameClock(const BenchOptions& options) {
+    return options.clock == "wall" ? CLOCK_MONOTONIC : CLOCK_THREAD_CPUTIME_ID;
 }
 
 /// A "Vm...:" field of /proc/self/status in kB, or -1.
@@ -123,21 +130,22 @@ RunResult measure(const BenchMethodEntry& entry, const MovingBoxes& initial,
     const bool peak_reset = options.isolate && resetPeakRss();
     const long rss_before = peak_reset ? statusKb("VmRSS:") : statusKb("VmHWM:");
 
-    const double t0 = threadCpuSeconds();
+    const clockid_t clock = frameClock(options);
+    const double t0 = clockSeconds(clock);
     std::unique_ptr<BenchMethod> method = entry.create();
     method->insertAll(boxes, volumes);
     method->findPairs();
-    r.insert_ms = 1e3 * (threadCpuSeconds() - t0);
+    r.insert_ms = 1e3 * (clockSeconds(clock) - t0);
     check(*method, 0);
 
     double total = 0;
     for (int frame = 1; frame <= options.frames; ++frame) {
         boxes.step();
         boxes.volumes(volumes);
-        const double start = threadCpuSeconds();
+        const double start = clockSeconds(clock);
         method->moveAll(boxes, volumes);
         method->findPairs();
-        const double dt = threadCpuSeconds() - start;
+        const double dt = clockSeconds(clock) - start;
         times.push_back(1e3 * dt);
         total += dt;
         check(*method, frame);
@@ -389,6 +397,10 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
         err << "--frames: " << options.frames << "; need at least 1\n";
         return kExitBadInput;
     }
+    if (options.clock != "thread" && options.clock != "wall") {
+        err << "--clock: '" << options.clock << "' is not thread or wall\n";
+        return kExitBadInput;
+    }
     std::vector<const BenchMethodEntry*> methods;
     if (options.methods.empty()) {
         for (const BenchMethodEntry& m : benchMethods()) {
@@ -416,9 +428,9 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
         }
     }
 
-    out << "cdlab bench broadphase: " << options.frames
-        << " frames per method; time = thread CPU time of (move all proxies + find pairs) per "
-           "frame, ms.\n"
+    out << "cdlab bench broadphase: " << options.frames << " frames per method; time = "
+        << (options.clock == "wall" ? "elapsed (wall-clock) time" : "thread CPU time")
+        << " of (move all proxies + find pairs) per frame, ms.\n"
         << "insert_ms = create + insert all + first find pairs; first100/last100 = median of the "
            "first/last "
         << kEdgeFrames << " frames; vs_peer = median / best peer's median;\n"
@@ -463,6 +475,13 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
                 row.workload = std::string(workloadName(kind));
                 row.n = n;
                 row.peer = m->peer;
+                if (m->threads > 1 && options.clock == "thread") {
+                    row.skipped = true;
+                    row.skip_reason = "runs on " + std::to_string(m->threads) +
+                                      " threads: thread CPU time would count one; use --clock wall";
+                    rows.push_back(std::move(row));
+                    continue;
+                }
                 if (options.methods.empty() && m->default_max_n > 0 && n > m->default_max_n) {
                     row.skipped = true;
                     row.skip_reason = m->skip_reason;
@@ -543,6 +562,7 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
         nlohmann::json doc;
         doc["frames"] = options.frames;
         doc["seed"] = options.seed;
+        doc["clock"] = options.clock;
         doc["rows"] = nlohmann::json::array();
         for (const Row& row : all_rows) doc["rows"].push_back(rowJson(row));
         if (!writeJsonAtomically(*options.json, doc, err)) return kExitFailure;

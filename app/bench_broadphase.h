@@ -26,6 +26,9 @@ struct BenchOptions {
     /// Run each method in a forked child, so peak memory is per method and a crashing peer is
     /// reported instead of ending the run. Off: in-process, peak memory not reported.
     bool isolate = true;
+    /// "thread": each frame's thread CPU time (steady under load from other processes; methods
+    /// on more than one thread are left out); "wall": elapsed time, every method.
+    std::string clock = "thread";
 };
 
 /// A small configuration for smoke tests: 200 boxes, 20 frames, both workloads, all methods.

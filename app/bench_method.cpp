@@ -40,6 +40,7 @@ std::vector<BenchMethodEntry> makeMethods() {
         m.name = std::string(entry.name);
         m.description = std::string(entry.description);
         m.default_set = true;
+        m.threads = entry.threads;
         const collision::BroadPhaseEntry* e = &entry;
         m.create = [e]() -> std::unique_ptr<BenchMethod> {
             return std::make_unique<CdlabMethod>(*e);

@@ -43,6 +43,9 @@ struct BenchMethodEntry {
     /// Skipped in the default set from this many boxes on (0: never), with `skip_reason`.
     int default_max_n = 0;
     std::string skip_reason;
+    /// Threads the method runs on. Thread CPU time (the default clock) would count only the
+    /// calling thread's share of a method on more than one, so those run with --clock wall only.
+    int threads = 1;
     std::function<std::unique_ptr<BenchMethod>()> create;
 };
 

@@ -5,16 +5,17 @@
 #include "bench_broadphase.h"
 #include "bench_ccd.h"
 #include "bench_convex.h"
-#include "check_command.h"
 #include "bench_narrowphase.h"
+#include "check_command.h"
 #include "collision/broad_phase.h"
 #include "query_command.h"
 #include "run_command.h"
 #include "sweep_command.h"
 
 int main(int argc, char** argv) {
-    CLI::App cli{"cdlab -- collision-detection lab: run rigid-body scenes headless and render "
-                 "every bounding volume coloured by its overlap state"};
+    CLI::App cli{
+        "cdlab -- collision-detection lab: run rigid-body scenes headless and render "
+        "every bounding volume coloured by its overlap state"};
     cli.require_subcommand(1);
 
     app::RunOptions run;
@@ -31,9 +32,10 @@ int main(int argc, char** argv) {
     run_cmd->add_flag("--no-frames", run.no_frames, "do not write per-frame PNGs");
     run_cmd->add_option("--broadphase", broad_phase,
                         "broad phase (overrides the scene): " + collision::broadPhaseNames());
-    run_cmd->add_option("--pause-at", run.pause_at,
-                        "pause at FRAME: write pause_FRAME.png (every bounding volume) and "
-                        "pause_FRAME.json (repeatable)")
+    run_cmd
+        ->add_option("--pause-at", run.pause_at,
+                     "pause at FRAME: write pause_FRAME.png (every bounding volume) and "
+                     "pause_FRAME.json (repeatable)")
         ->expected(1)
         ->take_all();
     bool no_timing = false;
@@ -65,9 +67,10 @@ int main(int argc, char** argv) {
     std::vector<std::string> check_scenes;
     int check_frames = 0;
     std::string check_out;
-    CLI::App* check_cmd = cli.add_subcommand(
-        "check", "run scenes headless and grade them against their 'expect:' sections: a "
-                 "pass/fail table, exit 0 all pass, 1 any failure, 2 bad input");
+    CLI::App* check_cmd =
+        cli.add_subcommand("check",
+                           "run scenes headless and grade them against their 'expect:' sections: a "
+                           "pass/fail table, exit 0 all pass, 1 any failure, 2 bad input");
     check_cmd->add_option("scenes", check_scenes, "scene files (YAML)")->required();
     check_cmd->add_option("--frames", check_frames,
                           "frames to run (overrides expect.frames and the scene)");
@@ -79,8 +82,9 @@ int main(int argc, char** argv) {
     // BEGIN query subcommand
     app::QueryOptions query;
     CLI::App* query_cmd = cli.add_subcommand(
-        "query", "mesh against mesh through every BVH volume type: answer, triangle pairs, "
-                 "BV and triangle tests, build and query time side by side");
+        "query",
+        "mesh against mesh through every BVH volume type: answer, triangle pairs, "
+        "BV and triangle tests, build and query time side by side");
     query_cmd->add_option("mesh_a", query.mesh_a, "mesh A (any format assimp reads)")->required();
     query_cmd->add_option("mesh_b", query.mesh_b, "mesh B")->required();
     query_cmd->add_option("--bv", query.bv, "volume type or all")->capture_default_str();
@@ -92,8 +96,9 @@ int main(int argc, char** argv) {
     std::string sweep_out;
     double sweep_duration = 0;
     CLI::App* sweep_cmd = cli.add_subcommand(
-        "sweep", "run one scene under every combination of choices; measure cost and accuracy "
-                 "against a fine reference run; write results.csv, report.md and charts");
+        "sweep",
+        "run one scene under every combination of choices; measure cost and accuracy "
+        "against a fine reference run; write results.csv, report.md and charts");
     sweep_cmd->add_option("scene", sweep.scene, "scene file (YAML)")->required();
     sweep_cmd
         ->add_option("--vary", sweep.vary,
@@ -147,6 +152,12 @@ int main(int argc, char** argv) {
         ->add_option("--budget", bench_bp.budget_seconds,
                      "stop a method after this many seconds of frame time (0: no limit)")
         ->capture_default_str();
+    bench_bp_cmd
+        ->add_option("--clock", bench_bp.clock,
+                     "thread: thread CPU time per frame (methods on several threads left out); "
+                     "wall: elapsed time, every method")
+        ->check(CLI::IsMember({"thread", "wall"}))
+        ->capture_default_str();
     bool bench_bp_in_process = false;
     bench_bp_cmd->add_flag("--in-process", bench_bp_in_process,
                            "do not fork per method (no per-method peak memory)");
@@ -162,16 +173,18 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"conservative", "naive", "all"}))
         ->capture_default_str();
     std::string bench_ccd_scenes;
-    bench_ccd_cmd->add_option("--scenes", bench_ccd_scenes,
-                              "folder with tunnel_sphere.yaml and tunnel_bar.yaml (default scenes): "
-                              "CCD cost per frame, off vs on");
+    bench_ccd_cmd->add_option(
+        "--scenes", bench_ccd_scenes,
+        "folder with tunnel_sphere.yaml and tunnel_bar.yaml (default scenes): "
+        "CCD cost per frame, off vs on");
     bool bench_ccd_no_scenes = false;
     bench_ccd_cmd->add_flag("--no-scenes", bench_ccd_no_scenes, "skip the tunnelling scenes");
     app::BenchConvexOptions bench_convex;
     std::string bench_convex_json;
     CLI::App* bench_convex_cmd = bench_cmd->add_subcommand(
-        "convex", "convex contact queries (GJK, EPA, SAT, closed forms) beside Bullet's GJK/EPA: "
-                  "us/query, answers compared");
+        "convex",
+        "convex contact queries (GJK, EPA, SAT, closed forms) beside Bullet's GJK/EPA: "
+        "us/query, answers compared");
     bench_convex_cmd->add_option("--queries", bench_convex.queries, "random pairs per workload")
         ->capture_default_str();
     bench_convex_cmd->add_option("--passes", bench_convex.passes, "timed passes (fastest kept)")
@@ -181,12 +194,14 @@ int main(int argc, char** argv) {
         ->add_option("--tolerance", bench_convex.tolerance,
                      "relative answer tolerance for counting disagreements")
         ->capture_default_str();
-    bench_convex_cmd->add_option("--json", bench_convex_json, "also write the rows as JSON to FILE");
+    bench_convex_cmd->add_option("--json", bench_convex_json,
+                                 "also write the rows as JSON to FILE");
     app::BenchNarrowphaseOptions bench_np;
     std::string bench_np_json;
     CLI::App* bench_np_cmd = bench_cmd->add_subcommand(
-        "narrowphase", "mesh-mesh queries on two tori: every BVH volume type beside FCL's "
-                       "BVHModel types (build, first contact, all pairs, Nv, Np)");
+        "narrowphase",
+        "mesh-mesh queries on two tori: every BVH volume type beside FCL's "
+        "BVHModel types (build, first contact, all pairs, Nv, Np)");
     bench_np_cmd->add_option("--triangles", bench_np.triangles, "triangles per torus")
         ->capture_default_str();
     bench_np_cmd->add_flag("--large", bench_np.large, "100k-triangle tori");

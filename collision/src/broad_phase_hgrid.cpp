@@ -79,6 +79,12 @@ using YzTest = YzTestOf<Real>;
 
 }  // namespace
 
+HierarchicalGrid::HierarchicalGrid(bool two_threads) {
+    if (two_threads) helper_ = std::make_unique<HelperThread>();
+}
+
+HierarchicalGrid::~HierarchicalGrid() = default;
+
 std::int64_t HierarchicalGrid::column(const Level& lv, Real v, Real origin, std::int64_t n) const {
     if (n == 1) return 0;
     // v >= origin (the smallest min coordinate of all proxies), so the product is >= 0 and the
@@ -114,7 +120,7 @@ void HierarchicalGrid::sortByMinX() {
     }
 }
 
-std::int64_t HierarchicalGrid::fixColumns(const Level& lv) {
+std::int64_t HierarchicalGrid::fixColumns(const Level& lv, std::size_t from, std::size_t to) {
     // Each column is in (float(min x), id) order: restore (min x, id) by insertion sort. Only
     // boxes whose min x round to the same float can be out of order, so this is one comparison
     // per entry unless the coordinates are far larger than the boxes (1e6 with 1e-4 boxes);
@@ -124,7 +130,7 @@ std::int64_t HierarchicalGrid::fixColumns(const Level& lv) {
         return before(a.min_x, a.id, b.min_x, b.id);
     };
     std::int64_t shifts = 0;
-    for (std::size_t c = 0; c + 1 < lv.start.size(); ++c) {
+    for (std::size_t c = from; c < to; ++c) {
         const std::uint32_t c0 = lv.start[c];
         const std::uint32_t c1 = lv.start[c + 1];
         const std::size_t budget = 8 * std::size_t(c1 - c0) + 64;
@@ -154,8 +160,9 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     moved_ = 0;
     pairs.clear();
     level_count_ = 0;
-    entries_.clear();
     if (table_.count() == 0) return;
+    const bool two_lanes = helper_ && std::size_t(table_.count()) >= kTwoLaneMinimum;
+    if (two_lanes) helper_->prepare();  // wakes while this thread sorts
     sortByMinX();
     const std::size_t n = order_.size();
 
@@ -231,25 +238,119 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
             }
             lv.cell *= 2;
         }
-        lv.start.assign(static_cast<std::size_t>(lv.ny * lv.nz) + 1, 0);
     }
 
-    // Count the entries of every column, then lay the levels out one after the other. A box
-    // touches one or two columns per axis (its extent is at most the cell, widened by 2^-20 so
-    // rounding cannot make it three in double); the common case runs without branches on it.
-    placements_.clear();
-    for (std::size_t p = 0; p < n; ++p) {
+    // The rest runs in lanes: lane 0 alone, or lanes 0 and 1 on two threads. Positions (for
+    // counting and scattering) and columns (for sweeping) are split in two fixed halves, and
+    // lane 0's results come first, so the output is the same however many lanes run.
+    const int lanes = two_lanes ? 2 : 1;
+    lane_count_ = lanes;
+    for (int t = 0; t < lanes; ++t) {
+        lanes_[t].first = n * std::size_t(t) / std::size_t(lanes);
+        lanes_[t].last = n * std::size_t(t + 1) / std::size_t(lanes);
+    }
+    const auto inLanes = [&](auto&& work) {
+        if (lanes == 1) {
+            work(0);
+        } else {
+            helper_->runBoth(work);
+        }
+    };
+    inLanes([this](int t) { countLane(lanes_[t]); });
+
+    // Columns laid out level after level; within a column lane 0's entries come before lane
+    // 1's, which keeps each column in (float(min x), id) order. Each lane's counts become its
+    // cursors.
+    std::size_t total = 0;
+    std::size_t flat_columns = 0;
+    for (int k = 0; k < level_count_; ++k) {
+        Level& lv = levels_[k];
+        lv.first = total;
+        lv.count = 0;
+        lv.first_column = flat_columns;
+        if (lv.members == 0) continue;
+        const std::size_t columns = std::size_t(lv.ny * lv.nz);
+        flat_columns += columns;
+        lv.start.resize(columns + 1);
+        std::uint32_t running = 0;
+        for (std::size_t c = 0; c < columns; ++c) {
+            lv.start[c] = running;
+            for (int t = 0; t < lanes; ++t) {
+                std::uint32_t& slot = lanes_[t].cursor[k][kCursorPad + c];
+                const std::uint32_t here = slot;
+                slot = running;
+                running += here;
+            }
+        }
+        lv.start[columns] = running;
+        lv.count = running;
+        total += lv.count;
+    }
+    // Past the end: where each lane's branch-free scatter drops entries, 4 slots (224 bytes)
+    // apart so that the two lanes never write one cache line.
+    entries_.resize(total + 5);
+    inLanes([this, total](int t) { scatterLane(lanes_[t], total + 4 * std::size_t(t)); });
+
+    // Sweep: the columns, level after level, in chunks of about 1/64 of the entries, which the
+    // lanes take in turn as they finish the last (column costs vary: a 1:100 size mix puts
+    // more candidates per entry in its coarse columns). Which lane sweeps a chunk varies from
+    // run to run; the pairs do not: each lane sorts its own, and the lists (disjoint: a pair is
+    // found in one column) are merged.
+    id_shift_ = bitsFor(static_cast<std::uint64_t>(table_.capacity()));
+    chunks_.clear();
+    chunks_.push_back(0);
+    const std::size_t target = std::max<std::size_t>(total / 64, 1);
+    std::size_t in_chunk = 0;
+    for (int k = 0; k < level_count_; ++k) {
+        const Level& lv = levels_[k];
+        if (lv.members == 0) continue;
+        for (std::size_t c = 0; c + 1 < lv.start.size(); ++c) {
+            in_chunk += lv.start[c + 1] - lv.start[c];
+            if (in_chunk >= target) {
+                chunks_.push_back(lv.first_column + c + 1);
+                in_chunk = 0;
+            }
+        }
+    }
+    if (chunks_.back() != flat_columns) chunks_.push_back(flat_columns);
+    next_chunk_.store(0);
+    if (lanes == 1) {
+        sweepLane(lanes_[0], pairs);
+    } else {
+        inLanes([this](int t) { sweepLane(lanes_[t], lanes_[t].pairs); });
+        const std::vector<ProxyPair>& a = lanes_[0].pairs;
+        const std::vector<ProxyPair>& b = lanes_[1].pairs;
+        pairs.resize(a.size() + b.size());
+        std::merge(a.begin(), a.end(), b.begin(), b.end(), pairs.begin());
+    }
+    for (int t = 0; t < lanes; ++t) {
+        counters.volume_tests += lanes_[t].tests;
+        counters.swaps += lanes_[t].swaps;
+    }
+    counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
+}
+
+void HierarchicalGrid::countLane(Lane& lane) {
+    // A box touches one or two columns per axis (its extent is at most the cell, widened by
+    // 2^-20 so rounding cannot make it three in double); the common case runs without
+    // branches on it. The columns found are kept for the scatter.
+    for (int k = 0; k < level_count_; ++k) {
+        const Level& lv = levels_[k];
+        if (lv.members > 0) lane.cursor[k].assign(std::size_t(lv.ny * lv.nz) + 2 * kCursorPad, 0);
+    }
+    lane.placements.clear();
+    for (std::size_t p = lane.first; p < lane.last; ++p) {
         const Aabb& b = box_[p];
         const int own = level_of_[p];
         for (int k = 0; k <= own; ++k) {
-            Level& lv = levels_[k];
+            const Level& lv = levels_[k];
             if (lv.members == 0) continue;
             const Span s = span(lv, b);
             const std::int64_t c = s.z0 * lv.ny + s.y0;
-            placements_.push_back(Placement{std::uint32_t(c), std::uint16_t(s.dy),
-                                            std::uint16_t(s.dz), std::uint8_t(k),
-                                            std::uint8_t(k == own)});
-            std::uint32_t* const count = lv.start.data() + 1;
+            lane.placements.push_back(Placement{std::uint32_t(c), std::uint16_t(s.dy),
+                                                std::uint16_t(s.dz), std::uint8_t(k),
+                                                std::uint8_t(k == own)});
+            std::uint32_t* const count = lane.cursor[k].data() + kCursorPad;
             if (s.dy <= 1 && s.dz <= 1) {
                 count[c] += 1;
                 count[c + s.dy] += std::uint32_t(s.dy);
@@ -262,46 +363,37 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
             }
         }
     }
-    std::size_t total = 0;
-    for (int k = 0; k < level_count_; ++k) {
-        Level& lv = levels_[k];
-        lv.first = total;
-        lv.count = 0;
-        if (lv.members == 0) continue;
-        for (std::size_t c = 1; c < lv.start.size(); ++c) lv.start[c] += lv.start[c - 1];
-        lv.count = lv.start.back();
-        total += lv.count;
-    }
-    entries_.resize(total + 1);  // + 1: where the branch-free scatter writes entries it drops
+}
 
-    // Scatter in (float(min x), id) order, so every column is nearly sorted by (min x, id).
-    const Placement* placement = placements_.data();
-    for (std::size_t p = 0; p < n; ++p) {
+void HierarchicalGrid::scatterLane(Lane& lane, std::size_t spare_slot) {
+    // In (float(min x), id) order, so every column is nearly sorted by (min x, id).
+    const Placement* placement = lane.placements.data();
+    for (std::size_t p = lane.first; p < lane.last; ++p) {
         const std::uint32_t id = order_[p];
         const Aabb& b = box_[p];
         const Entry proto{b.min.x(), b.max.x(), b.min.y(), b.min.z(), b.max.y(), b.max.z(), id, 0};
         for (bool last = false; !last; ++placement) {
             const Placement& pl = *placement;
             last = pl.own;  // a box's own level comes last, after the coarser ones it visits
-            Level& lv = levels_[pl.level];
+            const Level& lv = levels_[pl.level];
             Entry entry = proto;
-            const std::uint32_t level_bit = pl.own << 2;
+            const std::uint32_t level_bit = std::uint32_t(pl.own) << 2;
             Entry* const out = entries_.data() + lv.first;
-            std::uint32_t* const next = lv.start.data();
+            std::uint32_t* const next = lane.cursor[pl.level].data() + kCursorPad;
             const std::uint32_t c = pl.column, dy = pl.dy, dz = pl.dz;
             if (dy <= 1 && dz <= 1) {
                 // Four writes; those for columns the box does not touch go to the spare slot.
-                const std::uint32_t spare = std::uint32_t(total - lv.first);
+                const std::uint32_t spare = std::uint32_t(spare_slot - lv.first);
                 const std::uint32_t row = dz * std::uint32_t(lv.ny);
                 const std::uint32_t cells[4] = {c, c + dy, c + row, c + row + dy};
                 const std::uint32_t used[4] = {1, dy, dz, dy & dz};
                 const std::uint32_t flags[4] = {3, 2 | (1 - dy), 1 | (1 - dz) << 1,
                                                 (1 - dy) | (1 - dz) << 1};
-                for (int t = 0; t < 4; ++t) {
-                    const std::uint32_t slot = next[cells[t]];
-                    next[cells[t]] = slot + used[t];
-                    entry.flags = flags[t] | level_bit;
-                    out[used[t] ? slot : spare] = entry;
+                for (int i = 0; i < 4; ++i) {
+                    const std::uint32_t slot = next[cells[i]];
+                    next[cells[i]] = slot + used[i];
+                    entry.flags = flags[i] | level_bit;
+                    out[used[i] ? slot : spare] = entry;
                 }
                 continue;
             }
@@ -313,54 +405,60 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
             }
         }
     }
-    for (int k = 0; k < level_count_; ++k) {
-        Level& lv = levels_[k];
-        if (lv.members == 0) continue;
-        for (std::size_t c = lv.start.size() - 1; c > 0; --c) lv.start[c] = lv.start[c - 1];
-        lv.start[0] = 0;
-        counters.swaps += fixColumns(lv);
-    }
+}
 
-    // Sweep every column: each entry scans forward while the next ones start within its x
-    // interval. Keys are written unconditionally and kept when the pair counts (no branch on
-    // the outcome), so the buffer always has room for the rest of the column.
-    id_shift_ = bitsFor(static_cast<std::uint64_t>(table_.capacity()));
+void HierarchicalGrid::sweepLane(Lane& lane, std::vector<ProxyPair>& pairs) {
+    // Each entry scans forward while the next ones start within its x interval. Keys are
+    // written unconditionally and kept when the pair counts (no branch on the outcome), so the
+    // buffer always has room for the rest of the column.
+    lane.tests = 0;
+    lane.swaps = 0;
     const int shift = id_shift_;
     std::size_t count = 0;
     std::int64_t tests = 0;
-    for (int k = 0; k < level_count_; ++k) {
-        const Level& lv = levels_[k];
-        if (lv.members == 0) continue;
-        const Entry* const e = entries_.data() + lv.first;
-        const std::size_t columns = lv.start.size() - 1;
-        for (std::size_t c = 0; c < columns; ++c) {
-            const std::uint32_t c0 = lv.start[c];
-            const std::uint32_t c1 = lv.start[c + 1];
-            if (c1 - c0 < 2) continue;
-            for (std::uint32_t i = c0; i + 1 < c1; ++i) {
-                if (keys_.size() < count + (c1 - i)) {
-                    keys_.resize(std::max(2 * keys_.size(), count + (c1 - i)) + 1024);
+    for (;;) {
+        const std::size_t chunk = next_chunk_.fetch_add(1);
+        if (chunk + 1 >= chunks_.size()) break;
+        const std::size_t flat_from = chunks_[chunk];
+        const std::size_t flat_to = chunks_[chunk + 1];
+        for (int k = 0; k < level_count_; ++k) {
+            const Level& lv = levels_[k];
+            if (lv.members == 0) continue;
+            const std::size_t columns = lv.start.size() - 1;
+            const std::size_t lo = std::max(flat_from, lv.first_column);
+            const std::size_t hi = std::min(flat_to, lv.first_column + columns);
+            if (lo >= hi) continue;
+            const std::size_t from = lo - lv.first_column;
+            const std::size_t to = hi - lv.first_column;
+            lane.swaps += fixColumns(lv, from, to);
+            const Entry* const e = entries_.data() + lv.first;
+            for (std::size_t c = from; c < to; ++c) {
+                const std::uint32_t c0 = lv.start[c];
+                const std::uint32_t c1 = lv.start[c + 1];
+                if (c1 - c0 < 2) continue;
+                for (std::uint32_t i = c0; i + 1 < c1; ++i) {
+                    if (lane.keys.size() < count + (c1 - i)) {
+                        lane.keys.resize(std::max(2 * lane.keys.size(), count + (c1 - i)) + 1024);
+                    }
+                    std::uint64_t* const out = lane.keys.data();
+                    const Entry& a = e[i];
+                    const YzTest yz(a);
+                    std::uint32_t q = i + 1;
+                    for (; q < c1 && e[q].min_x <= a.max_x; ++q) {
+                        const Entry& b = e[q];
+                        const bool hit = yz.overlaps(b) & ((a.flags | b.flags) == 7u);
+                        out[count] = (std::uint64_t(a.id) << shift) | b.id;  // ordered later
+                        count += hit;
+                    }
+                    tests += q - i - 1;
                 }
-                std::uint64_t* const out = keys_.data();
-                const Entry& a = e[i];
-                const YzTest yz(a);
-                std::uint32_t q = i + 1;
-                for (; q < c1 && e[q].min_x <= a.max_x; ++q) {
-                    const Entry& b = e[q];
-                    const bool hit = yz.overlaps(b) & ((a.flags | b.flags) == 7u);
-                    out[count] = (std::uint64_t(a.id) << shift) | b.id;  // ordered later
-                    count += hit;
-                }
-                tests += q - i - 1;
             }
         }
     }
-    counters.volume_tests += tests;
-
-    // (a, b) order: one radix sort of the packed keys (3 passes of 11 bits up to 2^16 ids).
-    radix::keysToSortedPairs(std::span(keys_.data(), count), scratch_, id_shift_, pairs,
+    lane.tests = tests;
+    // (a, b) order: one radix sort of the packed keys.
+    radix::keysToSortedPairs(std::span(lane.keys.data(), count), lane.scratch, shift, pairs,
                              /*order_ids=*/true);
-    counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
 }
 
 void HierarchicalGrid::draw(DebugDraw& draw) const {

@@ -2,10 +2,13 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "collision/broad_phase.h"
+#include "helper_thread.h"
 #include "proxy_table.h"
 
 namespace collision {
@@ -35,7 +38,11 @@ namespace collision {
 /// on the proxies' own coordinates, touching counts.
 class HierarchicalGrid : public BroadPhase {
 public:
-    std::string_view name() const override { return "hgrid"; }
+    /// `two_threads`: count, scatter and sweep split between this thread and a helper thread
+    /// (from kTwoLaneMinimum proxies); the pairs are the same either way.
+    explicit HierarchicalGrid(bool two_threads = false);
+    ~HierarchicalGrid() override;
+    std::string_view name() const override { return helper_ ? "hgrid2" : "hgrid"; }
     void insert(ProxyId id, const ProxyVolumes& v) override { table_.insert(id, v); }
     void remove(ProxyId id) override { table_.remove(id); }
     void move(ProxyId id, const ProxyVolumes& v) override {
@@ -50,6 +57,8 @@ public:
     /// Cells shrink by 2^kLevelBits per level. Mirtich uses 2; 8 halves the levels a 1:100 size
     /// mix spreads over, and each proxy is a guest in every coarser level.
     static constexpr int kLevelBits = 3;
+    /// Fewer proxies than this run on one thread even when two are allowed.
+    static constexpr std::size_t kTwoLaneMinimum = 4096;
     /// Columns are at least this many times the mean extent of a level's own members.
     static constexpr Real kCellPerExtent = 2;
 
@@ -70,6 +79,7 @@ private:
         std::size_t members = 0;  // proxies whose own level this is
         std::size_t first = 0;    // this level's entries are entries_[first, first + count)
         std::size_t count = 0;
+        std::size_t first_column = 0;      // columns of the levels before (for the lane split)
         std::vector<std::uint32_t> start;  // column -> offset of its first entry in the level
     };
     struct Span {
@@ -82,8 +92,24 @@ private:
         std::uint16_t dy, dz;
         std::uint8_t level, own;
     };
+    /// Unused slots around each lane's cursors, so that two lanes' cursors (written for every
+    /// entry) never share a cache line.
+    static constexpr std::size_t kCursorPad = 16;
+    /// One thread's share of a frame: positions [first, last) to count and scatter, the
+    /// chunks of columns it swept, and what it found.
+    struct Lane {
+        std::size_t first = 0, last = 0;
+        std::vector<Placement> placements;                          // by position, then level
+        std::array<std::vector<std::uint32_t>, kMaxLevels> cursor;  // counts, then cursors
+        std::vector<std::uint64_t> keys, scratch;
+        std::vector<ProxyPair> pairs;  // with two lanes; one lane writes the caller's
+        std::int64_t tests = 0, swaps = 0;
+    };
     void sortByMinX();
-    std::int64_t fixColumns(const Level& level);
+    void countLane(Lane& lane);
+    void scatterLane(Lane& lane, std::size_t spare_slot);
+    void sweepLane(Lane& lane, std::vector<ProxyPair>& pairs);
+    std::int64_t fixColumns(const Level& level, std::size_t from, std::size_t to);
     Span span(const Level& level, const Aabb& box) const;
     std::int64_t column(const Level& level, Real v, Real origin, std::int64_t n) const;
 
@@ -97,11 +123,13 @@ private:
     std::vector<std::uint64_t> packed_scratch_;
     std::vector<Aabb> box_;               // their boxes
     std::vector<std::uint8_t> level_of_;  // by position in order_
-    std::vector<Placement> placements_;   // by position in order_, then level
+    int id_shift_ = 1;                    // bits per id in a packed pair key
     std::vector<Entry> entries_;
-    int id_shift_ = 1;  // bits per id in a packed pair key
-    std::vector<std::uint64_t> keys_;
-    std::vector<std::uint64_t> scratch_;
+    std::vector<std::size_t> chunks_;  // flat column index where each sweep chunk starts, + end
+    std::atomic<std::size_t> next_chunk_{0};
+    std::array<Lane, 2> lanes_;
+    int lane_count_ = 1;
+    std::unique_ptr<HelperThread> helper_;
 };
 
 }  // namespace collision

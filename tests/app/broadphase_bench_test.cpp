@@ -78,11 +78,14 @@ TEST(BroadphaseBench, SmallRunReportsEveryMethodWithTheSamePairsInTableAndJson) 
     // The default method set is what the binary runs: the same library is linked here.
     std::set<std::string> expected_methods;
     std::set<std::string> peers;
+    std::set<std::string> threaded;  // left out by the default thread-CPU clock
     for (const app::BenchMethodEntry& m : app::benchMethods()) {
         if (!m.default_set) continue;
         expected_methods.insert(m.name);
         if (m.peer) peers.insert(m.name);
+        if (m.threads > 1) threaded.insert(m.name);
     }
+    EXPECT_TRUE(threaded.count("hgrid2"));
     for (const char* cdlab : {"brute", "sap", "sap1", "grid", "hash", "hgrid", "tree", "octree"}) {
         EXPECT_TRUE(expected_methods.count(cdlab)) << cdlab << " missing from the default set";
     }
@@ -99,6 +102,12 @@ TEST(BroadphaseBench, SmallRunReportsEveryMethodWithTheSamePairsInTableAndJson) 
         const std::string method = row.value("method", "");
         const std::string workload = row.value("workload", "");
         SCOPED_TRACE(method + " / " + workload);
+        if (threaded.count(method)) {
+            ASSERT_TRUE(row.contains("skipped")) << row.dump();
+            EXPECT_NE(row["skipped"].get<std::string>().find("--clock wall"), std::string::npos);
+            methods_by_workload[workload].insert(method);
+            continue;
+        }
         EXPECT_FALSE(row.contains("skipped")) << row.dump();
         EXPECT_FALSE(row.contains("failed")) << row.dump();
         bool complete = true;
@@ -155,7 +164,7 @@ TEST(BroadphaseBench, SmallRunReportsEveryMethodWithTheSamePairsInTableAndJson) 
         const std::int64_t truth = bruteForcePairs(kind, n, small.seed, small.frames);
         EXPECT_GT(truth, n / 2) << name;
         for (const nlohmann::json& row : doc["rows"]) {
-            if (row["workload"] != name) continue;
+            if (row["workload"] != name || row.contains("skipped")) continue;
             EXPECT_EQ(row["pairs"].get<std::int64_t>(), truth) << row["method"] << " / " << name;
         }
     }
@@ -176,7 +185,11 @@ TEST(BroadphaseBench, SmallRunReportsEveryMethodWithTheSamePairsInTableAndJson) 
         for (std::string line; std::getline(lines, line);) {
             if (line.rfind(label + " ", 0) != 0) continue;
             ++rows;
-            EXPECT_EQ(line.substr(line.size() - 2), "ok") << line;
+            if (threaded.count(method)) {
+                EXPECT_NE(line.find("--clock wall"), std::string::npos) << line;
+            } else {
+                EXPECT_EQ(line.substr(line.size() - 2), "ok") << line;
+            }
         }
         EXPECT_EQ(rows, 2) << label << " rows in the table\n" << r.out;
     }
@@ -184,6 +197,33 @@ TEST(BroadphaseBench, SmallRunReportsEveryMethodWithTheSamePairsInTableAndJson) 
     if (!peers.empty()) {
         EXPECT_NE(r.out.find("; best peer: "), std::string::npos) << r.out;
     }
+    fs::remove_all(work);
+}
+
+// --clock wall times every method by elapsed time, the two-thread hgrid2 included; at 5000
+// boxes (over its 4096 threshold) it runs both lanes and must report hgrid's pairs.
+TEST(BroadphaseBench, WallClockRunsTheTwoThreadMethodWithTheSamePairs) {
+    const fs::path work = tempDir("wall");
+    const fs::path json = work / "wall.json";
+    const Result r = runCdlab(
+        "bench broadphase --sizes 5000 --frames 4 --methods hgrid,hgrid2 "
+        "--workload mixed --clock wall --in-process --json " +
+            json.string(),
+        work);
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    EXPECT_NE(r.out.find("elapsed (wall-clock) time"), std::string::npos) << r.out;
+    const nlohmann::json doc = nlohmann::json::parse(slurp(json));
+    EXPECT_EQ(doc["clock"], "wall");
+    ASSERT_EQ(doc["rows"].size(), 2u);
+    for (const nlohmann::json& row : doc["rows"]) {
+        ASSERT_FALSE(row.contains("skipped")) << row.dump();
+        EXPECT_EQ(row["mismatched_frames"], 0) << row.dump();
+        EXPECT_EQ(row["frames"], 4) << row.dump();
+    }
+    EXPECT_EQ(doc["rows"][0]["method"], "hgrid");
+    EXPECT_EQ(doc["rows"][1]["method"], "hgrid2");
+    EXPECT_EQ(doc["rows"][0]["pairs"], doc["rows"][1]["pairs"]);
+    EXPECT_GT(doc["rows"][0]["pairs"].get<std::int64_t>(), 5000);
     fs::remove_all(work);
 }
 
@@ -195,6 +235,9 @@ TEST(BroadphaseBench, BadOptionsExitTwoBeforeAnyWork) {
     r = runCdlab("bench broadphase --sizes 50 --frames 0", work);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("--frames: 0"), std::string::npos) << r.err;
+    r = runCdlab("bench broadphase --sizes 50 --frames 2 --clock cpu", work);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("--clock"), std::string::npos) << r.err;
     r = runCdlab("bench broadphase --sizes 50 --frames 2 --methods sap,nope", work);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("unknown method 'nope'"), std::string::npos) << r.err;

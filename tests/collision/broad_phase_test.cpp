@@ -248,6 +248,18 @@ TEST(BroadPhaseDifferential, FixedMembershipThroughJumpsTiesAndFloatTies) {
     }
 }
 
+// hgrid2 splits the work between two threads only from HierarchicalGrid's 4096 proxies on, so
+// the scenes above (120 and 400 boxes) run it on one. Here it runs both lanes: 5000 boxes,
+// with removals and re-insertions, against brute force on every frame.
+TEST(BroadPhaseDifferential, TwoThreadHgridEqualsItsReferenceAboveItsThreshold) {
+    const BroadPhaseEntry* entry = findBroadPhase("hgrid2");
+    ASSERT_NE(entry, nullptr);
+    EXPECT_EQ(entry->threads, 2);
+    for (const Layout layout : {Layout::Uniform, Layout::MixedSizes, Layout::FarFromOrigin}) {
+        expectEqualsReference(*entry, layout, 5000, 4, 11);
+    }
+}
+
 TEST(BroadPhaseDifferential, LatticeSceneReallyTouches) {
     // Guards the adversarial scene itself: exact face/edge/corner contacts must occur, else the
     // touching cases above test nothing.

@@ -36,10 +36,10 @@ struct ProxyVolumes {
 
 /// Cost-model counters of one findPairs call (F = Nv·Cv + Np·Cp + Nu·Cu).
 struct BroadPhaseCounters {
-    std::int64_t volume_tests = 0;    ///< Nv: bounding-volume overlap tests made
-    std::int64_t pairs_flagged = 0;   ///< pairs reported
-    std::int64_t volumes_updated = 0; ///< Nu: proxies whose volumes changed since the last call
-    std::int64_t swaps = 0;           ///< insertion-sort swaps (SAP), 0 elsewhere
+    std::int64_t volume_tests = 0;     ///< Nv: bounding-volume overlap tests made
+    std::int64_t pairs_flagged = 0;    ///< pairs reported
+    std::int64_t volumes_updated = 0;  ///< Nu: proxies whose volumes changed since the last call
+    std::int64_t swaps = 0;            ///< insertion-sort swaps (SAP), 0 elsewhere
 };
 
 class BroadPhase {
@@ -66,9 +66,10 @@ public:
 struct BroadPhaseEntry {
     std::string_view name;
     std::string_view description;
-    std::string_view volume;      ///< "aabb", "sphere" or "obb": the volume it decides on
-    std::string_view reference;   ///< name of the brute-force broad phase it must equal
+    std::string_view volume;     ///< "aabb", "sphere" or "obb": the volume it decides on
+    std::string_view reference;  ///< name of the brute-force broad phase it must equal
     std::unique_ptr<BroadPhase> (*create)();
+    int threads = 1;  ///< threads it runs on (timing it by thread CPU time needs 1)
 };
 
 std::span<const BroadPhaseEntry> broadPhaseRegistry();
