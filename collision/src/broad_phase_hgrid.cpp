@@ -43,6 +43,8 @@ inline int floorLog2(Real x) {
     return int((std::bit_cast<Bits>(x) >> kMantissa) & kMask) - kBias;
 }
 
+constexpr std::uint8_t kZeroSize = 0xff;  // level_of_ mark: any level will do
+
 inline bool before(Real xa, std::uint32_t ia, Real xb, std::uint32_t ib) {
     return xa < xb || (xa == xb && ia < ib);
 }
@@ -111,12 +113,47 @@ void HierarchicalGrid::sortByMinX() {
         packed_.push_back(orderedBits(x) << 32 | std::uint64_t(std::uint32_t(id)));
     }
     radix::radixSortHigh32(packed_, packed_scratch_);
-    const std::size_t n = packed_.size();
-    order_.resize(n);
-    box_.resize(n);
-    for (std::size_t p = 0; p < n; ++p) {
-        order_[p] = static_cast<std::uint32_t>(packed_[p]);
-        box_[p] = table_.aabb(ProxyId(order_[p]));
+}
+
+void HierarchicalGrid::gatherLane(Lane& lane) {
+    // The boxes in sorted order, with the lane's largest extent and (y, z) bounds.
+    lane.top = 0;
+    lane.lo_y = lane.lo_z = std::numeric_limits<Real>::max();
+    lane.hi_y = lane.hi_z = std::numeric_limits<Real>::lowest();
+    for (std::size_t p = lane.first; p < lane.last; ++p) {
+        const std::uint32_t id = static_cast<std::uint32_t>(packed_[p]);
+        order_[p] = id;
+        const Aabb& b = box_[p] = table_.aabb(ProxyId(id));
+        lane.top = std::max(lane.top, extentOf(b));
+        lane.lo_y = std::min(lane.lo_y, b.min.y());
+        lane.hi_y = std::max(lane.hi_y, b.max.y());
+        lane.lo_z = std::min(lane.lo_z, b.min.z());
+        lane.hi_z = std::max(lane.hi_z, b.max.z());
+    }
+}
+
+void HierarchicalGrid::levelLane(Lane& lane, Real top) {
+    // Level k has cells s_top / 8^k; a box goes to the finest level whose cells hold its
+    // extent. Zero-size boxes fit anywhere: marked here, they join the finest level in use.
+    std::array<Real, kMaxLevels> base_cell;  // s_top / 8^k
+    for (int k = 0; k < kMaxLevels; ++k) base_cell[k] = std::ldexp(top, -kLevelBits * k);
+    lane.extent_sum.fill(0);
+    lane.members.fill(0);
+    lane.zero_size = 0;
+    lane.finest = 0;
+    for (std::size_t p = lane.first; p < lane.last; ++p) {
+        const Real e = extentOf(box_[p]);
+        if (!(e > 0)) {
+            level_of_[p] = kZeroSize;
+            ++lane.zero_size;
+            continue;
+        }
+        int k = std::min(floorLog2(top / e) / kLevelBits, kMaxLevels - 1);
+        while (k > 0 && base_cell[k] < e) --k;  // guard: cell >= extent
+        level_of_[p] = static_cast<std::uint8_t>(k);
+        lane.extent_sum[k] += e;
+        ++lane.members[k];
+        lane.finest = std::max(lane.finest, k);
     }
 }
 
@@ -164,49 +201,53 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     const bool two_lanes = helper_ && std::size_t(table_.count()) >= kTwoLaneMinimum;
     if (two_lanes) helper_->prepare();  // wakes while this thread sorts
     sortByMinX();
-    const std::size_t n = order_.size();
+    const std::size_t n = packed_.size();
+    order_.resize(n);
+    box_.resize(n);
+    level_of_.resize(n);
 
-    // The largest extent and the (y, z) bounds of every box.
-    Real top = 0;
-    Real lo_y = std::numeric_limits<Real>::max(), hi_y = std::numeric_limits<Real>::lowest();
-    Real lo_z = lo_y, hi_z = hi_y;
-    for (const Aabb& b : box_) {
-        top = std::max(top, extentOf(b));
-        lo_y = std::min(lo_y, b.min.y());
-        hi_y = std::max(hi_y, b.max.y());
-        lo_z = std::min(lo_z, b.min.z());
-        hi_z = std::max(hi_z, b.max.z());
+    // Lanes: lane 0 alone, or lanes 0 and 1 on two threads. Positions (for gathering, level
+    // finding, counting and scattering) are split in two fixed halves, and lane 0's results
+    // come first, so the output is the same however many lanes run.
+    const int lanes = two_lanes ? 2 : 1;
+    lane_count_ = lanes;
+    for (int t = 0; t < lanes; ++t) {
+        lanes_[t].first = n * std::size_t(t) / std::size_t(lanes);
+        lanes_[t].last = n * std::size_t(t + 1) / std::size_t(lanes);
     }
-    if (!(top > 0)) top = 1;
+    const auto inLanes = [&](auto&& work) {
+        if (lanes == 1) {
+            work(0);
+        } else {
+            helper_->runBoth(work);
+        }
+    };
+    // Gathered by this thread alone: the table was just written here, by move(), and a helper
+    // reading half of it from the other core made the pass slower than on one thread (10k
+    // boxes: 75 against 38 us).
+    Lane& all = lanes_[0];
+    const std::size_t lane0_last = all.last;
+    all.last = n;
+    gatherLane(all);
+    const Real top = all.top > 0 ? all.top : Real(1);
+    const Real lo_y = all.lo_y, hi_y = all.hi_y, lo_z = all.lo_z, hi_z = all.hi_z;
     origin_y_ = lo_y;
     origin_z_ = lo_z;
 
-    // Levels: cells s_top / 8^k; a box at the finest level whose cells hold its extent.
-    // Zero-size boxes fit anywhere; they join the finest level in use (or level 0).
-    constexpr std::uint8_t kZeroSize = 0xff;
-    std::array<Real, kMaxLevels> base_cell;  // s_top / 8^k
+    all.last = lane0_last;
+    inLanes([this, top](int t) { levelLane(lanes_[t], top); });
+    finest_ = 0;
+    for (int t = 0; t < lanes; ++t) finest_ = std::max(finest_, lanes_[t].finest);
+    level_count_ = finest_ + 1;
     std::array<Real, kMaxLevels> extent_sum{};
-    for (int k = 0; k < kMaxLevels; ++k) base_cell[k] = std::ldexp(top, -kLevelBits * k);
-    level_of_.resize(n);
-    int finest = 0;
-    for (std::size_t p = 0; p < n; ++p) {
-        const Real e = extentOf(box_[p]);
-        if (!(e > 0)) {
-            level_of_[p] = kZeroSize;
-            continue;
+    for (int k = 0; k < level_count_; ++k) {
+        levels_[k].members = 0;
+        for (int t = 0; t < lanes; ++t) {
+            levels_[k].members += lanes_[t].members[k];
+            extent_sum[k] += lanes_[t].extent_sum[k];
         }
-        int k = std::min(floorLog2(top / e) / kLevelBits, kMaxLevels - 1);
-        while (k > 0 && base_cell[k] < e) --k;  // guard: cell >= extent
-        level_of_[p] = static_cast<std::uint8_t>(k);
-        extent_sum[k] += e;
-        finest = std::max(finest, k);
     }
-    level_count_ = finest + 1;
-    for (int k = 0; k < level_count_; ++k) levels_[k].members = 0;
-    for (std::size_t p = 0; p < n; ++p) {
-        if (level_of_[p] == kZeroSize) level_of_[p] = static_cast<std::uint8_t>(finest);
-        ++levels_[level_of_[p]].members;
-    }
+    for (int t = 0; t < lanes; ++t) levels_[finest_].members += lanes_[t].zero_size;
 
     // Column grids: cells widened (doubled) until a level has at most ~2 columns per entry.
     std::size_t guests = 0;  // entries of finer levels' proxies, as guests of this level
@@ -220,7 +261,8 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
         // more candidates, much narrower ones more entries per box (measured on the bench's
         // uniform workload: 1.11 ms/frame at the level's cell, 1.04 at twice the mean extent).
         const Real mean = extent_sum[k] / Real(lv.members);
-        lv.cell = std::max(base_cell[k], kCellPerExtent * mean) * (1 + std::ldexp(Real(1), -20));
+        lv.cell = std::max(std::ldexp(top, -kLevelBits * k), kCellPerExtent * mean) *
+                  (1 + std::ldexp(Real(1), -20));
         for (;;) {
             lv.inv_cell = 1 / lv.cell;
             const Real sy = (hi_y - lo_y) * lv.inv_cell;
@@ -240,22 +282,6 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
         }
     }
 
-    // The rest runs in lanes: lane 0 alone, or lanes 0 and 1 on two threads. Positions (for
-    // counting and scattering) and columns (for sweeping) are split in two fixed halves, and
-    // lane 0's results come first, so the output is the same however many lanes run.
-    const int lanes = two_lanes ? 2 : 1;
-    lane_count_ = lanes;
-    for (int t = 0; t < lanes; ++t) {
-        lanes_[t].first = n * std::size_t(t) / std::size_t(lanes);
-        lanes_[t].last = n * std::size_t(t + 1) / std::size_t(lanes);
-    }
-    const auto inLanes = [&](auto&& work) {
-        if (lanes == 1) {
-            work(0);
-        } else {
-            helper_->runBoth(work);
-        }
-    };
     inLanes([this](int t) { countLane(lanes_[t]); });
 
     // Columns laid out level after level; within a column lane 0's entries come before lane
@@ -318,10 +344,35 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
         sweepLane(lanes_[0], pairs);
     } else {
         inLanes([this](int t) { sweepLane(lanes_[t], lanes_[t].pairs); });
+        // Merged in two halves at once: the first half of the output takes the smallest
+        // `half` pairs of the two lists, i of them from a and half - i from b, with i found by
+        // binary search (the lists are disjoint, so the split is unique).
         const std::vector<ProxyPair>& a = lanes_[0].pairs;
         const std::vector<ProxyPair>& b = lanes_[1].pairs;
-        pairs.resize(a.size() + b.size());
-        std::merge(a.begin(), a.end(), b.begin(), b.end(), pairs.begin());
+        const std::size_t total_pairs = a.size() + b.size();
+        const std::size_t half = total_pairs / 2;
+        std::size_t lo = half > b.size() ? half - b.size() : 0;
+        std::size_t hi = std::min(half, a.size());
+        while (lo < hi) {  // smallest i with a[i] > b[half - i - 1] (or i = min(half, |a|))
+            const std::size_t i = (lo + hi) / 2;
+            if (a[i] < b[half - i - 1]) {
+                lo = i + 1;
+            } else {
+                hi = i;
+            }
+        }
+        const std::size_t take_a = lo;
+        pairs.resize(total_pairs);
+        inLanes([&](int t) {
+            if (t == 0) {
+                std::merge(a.begin(), a.begin() + std::ptrdiff_t(take_a), b.begin(),
+                           b.begin() + std::ptrdiff_t(half - take_a), pairs.begin());
+            } else {
+                std::merge(a.begin() + std::ptrdiff_t(take_a), a.end(),
+                           b.begin() + std::ptrdiff_t(half - take_a), b.end(),
+                           pairs.begin() + std::ptrdiff_t(half));
+            }
+        });
     }
     for (int t = 0; t < lanes; ++t) {
         counters.volume_tests += lanes_[t].tests;
@@ -341,7 +392,7 @@ void HierarchicalGrid::countLane(Lane& lane) {
     lane.placements.clear();
     for (std::size_t p = lane.first; p < lane.last; ++p) {
         const Aabb& b = box_[p];
-        const int own = level_of_[p];
+        const int own = level_of_[p] == kZeroSize ? finest_ : level_of_[p];
         for (int k = 0; k <= own; ++k) {
             const Level& lv = levels_[k];
             if (lv.members == 0) continue;

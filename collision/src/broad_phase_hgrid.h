@@ -99,6 +99,11 @@ private:
     /// chunks of columns it swept, and what it found.
     struct Lane {
         std::size_t first = 0, last = 0;
+        Real top = 0, lo_y = 0, hi_y = 0, lo_z = 0, hi_z = 0;  // of its boxes
+        std::array<Real, kMaxLevels> extent_sum{};             // of its boxes, by level
+        std::array<std::size_t, kMaxLevels> members{};
+        std::size_t zero_size = 0;
+        int finest = 0;
         std::vector<Placement> placements;                          // by position, then level
         std::array<std::vector<std::uint32_t>, kMaxLevels> cursor;  // counts, then cursors
         std::vector<std::uint64_t> keys, scratch;
@@ -106,6 +111,8 @@ private:
         std::int64_t tests = 0, swaps = 0;
     };
     void sortByMinX();
+    void gatherLane(Lane& lane);
+    void levelLane(Lane& lane, Real top);
     void countLane(Lane& lane);
     void scatterLane(Lane& lane, std::size_t spare_slot);
     void sweepLane(Lane& lane, std::vector<ProxyPair>& pairs);
@@ -116,6 +123,7 @@ private:
     ProxyTable table_;
     std::int64_t moved_ = 0;
     int level_count_ = 0;
+    int finest_ = 0;  // the finest level with members; zero-size boxes join it
     Real origin_y_ = 0, origin_z_ = 0;
     std::array<Level, kMaxLevels> levels_;
     std::vector<std::uint32_t> order_;   // present proxies by (min x, id)
