@@ -380,7 +380,7 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
     } else if (const auto kind = parseWorkloadKind(options.workload)) {
         kinds = {*kind};
     } else {
-        err << "--workload: '" << options.workload << "' is not uniform, mixed or both\n";
+        err << "--workload: '" << options.workload << "' is not uniform, mixed, both or wide\n";
         return kExitBadInput;
     }
     if (options.sizes.empty()) {

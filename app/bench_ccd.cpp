@@ -262,9 +262,9 @@ struct SceneRow {
     std::string scene;
     std::string ccd;
     int frames = 0;
-    double step_us = 0;        ///< mean World::step wall time per frame, microseconds
-    double ccd_us = 0;         ///< mean CCD stage time per frame, microseconds
-    double toi_queries = 0;    ///< mean timeOfImpact calls per frame
+    double step_us = 0;           ///< mean World::step wall time per frame, microseconds
+    double ccd_us = 0;            ///< mean CCD stage time per frame, microseconds
+    double toi_queries = 0;       ///< mean timeOfImpact calls per frame
     std::int64_t toi_events = 0;  ///< total times of impact acted on
 };
 
@@ -384,13 +384,13 @@ int runBenchCcd(const BenchCcdOptions& options, std::ostream& out, std::ostream&
                 << std::left << std::setw(16) << "scene" << std::setw(26) << "ccd" << std::right
                 << std::setw(7) << "frames" << std::setw(14) << "step_us/frame" << std::setw(13)
                 << "ccd_us/frame" << std::setw(15) << "queries/frame" << std::setw(11)
-                << "toi_events" << "\n";
+                << "toi_events"
+                << "\n";
             for (const SceneRow& r : scene_rows) {
-                out << std::left << std::setw(16) << r.scene << std::setw(26) << r.ccd
-                    << std::right << std::setw(7) << r.frames << std::fixed
-                    << std::setprecision(2) << std::setw(14) << r.step_us << std::setw(13)
-                    << r.ccd_us << std::setw(15) << r.toi_queries
-                    << std::setw(11) << r.toi_events << std::defaultfloat << "\n";
+                out << std::left << std::setw(16) << r.scene << std::setw(26) << r.ccd << std::right
+                    << std::setw(7) << r.frames << std::fixed << std::setprecision(2)
+                    << std::setw(14) << r.step_us << std::setw(13) << r.ccd_us << std::setw(15)
+                    << r.toi_queries << std::setw(11) << r.toi_events << std::defaultfloat << "\n";
             }
         }
     }

@@ -43,12 +43,21 @@ private:
 }  // namespace
 
 std::string_view workloadName(WorkloadKind kind) {
-    return kind == WorkloadKind::Uniform ? "uniform" : "mixed";
+    switch (kind) {
+        case WorkloadKind::Uniform:
+            return "uniform";
+        case WorkloadKind::Mixed:
+            return "mixed";
+        case WorkloadKind::Wide:
+            return "wide";
+    }
+    return "?";
 }
 
 std::optional<WorkloadKind> parseWorkloadKind(std::string_view name) {
     if (name == "uniform") return WorkloadKind::Uniform;
     if (name == "mixed") return WorkloadKind::Mixed;
+    if (name == "wide") return WorkloadKind::Wide;
     return std::nullopt;
 }
 
@@ -58,7 +67,10 @@ std::uint64_t pairHash(ProxyId a, ProxyId b) {
 }
 
 MovingBoxes::MovingBoxes(WorkloadKind kind, int n, std::uint64_t seed) : kind_(kind) {
-    Random random(splitmix64(seed) ^ (kind == WorkloadKind::Uniform ? 0x1234u : 0x5678u));
+    const std::uint64_t stream = kind == WorkloadKind::Uniform ? 0x1234u
+                                 : kind == WorkloadKind::Mixed ? 0x5678u
+                                                               : 0x9abcu;
+    Random random(splitmix64(seed) ^ stream);
     const std::size_t count = static_cast<std::size_t>(std::max(n, 2));
     unit_.resize(count);
     half_.resize(count);
@@ -69,8 +81,11 @@ MovingBoxes::MovingBoxes(WorkloadKind kind, int n, std::uint64_t seed) : kind_(k
         if (kind == WorkloadKind::Uniform) {
             h = Vec3(random.uniform(0.4, 0.6), random.uniform(0.4, 0.6), random.uniform(0.4, 0.6));
         } else {
-            // Log-uniform scale over two decades, then a mild per-axis jitter.
-            const double scale = 0.05 * std::pow(100.0, random.unit());
+            // Log-uniform scale over two decades (mixed) or four (wide), then a mild per-axis
+            // jitter.
+            const double scale = kind == WorkloadKind::Mixed
+                                     ? 0.05 * std::pow(100.0, random.unit())
+                                     : 0.005 * std::pow(10000.0, random.unit());
             h = Vec3(scale * random.uniform(0.8, 1.2), scale * random.uniform(0.8, 1.2),
                      scale * random.uniform(0.8, 1.2));
         }

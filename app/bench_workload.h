@@ -18,6 +18,7 @@ namespace app {
 enum class WorkloadKind {
     Uniform,  ///< half extents uniform in [0.4, 0.6] per axis
     Mixed,    ///< box scale log-uniform in [0.05, 5] (1:100), each axis x U[0.8, 1.2]
+    Wide,     ///< box scale log-uniform in [0.005, 50] (1:10^4), each axis x U[0.8, 1.2]
 };
 
 std::string_view workloadName(WorkloadKind kind);

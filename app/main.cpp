@@ -143,8 +143,10 @@ int main(int argc, char** argv) {
         ->add_option("--methods", bench_bp.methods,
                      "comma-separated (default: every AABB broad phase and the default peers)")
         ->delimiter(',');
-    bench_bp_cmd->add_option("--workload", bench_bp.workload, "uniform, mixed or both")
-        ->check(CLI::IsMember({"uniform", "mixed", "both"}))
+    bench_bp_cmd
+        ->add_option("--workload", bench_bp.workload,
+                     "uniform, mixed (sizes 1:100), both (those two) or wide (sizes 1:10^4)")
+        ->check(CLI::IsMember({"uniform", "mixed", "both", "wide"}))
         ->capture_default_str();
     bench_bp_cmd->add_option("--json", bench_bp_json, "also write the rows as JSON to FILE");
     bench_bp_cmd->add_option("--seed", bench_bp.seed, "workload seed")->capture_default_str();

@@ -6,16 +6,16 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <iterator>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 
-#include "engine/scene.h"
 #include "broadphase_check.h"
+#include "engine/scene.h"
 #include "output_files.h"
 #include "pause_dump.h"
 #include "render/image.h"
@@ -40,8 +40,7 @@ public:
         const int width = 40;
         const int filled = total_ > 0 ? done * width / total_ : width;
         std::fprintf(stderr, "\r[%.*s%*s] %d/%d frames", filled,
-                     "########################################", width - filled, "", done,
-                     total_);
+                     "########################################", width - filled, "", done, total_);
         std::fflush(stderr);
     }
     ~ProgressBar() {
@@ -91,12 +90,11 @@ std::string statsRow(int frame, const engine::World& world, const FrameStats& f)
                   "%d,%.9g,%s,%zu,%zu,%zu,%lld,%lld,%lld,%lld,%lld,%lld,%.6f,%.6f,%.6f,%.6f,%.6f,"
                   "%.6f,%.6f\n",
                   frame, double(world.time()), std::string(world.broadPhase().name()).c_str(),
-                  world.bodies().size(), world.flaggedPairs().size(),
-                  world.collidingPairs().size(), (long long)f.broad.volume_tests,
-                  (long long)f.broad.volumes_updated, (long long)f.broad.swaps,
-                  (long long)f.narrow_tests, (long long)f.triangle_tests, (long long)f.bv_tests,
-                  1e3 * f.integrate_s, 1e3 * f.volumes_s, 1e3 * f.broad_s, 1e3 * f.narrow_s,
-                  1e3 * f.ccd_s, 1e3 * f.response_s, 1e3 * f.total_s);
+                  world.bodies().size(), world.flaggedPairs().size(), world.collidingPairs().size(),
+                  (long long)f.broad.volume_tests, (long long)f.broad.volumes_updated,
+                  (long long)f.broad.swaps, (long long)f.narrow_tests, (long long)f.triangle_tests,
+                  (long long)f.bv_tests, 1e3 * f.integrate_s, 1e3 * f.volumes_s, 1e3 * f.broad_s,
+                  1e3 * f.narrow_s, 1e3 * f.ccd_s, 1e3 * f.response_s, 1e3 * f.total_s);
     return line;
 }
 
@@ -109,8 +107,8 @@ std::string traceLine(int frame, const engine::World& world) {
     nlohmann::json positions = nlohmann::json::array();
     nlohmann::json orientations = nlohmann::json::array();
     for (const engine::Body& b : world.bodies()) {
-        positions.push_back({double(b.position.x()), double(b.position.y()),
-                             double(b.position.z())});
+        positions.push_back(
+            {double(b.position.x()), double(b.position.y()), double(b.position.z())});
         const engine::Quat& q = b.orientation;
         orientations.push_back({double(q.w()), double(q.x()), double(q.y()), double(q.z())});
     }
@@ -162,11 +160,10 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
             return kExitBadInput;
         }
     }
-    const fs::path out_dir = options.out_dir.empty() ? fs::path("out") / scene.name
-                                                     : options.out_dir;
+    const fs::path out_dir =
+        options.out_dir.empty() ? fs::path("out") / scene.name : options.out_dir;
     const bool want_video = !options.no_video;
-    const fs::path video_path =
-        options.video ? *options.video : out_dir / (scene.name + ".mp4");
+    const fs::path video_path = options.video ? *options.video : out_dir / (scene.name + ".mp4");
     if (want_video && !render::ffmpegAvailable()) {
         err << "ffmpeg not found on PATH: install it (apt-get install ffmpeg) or pass --no-video\n";
         return kExitFailure;
@@ -274,8 +271,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
             << out_dir.string();
         if (want_video) out << " and " << video_path.string();
         out << " (" << world.bodies().size() << " bodies, " << world.stepCount() << " steps, "
-            << scene.world.broad_phase << (options.check_broad_phase ? ", every step checked"
-                                                                    : "")
+            << scene.world.broad_phase << (options.check_broad_phase ? ", every step checked" : "")
             << ")\n";
     } catch (const render::RenderError& e) {
         err << "error: " << e.what() << "\n";

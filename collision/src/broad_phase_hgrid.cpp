@@ -120,11 +120,16 @@ void HierarchicalGrid::gatherLane(Lane& lane) {
     lane.top = 0;
     lane.lo_y = lane.lo_z = std::numeric_limits<Real>::max();
     lane.hi_y = lane.hi_z = std::numeric_limits<Real>::lowest();
+    lane.lo_c = Vec3::Constant(std::numeric_limits<Real>::max());
+    lane.hi_c = Vec3::Constant(std::numeric_limits<Real>::lowest());
     for (std::size_t p = lane.first; p < lane.last; ++p) {
         const std::uint32_t id = static_cast<std::uint32_t>(packed_[p]);
         order_[p] = id;
         const Aabb& b = box_[p] = table_.aabb(ProxyId(id));
         lane.top = std::max(lane.top, extentOf(b));
+        const Vec3 c = (b.min + b.max) / 2;  // centres: where the boxes are, for planLevels
+        lane.lo_c = lane.lo_c.cwiseMin(c);
+        lane.hi_c = lane.hi_c.cwiseMax(c);
         lane.lo_y = std::min(lane.lo_y, b.min.y());
         lane.hi_y = std::max(lane.hi_y, b.max.y());
         lane.lo_z = std::min(lane.lo_z, b.min.z());
@@ -192,6 +197,66 @@ std::int64_t HierarchicalGrid::fixColumns(const Level& lv, std::size_t from, std
     return shifts;
 }
 
+double HierarchicalGrid::planLevels(const std::array<std::size_t, kMaxLevels>& members,
+                                    const std::array<Real, kMaxLevels>& extent_sum, int level_count,
+                                    Real top, const Bounds& b) {
+    // Column grids: cells at least the level's own s_top / 8^k and twice its members' mean
+    // extent (columns much wider than the boxes cost more candidates, much narrower ones more
+    // entries per box: on the bench's uniform workload 1.11 ms/frame at the level's cell, 1.04
+    // at twice the mean extent), widened (doubled) until a level has at most ~2 columns per
+    // entry. Returns an estimate of the sweep's cost in candidate tests, entries counted as 3:
+    // a level's entries spread evenly over its columns and over x, each entry of one of its
+    // own members meets those that start within its x extent, each guest only the members.
+    double cost = 0;
+    std::size_t guests = 0;  // proxies of finer levels, entered as guests
+    Real guest_extent = 0;   // their extents' sum
+    for (int k = level_count - 1; k >= 0; --k) {
+        Level& lv = levels_[k];
+        lv.members = members[k];
+        lv.guests = guests;
+        if (lv.members == 0) continue;
+        const std::size_t entries = lv.members + guests;
+        const Real limit = std::max<Real>(64, 2 * Real(entries));
+        const Real mean = extent_sum[k] / Real(lv.members);
+        lv.cell = std::max(std::ldexp(top, -kLevelBits * k), kCellPerExtent * mean) *
+                  (1 + std::ldexp(Real(1), -20));
+        for (;;) {
+            lv.inv_cell = 1 / lv.cell;
+            const Real sy = (b.hi_y - b.lo_y) * lv.inv_cell;
+            const Real sz = (b.hi_z - b.lo_z) * lv.inv_cell;
+            if (!std::isfinite(sy) || !std::isfinite(sz) || lv.inv_cell == 0) {
+                lv.ny = lv.nz = 1;  // coordinates beyond the range of a column index
+                break;
+            }
+            const Real ny = std::floor(sy) + 1;
+            const Real nz = std::floor(sz) + 1;
+            if (ny * nz <= limit) {
+                lv.ny = static_cast<std::int64_t>(ny);
+                lv.nz = static_cast<std::int64_t>(nz);
+                break;
+            }
+            lv.cell *= 2;
+        }
+        const double w = double(lv.cell);
+        const double own_mean = double(mean);
+        const double guest_mean = guests > 0 ? double(guest_extent) / double(guests) : 0;
+        const double own = double(lv.members) * (1 + own_mean / w) * (1 + own_mean / w);
+        const double visiting = double(guests) * (1 + guest_mean / w) * (1 + guest_mean / w);
+        // Entries per column and unit of x, over the columns and the x range the boxes' centres
+        // occupy (not the bounds, which a few huge boxes can stretch far beyond the rest).
+        const auto across = [&](Real range) { return std::floor(double(range) / w) + 1; };
+        const double per_x = 1 / (across(b.centre_span.y()) * across(b.centre_span.z()) *
+                                  std::max(double(b.centre_span.x()), own_mean));
+        if (std::isfinite(per_x)) {
+            cost += own * own_mean * (own + visiting) * per_x + visiting * guest_mean * own * per_x;
+        }
+        cost += 3 * (own + visiting);
+        guests += lv.members;
+        guest_extent += extent_sum[k];
+    }
+    return cost;
+}
+
 void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) {
     counters.volumes_updated += moved_;
     moved_ = 0;
@@ -240,45 +305,38 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     for (int t = 0; t < lanes; ++t) finest_ = std::max(finest_, lanes_[t].finest);
     level_count_ = finest_ + 1;
     std::array<Real, kMaxLevels> extent_sum{};
+    std::array<std::size_t, kMaxLevels> members{};
     for (int k = 0; k < level_count_; ++k) {
-        levels_[k].members = 0;
         for (int t = 0; t < lanes; ++t) {
-            levels_[k].members += lanes_[t].members[k];
+            members[k] += lanes_[t].members[k];
             extent_sum[k] += lanes_[t].extent_sum[k];
         }
     }
-    for (int t = 0; t < lanes; ++t) levels_[finest_].members += lanes_[t].zero_size;
+    for (int t = 0; t < lanes; ++t) members[finest_] += lanes_[t].zero_size;
 
-    // Column grids: cells widened (doubled) until a level has at most ~2 columns per entry.
-    std::size_t guests = 0;  // entries of finer levels' proxies, as guests of this level
-    for (int k = level_count_ - 1; k >= 0; --k) {
-        Level& lv = levels_[k];
-        const std::size_t entries = lv.members + guests;
-        if (lv.members > 0) guests += lv.members;
-        if (lv.members == 0) continue;
-        const Real limit = std::max<Real>(64, 2 * Real(entries));
-        // At least twice the members' mean extent: columns much wider than the boxes cost
-        // more candidates, much narrower ones more entries per box (measured on the bench's
-        // uniform workload: 1.11 ms/frame at the level's cell, 1.04 at twice the mean extent).
-        const Real mean = extent_sum[k] / Real(lv.members);
-        lv.cell = std::max(std::ldexp(top, -kLevelBits * k), kCellPerExtent * mean) *
-                  (1 + std::ldexp(Real(1), -20));
-        for (;;) {
-            lv.inv_cell = 1 / lv.cell;
-            const Real sy = (hi_y - lo_y) * lv.inv_cell;
-            const Real sz = (hi_z - lo_z) * lv.inv_cell;
-            if (!std::isfinite(sy) || !std::isfinite(sz) || lv.inv_cell == 0) {
-                lv.ny = lv.nz = 1;  // coordinates beyond the range of a column index
-                break;
-            }
-            const Real ny = std::floor(sy) + 1;
-            const Real nz = std::floor(sz) + 1;
-            if (ny * nz <= limit) {
-                lv.ny = static_cast<std::int64_t>(ny);
-                lv.nz = static_cast<std::int64_t>(nz);
-                break;
-            }
-            lv.cell *= 2;
+    // The hierarchy pays off when one level's columns, as wide as its largest box, would hold
+    // many much smaller boxes (a few huge boxes among many small ones); with sizes spread
+    // evenly it costs more entries than it saves tests (measured on the bench's 1:100 and
+    // 1:10^4 log-uniform mixes: one level 0.80 and 0.80 ms/frame at 10k, levels 8x apart 1.14
+    // and 1.46). So the levels are planned both ways and the cheaper estimate is kept.
+    const Bounds bounds{lo_y, hi_y, lo_z, hi_z, all.hi_c - all.lo_c};
+    const double levels_cost = planLevels(members, extent_sum, level_count_, top, bounds);
+    flat_ = false;
+    if (level_count_ > 1) {
+        std::array<std::size_t, kMaxLevels> one{};
+        std::array<Real, kMaxLevels> one_sum{};
+        for (int k = 0; k < level_count_; ++k) {
+            one[0] += members[k];
+            one_sum[0] += extent_sum[k];
+        }
+        const int levels_before = level_count_;
+        const double flat_cost = planLevels(one, one_sum, 1, top, bounds);
+        if (flat_cost <= levels_cost) {
+            flat_ = true;
+            level_count_ = 1;
+        } else {
+            planLevels(members, extent_sum, levels_before, top, bounds);
+            level_count_ = levels_before;
         }
     }
 
@@ -392,7 +450,7 @@ void HierarchicalGrid::countLane(Lane& lane) {
     lane.placements.clear();
     for (std::size_t p = lane.first; p < lane.last; ++p) {
         const Aabb& b = box_[p];
-        const int own = level_of_[p] == kZeroSize ? finest_ : level_of_[p];
+        const int own = flat_ ? 0 : level_of_[p] == kZeroSize ? finest_ : level_of_[p];
         for (int k = 0; k <= own; ++k) {
             const Level& lv = levels_[k];
             if (lv.members == 0) continue;
@@ -483,10 +541,25 @@ void HierarchicalGrid::sweepLane(Lane& lane, std::vector<ProxyPair>& pairs) {
             const std::size_t to = hi - lv.first_column;
             lane.swaps += fixColumns(lv, from, to);
             const Entry* const e = entries_.data() + lv.first;
+            const bool has_guests = lv.guests > 0;
             for (std::size_t c = from; c < to; ++c) {
                 const std::uint32_t c0 = lv.start[c];
                 const std::uint32_t c1 = lv.start[c + 1];
                 if (c1 - c0 < 2) continue;
+                // With guests, the column's own members in order: a guest scans only these
+                // (guests meet each other at their own level), from a cursor that follows it.
+                std::uint32_t* natives = nullptr;
+                std::uint32_t native_count = 0;
+                if (has_guests) {
+                    lane.natives.resize(c1 - c0 + 1);
+                    natives = lane.natives.data();
+                    for (std::uint32_t i = c0; i < c1; ++i) {
+                        natives[native_count] = i;
+                        native_count += (e[i].flags >> 2) & 1u;
+                    }
+                    natives[native_count] = c1;  // sentinel
+                }
+                std::uint32_t next_native = 0;  // first native after the current entry
                 for (std::uint32_t i = c0; i + 1 < c1; ++i) {
                     if (lane.keys.size() < count + (c1 - i)) {
                         lane.keys.resize(std::max(2 * lane.keys.size(), count + (c1 - i)) + 1024);
@@ -494,6 +567,20 @@ void HierarchicalGrid::sweepLane(Lane& lane, std::vector<ProxyPair>& pairs) {
                     std::uint64_t* const out = lane.keys.data();
                     const Entry& a = e[i];
                     const YzTest yz(a);
+                    if (has_guests) {
+                        while (natives[next_native] <= i) ++next_native;
+                        if ((a.flags & 4u) == 0) {
+                            std::uint32_t r = next_native;
+                            for (; natives[r] < c1 && e[natives[r]].min_x <= a.max_x; ++r) {
+                                const Entry& b = e[natives[r]];
+                                const bool hit = yz.overlaps(b) & ((a.flags | b.flags) == 7u);
+                                out[count] = (std::uint64_t(a.id) << shift) | b.id;
+                                count += hit;
+                            }
+                            tests += r - next_native;
+                            continue;
+                        }
+                    }
                     std::uint32_t q = i + 1;
                     for (; q < c1 && e[q].min_x <= a.max_x; ++q) {
                         const Entry& b = e[q];

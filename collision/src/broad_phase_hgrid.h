@@ -18,24 +18,33 @@ namespace collision {
 /// each proxy lives at the finest level whose cells are at least its largest extent. A pair is
 /// found once, at the coarser of its two levels (TR-97-23 §2.2): a proxy is also entered, as a
 /// guest, in every coarser level that holds proxies of its own, and guests are paired only with
-/// that level's own members.
+/// that level's own members. Each frame the levels are planned both ways, as above and as one
+/// level holding everything, and the plan with the cheaper estimated sweep is used (planLevels):
+/// the levels win when a few huge boxes would widen every column for many small ones, one
+/// level wins when sizes spread evenly (the bench's 1:100 and 1:10^4 log-uniform mixes).
 ///
-/// Within a level the cells are columns of a 2-D grid over (y, z); an entry is written into
-/// every column its box touches (at most 2 x 2, since cells are at least the extents), and each
-/// column is one list sorted by min x, swept forward (sort and sweep, Baraff 1992). A pair
-/// shares several columns when both boxes straddle a boundary; it is reported only in the
-/// column holding the point (max of the min y, max of the min z), which lies in both boxes
-/// (owner rule, as in Ericson, Real-Time Collision Detection §7.1.5), so it is met once. That
-/// column is known from two bits per entry: whether the entry's own min corner is in this
-/// column's row (y) and layer (z).
+/// Within a level the cells are columns of a 2-D grid over (y, z), at least twice the level's
+/// mean extent wide; an entry is written into every column its box touches (at most 2 x 2,
+/// since cells are at least the extents), and each column is one list sorted by min x, swept
+/// forward (sort and sweep, Baraff 1992). A pair shares several columns when both boxes
+/// straddle a boundary; it is reported only in the column holding the point (max of the min y,
+/// max of the min z), which lies in both boxes (owner rule, as in Ericson, Real-Time Collision
+/// Detection §7.1.5), so it is met once. That column is known from two bits per entry: whether
+/// the entry's own min corner is in this column's row (y) and layer (z).
 ///
-/// The global min-x order is kept from frame to frame and repaired by insertion sort, which
-/// costs O(n + swaps) for coherent motion (Cohen et al. 1995); when the motion is not coherent
-/// (or proxies were inserted or removed) it is rebuilt by a radix sort. Entries are scattered
-/// into columns stably in that order, so each column comes out sorted; pairs are put in (a, b)
-/// order by one more radix sort. Cost per frame O(n + swaps + candidates + pairs), whatever the
-/// size ratio, and no heap allocation once the buffers have grown. Exact: every comparison is
-/// on the proxies' own coordinates, touching counts.
+/// Each frame the proxies are radix-sorted by float(min x) (a non-decreasing image of min x)
+/// and scattered into the columns stably in that order, so each column is nearly sorted; an
+/// insertion sort per column restores the exact (min x, id) order (sorting a column outright
+/// past a budget of shifts). Pairs are put in (a, b) order by one more radix sort. Cost per
+/// frame O(n + candidates + pairs) for the sizes it is planned for, and no heap allocation once
+/// the buffers have grown. Exact: every comparison is on the proxies' own coordinates,
+/// touching counts.
+///
+/// With two threads ("hgrid2", from kTwoLaneMinimum proxies) a helper thread counts and
+/// scatters half of the proxies, sweeps chunks of columns as they come free, sorts its own
+/// pairs, and merges half of the two sorted lists; the output is identical to one thread's.
+/// The helper spins for about a millisecond after each job (waking a sleeping thread cost more
+/// than the jobs here), so hgrid2 keeps the second core busy while frames come quickly.
 class HierarchicalGrid : public BroadPhase {
 public:
     /// `two_threads`: count, scatter and sweep split between this thread and a helper thread
@@ -77,6 +86,7 @@ private:
         Real inv_cell = 1;
         std::int64_t ny = 1, nz = 1;
         std::size_t members = 0;  // proxies whose own level this is
+        std::size_t guests = 0;   // proxies of finer levels, entered here as guests
         std::size_t first = 0;    // this level's entries are entries_[first, first + count)
         std::size_t count = 0;
         std::size_t first_column = 0;      // columns of the levels before (for the lane split)
@@ -99,7 +109,8 @@ private:
     /// chunks of columns it swept, and what it found.
     struct Lane {
         std::size_t first = 0, last = 0;
-        Real top = 0, lo_y = 0, hi_y = 0, lo_z = 0, hi_z = 0;  // of its boxes
+        Real top = 0, lo_y = 0, hi_y = 0, lo_z = 0, hi_z = 0;  // its boxes' bounds
+        Vec3 lo_c = Vec3::Zero(), hi_c = Vec3::Zero();         // ... and their centres
         std::array<Real, kMaxLevels> extent_sum{};             // of its boxes, by level
         std::array<std::size_t, kMaxLevels> members{};
         std::size_t zero_size = 0;
@@ -107,9 +118,17 @@ private:
         std::vector<Placement> placements;                          // by position, then level
         std::array<std::vector<std::uint32_t>, kMaxLevels> cursor;  // counts, then cursors
         std::vector<std::uint64_t> keys, scratch;
-        std::vector<ProxyPair> pairs;  // with two lanes; one lane writes the caller's
+        std::vector<std::uint32_t> natives;  // sweep scratch: a column's own members
+        std::vector<ProxyPair> pairs;        // with two lanes; one lane writes the caller's
         std::int64_t tests = 0, swaps = 0;
     };
+    struct Bounds {
+        Real lo_y, hi_y, lo_z, hi_z;
+        Vec3 centre_span;  // of the boxes' centres
+    };
+    double planLevels(const std::array<std::size_t, kMaxLevels>& members,
+                      const std::array<Real, kMaxLevels>& extent_sum, int level_count, Real top,
+                      const Bounds& bounds);
     void sortByMinX();
     void gatherLane(Lane& lane);
     void levelLane(Lane& lane, Real top);
@@ -123,7 +142,8 @@ private:
     ProxyTable table_;
     std::int64_t moved_ = 0;
     int level_count_ = 0;
-    int finest_ = 0;  // the finest level with members; zero-size boxes join it
+    int finest_ = 0;     // the finest level with members; zero-size boxes join it
+    bool flat_ = false;  // every box at level 0 (planLevels found that cheaper)
     Real origin_y_ = 0, origin_z_ = 0;
     std::array<Level, kMaxLevels> levels_;
     std::vector<std::uint32_t> order_;   // present proxies by (min x, id)

@@ -260,6 +260,70 @@ TEST(BroadPhaseDifferential, TwoThreadHgridEqualsItsReferenceAboveItsThreshold) 
     }
 }
 
+// hgrid plans its levels both ways (one level, or levels 8x apart) and keeps the cheaper
+// estimate. A few huge boxes among many small ones is the case the hierarchy exists for: in one
+// level, columns as wide as the huge boxes would make every small box meet hundreds of others
+// in x. The counted volume tests (not time) must stay near linear, and the pairs exact.
+TEST(BroadPhaseDifferential, HierarchicalGridKeepsFewHugeAmongManySmallNearLinear) {
+    Rng rng(5);
+    constexpr int kSmall = 4000;
+    constexpr int kHuge = 12;
+    for (const char* name : {"hgrid", "hgrid2"}) {
+        SCOPED_TRACE(name);
+        std::unique_ptr<BroadPhase> fast = findBroadPhase(name)->create();
+        std::unique_ptr<BroadPhase> ref = findBroadPhase("brute")->create();
+        for (int i = 0; i < kSmall + kHuge; ++i) {
+            const Real half = i < kHuge ? Real(60) : Real(0.5);
+            const Vec3 c = rng.vec(0, 30);
+            ProxyVolumes v;
+            v.aabb = Aabb{c - Vec3::Constant(half), c + Vec3::Constant(half)};
+            fast->insert(i, v);
+            ref->insert(i, v);
+        }
+        std::vector<ProxyPair> fast_pairs, ref_pairs;
+        BroadPhaseCounters fc, rc;
+        fast->findPairs(fast_pairs, fc);
+        ref->findPairs(ref_pairs, rc);
+        ASSERT_EQ(fast_pairs, ref_pairs);
+        EXPECT_EQ(fast->validate(), "");
+        // Pairs: every huge box with every box (kHuge * 4000), plus the small boxes' own.
+        EXPECT_GT(fast_pairs.size(), std::size_t(kHuge * kSmall));
+        // One level (columns 120 wide, one column) would test about 4000 * 4000 / 2 small-small
+        // candidates in x alone; the levels test the huge boxes against everything plus a few
+        // per small box.
+        EXPECT_LT(fc.volume_tests, 3 * kHuge * (kSmall + kHuge) + 64 * kSmall) << fc.volume_tests;
+
+        // Sizes spread evenly over four decades instead (one level is planned there): the
+        // pairs are still exact, frame after frame.
+        std::unique_ptr<BroadPhase> spread = findBroadPhase(name)->create();
+        std::unique_ptr<BroadPhase> spread_ref = findBroadPhase("brute")->create();
+        std::vector<Vec3> centre(kSmall), half(kSmall);
+        for (int i = 0; i < kSmall; ++i) {
+            centre[i] = rng.vec(0, 60);
+            half[i] = Vec3::Constant(Real(0.01) * std::pow(Real(10), rng.uniform(0, 4)));
+        }
+        for (int frame = 0; frame < 3; ++frame) {
+            for (int i = 0; i < kSmall; ++i) {
+                centre[i] += Vec3::Constant(Real(0.05));
+                ProxyVolumes v;
+                v.aabb = Aabb{centre[i] - half[i], centre[i] + half[i]};
+                if (frame == 0) {
+                    spread->insert(i, v);
+                    spread_ref->insert(i, v);
+                } else {
+                    spread->move(i, v);
+                    spread_ref->move(i, v);
+                }
+            }
+            spread->findPairs(fast_pairs, fc);
+            spread_ref->findPairs(ref_pairs, rc);
+            ASSERT_EQ(fast_pairs, ref_pairs) << "frame " << frame;
+            EXPECT_EQ(spread->validate(), "");
+            EXPECT_GT(ref_pairs.size(), std::size_t(kSmall));
+        }
+    }
+}
+
 TEST(BroadPhaseDifferential, LatticeSceneReallyTouches) {
     // Guards the adversarial scene itself: exact face/edge/corner contacts must occur, else the
     // touching cases above test nothing.
