@@ -201,13 +201,14 @@ TEST(BroadphaseBench, SmallRunReportsEveryMethodWithTheSamePairsInTableAndJson) 
 }
 
 // --clock wall times every method by elapsed time, the two-thread hgrid2 included; at 5000
-// boxes (over its 4096 threshold) it runs both lanes and must report hgrid's pairs.
+// boxes (over its 4096 threshold) it runs both lanes and must report hgrid's pairs, here on
+// the 1:10^4 size mix (--workload wide).
 TEST(BroadphaseBench, WallClockRunsTheTwoThreadMethodWithTheSamePairs) {
     const fs::path work = tempDir("wall");
     const fs::path json = work / "wall.json";
     const Result r = runCdlab(
         "bench broadphase --sizes 5000 --frames 4 --methods hgrid,hgrid2 "
-        "--workload mixed --clock wall --in-process --json " +
+        "--workload wide --clock wall --in-process --json " +
             json.string(),
         work);
     ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
@@ -219,6 +220,7 @@ TEST(BroadphaseBench, WallClockRunsTheTwoThreadMethodWithTheSamePairs) {
         ASSERT_FALSE(row.contains("skipped")) << row.dump();
         EXPECT_EQ(row["mismatched_frames"], 0) << row.dump();
         EXPECT_EQ(row["frames"], 4) << row.dump();
+        EXPECT_EQ(row["workload"], "wide") << row.dump();
     }
     EXPECT_EQ(doc["rows"][0]["method"], "hgrid");
     EXPECT_EQ(doc["rows"][1]["method"], "hgrid2");
