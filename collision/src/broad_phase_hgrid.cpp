@@ -8,7 +8,9 @@
 // the only column where each axis has one of the two entries at its own min column, i.e. where
 // the flags' OR has bits 0 and 1 set. Bit 2 (one of them is at its own level) holds at level j
 // only, since at a coarser level both are guests and at a finer one the coarser box is absent.
-// In that one column the two entries are swept once, from whichever comes first in (min x, id).
+// In that one column the two entries are swept once, from whichever comes first in (min x, id):
+// an own member scans every entry after it, a guest only the own members after it (two guests
+// never need to meet there: they meet at the coarser of their own levels).
 #include "broad_phase_hgrid.h"
 
 #include <algorithm>
