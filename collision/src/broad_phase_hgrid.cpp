@@ -53,7 +53,7 @@ inline bool before(Real xa, std::uint32_t ia, Real xb, std::uint32_t ib) {
 
 // Overlap of a fixed entry's (y, z) interval with others'; touching counts. With SSE2 and double
 // coordinates, the four comparisons are two (min y, min z) <= (max y, max z) vector compares.
-#if defined(__SSE2__)
+#if defined(__SSE2__) && !defined(CDLAB_USE_FLOAT)
 template <typename T>
 struct YzTestOf;
 template <>
