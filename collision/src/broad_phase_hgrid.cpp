@@ -114,29 +114,33 @@ void HierarchicalGrid::sortByMinX() {
         const float x = static_cast<float>(table_.aabb(id).min.x());
         packed_.push_back(orderedBits(x) << 32 | std::uint64_t(std::uint32_t(id)));
     }
-    radix::radixSortHigh32(packed_, packed_scratch_);
+    order_.resize(packed_.size());
+    radix::lsdRadixSort(packed_, packed_scratch_, 32, 32, [this](std::size_t p, std::uint64_t key) {
+        order_[p] = static_cast<std::uint32_t>(key);
+    });
 }
 
-void HierarchicalGrid::gatherLane(Lane& lane) {
-    // The boxes in sorted order, with the lane's largest extent and (y, z) bounds.
-    lane.top = 0;
-    lane.lo_y = lane.lo_z = std::numeric_limits<Real>::max();
-    lane.hi_y = lane.hi_z = std::numeric_limits<Real>::lowest();
-    lane.lo_c = Vec3::Constant(std::numeric_limits<Real>::max());
-    lane.hi_c = Vec3::Constant(std::numeric_limits<Real>::lowest());
-    for (std::size_t p = lane.first; p < lane.last; ++p) {
-        const std::uint32_t id = static_cast<std::uint32_t>(packed_[p]);
-        order_[p] = id;
-        const Aabb& b = box_[p] = table_.aabb(ProxyId(id));
-        lane.top = std::max(lane.top, extentOf(b));
+HierarchicalGrid::Extents HierarchicalGrid::gatherBoxes() {
+    // The boxes in sorted order, with their largest extent and bounds.
+    Extents x;
+    x.lo_y = x.lo_z = std::numeric_limits<Real>::max();
+    x.hi_y = x.hi_z = std::numeric_limits<Real>::lowest();
+    x.lo_c = Vec3::Constant(std::numeric_limits<Real>::max());
+    x.hi_c = Vec3::Constant(std::numeric_limits<Real>::lowest());
+    box_.resize(order_.size());
+    for (std::size_t p = 0; p < order_.size(); ++p) {
+        const Aabb& b = box_[p] = table_.aabb(ProxyId(order_[p]));
+        x.top = std::max(x.top, extentOf(b));
         const Vec3 c = (b.min + b.max) / 2;  // centres: where the boxes are, for planLevels
-        lane.lo_c = lane.lo_c.cwiseMin(c);
-        lane.hi_c = lane.hi_c.cwiseMax(c);
-        lane.lo_y = std::min(lane.lo_y, b.min.y());
-        lane.hi_y = std::max(lane.hi_y, b.max.y());
-        lane.lo_z = std::min(lane.lo_z, b.min.z());
-        lane.hi_z = std::max(lane.hi_z, b.max.z());
+        x.lo_c = x.lo_c.cwiseMin(c);
+        x.hi_c = x.hi_c.cwiseMax(c);
+        x.lo_y = std::min(x.lo_y, b.min.y());
+        x.hi_y = std::max(x.hi_y, b.max.y());
+        x.lo_z = std::min(x.lo_z, b.min.z());
+        x.hi_z = std::max(x.hi_z, b.max.z());
     }
+    if (!(x.top > 0)) x.top = 1;
+    return x;
 }
 
 void HierarchicalGrid::levelLane(Lane& lane, Real top) {
@@ -201,7 +205,7 @@ std::int64_t HierarchicalGrid::fixColumns(const Level& lv, std::size_t from, std
 
 double HierarchicalGrid::planLevels(const std::array<std::size_t, kMaxLevels>& members,
                                     const std::array<Real, kMaxLevels>& extent_sum, int level_count,
-                                    Real top, const Bounds& b) {
+                                    Real top, const Bounds& b, Plan& plan) {
     // Column grids: cells at least the level's own s_top / 8^k and twice its members' mean
     // extent (columns much wider than the boxes cost more candidates, much narrower ones more
     // entries per box: on the bench's uniform workload 1.11 ms/frame at the level's cell, 1.04
@@ -213,7 +217,7 @@ double HierarchicalGrid::planLevels(const std::array<std::size_t, kMaxLevels>& m
     std::size_t guests = 0;  // proxies of finer levels, entered as guests
     Real guest_extent = 0;   // their extents' sum
     for (int k = level_count - 1; k >= 0; --k) {
-        Level& lv = levels_[k];
+        Grid& lv = plan[k];
         lv.members = members[k];
         lv.guests = guests;
         if (lv.members == 0) continue;
@@ -268,14 +272,12 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     const bool two_lanes = helper_ && std::size_t(table_.count()) >= kTwoLaneMinimum;
     if (two_lanes) helper_->prepare();  // wakes while this thread sorts
     sortByMinX();
-    const std::size_t n = packed_.size();
-    order_.resize(n);
-    box_.resize(n);
+    const std::size_t n = order_.size();
     level_of_.resize(n);
 
-    // Lanes: lane 0 alone, or lanes 0 and 1 on two threads. Positions (for gathering, level
-    // finding, counting and scattering) are split in two fixed halves, and lane 0's results
-    // come first, so the output is the same however many lanes run.
+    // Lanes: lane 0 alone, or lanes 0 and 1 on two threads. Positions (for level finding,
+    // counting and scattering) are split in two fixed halves, lane 0's first, and the sweep
+    // takes chunks of columns; the output is the same however many lanes run.
     const int lanes = two_lanes ? 2 : 1;
     lane_count_ = lanes;
     for (int t = 0; t < lanes; ++t) {
@@ -292,16 +294,11 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     // Gathered by this thread alone: the table was just written here, by move(), and a helper
     // reading half of it from the other core made the pass slower than on one thread (10k
     // boxes: 75 against 38 us).
-    Lane& all = lanes_[0];
-    const std::size_t lane0_last = all.last;
-    all.last = n;
-    gatherLane(all);
-    const Real top = all.top > 0 ? all.top : Real(1);
-    const Real lo_y = all.lo_y, hi_y = all.hi_y, lo_z = all.lo_z, hi_z = all.hi_z;
-    origin_y_ = lo_y;
-    origin_z_ = lo_z;
+    const Extents x = gatherBoxes();
+    const Real top = x.top;
+    origin_y_ = x.lo_y;
+    origin_z_ = x.lo_z;
 
-    all.last = lane0_last;
     inLanes([this, top](int t) { levelLane(lanes_[t], top); });
     finest_ = 0;
     for (int t = 0; t < lanes; ++t) finest_ = std::max(finest_, lanes_[t].finest);
@@ -321,8 +318,10 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     // evenly it costs more entries than it saves tests (measured on the bench's 1:100 and
     // 1:10^4 log-uniform mixes: one level 0.80 and 0.80 ms/frame at 10k, levels 8x apart 1.14
     // and 1.46). So the levels are planned both ways and the cheaper estimate is kept.
-    const Bounds bounds{lo_y, hi_y, lo_z, hi_z, all.hi_c - all.lo_c};
-    const double levels_cost = planLevels(members, extent_sum, level_count_, top, bounds);
+    const Bounds bounds{x.lo_y, x.hi_y, x.lo_z, x.hi_z, x.hi_c - x.lo_c};
+    Plan levels_plan, flat_plan;
+    const double levels_cost =
+        planLevels(members, extent_sum, level_count_, top, bounds, levels_plan);
     flat_ = false;
     if (level_count_ > 1) {
         std::array<std::size_t, kMaxLevels> one{};
@@ -331,16 +330,11 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
             one[0] += members[k];
             one_sum[0] += extent_sum[k];
         }
-        const int levels_before = level_count_;
-        const double flat_cost = planLevels(one, one_sum, 1, top, bounds);
-        if (flat_cost <= levels_cost) {
-            flat_ = true;
-            level_count_ = 1;
-        } else {
-            planLevels(members, extent_sum, levels_before, top, bounds);
-            level_count_ = levels_before;
-        }
+        flat_ = planLevels(one, one_sum, 1, top, bounds, flat_plan) <= levels_cost;
     }
+    if (flat_) level_count_ = 1;
+    const Plan& plan = flat_ ? flat_plan : levels_plan;
+    for (int k = 0; k < level_count_; ++k) static_cast<Grid&>(levels_[k]) = plan[k];
 
     inLanes([this](int t) { countLane(lanes_[t]); });
 

@@ -81,13 +81,17 @@ public:
     };
 
 private:
-    struct Level {
+    /// A level's column grid, as planLevels plans it.
+    struct Grid {
         Real cell = 1;  // column width in y and z
         Real inv_cell = 1;
         std::int64_t ny = 1, nz = 1;
         std::size_t members = 0;  // proxies whose own level this is
         std::size_t guests = 0;   // proxies of finer levels, entered here as guests
-        std::size_t first = 0;    // this level's entries are entries_[first, first + count)
+    };
+    using Plan = std::array<Grid, kMaxLevels>;
+    struct Level : Grid {
+        std::size_t first = 0;  // this level's entries are entries_[first, first + count)
         std::size_t count = 0;
         std::size_t first_column = 0;      // columns of the levels before (for the lane split)
         std::vector<std::uint32_t> start;  // column -> offset of its first entry in the level
@@ -109,9 +113,7 @@ private:
     /// chunks of columns it swept, and what it found.
     struct Lane {
         std::size_t first = 0, last = 0;
-        Real top = 0, lo_y = 0, hi_y = 0, lo_z = 0, hi_z = 0;  // its boxes' bounds
-        Vec3 lo_c = Vec3::Zero(), hi_c = Vec3::Zero();         // ... and their centres
-        std::array<Real, kMaxLevels> extent_sum{};             // of its boxes, by level
+        std::array<Real, kMaxLevels> extent_sum{};  // of its boxes, by level
         std::array<std::size_t, kMaxLevels> members{};
         std::size_t zero_size = 0;
         int finest = 0;
@@ -126,11 +128,17 @@ private:
         Real lo_y, hi_y, lo_z, hi_z;
         Vec3 centre_span;  // of the boxes' centres
     };
-    double planLevels(const std::array<std::size_t, kMaxLevels>& members,
-                      const std::array<Real, kMaxLevels>& extent_sum, int level_count, Real top,
-                      const Bounds& bounds);
+    /// The boxes' bounds, gathered with them.
+    struct Extents {
+        Real top = 0;                 // largest extent
+        Real lo_y, hi_y, lo_z, hi_z;  // of the boxes
+        Vec3 lo_c, hi_c;              // of their centres
+    };
+    static double planLevels(const std::array<std::size_t, kMaxLevels>& members,
+                             const std::array<Real, kMaxLevels>& extent_sum, int level_count,
+                             Real top, const Bounds& bounds, Plan& plan);
+    Extents gatherBoxes();
     void sortByMinX();
-    void gatherLane(Lane& lane);
     void levelLane(Lane& lane, Real top);
     void countLane(Lane& lane);
     void scatterLane(Lane& lane, std::size_t spare_slot);
