@@ -241,6 +241,8 @@ Answers timeQueries(std::size_t n, int passes, Query&& query) {
     return ans;
 }
 
+#ifdef CDLAB_HAVE_BULLET
+// Used only beside Bullet: the pairs Bullet and cdlab disagree on are retried on cdlab's other path.
 bool isBoxLike(const Shape& s) {
     return s.type == ShapeType::Box || s.type == ShapeType::ConvexHull;
 }
@@ -252,6 +254,7 @@ Shape otherPath(const Shape& s) {
     if (s.type == ShapeType::ConvexHull) return Shape::box(s.hull->vertices.back().cwiseAbs());
     return s;
 }
+#endif
 
 Real cdlabQuery(const Pair& p) {
     const collision::ContactOutput out = contact(p.a, p.pose_a, p.b, p.pose_b);

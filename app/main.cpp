@@ -62,7 +62,6 @@ int main(int argc, char** argv) {
     run_cmd->add_option("--trace", run_trace,
                         "write every frame's body poses and confirmed pairs to FILE (JSON lines)");
 
-    // BEGIN check subcommand
     app::CheckOptions check;
     std::vector<std::string> check_scenes;
     int check_frames = 0;
@@ -76,10 +75,6 @@ int main(int argc, char** argv) {
                           "frames to run (overrides expect.frames and the scene)");
     check_cmd->add_option("--out", check_out,
                           "keep pause dumps in DIR (default: a temporary folder, removed)");
-    // END check subcommand
-    // BEGIN ccd subcommand
-    // END ccd subcommand
-    // BEGIN query subcommand
     app::QueryOptions query;
     CLI::App* query_cmd = cli.add_subcommand(
         "query",
@@ -91,7 +86,6 @@ int main(int argc, char** argv) {
     query_cmd->add_option("--pose-b", query.pose_b,
                           "B's pose in A's frame: x,y,z,qw,qx,qy,qz (default identity)");
     query_cmd->add_flag("--json", query.json, "machine-readable output");
-    // END query subcommand
     app::SweepOptions sweep;
     std::string sweep_out;
     double sweep_duration = 0;
@@ -127,7 +121,6 @@ int main(int argc, char** argv) {
     bool sweep_no_timing = false;
     sweep_cmd->add_flag("--no-report-timing", sweep_no_timing,
                         "leave wall-clock times out of report.md so it is bit-identical");
-    // BEGIN bench subcommand (registered by app/bench_*.cpp)
     CLI::App* bench_cmd = cli.add_subcommand("bench", "performance benchmarks");
     bench_cmd->require_subcommand(1);
     app::BenchOptions bench_bp;
@@ -218,7 +211,6 @@ int main(int argc, char** argv) {
                      "and fcl-obbrss, fcl-obb, fcl-rss, fcl-kios, fcl-aabb, fcl-kdop18")
         ->delimiter(',');
     bench_np_cmd->add_option("--json", bench_np_json, "also write the table as JSON to FILE");
-    // END bench subcommand
 
     try {
         cli.parse(argc, argv);
@@ -253,20 +245,13 @@ int main(int argc, char** argv) {
         if (!sweep_float.empty()) sweep.float_binary = sweep_float;
         return app::runSweep(sweep, std::cout, std::cerr);
     }
-    // BEGIN check dispatch
     if (check_cmd->parsed()) {
         for (const std::string& sc : check_scenes) check.scenes.emplace_back(sc);
         if (check_cmd->count("--frames") > 0) check.frames = check_frames;
         if (!check_out.empty()) check.out_dir = check_out;
         return app::runCheck(check, std::cout, std::cerr);
     }
-    // END check dispatch
-    // BEGIN ccd dispatch
-    // END ccd dispatch
-    // BEGIN query dispatch
     if (query_cmd->parsed()) return app::runQuery(query, std::cout, std::cerr);
-    // END query dispatch
-    // BEGIN bench dispatch
     if (bench_bp_cmd->parsed()) {
         if (!bench_bp_json.empty()) bench_bp.json = bench_bp_json;
         bench_bp.isolate = !bench_bp_in_process;
@@ -290,6 +275,5 @@ int main(int argc, char** argv) {
         if (!bench_np_json.empty()) bench_np.json = bench_np_json;
         return app::runBenchNarrowphase(bench_np, std::cout, std::cerr);
     }
-    // END bench dispatch
     return 2;
 }
