@@ -13,16 +13,27 @@
 namespace collision {
 
 /// Integer cell coordinates along each axis. 64-bit so that small cells far from the origin
-/// (1e6 m / 1e-3 m) do not overflow; clamped to +-2^52 to stay exact as a double.
+/// (1e6 m / 1e-3 m) do not overflow. Range: every coordinate lies in [-2^52, 2^52] (exact as a
+/// double, and a difference of two plus one fits in int64); values beyond, infinities and NaN
+/// map to the ends of that range (NaN to the low end), never to undefined behaviour. Cell counts
+/// of a box are products of such differences: compute them in Real (cellCount), not in int64.
 struct CellCoord {
     std::int64_t x = 0, y = 0, z = 0;
     friend bool operator==(const CellCoord&, const CellCoord&) = default;
 };
 
+inline constexpr Real kMaxCellIndex = Real(4503599627370496.0);  // 2^52
+
 inline std::int64_t cellIndex(Real value, Real inv_size) {
     const Real c = std::floor(value * inv_size);
-    constexpr Real kLimit = Real(4503599627370496.0);  // 2^52
-    return static_cast<std::int64_t>(std::clamp(c, -kLimit, kLimit));
+    if (c > kMaxCellIndex) return static_cast<std::int64_t>(kMaxCellIndex);
+    if (!(c >= -kMaxCellIndex)) return -static_cast<std::int64_t>(kMaxCellIndex);  // NaN too
+    return static_cast<std::int64_t>(c);
+}
+
+/// Cells in the range [lo, hi] (inclusive), as a Real: up to (2^53 + 1)^3, which overflows int64.
+inline Real cellCount(const CellCoord& lo, const CellCoord& hi) {
+    return Real(hi.x - lo.x + 1) * Real(hi.y - lo.y + 1) * Real(hi.z - lo.z + 1);
 }
 
 inline CellCoord cellOf(const Vec3& p, Real inv_size) {

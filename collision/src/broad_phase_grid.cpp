@@ -44,8 +44,13 @@ void GridBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters
         }
         origin_ = all.min;
         // At most ~2n cells: a grid far larger than the population is mostly empty memory.
+        // Doubling from any positive size reaches the extent of any finite box within ~2100
+        // steps; infinite or NaN extents never fit, and get one cell holding every proxy (all
+        // pairs tested: slow, but exact and finite).
         const Real limit = std::max<Real>(64, 2 * Real(table_.count()));
-        for (;;) {
+        constexpr int kMaxDoublings = 2200;
+        dims_ = CellCoord{1, 1, 1};
+        for (int k = 0; k < kMaxDoublings && std::isfinite(cell_size_); ++k) {
             const Vec3 d = (all.extents() / cell_size_).array().ceil().max(Real(1));
             if (d.prod() <= limit) {
                 dims_ =
@@ -55,6 +60,7 @@ void GridBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters
             }
             cell_size_ *= 2;
         }
+        if (!all.min.allFinite()) origin_.setZero();
     } else {
         origin_.setZero();
         // Twice the median extent leaves a mixed 1:100 population with ~8 % oversized proxies,
@@ -72,9 +78,7 @@ void GridBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters
                 const Aabb& box = table_.aabb(id);
                 const CellCoord lo = cellOf(box.min, inv_try);
                 const CellCoord hi = cellOf(box.max, inv_try);
-                const Real cells =
-                    Real(hi.x - lo.x + 1) * Real(hi.y - lo.y + 1) * Real(hi.z - lo.z + 1);
-                oversized += !(cells <= Real(kMaxCellsPerProxy));
+                oversized += !(cellCount(lo, hi) <= Real(kMaxCellsPerProxy));
             }
             if (oversized * kOversizedShare <= table_.count()) break;
             cell_size_ *= 2;
@@ -88,8 +92,7 @@ void GridBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters
         const Aabb& box = table_.aabb(id);
         const CellCoord lo = clampToGrid(cellOf(box.min - origin_, inv));
         const CellCoord hi = clampToGrid(cellOf(box.max - origin_, inv));
-        const std::int64_t n = (hi.x - lo.x + 1) * (hi.y - lo.y + 1) * (hi.z - lo.z + 1);
-        if (n > kMaxCellsPerProxy || n <= 0) {
+        if (!(cellCount(lo, hi) <= Real(kMaxCellsPerProxy))) {
             big_.push_back(id);
             continue;
         }
@@ -152,7 +155,7 @@ void GridBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters
         const Aabb& bb = table_.aabb(b);
         const CellCoord lo = clampToGrid(cellOf(bb.min - origin_, inv));
         const CellCoord hi = clampToGrid(cellOf(bb.max - origin_, inv));
-        const Real cells = Real(hi.x - lo.x + 1) * Real(hi.y - lo.y + 1) * Real(hi.z - lo.z + 1);
+        const Real cells = cellCount(lo, hi);
         if (cells > 0 && cells <= cell_budget) {
             for (std::int64_t z = lo.z; z <= hi.z; ++z) {
                 for (std::int64_t y = lo.y; y <= hi.y; ++y) {

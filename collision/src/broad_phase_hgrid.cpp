@@ -93,8 +93,11 @@ std::int64_t HierarchicalGrid::column(const Level& lv, Real v, Real origin, std:
     if (n == 1) return 0;
     // v >= origin (the smallest min coordinate of all proxies), so the product is >= 0 and the
     // truncation is floor: non-decreasing in v, which is all the owner rule needs.
+    // Compared before the cast: a value past the last column (huge, infinite or NaN) would make
+    // the cast undefined.
     const Real c = (v - origin) * lv.inv_cell;
-    return std::min<std::int64_t>(static_cast<std::int64_t>(c), n - 1);
+    if (!(c < Real(n - 1))) return n - 1;
+    return static_cast<std::int64_t>(c);
 }
 
 HierarchicalGrid::Span HierarchicalGrid::span(const Level& lv, const Aabb& b) const {

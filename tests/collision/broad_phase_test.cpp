@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <set>
 
 #include "test_random.h"
@@ -392,6 +393,76 @@ TEST(BroadPhaseDifferential, SpheresTouchingAlongXEqualTheirReference) {
     // Rounding must put pairs on both sides of the touching test, or nothing was probed.
     EXPECT_GT(overlapping, 300);
     EXPECT_GT(apart, 0);
+}
+
+// Extreme extents. Regression: `grid` never returned when a box's extent was infinite (its
+// cell-size doubling loop could not fit the grid), and `hash` multiplied cell counts in int64
+// with a half-extent-1e4 box beside radius-1e-4 spheres (UBSan: signed overflow). Volumes are
+// finite by contract (World::step stops on a non-finite state before any volume reaches a broad
+// phase), and every broad phase must equal its reference with finite but huge (1e300) and tiny
+// boxes side by side:
+//
+//         [-1e300 ................. 1e300]       box 0
+//      [-1e4 ... 1e4]                            box 1
+//        .  .  .  .                              boxes 2.. (1e-4), a row along x
+//
+// The cell-based broad phases must also return, with every pair, when a box is infinite in x.
+std::vector<ProxyVolumes> extremeBoxes(bool with_infinite) {
+    auto box = [](const Vec3& lo, const Vec3& hi) {
+        const Vec3 c = (lo + hi) / 2;
+        const Vec3 h = (hi - lo) / 2;
+        return ProxyVolumes{Aabb{lo, hi}, BoundingSphere{c, h.norm()},
+                            Obb{c, Mat3::Identity(), h}};
+    };
+    std::vector<ProxyVolumes> volumes{
+        box(Vec3::Constant(Real(-1e300)), Vec3::Constant(Real(1e300))),
+        box(Vec3::Constant(Real(-1e4)), Vec3::Constant(Real(1e4))),
+    };
+    for (int i = 0; i < 40; ++i) {
+        const Vec3 c(Real(i) * Real(1.5e-4), 0, 0);
+        volumes.push_back(box(c - Vec3::Constant(Real(1e-4)), c + Vec3::Constant(Real(1e-4))));
+    }
+    if (with_infinite) {
+        const Real inf = std::numeric_limits<Real>::infinity();
+        // Its centre is 0 (the midpoint formula would give inf - inf = NaN).
+        volumes.push_back(ProxyVolumes{Aabb{Vec3(-inf, -1, -1), Vec3(inf, 1, 1)},
+                                       BoundingSphere{Vec3::Zero(), inf},
+                                       Obb{Vec3::Zero(), Mat3::Identity(), Vec3(inf, 1, 1)}});
+    }
+    return volumes;
+}
+
+std::vector<ProxyPair> pairsOf(const BroadPhaseEntry& entry,
+                               const std::vector<ProxyVolumes>& volumes) {
+    std::unique_ptr<BroadPhase> bp = entry.create();
+    for (std::size_t i = 0; i < volumes.size(); ++i) bp->insert(static_cast<ProxyId>(i), volumes[i]);
+    std::vector<ProxyPair> pairs;
+    BroadPhaseCounters counters;
+    bp->findPairs(pairs, counters);
+    return pairs;
+}
+
+TEST(BroadPhaseDifferential, HugeAndTinyExtentsEqualTheReference) {
+    const std::vector<ProxyVolumes> volumes = extremeBoxes(false);
+    for (const BroadPhaseEntry& entry : broadPhaseRegistry()) {
+        SCOPED_TRACE(std::string(entry.name));
+        const std::vector<ProxyPair> ref = pairsOf(*findBroadPhase(entry.reference), volumes);
+        EXPECT_EQ(pairsOf(entry, volumes), ref);
+        // The two big boxes overlap every box, and neighbours in the row (1.5e-4 apart) overlap:
+        // at least 41 + 40 + 39 pairs (bounding spheres, 1.7e-4 in radius, add second
+        // neighbours).
+        EXPECT_GE(ref.size(), 41u + 40 + 39) << "the reference itself";
+    }
+}
+
+TEST(BroadPhaseDifferential, CellBroadPhasesReturnOnInfiniteExtents) {
+    const std::vector<ProxyVolumes> volumes = extremeBoxes(true);
+    const std::vector<ProxyPair> ref = pairsOf(*findBroadPhase("brute"), volumes);
+    EXPECT_EQ(ref.size(), 41u + 40 + 39 + 42);
+    for (const char* name : {"grid", "hash", "hgrid", "hgrid2", "sap", "sap1"}) {
+        SCOPED_TRACE(name);
+        EXPECT_EQ(pairsOf(*findBroadPhase(name), volumes), ref);
+    }
 }
 
 TEST(BroadPhaseRegistry, NamesAreUniqueAndReferencesExist) {
