@@ -29,6 +29,8 @@
 
 #include "bench_method.h"
 #include "bench_workload.h"
+#include "output_files.h"
+#include "render/output_file.h"
 
 namespace app {
 
@@ -334,24 +336,7 @@ nlohmann::json rowJson(const Row& row) {
 }
 
 bool writeJsonAtomically(const fs::path& file, const nlohmann::json& doc, std::ostream& err) {
-    const fs::path partial = fs::path(file.string() + ".partial");
-    {
-        std::ofstream f(partial, std::ios::binary | std::ios::trunc);
-        f << doc.dump(2) << '\n';
-        f.flush();
-        if (!f) {
-            err << partial.string() << ": cannot write\n";
-            return false;
-        }
-    }
-    std::error_code ec;
-    fs::rename(partial, file, ec);
-    if (ec) {
-        err << file.string() << ": cannot rename " << partial.string() << ": " << ec.message()
-            << '\n';
-        return false;
-    }
-    return true;
+    return writeTextReporting(file, doc.dump(2) + "\n", err);
 }
 
 std::string methodList() {
@@ -420,10 +405,10 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
     }
     if (options.json) {
         // Prove the JSON file writable now rather than after an hour of measuring.
-        const fs::path partial = fs::path(options.json->string() + ".partial");
-        std::ofstream probe(partial, std::ios::binary | std::ios::trunc);
-        if (!probe) {
-            err << partial.string() << ": cannot write\n";
+        try {
+            render::checkOutputWritable(*options.json);
+        } catch (const render::RenderError& e) {
+            err << e.what() << '\n';
             return kExitBadInput;
         }
     }

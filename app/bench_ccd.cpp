@@ -19,6 +19,7 @@
 #include "collision/ccd.h"
 #include "engine/scene.h"
 #include "engine/world.h"
+#include "output_files.h"
 
 namespace app {
 namespace {
@@ -410,25 +411,7 @@ int runBenchCcd(const BenchCcdOptions& options, std::ostream& out, std::ostream&
                                                    {"toi_queries_per_frame", r.toi_queries},
                                                    {"toi_events", r.toi_events}});
         }
-        // Written next to the target and renamed, so a partial file never looks complete.
-        const fs::path partial = fs::path(options.json->string() + ".partial");
-        {
-            std::ofstream f(partial);
-            f << doc.dump(2) << "\n";
-            if (!f) {
-                err << options.json->string() << ":1:1: cannot write\n";
-                std::error_code ec;
-                fs::remove(partial, ec);
-                return 1;
-            }
-        }
-        std::error_code ec;
-        fs::rename(partial, *options.json, ec);
-        if (ec) {
-            err << options.json->string() << ":1:1: cannot write: " << ec.message() << "\n";
-            fs::remove(partial, ec);
-            return 1;
-        }
+        if (!writeTextReporting(*options.json, doc.dump(2) + "\n", err)) return 1;
     }
     return status;
 }

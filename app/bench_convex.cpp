@@ -27,6 +27,7 @@
 #include "collision/contact.h"
 #include "collision/contact_reference.h"
 #include "collision/narrow_phase.h"
+#include "output_files.h"
 
 #ifdef CDLAB_HAVE_BULLET
 #include <BulletCollision/CollisionShapes/btBoxShape.h>
@@ -541,25 +542,7 @@ int runBenchConvex(const BenchConvexOptions& options, std::ostream& out, std::os
 #endif
         doc["rows"] = nlohmann::json::array();
         for (const Row& r : rows) doc["rows"].push_back(rowJson(r));
-        // Written next to the target and renamed, so a partial file never looks complete.
-        const fs::path partial = fs::path(options.json->string() + ".partial");
-        {
-            std::ofstream f(partial);
-            f << doc.dump(2) << "\n";
-            if (!f) {
-                err << options.json->string() << ":1:1: cannot write\n";
-                std::error_code ec;
-                fs::remove(partial, ec);
-                return 1;
-            }
-        }
-        std::error_code ec;
-        fs::rename(partial, *options.json, ec);
-        if (ec) {
-            err << options.json->string() << ":1:1: cannot write: " << ec.message() << "\n";
-            fs::remove(partial, ec);
-            return 1;
-        }
+        if (!writeTextReporting(*options.json, doc.dump(2) + "\n", err)) return 1;
     }
     return 0;
 }

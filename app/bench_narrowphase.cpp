@@ -21,6 +21,7 @@
 
 #include "bvh_unit_costs.h"
 #include "collision/bvh.h"
+#include "output_files.h"
 
 #ifdef CDLAB_HAVE_FCL
 #include <fcl/geometry/bvh/BVH_model.h>
@@ -457,13 +458,7 @@ int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& ou
             arr.push_back(o);
         }
         j["rows"] = arr;
-        std::ofstream f(*options.json, std::ios::binary);
-        f << j.dump(2) << '\n';
-        f.close();
-        if (!f) {
-            err << "cdlab bench narrowphase: cannot write '" << options.json->string() << "'\n";
-            return 1;
-        }
+        if (!writeTextReporting(*options.json, j.dump(2) + "\n", err)) return 1;
     }
     if (cdlab_wrong) {
         err << "cdlab bench narrowphase: a cdlab method disagrees with the brute force\n";

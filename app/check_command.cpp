@@ -18,6 +18,7 @@
 
 #include "broadphase_check.h"
 #include "collision/broad_phase.h"
+#include "output_files.h"
 #include "pause_dump.h"
 #include "render/image.h"
 #include "render/renderer.h"
@@ -164,13 +165,6 @@ struct PairTracker {
     bool any_held = false;
     int frames_seen = 0;
 };
-
-void writeText(const fs::path& file, const std::string& text) {
-    std::ofstream f(file, std::ios::binary | std::ios::trunc);
-    f << text;
-    f.flush();
-    if (!f) throw render::RenderError("cannot write " + file.string());
-}
 
 std::string verifyPauseDump(const fs::path& dir, int frame, const engine::Scene& scene) {
     const fs::path png = dir / ("pause_" + std::to_string(frame) + ".png");
@@ -409,7 +403,7 @@ std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames, const f
             const std::string stem = "pause_" + std::to_string(frame);
             render::writePng(dump_dir / (stem + ".png"),
                              getRenderer().render(world, scene.camera, options));
-            writeText(dump_dir / (stem + ".json"), pauseDumpJson(world, frame));
+            writeTextAtomically(dump_dir / (stem + ".json"), pauseDumpJson(world, frame));
         }
     }
 

@@ -19,6 +19,7 @@
 #include "output_files.h"
 #include "pause_dump.h"
 #include "render/image.h"
+#include "render/output_file.h"
 #include "render/renderer.h"
 
 namespace app {
@@ -178,8 +179,12 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         if (options.trace && options.trace->has_parent_path()) {
             prepareOutputDir(options.trace->parent_path());
         }
-        std::error_code ec;
-        fs::remove(out_dir / "summary.json", ec);
+        // Every output path proven writable (and not a device, FIFO, link or directory) before
+        // the first step, not after the whole simulation.
+        if (options.stats_csv) render::checkOutputWritable(*options.stats_csv);
+        if (options.trace) render::checkOutputWritable(*options.trace);
+        if (want_video) render::checkOutputWritable(video_path);
+        clearPreviousRun(out_dir);
 
         engine::World world = engine::makeWorld(scene);
         render::Renderer renderer(scene.output.width, scene.output.height);
@@ -221,7 +226,14 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
                 if (!checkStep(0)) return kExitCheckFailed;
             } else {
                 for (int s = 0; s < scene.steps_per_frame; ++s) {
-                    world.step();
+                    try {
+                        world.step();
+                    } catch (const engine::SimulationError& e) {
+                        // No summary.json: the run is incomplete, and says so.
+                        err << "error: " << options.scene.string() << ": frame " << frame << ": "
+                            << e.what() << "\n";
+                        return kExitFailure;
+                    }
                     frame_stats.add(world.lastStats());
                     step_seconds += world.lastStats().total_s;
                     if (!checkStep(static_cast<int>(world.stepCount()))) return kExitCheckFailed;

@@ -1,6 +1,7 @@
 // render/src/image.cpp -- PNG files through libpng's simplified API, and the ffmpeg video pipe.
 // Invariant: an output file exists under its final name only when it is complete. Every writer
-// writes a sibling ".partial" file and renames it at the end; failures remove the partial file.
+// writes a sibling ".partial" file and renames it at the end (render/output_file.h: only ever over
+// a regular file); failures remove the partial file.
 #include "render/image.h"
 
 #include <fcntl.h>
@@ -17,6 +18,8 @@
 #include <ctime>
 #include <string_view>
 #include <system_error>
+
+#include "render/output_file.h"
 
 extern char** environ;
 
@@ -74,21 +77,15 @@ void checkImage(const Image& image, const char* what) {
     }
 }
 
-fs::path partialName(const fs::path& file) {
-    fs::path partial = file;
-    partial += ".partial";
-    return partial;
-}
-
 }  // namespace
 
 void writePng(const fs::path& file, const Image& image) {
     checkImage(image, file.c_str());
-    const fs::path partial = partialName(file);
-    std::FILE* f = std::fopen(partial.c_str(), "wb");
-    if (!f) {
-        throw RenderError(file.string() + ": cannot write PNG: " + errnoText(errno));
-    }
+    checkOutputPath(file);
+    fs::path partial = file;
+    partial += ".partial";
+    claimPartial(partial);
+    std::FILE* f = openPartial(partial, file);
     png_image png{};
     png.version = PNG_IMAGE_VERSION;
     png.width = static_cast<png_uint_32>(image.width);
@@ -105,13 +102,7 @@ void writePng(const fs::path& file, const Image& image) {
         throw RenderError(file.string() +
                           ": cannot write PNG: " + (!ok ? png_message : errnoText(flush_errno)));
     }
-    std::error_code ec;
-    fs::rename(partial, file, ec);
-    if (ec) {
-        removeQuietly(partial);
-        throw RenderError(file.string() + ": cannot rename " + partial.string() + ": " +
-                          ec.message());
-    }
+    commitPartial(partial, file);
 }
 
 Image readPng(const fs::path& file) {
@@ -167,9 +158,10 @@ VideoWriter::VideoWriter(const fs::path& file, int width, int height, int fps)
     // ffmpeg picks the container from the extension, so the partial name keeps it last:
     // "clip.mp4" is written as "clip.partial.mp4".
     const fs::path ext = file.has_extension() ? file.extension() : fs::path(".mp4");
+    checkOutputPath(file);
     partial_ = file;
     partial_.replace_extension(".partial" + ext.string());
-    removeQuietly(partial_);
+    claimPartial(partial_);
 
     int fds[2];
     if (::pipe2(fds, O_CLOEXEC) != 0) {
@@ -273,13 +265,9 @@ void VideoWriter::finish() {
                          : std::string("ffmpeg wrote no output");
         throw RenderError(file_.string() + ": video failed: " + why);
     }
-    fs::rename(partial_, file_, ec);
-    if (ec) {
-        removeQuietly(partial_);
-        throw RenderError(file_.string() + ": cannot rename " + partial_.string() + ": " +
-                          ec.message());
-    }
+    const fs::path partial = partial_;
     partial_.clear();
+    commitPartial(partial, file_);
 }
 
 }  // namespace render

@@ -2,6 +2,7 @@
 // summary; bad input gets a precise message and exit code 2; output failures (an unwritable
 // directory, ffmpeg missing) a message and a non-zero exit.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -239,6 +240,106 @@ TEST(Cli, UnwritableOutputIsAClearFailure) {
                               work);
     EXPECT_NE(r.exit_code, 0);
     EXPECT_NE(r.err.find("cannot create output directory"), std::string::npos) << r.err;
+    fs::remove_all(work);
+}
+
+// Regression: every output was written to X.partial and renamed over X, whatever X was, so
+// `--video /dev/null` as root replaced the machine's /dev/null with an mp4 (exit 0). An existing
+// output path that is not a regular file is refused before any work, and left as it was: here a
+// FIFO, a symbolic link (to a regular file, which stays untouched too) and a directory, through
+// --video, --stats and --trace. (/dev/null itself is not used: a regression would replace it.)
+TEST(Cli, OutputPathsThatAreNotRegularFilesAreRefusedAndLeftAlone) {
+    const fs::path work = tempDir("special_outputs");
+    const fs::path fifo = work / "pipe.mp4";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    const fs::path target = work / "target.csv";
+    std::ofstream(target) << "keep me";
+    const fs::path link = work / "link.csv";
+    fs::create_symlink(target, link);
+    const fs::path dir = work / "dir";
+    fs::create_directories(dir);
+    const std::string out = " --out " + (work / "out").string();
+    struct Case {
+        std::string flags;
+        fs::path path;
+        std::string kind;
+    };
+    const Case cases[] = {
+        {"--video " + fifo.string(), fifo, "a FIFO"},
+        {"--no-video --stats " + link.string(), link, "a symbolic link"},
+        {"--no-video --trace " + link.string(), link, "a symbolic link"},
+        {"--no-video --stats " + dir.string(), dir, "a directory"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.flags);
+        const Result r = runCdlab("run " + kTiny + out + " " + c.flags, work);
+        EXPECT_EQ(r.exit_code, 1);
+        EXPECT_NE(r.err.find(c.path.string() + ": exists and is " + c.kind), std::string::npos)
+            << r.err;
+        EXPECT_FALSE(fs::exists(work / "out" / "summary.json"));
+        EXPECT_FALSE(fs::exists(work / "out" / "frame_00000.png")) << "refused after work began";
+    }
+    EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
+    EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link)));
+    EXPECT_EQ(slurp(target), "keep me");
+    EXPECT_TRUE(fs::is_directory(dir));
+    EXPECT_TRUE(fs::is_empty(dir));
+    // A planted partial file that is a link is not written through either.
+    const fs::path victim = work / "victim.txt";
+    std::ofstream(victim) << "untouched";
+    fs::create_directories(work / "out2");
+    fs::create_symlink(victim, work / "out2" / "frame_00000.png.partial");
+    const Result r = runCdlab("run " + kTiny + " --no-video --out " + (work / "out2").string(),
+                              work);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("frame_00000.png.partial: exists and is a symbolic link"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(slurp(victim), "untouched");
+    fs::remove_all(work);
+}
+
+// Regression: a rerun into the folder of a longer (or killed) run left the old frames and a
+// .partial file beside the new summary.json. The run's own earlier outputs are cleared first;
+// files that are not cdlab's stay.
+TEST(Cli, RerunClearsTheEarlierRunsOutputsOnly) {
+    const fs::path work = tempDir("rerun");
+    const fs::path out = work / "out";
+    ASSERT_EQ(runCdlab("run " + kTiny + " --no-video --pause-at 5 --out " + out.string(), work)
+                  .exit_code,
+              0);
+    ASSERT_TRUE(fs::exists(out / "frame_00005.png"));
+    std::ofstream(out / "frame_00004.png.partial") << "killed mid-write";
+    std::ofstream(out / "notes.txt") << "mine";
+    const Result r =
+        runCdlab("run " + kTiny + " --no-video --frames 3 --out " + out.string(), work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(out / "frame_00002.png"));
+    EXPECT_TRUE(fs::exists(out / "summary.json"));
+    for (const char* stale :
+         {"frame_00003.png", "frame_00005.png", "pause_5.png", "pause_5.json",
+          "frame_00004.png.partial"}) {
+        EXPECT_FALSE(fs::exists(out / stale)) << stale;
+    }
+    EXPECT_EQ(slurp(out / "notes.txt"), "mine");
+    fs::remove_all(work);
+}
+
+// Regression: contradictory or empty flags were accepted (`--video x.mp4 --no-video` ran with no
+// video; `--broadphase ""` ran the scene's broad phase).
+TEST(Cli, ContradictoryAndEmptyFlagsExit2) {
+    const fs::path work = tempDir("flags");
+    const std::string out = " --out " + (work / "out").string();
+    Result r = runCdlab("run " + kTiny + out + " --video x.mp4 --no-video", work);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("excludes"), std::string::npos) << r.err;
+    for (const char* flag : {"--broadphase", "--stats", "--trace", "--video", "--out"}) {
+        r = runCdlab("run " + kTiny + " --no-frames " + flag + " ''", work);
+        EXPECT_EQ(r.exit_code, 2) << flag;
+        EXPECT_NE(r.err.find(std::string(flag) + ": must not be empty"), std::string::npos)
+            << r.err;
+    }
+    EXPECT_FALSE(fs::exists(work / "out"));
     fs::remove_all(work);
 }
 
