@@ -554,9 +554,32 @@ void World::reflectOffBounds() {
     // crosses a face of the bounds while moving outward has that velocity component negated.
     // Kinetic energy is unchanged by the flip.
     // Runs after updateVolumes: the flip changes momenta only, so the AABBs stay valid.
+    // A body fast enough to carry its centre of mass past a face within one step (a 20 m world
+    // crossed at 1e4 m/s) would leave for good, flipping back and forth outside. Its centre is
+    // folded back instead, mirrored across the faces as many times as it crossed them (a
+    // triangle wave over the bounds), with the velocity flipped once per crossing: the path a
+    // perfectly elastic bounce would have taken, and the centre always ends inside. Bodies
+    // whose centre stays inside (every moderate speed) take the plain flip only.
     const collision::Aabb& bounds = settings_.bounds;
     for (std::size_t i = 0; i < bodies_.size(); ++i) {
         Body& b = bodies_[i];
+        bool folded = false;
+        for (int k = 0; k < 3; ++k) {
+            const Real lo = bounds.min[k];
+            const Real width = bounds.max[k] - lo;
+            const Real x = b.position[k];
+            if (b.is_static || (x >= lo && x <= bounds.max[k])) continue;
+            // u in [0, 2 width): the position on the unfolded path, modulo one round trip.
+            Real u = std::fmod(x - lo, 2 * width);
+            if (u < 0) u += 2 * width;
+            // The fold maps the unfolded straight path onto the bounced one: in the mirrored
+            // half (u > width) positions and velocities are mirrored, in the other they are not.
+            const bool mirrored = u > width;
+            b.position[k] = lo + (mirrored ? 2 * width - u : u);
+            if (mirrored) b.linear_momentum[k] = -b.linear_momentum[k];
+            folded = true;
+        }
+        if (folded) updateVolume(i);
         const collision::Aabb& box = volumes_[i].aabb;
         for (int k = 0; k < 3; ++k) {
             const Real p = b.linear_momentum[k];
@@ -567,21 +590,23 @@ void World::reflectOffBounds() {
     }
 }
 
-void World::updateVolumes() {
-    for (std::size_t i = 0; i < bodies_.size(); ++i) {
-        const Body& b = bodies_[i];
-        const Pose pose = b.pose();
-        collision::ProxyVolumes& v = volumes_[i];
-        v.aabb = collision::computeWorldAabb(b.shape, pose);
-        v.sphere = collision::transformSphere(b.local_bounds.sphere, pose);
-        v.obb = collision::transformObb(b.local_bounds.obb, pose);
-        const auto id = static_cast<collision::ProxyId>(i);
-        if (proxies_inserted_) {
-            broad_phase_->move(id, v);
-        } else {
-            broad_phase_->insert(id, v);
-        }
+void World::updateVolume(std::size_t i) {
+    const Body& b = bodies_[i];
+    const Pose pose = b.pose();
+    collision::ProxyVolumes& v = volumes_[i];
+    v.aabb = collision::computeWorldAabb(b.shape, pose);
+    v.sphere = collision::transformSphere(b.local_bounds.sphere, pose);
+    v.obb = collision::transformObb(b.local_bounds.obb, pose);
+    const auto id = static_cast<collision::ProxyId>(i);
+    if (proxies_inserted_) {
+        broad_phase_->move(id, v);
+    } else {
+        broad_phase_->insert(id, v);
     }
+}
+
+void World::updateVolumes() {
+    for (std::size_t i = 0; i < bodies_.size(); ++i) updateVolume(i);
     proxies_inserted_ = true;
 }
 
@@ -685,12 +710,30 @@ void World::step() {
         }
     }
 
+    checkFiniteState();
     t = Clock::now();
     updateVolumes();
     reflectOffBounds();
     stats_.volumes_s = secondsSince(t);
     runCollisionPipeline();
     stats_.total_s = secondsSince(start);
+}
+
+void World::checkFiniteState() const {
+    for (std::size_t i = 0; i < bodies_.size(); ++i) {
+        const Body& b = bodies_[i];
+        const char* quantity = !b.position.allFinite()                 ? "position"
+                               : !b.orientation.coeffs().allFinite()   ? "orientation"
+                               : !b.linear_momentum.allFinite()        ? "linear momentum"
+                               : !b.angular_momentum.allFinite()       ? "angular momentum"
+                                                                       : nullptr;
+        if (quantity == nullptr) continue;
+        throw SimulationError("body '" + b.name + "' (bodies[" + std::to_string(i) + "]): " +
+                              quantity + " is not finite after step " +
+                              std::to_string(step_count_) +
+                              " (the scene's speeds, spins or forces exceed what double "
+                              "precision can integrate)");
+    }
 }
 
 std::uint64_t World::stateHash() const {

@@ -42,7 +42,6 @@ struct DrawSettings {
     bool contacts = false;
 };
 
-// BEGIN expect (self-grading scenes)
 /// A frame or an inclusive frame range [first, last] of a run (frame 0 is the initial state).
 struct FrameRange {
     int first = 0;
@@ -126,7 +125,6 @@ struct Expectations {
     std::vector<ToiExpectation> toi;
     std::vector<RestExpectation> rest;
 };
-// END expect (self-grading scenes)
 
 struct Scene {
     std::string name;  ///< file stem

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -118,6 +119,14 @@ struct StepStats {
 
 class ContactSolver;
 
+/// The state left what double precision represents: a body's position, orientation or momentum
+/// is no longer finite. what() names the body, the quantity and the step; the world is left as
+/// it was after the step that broke it, and stepping it further is meaningless.
+class SimulationError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
 class World {
 public:
     /// Throws std::invalid_argument when the broad phase name is unknown.
@@ -129,7 +138,9 @@ public:
     BodyId addBody(Body body);
 
     /// One time step: integrate (settings().integrator); with ccd on, stop every pair at its time
-    /// of impact (see world.cpp); reflect off the bounds; then detect.
+    /// of impact (see world.cpp); reflect off the bounds; then detect. Throws SimulationError,
+    /// before any volume is updated, when a body's state is no longer finite (so NaN and inf never
+    /// reach the broad phase).
     void step();
     /// Recomputes volumes, pairs and states at the current state, without moving anything.
     void detect();
@@ -163,7 +174,9 @@ private:
     void integrateSemiImplicitEuler(Real dt, const Vec3& gravity);
     void integrateRk4(Real dt, const Vec3& gravity);
     void reflectOffBounds();
+    void checkFiniteState() const;
     void updateVolumes();
+    void updateVolume(std::size_t i);
     void resolveContinuous();
     void findResponsePairs(Real margin_fraction);
     void runCollisionPipeline();
