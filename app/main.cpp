@@ -27,8 +27,9 @@ int main(int argc, char** argv) {
     run_cmd->add_option("scene", run.scene, "scene file (YAML)")->required();
     run_cmd->add_option("--out", out_dir, "output directory (default out/<scene name>)");
     run_cmd->add_option("--frames", frames, "number of frames (overrides the scene)");
-    run_cmd->add_option("--video", video, "video file (default <out>/<scene name>.mp4)");
-    run_cmd->add_flag("--no-video", run.no_video, "do not write a video");
+    CLI::Option* video_opt =
+        run_cmd->add_option("--video", video, "video file (default <out>/<scene name>.mp4)");
+    run_cmd->add_flag("--no-video", run.no_video, "do not write a video")->excludes(video_opt);
     run_cmd->add_flag("--no-frames", run.no_frames, "do not write per-frame PNGs");
     run_cmd->add_option("--broadphase", broad_phase,
                         "broad phase (overrides the scene): " + collision::broadPhaseNames());
@@ -220,6 +221,13 @@ int main(int argc, char** argv) {
     }
 
     if (run_cmd->parsed()) {
+        // A flag given with an empty value ("--broadphase ''") is an error, not "unset".
+        for (const char* name : {"--out", "--video", "--broadphase", "--stats", "--trace"}) {
+            if (run_cmd->count(name) > 0 && run_cmd->get_option(name)->as<std::string>().empty()) {
+                std::cerr << name << ": must not be empty\n";
+                return 2;
+            }
+        }
         if (!out_dir.empty()) run.out_dir = out_dir;
         if (!video.empty()) run.video = video;
         if (run_cmd->count("--frames") > 0) run.frames = frames;

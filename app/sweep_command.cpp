@@ -667,6 +667,13 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
             err << "--vary " << error << "\n";
             return kExitBadInput;
         }
+        for (const auto& axis : axes) {
+            if (axis.first == key) {
+                err << "--vary " << key << ": given twice; list every value in one --vary ("
+                    << key << "=A,B,...)\n";
+                return kExitBadInput;
+            }
+        }
         axes.emplace_back(key, values);
     }
     std::vector<engine::SceneOverride> reference_overrides;
@@ -737,6 +744,21 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
     } catch (const engine::SceneError& e) {
         err << "sweep reference: " << e.what() << "\n";
         return kExitBadInput;
+    }
+
+    // Steps per run, checked before anything runs: llround of a huge quotient is undefined, and
+    // a run of 1e20 s would never end.
+    constexpr double kMaxSweepSteps = 1e9;
+    std::vector<const engine::Scene*> all_runs{&reference_scene};
+    for (const engine::Scene& s : scenes) all_runs.push_back(&s);
+    for (const engine::Scene* s : all_runs) {
+        const double steps = duration / s->world.time_step;
+        if (!(steps <= kMaxSweepSteps)) {
+            err << "--duration " << fmt(duration) << ": " << fmt(steps) << " steps at time step "
+                << fmt(s->world.time_step) << " s, more than the limit of " << fmt(kMaxSweepSteps)
+                << "\n";
+            return kExitBadInput;
+        }
     }
 
     const fs::path out_dir =

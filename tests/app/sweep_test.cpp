@@ -223,7 +223,9 @@ TEST(Sweep, MemoryPerRunIsMeasured) {
         const double mib = std::stod(row.at("memory_mib"));
         EXPECT_TRUE(std::isfinite(mib) && mib >= 0) << row.at("run");
         // ASan's allocator keeps freed pages in quarantine, so a run may add nothing there.
-        if (!kAddressSanitizer) EXPECT_GT(mib, 0) << row.at("run");
+        if (!kAddressSanitizer) {
+            EXPECT_GT(mib, 0) << row.at("run");
+        }
     }
     EXPECT_NE(slurp(o.out_dir / "report.md").find("memory (MiB)"), std::string::npos);
     fs::remove_all(o.out_dir);
@@ -238,6 +240,26 @@ TEST(Sweep, ParseVaryKeepsBracketedValuesWhole) {
     EXPECT_FALSE(app::parseVary("broadphase", key, values, error));
     EXPECT_FALSE(app::parseVary("broadphase=sap,,hgrid", key, values, error));
     EXPECT_FALSE(app::parseVary("world.gravity=[0,0", key, values, error));
+}
+
+// Regression: `--vary broadphase=sap --vary broadphase=grid` made one run labelled with both,
+// and `--duration 1e20` overflowed llround and ran one step, exit 0.
+TEST(Sweep, RepeatedVaryKeysAndEndlessDurationsAreBadInput) {
+    app::SweepOptions o;
+    o.scene = kScene;
+    o.out_dir = tempDir("repeated");
+    o.vary = {"broadphase=sap", "broadphase=grid"};
+    Outcome r = sweep(o);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--vary broadphase: given twice"), std::string::npos) << r.err;
+    o.vary = {"broadphase=sap"};
+    o.duration = 1e20;
+    r = sweep(o);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("--duration 1e+20: "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("more than the limit of 1e+09"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(o.out_dir / "results.csv"));
+    fs::remove_all(o.out_dir);
 }
 
 TEST(Sweep, BadInputIsExitTwoWithTheKeyNamed) {

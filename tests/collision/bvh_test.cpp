@@ -335,8 +335,8 @@ TYPED_TEST(BvhTyped, DistanceMatchesBruteForceWithWitnesses) {
         const Bvh<TypeParam> a(ma);
         const Bvh<TypeParam> b(mb);
         const Real tol = Real(1e-9) * scale;  // relative to the meshes' size
-        for (std::size_t k = 0; k < pose_count; ++k) {
-            const Pose& p0 = distancePoses()[k];
+        for (std::size_t pose_index = 0; pose_index < pose_count; ++pose_index) {
+            const Pose& p0 = distancePoses()[pose_index];
             const Pose pose = scaledPose(p0, scale, offset);
             BvhQueryStats stats;
             const collision::MeshDistance fast = collision::distanceBvhBvh(a, b, pose, &stats);

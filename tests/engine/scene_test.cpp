@@ -729,7 +729,8 @@ TEST(SceneErrors, HostileYamlFailsCleanly) {
         "world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\nbodies:\n  - !!binary AAAA\n",
         std::string("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n") +
             std::string("\0\0\xff\xfe", 4),
-        "world:\n  bounds: {min: [-1e308,-1e308,-1e308], max: [1e308,1e308,1e308]}\n"
+        // (Bounds of +-1e308 are refused in their own right now: +-1e150 at most.)
+        "world:\n  bounds: {min: [-1e150,-1e150,-1e150], max: [1e150,1e150,1e150]}\n"
         "bodies:\n  - shape: sphere\n    radius: 1e300\n    position: [0, 0, 0]\n",
         "world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n"
         "bodies:\n  - shape: sphere\n    radius: 1e-300\n    position: [0, 0, 0]\n",
@@ -823,6 +824,55 @@ TEST(SceneRepeat, ErrorsNameTheKey) {
                        "6:32: bodies[0].repeat.region: ", "inside the world bounds");
     EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 0.5\n    repeat: {cont: 2}\n"),
                        "6:14: bodies[0].repeat.cont: ", "unknown key 'cont'");
+}
+
+// Regression: finite but absurd magnitudes passed the loader and became NaN in the first step
+// (velocity, angular velocity or gravity of 1e308), and steps_per_frame 2147483647 never finished
+// a frame. Each is refused at its line and column with the limit it broke.
+TEST(SceneErrors, MagnitudesDoublePrecisionCannotIntegrateAreRefused) {
+    const std::string ball = "  - {shape: sphere, radius: 0.5, position: [0, 0, 0], ";
+    EXPECT_SCENE_ERROR(withBody(ball + "velocity: [1e308, 0, 0]}\n"), "4:",
+                       "bodies[0].velocity: speed 1e+308 m/s is beyond what the world can "
+                       "integrate: at most ");
+    EXPECT_SCENE_ERROR(withBody(ball + "angular_velocity: [0, 1e308, 0]}\n"), "4:",
+                       "bodies[0].angular_velocity: angular speed 1e+308 rad/s is beyond");
+    EXPECT_SCENE_ERROR(withBody("  - {shape: sphere, radius: 0.5, repeat: {count: 3, speed: 1e300}}\n"),
+                       "4:", "repeat.speed: speed 1e+300 m/s is beyond");
+    EXPECT_SCENE_ERROR(withBody("  - {shape: sphere, radius: 0.5, repeat: {count: 3, spin: 1e300}}\n"),
+                       "4:", "repeat.spin: angular speed 1e+300 rad/s is beyond");
+    EXPECT_SCENE_ERROR("world:\n  bounds: {min: [-1, -1, -1], max: [1, 1, 1]}\n"
+                       "  gravity: [0, -1e308, 0]\nbodies:\n",
+                       "3:12: world.gravity: ", "too strong for the time step");
+    EXPECT_SCENE_ERROR("world:\n  bounds: {min: [-1e200, -1, -1], max: [1, 1, 1]}\nbodies:\n",
+                       "2:", "world.bounds.min: coordinates must lie within +-1e+150");
+    EXPECT_SCENE_ERROR("world:\n  bounds: {min: [-1, -1, -1], max: [1, 1, 1]}\n"
+                       "  steps_per_frame: 2147483647\nbodies:\n",
+                       "3:20: world.steps_per_frame: ", "must be <= 100000");
+    EXPECT_SCENE_ERROR("world:\n  bounds: {min: [-1, -1, -1], max: [1, 1, 1]}\n"
+                       "  frames: 2000000000\nbodies:\n",
+                       "3:11: world.frames: ", "must be <= 1000000");
+    // The limits leave every real scene alone: 1e4 m/s in a 20 m box at 1/60 s is fine.
+    EXPECT_EQ(errorOf(withBody(ball + "velocity: [1e4, 0, 0], angular_velocity: [0, 0, 1e4]}\n")),
+              "");
+}
+
+// Regression: values that parsed silently wrong. `frames: 0300` was octal (192 frames) while
+// `09` was an error; "0.5" in quotes (a string) was read as a number; a second YAML document after
+// `---` was never checked.
+TEST(SceneErrors, OctalQuotedNumbersAndSecondDocumentsAreRefused) {
+    const std::string world = "world:\n  bounds: {min: [-1, -1, -1], max: [1, 1, 1]}\n";
+    EXPECT_SCENE_ERROR(world + "  frames: 0300\nbodies:\n", "3:11: world.frames: ",
+                       "expected a decimal integer without leading zeros, got '0300'");
+    EXPECT_SCENE_ERROR(world + "  frames: 0x10\nbodies:\n", "3:11: world.frames: ",
+                       "decimal integer");
+    EXPECT_SCENE_ERROR(world + "  frames: \"30\"\nbodies:\n", "3:11: world.frames: ",
+                       "expected an integer, got the string \"30\"");
+    EXPECT_SCENE_ERROR(world + "  time_step: \"0.5\"\nbodies:\n", "3:14: world.time_step: ",
+                       "expected a number, got the string \"0.5\"");
+    EXPECT_SCENE_ERROR(world + "bodies:\n---\nworld: {}\n", "5:",
+                       "a second YAML document");
+    // What stays valid: plain decimals, a sign, zero itself, and one leading "---".
+    EXPECT_EQ(errorOf("---\n" + world + "  frames: 300\n  steps_per_frame: +2\nbodies:\n"), "");
 }
 
 }  // namespace
