@@ -372,9 +372,12 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
         err << "--sizes: no sizes given\n";
         return kExitBadInput;
     }
+    // Past 10^7 boxes the workload alone needs gigabytes (2e9 ended in an uncaught bad_alloc).
+    constexpr int kMaxBenchBoxes = 10000000;
     for (int n : options.sizes) {
-        if (n < 2) {
-            err << "--sizes: " << n << " boxes; need at least 2\n";
+        if (n < 2 || n > kMaxBenchBoxes) {
+            err << "--sizes: " << n << " boxes; need at least 2 and at most " << kMaxBenchBoxes
+                << "\n";
             return kExitBadInput;
         }
     }

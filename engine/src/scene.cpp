@@ -59,6 +59,10 @@ constexpr std::string_view kRepeatKeys[] = {"count", "seed", "region",
 constexpr std::string_view kGeneratedKeys[] = {"position", "velocity", "angular_velocity",
                                                "orientation_wxyz", "euler_deg"};
 constexpr int kMaxRepeat = 1000000;
+// Bodies in a whole scene, however they are written (a 1.7 KB file aliasing one 10^6-body
+// `repeat` 200 times asked for 2e8 bodies and ran out of memory at 5.9 GB): refused before the
+// bodies are made.
+constexpr std::size_t kMaxBodies = 1000000;
 
 // Magnitudes double precision can integrate. Coordinates of the bounds stay within 1e150, so a
 // squared distance between two points of the world (at most 3 (2e150)^2 = 1.2e301) is finite.
@@ -69,6 +73,8 @@ constexpr int kMaxRepeat = 1000000;
 constexpr Real kMaxWorldCoordinate = Real(1e150);
 constexpr Real kMaxTravelPerStep = Real(1e6);
 constexpr Real kMaxTurnPerStep = Real(1e3);
+constexpr Real kMinMeshScale = Real(1e-50);
+constexpr Real kMaxMeshScale = Real(1e50);
 // Upper bounds of a run's length: larger values are typing mistakes, not experiments.
 constexpr int kMaxStepsPerFrame = 100000;
 constexpr int kMaxFrames = 1000000;
@@ -467,9 +473,17 @@ void SceneParser::parseCamera(const YAML::Node& n, Scene& scene) const {
     CameraSettings& cam = scene.camera;
     for (const Entry& e : es) {
         const std::string p = childPath(path, e.key);
-        if (e.key == "position") cam.position = readVec3(e.value, p);
-        if (e.key == "look_at") cam.look_at = readVec3(e.value, p);
-        if (e.key == "up") cam.up = readVec3(e.value, p);
+        if (e.key == "position" || e.key == "look_at" || e.key == "up") {
+            const Vec3 v = readVec3(e.value, p);
+            // The view's cross products square these: past 1e150 they overflow, and the camera
+            // would be reported as looking along `up` ("up must not be parallel" at 1e308).
+            if (!(v.cwiseAbs().maxCoeff() <= kMaxWorldCoordinate)) {
+                fail(e.value, p,
+                     "coordinates must lie within +-" + formatLimit(kMaxWorldCoordinate) +
+                         " (the view's products must stay finite in double precision)");
+            }
+            (e.key == "position" ? cam.position : e.key == "look_at" ? cam.look_at : cam.up) = v;
+        }
         if (e.key == "fov_deg") {
             cam.fov_deg = readReal(e.value, p);
             if (!(cam.fov_deg > 0 && cam.fov_deg < 180)) {
@@ -723,6 +737,14 @@ std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
         } else if (e.key == "scale") {
             scale = readReal(v, p);
             if (!(scale > 0)) fail(v, p, "must be > 0");
+            // The hull and mass properties multiply up to three coordinates: at 1e300 they
+            // overflowed ("points are coplanar"), at 1e-300 underflowed ("no triangles").
+            if (!(scale >= kMinMeshScale && scale <= kMaxMeshScale)) {
+                fail(v, p,
+                     "must be in [" + formatLimit(kMinMeshScale) + ", " +
+                         formatLimit(kMaxMeshScale) +
+                         "]: beyond, products of the scaled coordinates over- or underflow");
+            }
         } else if (e.key == "position") {
             position = readVec3(v, p);
             if (!scene.world.bounds.contains(position)) {
@@ -869,6 +891,11 @@ std::vector<Body> SceneParser::repeatBody(const Body& base, const Entry& entry,
     if (count < 1 || count > kMaxRepeat) {
         fail(count_entry.value, childPath(path, "count"),
              "must be in 1.." + std::to_string(kMaxRepeat));
+    }
+    if (scene.bodies.size() + static_cast<std::size_t>(count) > kMaxBodies) {
+        fail(count_entry.value, childPath(path, "count"),
+             std::to_string(count) + " more bodies after " + std::to_string(scene.bodies.size()) +
+                 " would pass the limit of " + std::to_string(kMaxBodies) + " bodies in a scene");
     }
     std::uint64_t seed = 1;
     collision::Aabb region = scene.world.bounds;
@@ -1259,6 +1286,10 @@ Scene SceneParser::parse(const std::string& text) {
             if (e.value.IsNull()) continue;  // "bodies:" with nothing after it: no bodies
             if (!e.value.IsSequence()) fail(e.value, "bodies", "expected a list of bodies");
             for (std::size_t i = 0; i < e.value.size(); ++i) {
+                if (scene.bodies.size() >= kMaxBodies) {
+                    fail(e.value[i], indexPath("bodies", i),
+                         "more than " + std::to_string(kMaxBodies) + " bodies in a scene");
+                }
                 std::vector<Body> made = parseBody(e.value[i], i, scene);
                 for (Body& b : made) scene.bodies.push_back(std::move(b));
             }
@@ -1359,6 +1390,16 @@ Scene loadScene(const std::filesystem::path& file, const std::vector<SceneOverri
     if (!fs::is_regular_file(file, ec)) {
         throw SceneError(file.string() + ":1:1: scene: cannot open the file (" +
                          (fs::exists(file, ec) ? "not a regular file" : "no such file") + ")");
+    }
+    // yaml-cpp's nodes take about 100 bytes of memory per byte of a long list (a 50 MB file took
+    // 4.8 GB): files past kMaxSceneBytes are refused before parsing. Large populations belong in
+    // `repeat:`, which costs a few lines.
+    constexpr std::uintmax_t kMaxSceneBytes = std::uintmax_t(16) << 20;
+    const std::uintmax_t bytes = fs::file_size(file, ec);
+    if (!ec && bytes > kMaxSceneBytes) {
+        throw SceneError(file.string() + ":1:1: scene: the file has " + std::to_string(bytes) +
+                         " bytes, more than the limit of " + std::to_string(kMaxSceneBytes) +
+                         " (16 MiB); describe large populations with repeat:");
     }
     std::ifstream in(file, std::ios::binary);
     std::ostringstream text;

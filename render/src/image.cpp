@@ -6,6 +6,7 @@
 
 #include <fcntl.h>
 #include <png.h>
+#include <poll.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/stat.h>
@@ -146,8 +147,9 @@ bool ffmpegAvailable() {
     }
 }
 
-VideoWriter::VideoWriter(const fs::path& file, int width, int height, int fps)
-    : file_(file), width_(width), height_(height) {
+VideoWriter::VideoWriter(const fs::path& file, int width, int height, int fps,
+                         std::chrono::milliseconds stall_timeout)
+    : file_(file), width_(width), height_(height), stall_timeout_(stall_timeout) {
     if (width <= 0 || height <= 0 || width % 2 != 0 || height % 2 != 0) {
         throw RenderError(file.string() + ": video size " + std::to_string(width) + "x" +
                           std::to_string(height) + " must be positive and even (H.264 yuv420p)");
@@ -190,21 +192,22 @@ VideoWriter::VideoWriter(const fs::path& file, int width, int height, int fps)
         throw RenderError(file.string() + ": cannot start ffmpeg: " + errnoText(spawn_error));
     }
     pid_ = pid;
-    pipe_ = ::fdopen(fds[1], "wb");
-    if (!pipe_) {
-        ::close(fds[1]);
+    pipe_fd_ = fds[1];
+    // Non-blocking, so a frame write waits in poll() with a deadline instead of in write().
+    const int flags = ::fcntl(pipe_fd_, F_GETFL);
+    if (flags < 0 || ::fcntl(pipe_fd_, F_SETFL, flags | O_NONBLOCK) != 0) {
+        const int err = errno;
         abandon();
-        throw RenderError(file.string() + ": cannot open the pipe to ffmpeg: " + errnoText(errno));
+        throw RenderError(file.string() + ": cannot set up the pipe to ffmpeg: " + errnoText(err));
     }
 }
 
 VideoWriter::~VideoWriter() { abandon(); }
 
 void VideoWriter::abandon() noexcept {
-    if (pipe_) {
-        SigpipeGuard guard;
-        std::fclose(pipe_);
-        pipe_ = nullptr;
+    if (pipe_fd_ >= 0) {
+        ::close(pipe_fd_);
+        pipe_fd_ = -1;
     }
     if (pid_ > 0) {
         // Our own child, by id: stop it rather than let it encode a video nobody keeps.
@@ -218,19 +221,36 @@ void VideoWriter::abandon() noexcept {
 }
 
 void VideoWriter::addFrame(const Image& image) {
-    if (!pipe_) throw RenderError(file_.string() + ": video already finished or abandoned");
+    if (pipe_fd_ < 0) throw RenderError(file_.string() + ": video already finished or abandoned");
     if (image.width != width_ || image.height != height_ ||
         image.rgb.size() != std::size_t(width_) * std::size_t(height_) * 3) {
         throw RenderError(file_.string() + ": frame is " + std::to_string(image.width) + "x" +
                           std::to_string(image.height) + ", video is " + std::to_string(width_) +
                           "x" + std::to_string(height_));
     }
-    bool ok = false;
-    {
-        SigpipeGuard guard;
-        ok = std::fwrite(image.rgb.data(), 1, image.rgb.size(), pipe_) == image.rgb.size();
-    }
-    if (!ok) {
+    // Each wait for room in the pipe is bounded by the stall timeout: progress resets it.
+    const std::uint8_t* data = image.rgb.data();
+    std::size_t left = image.rgb.size();
+    SigpipeGuard guard;
+    while (left > 0) {
+        const ssize_t n = ::write(pipe_fd_, data, left);
+        if (n > 0) {
+            data += n;
+            left -= static_cast<std::size_t>(n);
+            continue;
+        }
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+            pollfd p{pipe_fd_, POLLOUT, 0};
+            const int ready = ::poll(&p, 1, static_cast<int>(stall_timeout_.count()));
+            if (ready > 0 || (ready < 0 && errno == EINTR)) continue;
+            if (ready == 0) {
+                abandon();
+                throw RenderError(file_.string() + ": ffmpeg accepted no frame data for " +
+                                  std::to_string(stall_timeout_.count()) +
+                                  " ms (stalled encoder; the video was abandoned)");
+            }
+        }
         const int err = errno;
         abandon();
         throw RenderError(file_.string() + ": ffmpeg stopped accepting frames: " + errnoText(err));
@@ -238,18 +258,25 @@ void VideoWriter::addFrame(const Image& image) {
 }
 
 void VideoWriter::finish() {
-    if (!pipe_ || pid_ <= 0) {
+    if (pipe_fd_ < 0 || pid_ <= 0) {
         throw RenderError(file_.string() + ": video already finished or abandoned");
     }
-    bool closed = false;
-    {
-        SigpipeGuard guard;
-        closed = std::fclose(pipe_) == 0;
-    }
-    pipe_ = nullptr;
+    const bool closed = ::close(pipe_fd_) == 0;
+    pipe_fd_ = -1;
+    // ffmpeg finishes encoding after end of input: wait for it, but not forever.
     int status = 0;
-    pid_t waited = -1;
-    while ((waited = ::waitpid(pid_, &status, 0)) < 0 && errno == EINTR) {
+    pid_t waited = 0;
+    const auto deadline = std::chrono::steady_clock::now() + stall_timeout_;
+    while ((waited = ::waitpid(pid_, &status, WNOHANG)) == 0 ||
+           (waited < 0 && errno == EINTR)) {
+        if (std::chrono::steady_clock::now() > deadline) {
+            abandon();
+            throw RenderError(file_.string() + ": ffmpeg did not finish within " +
+                              std::to_string(stall_timeout_.count()) +
+                              " ms after the last frame (stalled encoder; the video was abandoned)");
+        }
+        const timespec pause{0, 5'000'000};
+        ::nanosleep(&pause, nullptr);
     }
     pid_ = -1;
     const bool exited_ok = waited > 0 && WIFEXITED(status) && WEXITSTATUS(status) == 0;

@@ -249,6 +249,17 @@ TEST(BroadphaseBench, BadOptionsExitTwoBeforeAnyWork) {
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("cannot write"), std::string::npos) << r.err;
     EXPECT_EQ(r.out.find("== workload"), std::string::npos) << "measured before failing";
+    // Regression: 2e9 boxes ended in an uncaught bad_alloc (exit 134).
+    r = runCdlab("bench broadphase --sizes 2000000000 --frames 2 --methods sap", work);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("--sizes: 2000000000 boxes; need at least 2 and at most 10000000"),
+              std::string::npos)
+        << r.err;
+    // Regression: a JSON path that is a directory (or any non-regular file) is refused up front.
+    r = runCdlab("bench broadphase --sizes 50 --frames 2 --methods sap --json " + work.string(),
+                 work);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find(": exists and is a directory"), std::string::npos) << r.err;
     fs::remove_all(work);
 }
 

@@ -612,6 +612,18 @@ TEST_F(SceneMeshes, LoadSceneFileErrors) {
         EXPECT_EQ(std::string(e.what()),
                   (dir_ / "bad.yaml").string() + ":3:11: world.frames: must be >= 1");
     }
+    // Regression: a 50 MB list of bodies took 4.8 GB in yaml-cpp's nodes. Past 16 MiB the file
+    // is refused before it is parsed (a comment line fills this one).
+    write("huge.yaml", "# " + std::string((std::size_t(16) << 20) + 1, 'x') + "\n");
+    try {
+        loadScene(dir_ / "huge.yaml");
+        FAIL() << "no error";
+    } catch (const SceneError& e) {
+        EXPECT_EQ(std::string(e.what()), (dir_ / "huge.yaml").string() +
+                                             ":1:1: scene: the file has 16777220 bytes, more than "
+                                             "the limit of 16777216 (16 MiB); describe large "
+                                             "populations with repeat:");
+    }
 }
 
 // --- conventions -------------------------------------------------------------------------------
@@ -851,6 +863,22 @@ TEST(SceneErrors, MagnitudesDoublePrecisionCannotIntegrateAreRefused) {
     EXPECT_SCENE_ERROR("world:\n  bounds: {min: [-1, -1, -1], max: [1, 1, 1]}\n"
                        "  frames: 2000000000\nbodies:\n",
                        "3:11: world.frames: ", "must be <= 1000000");
+    // Regression: `scale: 1e300` was reported as "points are coplanar", 1e-300 as "no triangles".
+    for (const char* scale : {"1e300", "1e-300"}) {
+        EXPECT_SCENE_ERROR(withBody(std::string("  - {shape: hull, file: ../assets/crystal.obj, "
+                                                "position: [0, 0, 0], scale: ") +
+                                    scale + "}\n"),
+                           "4:", "scale: must be in [1e-50, 1e+50]");
+    }
+    // Regression: a camera at 1e308 was reported as "up must not be parallel".
+    EXPECT_SCENE_ERROR(kHeader + "camera: {position: [1e308, 0, 0], look_at: [0, 0, 0]}\n", "4:",
+                       "camera.position: coordinates must lie within +-1e+150");
+    // Regression: one 10^6-body `repeat` aliased 200 times asked for 2e8 bodies (5.9 GB, then
+    // bad_alloc). The total is capped before any body of an entry is made.
+    EXPECT_SCENE_ERROR(withBody("  - {shape: sphere, radius: 0.5, position: [0, 0, 0]}\n"
+                                "  - &many {shape: sphere, radius: 0.01, "
+                                       "repeat: {count: 1000000}}\n  - *many\n"),
+                       "5:", "1000000 more bodies after 1 would pass the limit of 1000000 bodies");
     // The limits leave every real scene alone: 1e4 m/s in a 20 m box at 1/60 s is fine.
     EXPECT_EQ(errorOf(withBody(ball + "velocity: [1e4, 0, 0], angular_velocity: [0, 0, 1e4]}\n")),
               "");

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -694,6 +695,49 @@ TEST(Video, AnFfmpegThatDiesBecomesARenderError) {
     EXPECT_TRUE(threw);
     EXPECT_FALSE(fs::exists(dir.path() / "dead.mp4"));
     EXPECT_FALSE(fs::exists(dir.path() / "dead.partial.mp4"));
+}
+
+// Regression: an ffmpeg that stops reading hung the run forever (blocking writes, no timeout).
+// A fake "ffmpeg" that never reads, and one that reads everything but never exits: each is a
+// RenderError after the stall timeout (here 300 ms), and no output is left behind.
+//
+//   us --frames--> [pipe, 64 KiB] --x  "exec sleep 30"          (addFrame stalls)
+//   us --frames--> [pipe] --> "cat > /dev/null; exec sleep 30"  (finish stalls)
+TEST(Video, AStalledFfmpegIsAnErrorAfterTheTimeout) {
+    const char* scripts[] = {"#!/bin/sh\nexec sleep 30\n",
+                             "#!/bin/sh\ncat > /dev/null\nexec sleep 30\n"};
+    const char* old_path = std::getenv("PATH");
+    const std::string saved = old_path ? old_path : "";
+    for (const char* script : scripts) {
+        SCOPED_TRACE(script);
+        TempDir dir;
+        const fs::path fake = dir.path() / "ffmpeg";
+        std::ofstream(fake) << script;
+        fs::permissions(fake, fs::perms::owner_all);
+        ::setenv("PATH", (dir.path().string() + ":" + saved).c_str(), 1);
+        std::string message;
+        const auto start = std::chrono::steady_clock::now();
+        try {
+            render::VideoWriter video(dir.path() / "stalled.mp4", kWidth, kHeight, 30,
+                                      std::chrono::milliseconds(300));
+            render::Image frame;
+            frame.width = kWidth;
+            frame.height = kHeight;
+            frame.rgb.assign(std::size_t(kWidth) * kHeight * 3, 7);
+            for (int i = 0; i < 50; ++i) video.addFrame(frame);  // > the 64 KiB pipe buffer
+            video.finish();
+        } catch (const render::RenderError& e) {
+            message = e.what();
+        }
+        ::setenv("PATH", saved.c_str(), 1);
+        const double seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        EXPECT_NE(message.find("(stalled encoder; the video was abandoned)"), std::string::npos)
+            << message;
+        EXPECT_LT(seconds, 10);
+        EXPECT_FALSE(fs::exists(dir.path() / "stalled.mp4"));
+        EXPECT_FALSE(fs::exists(dir.path() / "stalled.partial.mp4"));
+    }
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // render/image.h -- an RGB8 picture, the PNG writer and the ffmpeg video pipe.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -35,17 +36,21 @@ Image readPng(const std::filesystem::path& file);
 bool ffmpegAvailable();
 
 /// Pipes raw frames to ffmpeg: H.264, yuv420p, +faststart, so browsers play the file.
-/// The output appears under its final name only after finish() succeeded.
+/// The output appears under its final name only after finish() succeeded. An ffmpeg that stops
+/// reading (or never exits) is an error after `stall_timeout` without progress, not a hang.
 class VideoWriter {
 public:
     /// Starts ffmpeg; throws RenderError when it cannot (missing ffmpeg, odd size).
-    VideoWriter(const std::filesystem::path& file, int width, int height, int fps);
+    VideoWriter(const std::filesystem::path& file, int width, int height, int fps,
+                std::chrono::milliseconds stall_timeout = std::chrono::seconds(60));
     ~VideoWriter();  ///< abandons an unfinished video (the partial file is removed)
     VideoWriter(const VideoWriter&) = delete;
     VideoWriter& operator=(const VideoWriter&) = delete;
 
-    void addFrame(const Image& image);  ///< throws RenderError if ffmpeg died
-    void finish();                      ///< waits for ffmpeg; throws RenderError on failure
+    /// Throws RenderError if ffmpeg died, or accepted no byte for the stall timeout.
+    void addFrame(const Image& image);
+    /// Waits for ffmpeg (at most the stall timeout); throws RenderError on failure.
+    void finish();
 
 private:
     void abandon() noexcept;  ///< kills ffmpeg (our child, by pid) and removes the partial file
@@ -54,8 +59,9 @@ private:
     std::filesystem::path partial_;
     int width_;
     int height_;
-    std::FILE* pipe_ = nullptr;
-    int pid_ = -1;  ///< ffmpeg's process id while it runs
+    std::chrono::milliseconds stall_timeout_;
+    int pipe_fd_ = -1;  ///< write end of ffmpeg's stdin, non-blocking
+    int pid_ = -1;      ///< ffmpeg's process id while it runs
 };
 
 }  // namespace render
