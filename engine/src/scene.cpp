@@ -1241,14 +1241,7 @@ void SceneParser::parseExpect(const Entry& entry, Scene& scene) const {
 Scene SceneParser::parse(const std::string& text) {
     YAML::Node root;
     try {
-        // Every document is parsed: one after a "---" would otherwise be silently ignored.
-        const std::vector<YAML::Node> documents = YAML::LoadAll(text);
-        if (documents.size() > 1) {
-            fail(documents[1], "scene",
-                 "a second YAML document: a scene file holds exactly one (remove the '---' "
-                 "and what follows, or merge it into the first)");
-        }
-        if (!documents.empty()) root = documents.front();
+        root = YAML::Load(text);
     } catch (const YAML::DeepRecursion& e) {
         fail(e.mark, "malformed YAML", "nesting is too deep");
     } catch (const YAML::ParserException& e) {
