@@ -667,6 +667,16 @@ TEST(Video, OddSizeOrWrongFrameSizeThrows) {
     EXPECT_THROW(video.addFrame(small), render::RenderError);
 }
 
+// Writes 50 uniform frames (2.9 MB), far past the 64 KiB a pipe buffers, so a reader that died
+// or stopped reading is met by addFrame.
+void feedPastThePipeBuffer(render::VideoWriter& video) {
+    render::Image frame;
+    frame.width = kWidth;
+    frame.height = kHeight;
+    frame.rgb.assign(std::size_t(kWidth) * kHeight * 3, 7);
+    for (int i = 0; i < 50; ++i) video.addFrame(frame);
+}
+
 // Regression guard for SIGPIPE: an ffmpeg that dies at once must turn into a RenderError, not
 // kill the test process when we write into its closed pipe.
 //
@@ -682,11 +692,7 @@ TEST(Video, AnFfmpegThatDiesBecomesARenderError) {
     bool threw = false;
     try {
         render::VideoWriter video(dir.path() / "dead.mp4", kWidth, kHeight, 30);
-        render::Image frame;
-        frame.width = kWidth;
-        frame.height = kHeight;
-        frame.rgb.assign(std::size_t(kWidth) * kHeight * 3, 7);
-        for (int i = 0; i < 50; ++i) video.addFrame(frame);  // > the 64 KiB pipe buffer
+        feedPastThePipeBuffer(video);
         video.finish();
     } catch (const render::RenderError&) {
         threw = true;
@@ -720,11 +726,7 @@ TEST(Video, AStalledFfmpegIsAnErrorAfterTheTimeout) {
         try {
             render::VideoWriter video(dir.path() / "stalled.mp4", kWidth, kHeight, 30,
                                       std::chrono::milliseconds(300));
-            render::Image frame;
-            frame.width = kWidth;
-            frame.height = kHeight;
-            frame.rgb.assign(std::size_t(kWidth) * kHeight * 3, 7);
-            for (int i = 0; i < 50; ++i) video.addFrame(frame);  // > the 64 KiB pipe buffer
+            feedPastThePipeBuffer(video);
             video.finish();
         } catch (const render::RenderError& e) {
             message = e.what();
