@@ -1,6 +1,8 @@
 // app/main.cpp -- the cdlab command line: parses flags and hands off to the commands.
 #include <CLI/CLI.hpp>
+#include <exception>
 #include <iostream>
+#include <new>
 
 #include "bench_broadphase.h"
 #include "bench_ccd.h"
@@ -12,7 +14,9 @@
 #include "run_command.h"
 #include "sweep_command.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int runCli(int argc, char** argv) {
     CLI::App cli{
         "cdlab -- collision-detection lab: run rigid-body scenes headless and render "
         "every bounding volume coloured by its overlap state"};
@@ -284,4 +288,20 @@ int main(int argc, char** argv) {
         return app::runBenchNarrowphase(bench_np, std::cout, std::cerr);
     }
     return 2;
+}
+
+}  // namespace
+
+// Whatever escapes a command ends the run with a message and exit 1, never an abort: running out
+// of memory (a scene past what this machine holds) is reported as such.
+int main(int argc, char** argv) {
+    try {
+        return runCli(argc, argv);
+    } catch (const std::bad_alloc&) {
+        std::cerr << "cdlab: out of memory (the scene or request needs more than this machine "
+                     "can allocate)\n";
+    } catch (const std::exception& e) {
+        std::cerr << "cdlab: internal error: " << e.what() << "\n";
+    }
+    return 1;
 }

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <new>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -287,6 +288,10 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
             << ")\n";
     } catch (const render::RenderError& e) {
         err << "error: " << e.what() << "\n";
+        return kExitFailure;
+    } catch (const std::bad_alloc&) {
+        err << "error: out of memory: this scene needs more memory than the machine can allocate "
+               "(fewer bodies, fewer volumes drawn, or --no-frames --no-video)\n";
         return kExitFailure;
     } catch (const std::exception& e) {
         err << "error: " << e.what() << "\n";

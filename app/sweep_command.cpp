@@ -669,8 +669,8 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
         }
         for (const auto& axis : axes) {
             if (axis.first == key) {
-                err << "--vary " << key << ": given twice; list every value in one --vary ("
-                    << key << "=A,B,...)\n";
+                err << "--vary " << key << ": given twice; list every value in one --vary (" << key
+                    << "=A,B,...)\n";
                 return kExitBadInput;
             }
         }
@@ -685,7 +685,7 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
                 << "\n";
             return kExitBadInput;
         }
-        reference_overrides.push_back({key, values[0]});
+        reference_overrides.push_back({key, values[0], "--reference"});
     }
     if (!(options.reference_refine >= 1) || !std::isfinite(options.reference_refine)) {
         err << "--reference-refine: must be a finite number >= 1\n";
@@ -711,7 +711,7 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
         for (const auto& c : combos) {
             for (const std::string& v : values) {
                 next.push_back(c);
-                next.back().push_back({key, v});
+                next.back().push_back({key, v, "--vary"});
             }
         }
         combos = std::move(next);

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <string>
+#include <vector>
 
 #include "engine/scene.h"
 
@@ -25,14 +26,23 @@ constexpr int kSteps = 2;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     const std::string text(reinterpret_cast<const char*>(data), size);
+    // An input whose first line is "#set KEY=VALUE" also applies that override, as `--set` does
+    // (a comment to YAML, so the rest of the file still parses the same).
+    std::vector<engine::SceneOverride> overrides;
+    if (text.rfind("#set ", 0) == 0) {
+        const std::string line = text.substr(5, text.find('\n') - 5);
+        const std::size_t eq = line.find('=');
+        if (eq != std::string::npos) overrides.push_back({line.substr(0, eq), line.substr(eq + 1)});
+    }
     engine::Scene scene;
     try {
         // Mesh paths resolve like a file in scenes/, so seeds that name ../assets/*.obj load.
-        scene = engine::parseScene(text, "fuzz.yaml", CDLAB_FUZZ_BASE_DIR);
+        scene = engine::parseScene(text, "fuzz.yaml", CDLAB_FUZZ_BASE_DIR, overrides);
     } catch (const engine::SceneError& e) {
-        // Messages are "FILE:LINE:COL: path: what", one line.
+        // Messages are "FILE:LINE:COL: path: what" (or "FILE: --set K=V: path: what"), one line.
         const std::string what = e.what();
-        if (what.rfind("fuzz.yaml:", 0) != 0 || what.find('\n') != std::string::npos) std::abort();
+        const bool positioned = what.rfind("fuzz.yaml:", 0) == 0;
+        if (!positioned || what.find('\n') != std::string::npos) std::abort();
         return 0;
     }
     if (scene.bodies.size() > kMaxSteppedBodies) return 0;

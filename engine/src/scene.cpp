@@ -10,6 +10,7 @@
 #include "engine/scene.h"
 
 #include <yaml-cpp/depthguard.h>
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -20,6 +21,7 @@
 #include <map>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string_view>
@@ -99,9 +101,9 @@ std::string speedProblem(Real speed, const WorldSettings& world) {
 std::string spinProblem(Real rate, const WorldSettings& world) {
     const Real limit = kMaxTurnPerStep / world.time_step;
     if (std::isfinite(rate) && rate <= limit) return "";
-    return "angular speed " + formatLimit(rate) + " rad/s is beyond what the world can integrate: " +
-           "at most " + formatLimit(limit) + " rad/s (" + formatLimit(kMaxTurnPerStep) +
-           " rad per time step)";
+    return "angular speed " + formatLimit(rate) +
+           " rad/s is beyond what the world can integrate: " + "at most " + formatLimit(limit) +
+           " rad/s (" + formatLimit(kMaxTurnPerStep) + " rad per time step)";
 }
 
 struct Entry {
@@ -133,6 +135,46 @@ struct PreparedShape {
     MassProperties unit;  // mass = volume
 };
 
+// Where the second YAML document of a stream starts, if there is one. YAML::Load reads the first
+// document and ignores the rest, so a scene split by a "---" would lose its second half without a
+// word. yaml-cpp's LoadAll cannot be used to count documents: on some malformed streams its
+// HandleNextDocument keeps returning an empty document without consuming the offending token
+// (jbeder/yaml-cpp#1319), and LoadAll then loops allocating nodes. Here the parser is asked for
+// at most two documents, and the events build nothing.
+class DocumentProbe final : public YAML::EventHandler {
+public:
+    struct Second {
+        YAML::Mark start;
+        bool stalled;  ///< the parser did not move on: a token it cannot place, not a "---"
+    };
+    /// Null when the stream holds at most one document; else where the second one starts.
+    static std::optional<Second> secondDocument(const std::string& text) {
+        std::istringstream in(text);
+        YAML::Parser parser(in);
+        DocumentProbe first;
+        if (!parser.HandleNextDocument(first)) return std::nullopt;
+        DocumentProbe second;
+        if (!parser.HandleNextDocument(second)) return std::nullopt;
+        return Second{second.start_, second.start_.pos <= first.start_.pos};
+    }
+
+    void OnDocumentStart(const YAML::Mark& mark) override { start_ = mark; }
+    void OnDocumentEnd() override {}
+    void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+    void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+    void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                  const std::string&) override {}
+    void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                         YAML::EmitterStyle::value) override {}
+    void OnSequenceEnd() override {}
+    void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                    YAML::EmitterStyle::value) override {}
+    void OnMapEnd() override {}
+
+private:
+    YAML::Mark start_ = YAML::Mark::null_mark();
+};
+
 class SceneParser {
 public:
     SceneParser(std::string display_name, fs::path base_dir)
@@ -144,10 +186,12 @@ public:
 private:
     [[noreturn]] void fail(const YAML::Mark& mark, const std::string& path,
                            const std::string& what) const;
+    /// At a node; one that came from an override's value is reported as the option that set
+    /// it (`FILE: --set KEY=VALUE: path: what`), since its line and column are not the file's.
     [[noreturn]] void fail(const YAML::Node& node, const std::string& path,
-                           const std::string& what) const {
-        fail(node.Mark(), path, what);
-    }
+                           const std::string& what) const;
+    [[noreturn]] void failOverride(const SceneOverride& o, const std::string& path,
+                                   const std::string& what) const;
 
     std::vector<Entry> entries(const YAML::Node& map, const std::string& path,
                                std::initializer_list<std::string_view> allowed) const;
@@ -179,11 +223,14 @@ private:
     std::vector<Body> repeatBody(const Body& base, const Entry& entry, const std::string& path,
                                  const Scene& scene, Place&& place) const;
 
-    void applyOverrides(YAML::Node& root) const;
+    void applyOverrides(YAML::Node& root);
+    void collectOverrideNodes(const YAML::Node& node, const SceneOverride& o);
 
     std::string file_;
     fs::path base_dir_;
     std::vector<SceneOverride> overrides_;
+    // Every node of every override's value, with its override (see fail()).
+    std::vector<std::pair<YAML::Node, const SceneOverride*>> override_nodes_;
     std::map<std::string, std::shared_ptr<const MeshImportOutput>> import_cache_;  // scale 1
     std::map<std::tuple<std::string, Real, int>, PreparedShape> mesh_cache_;
 };
@@ -220,6 +267,22 @@ std::string formatMessage(const std::string& file, const YAML::Mark& mark, const
 void SceneParser::fail(const YAML::Mark& mark, const std::string& path,
                        const std::string& what) const {
     throw SceneError(formatMessage(file_, mark, path, what));
+}
+
+void SceneParser::fail(const YAML::Node& node, const std::string& path,
+                       const std::string& what) const {
+    if (node.IsDefined()) {
+        for (const auto& [value_node, o] : override_nodes_) {
+            if (value_node.is(node)) failOverride(*o, path, what);
+        }
+    }
+    fail(node.Mark(), path, what);
+}
+
+void SceneParser::failOverride(const SceneOverride& o, const std::string& path,
+                               const std::string& what) const {
+    throw SceneError(file_ + ": " + printable(o.option + " " + o.key + "=" + o.value) + ": " +
+                     printable(path.empty() ? "scene" : path) + ": " + printable(what));
 }
 
 std::vector<Entry> SceneParser::entries(const YAML::Node& map, const std::string& path,
@@ -383,7 +446,8 @@ void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
         } else if (e.key == "frames") {
             scene.frames = readInt(e.value, p);
             if (scene.frames < 1) fail(e.value, p, "must be >= 1");
-            if (scene.frames > kMaxFrames) fail(e.value, p, "must be <= " + std::to_string(kMaxFrames));
+            if (scene.frames > kMaxFrames)
+                fail(e.value, p, "must be <= " + std::to_string(kMaxFrames));
         } else if (e.key == "mesh_bvh") {
             const std::string name = readString(e.value, p);
             const auto& names = collision::bvhVolumeNames();
@@ -590,6 +654,27 @@ const PreparedShape& SceneParser::prepareMeshShape(ShapeType type, const std::st
     }
     const collision::ConvexHullOutput hull = collision::computeConvexHull(imported.mesh.vertices);
     if (!hull.ok) {
+        // A flat or degenerate point set is the file's shape, not a failure of the hull: say so.
+        const std::size_t n = imported.mesh.vertices.size();
+        const std::string counts = std::to_string(n) + (n == 1 ? " vertex" : " vertices") + ", " +
+                                   std::to_string(imported.mesh.triangles.size()) + " triangle" +
+                                   (imported.mesh.triangles.size() == 1 ? "" : "s");
+        std::string flat;
+        if (hull.error == "points are coplanar" || n == 3) {
+            flat = "lie in one plane";
+        } else if (hull.error == "points are collinear" || n == 2) {
+            flat = "lie on one line";
+        } else if (hull.error == "all points coincide" || n < 2) {
+            flat = "coincide";
+        }
+        if (!flat.empty()) {
+            fail(
+                file_entry.key_node, path,
+                "'" + resolved.string() + "' has no volume: its points " + flat + " (" + counts +
+                    "); a body is a solid, so its " +
+                    (type == ShapeType::ConvexHull ? "hull" : "mesh's hull (for mass properties)") +
+                    " needs points in three dimensions");
+        }
         fail(file_entry.key_node, path,
              "cannot build the convex hull of '" + resolved.string() + "': " + hull.error);
     }
@@ -1257,6 +1342,16 @@ Scene SceneParser::parse(const std::string& text) {
              "expected a mapping with keys: world, broadphase, output, camera, draw, bodies, "
              "expect");
     }
+    // The first document parsed, so the probe's parser (the same one) cannot throw before it
+    // reaches the second.
+    if (const std::optional<DocumentProbe::Second> second = DocumentProbe::secondDocument(text)) {
+        if (second->stalled)
+            fail(second->start, "malformed YAML",
+                 "text the YAML parser cannot place in the document");
+        fail(second->start, "scene",
+             "a second YAML document: a scene file holds exactly one (remove the '---' or '...' "
+             "and what follows, or merge it into the first)");
+    }
     const std::vector<Entry> es =
         entries(root, "", {"world", "broadphase", "output", "camera", "draw", "bodies", "expect"});
     parseWorld(require(es, "world", root, "").value, scene);
@@ -1292,9 +1387,20 @@ Scene SceneParser::parse(const std::string& text) {
     return scene;
 }
 
-void SceneParser::applyOverrides(YAML::Node& root) const {
+void SceneParser::collectOverrideNodes(const YAML::Node& node, const SceneOverride& o) {
+    override_nodes_.emplace_back(node, &o);
+    if (node.IsSequence()) {
+        for (const YAML::Node& child : node) collectOverrideNodes(child, o);
+    } else if (node.IsMap()) {
+        for (const auto& kv : node) {
+            collectOverrideNodes(kv.first, o);
+            collectOverrideNodes(kv.second, o);
+        }
+    }
+}
+
+void SceneParser::applyOverrides(YAML::Node& root) {
     for (const SceneOverride& o : overrides_) {
-        const std::string where = "override " + o.key + "=" + o.value;
         std::vector<std::string> parts;
         for (std::size_t from = 0;;) {
             const std::size_t dot = o.key.find('.', from);
@@ -1303,14 +1409,15 @@ void SceneParser::applyOverrides(YAML::Node& root) const {
             from = dot + 1;
         }
         for (const std::string& p : parts) {
-            if (p.empty()) fail(YAML::Mark::null_mark(), where, "empty key in the path");
+            if (p.empty()) failOverride(o, o.key, "empty key in the path");
         }
         YAML::Node value;
         try {
             value = YAML::Load(o.value);
         } catch (const YAML::Exception& e) {
-            fail(YAML::Mark::null_mark(), where, "malformed YAML value: " + e.msg);
+            failOverride(o, o.key, "malformed YAML value: " + e.msg);
         }
+        collectOverrideNodes(value, o);
         if (!root.IsDefined() || root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
         // Node::reset rebinds; plain assignment between nodes would overwrite the content.
         YAML::Node node;
@@ -1323,9 +1430,9 @@ void SceneParser::applyOverrides(YAML::Node& root) const {
                     std::all_of(p.begin(), p.end(), [](char c) { return c >= '0' && c <= '9'; });
                 const std::size_t index = digits && p.size() < 9 ? std::stoul(p) : node.size();
                 if (index >= node.size()) {
-                    fail(node, where,
-                         "'" + p + "' is not an index of this list of " +
-                             std::to_string(node.size()));
+                    failOverride(o, o.key,
+                                 "'" + p + "' is not an index of this list of " +
+                                     std::to_string(node.size()));
                 }
                 if (last) {
                     node[index] = value;
@@ -1345,7 +1452,7 @@ void SceneParser::applyOverrides(YAML::Node& root) const {
                     node.reset(child);
                 }
             } else {
-                fail(node, where, "'" + p + "' is below a value, not a mapping or list");
+                failOverride(o, o.key, "'" + p + "' is below a value, not a mapping or list");
             }
         }
     }
@@ -1372,7 +1479,14 @@ Scene runParser(SceneParser& parser, const std::string& text, const std::string&
 
 Scene parseScene(const std::string& yaml_text, const std::string& display_name,
                  const std::filesystem::path& base_dir) {
+    return parseScene(yaml_text, display_name, base_dir, {});
+}
+
+Scene parseScene(const std::string& yaml_text, const std::string& display_name,
+                 const std::filesystem::path& base_dir,
+                 const std::vector<SceneOverride>& overrides) {
     SceneParser parser(display_name, base_dir);
+    parser.setOverrides(overrides);
     return runParser(parser, yaml_text, display_name);
 }
 

@@ -59,6 +59,25 @@ struct CameraFrame {
 
     Vec3 toEye(const Vec3& world) const { return world - eye; }
     Real depth(const Vec3& world) const { return forward.dot(world - eye); }
+
+    /// False only when the sphere lies wholly outside one of the four side planes of the view
+    /// pyramid (the clip planes enclose every body by construction, see setUpCamera). Geometry
+    /// there would be clipped away entirely, so leaving it out changes no pixel; the test is
+    /// padded (1 % of the radius plus a relative 1e-9 of the distance) so rounding never culls
+    /// a sphere that reaches into the view.
+    bool mayShow(const Vec3& center, Real radius) const {
+        if (!center.allFinite() || !std::isfinite(radius)) return true;
+        const Vec3 rel = center - eye;
+        const Real x = right.dot(rel);
+        const Real y = up.dot(rel);
+        const Real z = forward.dot(rel);
+        const Real pad = Real(1.01) * radius + Real(1e-9) * rel.norm();
+        const Real tx = tan_half_fov * aspect;
+        const Real ty = tan_half_fov;
+        // Distance outside the plane |x| = z tx is (|x| - z tx) / sqrt(1 + tx^2).
+        return (std::abs(x) - z * tx) <= pad * std::sqrt(1 + tx * tx) &&
+               (std::abs(y) - z * ty) <= pad * std::sqrt(1 + ty * ty);
+    }
 };
 
 CameraFrame makeCameraFrame(const engine::CameraSettings& camera, int gl_width, int gl_height) {
@@ -464,6 +483,7 @@ struct Renderer::Impl {
     LineBuffer bvh_lines;        ///< mesh hierarchy levels (draw.bvh_depth)
     LineBuffer contact_lines;    ///< contact witnesses and normals (draw.contacts)
     std::vector<GLubyte> readback;
+    FrameStats stats;
 
     const UnitSphereGrid& sphereGrid(int slices) {
         auto it = sphere_grids.find(slices);
@@ -475,11 +495,14 @@ struct Renderer::Impl {
 
     CameraFrame setUpCamera(const engine::World& world, const engine::CameraSettings& camera);
     void setUpGl(const CameraFrame& cam);
-    void buildBodies(const engine::World& world, const CameraFrame& cam);
+    /// Tessellates and draws every body that may show, in batches.
+    void drawBodies(const engine::World& world, const CameraFrame& cam,
+                    const FrameOptions& options);
     void buildHierarchyLevels(const engine::World& world, int depth, GlDebugDraw& debug);
     void buildContacts(const engine::World& world, GlDebugDraw& debug);
     void buildLines(const engine::World& world, const CameraFrame& cam,
                     const FrameOptions& options);
+    /// Draws the triangle buffer and empties it.
     void drawTriangles();
     void drawLines(const LineBuffer& lines, float width_px);
     Image readPixels();
@@ -574,12 +597,22 @@ void Renderer::Impl::setUpGl(const CameraFrame& cam) {
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
 }
 
-void Renderer::Impl::buildBodies(const engine::World& world, const CameraFrame& cam) {
+void Renderer::Impl::drawBodies(const engine::World& world, const CameraFrame& cam,
+                                const FrameOptions& options) {
     triangles.clear();
     for (const engine::Body& body : world.bodies()) {
         const collision::Shape& shape = body.shape;
         const Pose pose = body.pose();
         if (!pose.position.allFinite() || !pose.orientation.coeffs().allFinite()) continue;
+        if (options.cull && !cam.mayShow(pose.apply(body.local_bounds.sphere.center),
+                                         body.local_bounds.sphere.radius)) {
+            ++stats.bodies_culled;
+            continue;
+        }
+        ++stats.bodies_drawn;
+        // Drawn in batches, in body order: the depth test sees the same fragments in the same
+        // order as one draw of everything, and memory stays bounded for 10^5 bodies.
+        if (triangles.count() >= options.triangle_batch_vertices) drawTriangles();
         switch (shape.type) {
             case collision::ShapeType::Sphere:
             case collision::ShapeType::Capsule: {
@@ -605,6 +638,7 @@ void Renderer::Impl::buildBodies(const engine::World& world, const CameraFrame& 
                 break;
         }
     }
+    drawTriangles();
 }
 
 void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& cam,
@@ -645,9 +679,20 @@ void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& c
     for (std::size_t i = 0; i < volumes.size() && i < world.bodies().size(); ++i) {
         const Color color = stateColor(i < states.size() ? states[i] : engine::BodyState::Apart);
         const collision::ProxyVolumes& v = volumes[i];
-        if (options.draw.sphere) debug.drawSphere(v.sphere, color);
-        if (options.draw.aabb) debug.drawAabb(v.aabb, color);
-        if (options.draw.obb) debug.drawObb(v.obb, color);
+        auto shows = [&](const Vec3& center, Real radius) {
+            if (!options.cull || cam.mayShow(center, radius)) return true;
+            ++stats.volumes_culled;
+            return false;
+        };
+        if (options.draw.sphere && shows(v.sphere.center, v.sphere.radius)) {
+            debug.drawSphere(v.sphere, color);
+        }
+        if (options.draw.aabb && shows(v.aabb.center(), Real(0.5) * v.aabb.extents().norm())) {
+            debug.drawAabb(v.aabb, color);
+        }
+        if (options.draw.obb && shows(v.obb.center, v.obb.half_extents.norm())) {
+            debug.drawObb(v.obb, color);
+        }
     }
 
     // CCD: each moving body of a time-of-impact event at its pose there (spheres as spheres,
@@ -659,7 +704,8 @@ void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& c
             const engine::Body& b = bodies[static_cast<std::size_t>(id)];
             if (b.is_static) continue;
             if (b.shape.type == collision::ShapeType::Sphere) {
-                debug.drawSphere(collision::transformSphere(b.local_bounds.sphere, pose), kToiColor);
+                debug.drawSphere(collision::transformSphere(b.local_bounds.sphere, pose),
+                                 kToiColor);
             } else {
                 debug.drawObb(collision::transformObb(b.local_bounds.obb, pose), kToiColor);
             }
@@ -667,7 +713,8 @@ void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& c
         Real size = 0;
         for (const engine::BodyId id : {e.a, e.b}) {
             if (id >= 0 && static_cast<std::size_t>(id) < bodies.size()) {
-                size = std::max(size, bodies[static_cast<std::size_t>(id)].local_bounds.sphere.radius);
+                size =
+                    std::max(size, bodies[static_cast<std::size_t>(id)].local_bounds.sphere.radius);
             }
         }
         debug.drawLine(e.point, e.point + e.normal * size, kToiColor);
@@ -782,6 +829,14 @@ void Renderer::Impl::buildContacts(const engine::World& world, GlDebugDraw& debu
 
 void Renderer::Impl::drawTriangles() {
     if (triangles.count() == 0) return;
+    struct Clear {
+        TriangleBuffer& buffer;
+        ~Clear() { buffer.clear(); }
+    } clear_after{triangles};
+    ++stats.batches;
+    stats.triangle_vertices += triangles.count();
+    stats.largest_batch_vertices =
+        std::max<std::int64_t>(stats.largest_batch_vertices, triangles.count());
     glEnable(GL_LIGHTING);
     glEnable(GL_COLOR_MATERIAL);
     glColorMaterial(GL_FRONT_AND_BACK, GL_AMBIENT_AND_DIFFUSE);
@@ -917,6 +972,7 @@ Renderer::~Renderer() = default;
 int Renderer::width() const { return impl_->width; }
 int Renderer::height() const { return impl_->height; }
 int Renderer::supersample() const { return impl_->ss; }
+const FrameStats& Renderer::lastFrameStats() const { return impl_->stats; }
 
 Image Renderer::render(const engine::World& world, const engine::CameraSettings& camera,
                        const FrameOptions& options) {
@@ -924,10 +980,8 @@ Image Renderer::render(const engine::World& world, const engine::CameraSettings&
     im.context.makeCurrent();
     const CameraFrame cam = im.setUpCamera(world, camera);
     im.setUpGl(cam);
-    if (options.draw.bodies) {
-        im.buildBodies(world, cam);
-        im.drawTriangles();
-    }
+    im.stats = FrameStats{};
+    if (options.draw.bodies) im.drawBodies(world, cam, options);
     im.buildLines(world, cam, options);
     im.drawLines(im.frame_lines, 1.0f);
     im.drawLines(im.structure_lines, 1.0f);
@@ -950,21 +1004,19 @@ std::string hudLine(const engine::World& world, int frame, bool include_timing) 
     const engine::StepStats& st = world.lastStats();
     const std::string_view bp = world.broadPhase().name();
     char buffer[512];
-    int n = std::snprintf(buffer, sizeof buffer,
-                          "frame %d  t=%.3f s  %.*s  flagged %zu  colliding %zu\n"
-                          "BV tests %lld  updated %lld  narrow tests %lld  triangle tests %lld",
-                          frame, double(world.time()), int(bp.size()), bp.data(),
-                          world.flaggedPairs().size(), world.collidingPairs().size(),
-                          static_cast<long long>(st.broad.volume_tests),
-                          static_cast<long long>(st.broad.volumes_updated),
-                          static_cast<long long>(st.narrow_tests),
-                          static_cast<long long>(st.triangle_tests));
+    int n = std::snprintf(
+        buffer, sizeof buffer,
+        "frame %d  t=%.3f s  %.*s  flagged %zu  colliding %zu\n"
+        "BV tests %lld  updated %lld  narrow tests %lld  triangle tests %lld",
+        frame, double(world.time()), int(bp.size()), bp.data(), world.flaggedPairs().size(),
+        world.collidingPairs().size(), static_cast<long long>(st.broad.volume_tests),
+        static_cast<long long>(st.broad.volumes_updated), static_cast<long long>(st.narrow_tests),
+        static_cast<long long>(st.triangle_tests));
     std::string line(buffer, std::size_t(std::clamp(n, 0, int(sizeof buffer) - 1)));
     if (include_timing) {
-        n = std::snprintf(buffer, sizeof buffer,
-                          "\nstep %.3f ms  volumes %.3f  broad %.3f  narrow %.3f ms",
-                          1e3 * st.total_s, 1e3 * st.volumes_s, 1e3 * st.broad_phase_s,
-                          1e3 * st.narrow_phase_s);
+        n = std::snprintf(
+            buffer, sizeof buffer, "\nstep %.3f ms  volumes %.3f  broad %.3f  narrow %.3f ms",
+            1e3 * st.total_s, 1e3 * st.volumes_s, 1e3 * st.broad_phase_s, 1e3 * st.narrow_phase_s);
         line.append(buffer, std::size_t(std::clamp(n, 0, int(sizeof buffer) - 1)));
     }
     return line;

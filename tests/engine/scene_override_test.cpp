@@ -70,4 +70,27 @@ TEST(SceneOverride, BadOverridesAreRejectedWithTheKeyPath) {
     EXPECT_EQ(errorOf({{"world.time_step", "0"}}).rfind(kScene.string(), 0), 0u);
 }
 
+// Regression: errors about an override's value were reported at FILE:1:1 (the line and column of
+// the value's own text), pointing into the file at a line that has nothing to do with them.
+TEST(SceneOverride, ErrorsNameTheOptionNotALineOfTheFile) {
+    const std::string file = kScene.string();
+    EXPECT_EQ(errorOf({{"world.frames", "abc"}}),
+              file + ": --set world.frames=abc: world.frames: expected an integer, got 'abc'");
+    EXPECT_EQ(errorOf({{"bodies.0.position", "[1, x, 2]"}}),
+              file + ": --set bodies.0.position=[1, x, 2]: bodies[0].position[1]: expected a "
+                     "number, got 'x'");
+    EXPECT_EQ(errorOf({{"world..x", "1"}}),
+              file + ": --set world..x=1: world..x: empty key in the path");
+    // The option is the one that gave the override (sweep passes --vary).
+    EXPECT_EQ(errorOf({{"world.time_step", "-1", "--vary"}}).rfind(
+                  file + ": --vary world.time_step=-1: world.time_step: must be > 0", 0),
+              0u);
+    // Inside a value that replaces a whole mapping, the error still names the option.
+    EXPECT_EQ(errorOf({{"bodies.0", "{shape: sphere, radius: -1, position: [0, 0, 0]}"}}).rfind(
+                  file + ": --set bodies.0={shape: sphere, radius: -1, position: [0, 0, 0]}: "
+                         "bodies[0].radius: must be > 0",
+                  0),
+              0u);
+}
+
 }  // namespace

@@ -586,7 +586,7 @@ TEST_F(SceneMeshes, MeshErrorsAreReportedAtTheFileKey) {
     EXPECT_EQ(garbage.rfind("test.yaml:5:5: bodies[0].file: ", 0), 0u) << garbage;
     const std::string flat = error("hull", "flat.obj");
     EXPECT_EQ(flat.rfind("test.yaml:5:5: bodies[0].file: ", 0), 0u) << flat;
-    EXPECT_NE(flat.find("convex hull"), std::string::npos) << flat;
+    EXPECT_NE(flat.find("has no volume: its points lie in one plane"), std::string::npos) << flat;
     const std::string open = error("mesh", "open.obj");
     EXPECT_EQ(open.rfind("test.yaml:5:5: bodies[0].file: ", 0), 0u) << open;
     EXPECT_NE(open.find("not closed"), std::string::npos) << open;
@@ -898,6 +898,51 @@ TEST(SceneErrors, OctalAndQuotedNumbersAreRefused) {
                        "expected a number, got the string \"0.5\"");
     // What stays valid: plain decimals, a sign, zero itself, and one leading "---".
     EXPECT_EQ(errorOf("---\n" + world + "  frames: 300\n  steps_per_frame: +2\nbodies:\n"), "");
+}
+
+// Regression: YAML::Load reads the first document only, so everything after a "---" was dropped
+// without a word (a scene split in two lost its second half).
+TEST(SceneErrors, ASecondDocumentIsRefusedWhereItStarts) {
+    const std::string world = "world:\n  bounds: {min: [-1, -1, -1], max: [1, 1, 1]}\nbodies:\n";
+    EXPECT_SCENE_ERROR(world + "---\nworld: {}\n", "4:1: scene: ", "a second YAML document");
+    EXPECT_SCENE_ERROR(world + "...\n- {shape: sphere, radius: 1}\n", "5:1: scene: ",
+                       "a second YAML document");
+    // An empty second document is still a second document.
+    EXPECT_SCENE_ERROR(world + "---\n", "4:1: scene: ", "a second YAML document");
+    // One document with its own end marker, a leading "---" and trailing comments stay valid.
+    EXPECT_EQ(errorOf("---\n" + world + "...\n"), "");
+    EXPECT_EQ(errorOf(world + "# the end\n"), "");
+}
+
+// Regression: a one-triangle mesh was refused with "cannot build the convex hull ... needs at
+// least 4 points", which names a step of ours instead of what is wrong with the file.
+TEST_F(SceneMeshes, AFlatMeshIsRefusedAsHavingNoVolume) {
+    write("tri.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    write("square.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n");
+    auto errorIn = [&](const std::string& file, const char* shape) -> std::string {
+        write("scene.yaml", "world:\n  bounds: {min: [-5, -5, -5], max: [5, 5, 5]}\nbodies:\n"
+                            "  - {shape: " + std::string(shape) + ", file: " + file +
+                                ", position: [0, 0, 0]}\n");
+        try {
+            loadScene(dir_ / "scene.yaml");
+        } catch (const SceneError& e) {
+            return e.what();
+        }
+        return "";
+    };
+    for (const char* shape : {"hull", "mesh"}) {
+        SCOPED_TRACE(shape);
+        std::string err = errorIn("tri.off", shape);
+        EXPECT_NE(err.find(":4:"), std::string::npos) << err;
+        EXPECT_NE(err.find(": bodies[0].file: "), std::string::npos) << err;
+        EXPECT_NE(err.find("has no volume: its points lie in one plane (3 vertices, 1 triangle)"),
+                  std::string::npos)
+            << err;
+        err = errorIn("square.off", shape);
+        EXPECT_NE(err.find("has no volume: its points lie in one plane (4 vertices, 2 triangles)"),
+                  std::string::npos)
+            << err;
+    }
 }
 
 }  // namespace

@@ -331,6 +331,77 @@ TEST(Renderer, TranslatingSceneAndCameraKeepsThePicture) {
     EXPECT_LT(differing, kWidth * kHeight / 200) << differing << " pixels differ";
 }
 
+// Regression: with the camera inside a crowd, bodies behind it were tessellated at the finest
+// level and everything went into one vertex array (15,000 spheres took 2.7 GB and 30 s a frame;
+// 150,000 crashed). Culling what lies outside the view and drawing in batches must change no
+// pixel: the reference draws everything in one batch.
+TEST(Renderer, CullingAndBatchingChangeNoPixel) {
+    engine::WorldSettings settings;
+    settings.bounds = collision::Aabb{Vec3::Constant(-12), Vec3::Constant(12)};
+    engine::World world(settings);
+    int n = 0;
+    for (int i = -4; i <= 4; ++i) {
+        for (int j = -4; j <= 4; ++j) {
+            for (int k = -4; k <= 4; ++k) {
+                const Vec3 p(2.5 * i + 0.3 * j, 2.5 * j + 0.2 * k, 2.5 * k + 0.1 * i);
+                const std::string name = std::to_string(n);
+                switch (n++ % 3) {
+                    case 0:
+                        world.addBody(sphereBody(name, 0.9, p));
+                        break;
+                    case 1:
+                        world.addBody(
+                            makeShapeBody(name, collision::Shape::box(Vec3(0.9, 0.4, 0.6)), p,
+                                          Quat(Eigen::AngleAxisd(0.1 * n, Vec3::UnitZ()))));
+                        break;
+                    default:
+                        world.addBody(makeShapeBody(name, collision::Shape::capsule(0.4, 0.5), p));
+                        break;
+                }
+            }
+        }
+    }
+    world.detect();
+    engine::CameraSettings camera;  // inside the crowd, looking along a diagonal
+    camera.position = Vec3(0.4, 1.3, 1.1);
+    camera.look_at = Vec3(8, 3, -6);
+    camera.up = Vec3::UnitY();
+    camera.fov_deg = 60;
+    render::FrameOptions reference = plainOptions();
+    reference.draw.aabb = reference.draw.obb = true;
+    reference.cull = false;
+    reference.triangle_batch_vertices = std::int64_t(1) << 40;
+    render::FrameOptions fast = reference;
+    fast.cull = true;
+    fast.triangle_batch_vertices = 2000;
+
+    render::Renderer renderer(kWidth, kHeight);
+    const render::Image all = renderer.render(world, camera, reference);
+    const render::FrameStats all_stats = renderer.lastFrameStats();
+    const render::Image culled = renderer.render(world, camera, fast);
+    const render::FrameStats culled_stats = renderer.lastFrameStats();
+    EXPECT_EQ(all.rgb, culled.rgb);
+    EXPECT_EQ(all_stats.bodies_drawn, n);
+    EXPECT_EQ(all_stats.bodies_culled + all_stats.volumes_culled, 0);
+    EXPECT_EQ(all_stats.batches, 1);
+    // Most of the crowd is behind or beside the camera; what is left still shows bodies.
+    EXPECT_GT(culled_stats.bodies_culled, n / 2);
+    EXPECT_GT(culled_stats.volumes_culled, n);
+    EXPECT_EQ(culled_stats.bodies_drawn + culled_stats.bodies_culled, n);
+    EXPECT_GT(culled_stats.bodies_drawn, 10);
+    EXPECT_GT(culled_stats.batches, 3);
+    EXPECT_LT(culled_stats.triangle_vertices, all_stats.triangle_vertices / 2);
+    // A batch closes at the first body past the limit: at most one body's worth beyond it.
+    EXPECT_LT(culled_stats.largest_batch_vertices, 2000 + 64 * 32 * 6);
+    int background = 0;
+    for (int y = 0; y < kHeight; ++y) {
+        for (int x = 0; x < kWidth; ++x) {
+            background += pixelAt(culled, x, y) == toRgb(render::kBackgroundColor);
+        }
+    }
+    EXPECT_LT(background, kWidth * kHeight * 9 / 10);
+}
+
 TEST(Renderer, EveryShapeTypeIsDrawn) {
     engine::WorldSettings settings;
     settings.bounds = collision::Aabb{Vec3::Constant(-20), Vec3::Constant(20)};
@@ -549,18 +620,17 @@ TEST(StateColor, MatchesTheDocumentedColours) {
 TEST(HudLine, ShowsFrameTimeBroadPhaseAndCounts) {
     const engine::World world = makeThreeSphereWorld();
     const engine::StepStats& st = world.lastStats();
-    const std::string counters =
-        "BV tests " + std::to_string(st.broad.volume_tests) + "  updated " +
-        std::to_string(st.broad.volumes_updated) + "  narrow tests " +
-        std::to_string(st.narrow_tests) + "  triangle tests " + std::to_string(st.triangle_tests);
+    const std::string counters = "BV tests " + std::to_string(st.broad.volume_tests) +
+                                 "  updated " + std::to_string(st.broad.volumes_updated) +
+                                 "  narrow tests " + std::to_string(st.narrow_tests) +
+                                 "  triangle tests " + std::to_string(st.triangle_tests);
     EXPECT_EQ(render::hudLine(world, 12, false),
               "frame 12  t=0.000 s  sap  flagged 1  colliding 1\n" + counters);
     EXPECT_EQ(st.narrow_tests, 1);  // the one flagged pair went to the narrow phase
     const std::string timed = render::hudLine(world, 12, true);
-    EXPECT_EQ(timed.rfind("frame 12  t=0.000 s  sap  flagged 1  colliding 1\n" + counters +
-                              "\nstep ",
-                          0),
-              0u)
+    EXPECT_EQ(
+        timed.rfind("frame 12  t=0.000 s  sap  flagged 1  colliding 1\n" + counters + "\nstep ", 0),
+        0u)
         << timed;
     EXPECT_EQ(timed.substr(timed.size() - 3), " ms");
 }

@@ -160,11 +160,17 @@ Scene parseScene(const std::string& yaml_text, const std::string& display_name,
 struct SceneOverride {
     std::string key;
     std::string value;
+    std::string option = "--set";  ///< the command-line option that gave it, for messages
 };
 
-/// loadScene with `overrides` applied, in order, to the document before validation. Errors
-/// about an overridden value carry its key path (their line:col is that of the value text).
+/// loadScene with `overrides` applied, in order, to the document before validation. An error
+/// about an overridden value, or about an override's key path, names the option instead of a
+/// line of the file: "FILE: --set world.frames=abc: world.frames: expected an integer ...".
 Scene loadScene(const std::filesystem::path& file, const std::vector<SceneOverride>& overrides);
+/// parseScene with overrides, as loadScene.
+Scene parseScene(const std::string& yaml_text, const std::string& display_name,
+                 const std::filesystem::path& base_dir,
+                 const std::vector<SceneOverride>& overrides);
 
 /// Builds a World holding the scene's bodies, with volumes and pairs already detected.
 World makeWorld(const Scene& scene);

@@ -2,6 +2,7 @@
 // shaded bodies, bounding-volume wireframes coloured by overlap state, world bounds, HUD text.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -39,6 +40,22 @@ struct FrameOptions {
     engine::DrawSettings draw;
     bool draw_structure = false;  ///< the broad phase's own structure (BroadPhase::draw)
     std::string hud_text;         ///< the HUD line, top-left; empty = none
+    /// Leave out bodies and volumes wholly outside the view's side planes. Changes no pixel;
+    /// false draws everything (the reference the tests compare against).
+    bool cull = true;
+    /// Bodies are drawn in batches once this many triangle vertices are buffered, so memory
+    /// stays bounded whatever the number of bodies; batches change no pixel (same draw order).
+    std::int64_t triangle_batch_vertices = std::int64_t(1) << 20;
+};
+
+/// What the last frame drew, for tests and the curious.
+struct FrameStats {
+    std::int64_t bodies_drawn = 0;
+    std::int64_t bodies_culled = 0;      ///< outside the view (FrameOptions::cull)
+    std::int64_t volumes_culled = 0;     ///< bounding-volume wireframes outside the view
+    std::int64_t triangle_vertices = 0;  ///< all batches
+    std::int64_t batches = 0;
+    std::int64_t largest_batch_vertices = 0;
 };
 
 class Renderer {
@@ -60,6 +77,8 @@ public:
     int height() const;
     /// Supersampling factor per axis actually used (1 or 2).
     int supersample() const;
+    /// Counts of the last render().
+    const FrameStats& lastFrameStats() const;
 
 private:
     struct Impl;
