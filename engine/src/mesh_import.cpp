@@ -11,10 +11,14 @@
 #include <algorithm>
 #include <array>
 #include <assimp/Importer.hpp>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <exception>
+#include <fstream>
 #include <map>
+#include <optional>
+#include <string>
 #include <system_error>
 #include <utility>
 #include <vector>
@@ -28,6 +32,123 @@ using collision::Vec3;
 
 // A triangle is degenerate when |(b-a) x (c-a)| is at rounding level of its longest edge squared.
 constexpr Real kDegenerateArea = Real(4) * collision::kEpsilon;
+
+// Model files past this size are refused before assimp reads them (a binary STL of 256 MiB holds
+// 5.4 million triangles); assimp's memory grows with the file.
+constexpr std::uintmax_t kMaxMeshFileBytes = std::uintmax_t(256) << 20;
+
+// Reads whitespace-separated tokens of a text header, skipping '#' comments.
+class HeaderTokens {
+public:
+    explicit HeaderTokens(std::string text) : text_(std::move(text)) {}
+    std::optional<std::string> next() {
+        for (;;) {
+            while (pos_ < text_.size() && std::isspace(static_cast<unsigned char>(text_[pos_]))) {
+                ++pos_;
+            }
+            if (pos_ >= text_.size()) return std::nullopt;
+            if (text_[pos_] != '#') break;
+            while (pos_ < text_.size() && text_[pos_] != '\n') ++pos_;
+        }
+        const std::size_t from = pos_;
+        while (pos_ < text_.size() && !std::isspace(static_cast<unsigned char>(text_[pos_]))) {
+            ++pos_;
+        }
+        return text_.substr(from, pos_ - from);
+    }
+    /// The next token as a count (decimal digits only), or nullopt.
+    std::optional<long double> count() {
+        const std::optional<std::string> t = next();
+        if (!t || t->empty() || t->size() > 30 ||
+            !std::all_of(t->begin(), t->end(), [](char c) { return c >= '0' && c <= '9'; })) {
+            return std::nullopt;
+        }
+        return std::stold(*t);
+    }
+
+private:
+    std::string text_;
+    std::size_t pos_ = 0;
+};
+
+// Formats whose header states how many elements follow (OFF, PLY) are checked against the file's
+// size before assimp allocates for them: each element takes at least a few bytes, so a count the
+// bytes cannot hold is a lie (a 100-byte OFF claiming 2e8 vertices took assimp 5.5 GB and 16 s
+// to refuse; the same PLY in ASCII did not finish). Empty when the header is consistent or is
+// not one of these formats (assimp then judges the file alone).
+std::string declaredCountsError(const std::filesystem::path& file, std::uintmax_t bytes) {
+    std::ifstream in(file, std::ios::binary);
+    std::string head(64 * 1024, '\0');
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(in.gcount()));
+    const auto tooMany = [&](long double least_bytes, const std::string& what) -> std::string {
+        if (least_bytes <= static_cast<long double>(bytes)) return "";
+        return "'" + file.string() + "' declares " + what + ", more than its " +
+               std::to_string(bytes) + " bytes can hold (a truncated or corrupt file)";
+    };
+    HeaderTokens tokens(head);
+    const std::optional<std::string> magic = tokens.next();
+    if (!magic) return "";
+    // OFF (and COFF, NOFF, STOFF...): "OFF", then vertex, face and edge counts. A vertex takes at
+    // least 6 bytes of text ("0 0 0\n"), a face at least 2 ("0\n").
+    if (magic->size() >= 3 && magic->compare(magic->size() - 3, 3, "OFF") == 0 &&
+        magic->size() <= 8) {
+        const std::optional<long double> nv = tokens.count();
+        const std::optional<long double> nf = tokens.count();
+        if (!nv || !nf) return "";
+        return tooMany(*nv * 6 + *nf * 2,
+                       std::to_string(static_cast<unsigned long long>(std::min(*nv, 1e19L))) +
+                           " vertices and " +
+                           std::to_string(static_cast<unsigned long long>(std::min(*nf, 1e19L))) +
+                           " faces");
+    }
+    // PLY: "element NAME N" lines, each followed by its properties; the smallest element is the
+    // sum of its properties' sizes in binary (a list at least its count), two bytes each in ASCII.
+    if (*magic == "ply") {
+        bool binary = false;
+        long double least = 0;
+        long double elements = 0;
+        long double element_count = 0;
+        long double element_bytes = 0;
+        const auto sizeOf = [](const std::string& type) -> int {
+            if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+            if (type == "short" || type == "ushort" || type == "int16" || type == "uint16")
+                return 2;
+            if (type == "double" || type == "float64") return 8;
+            return 4;  // int, uint, float and their sized names
+        };
+        for (std::optional<std::string> t = tokens.next(); t; t = tokens.next()) {
+            if (*t == "format") {
+                const std::optional<std::string> f = tokens.next();
+                binary = f && f->rfind("binary", 0) == 0;
+            } else if (*t == "element" || *t == "end_header") {
+                least += element_count * element_bytes;
+                element_count = 0;
+                element_bytes = 0;
+                if (*t == "end_header") break;
+                tokens.next();  // name
+                const std::optional<long double> n = tokens.count();
+                if (!n) return "";
+                element_count = *n;
+                elements += *n;
+            } else if (*t == "property") {
+                std::optional<std::string> type = tokens.next();
+                if (type && *type == "list") {
+                    const std::optional<std::string> count_type = tokens.next();
+                    tokens.next();  // item type
+                    element_bytes += binary ? (count_type ? sizeOf(*count_type) : 1) : 2;
+                } else {
+                    element_bytes += binary ? (type ? sizeOf(*type) : 1) : 2;
+                }
+                tokens.next();  // property name
+            }
+        }
+        return tooMany(least,
+                       std::to_string(static_cast<unsigned long long>(std::min(elements, 1e19L))) +
+                           " elements (vertices, faces...)");
+    }
+    return "";
+}
 
 }  // namespace
 
@@ -45,6 +166,17 @@ MeshImportOutput importMesh(const std::filesystem::path& file, collision::Real s
     if (!std::filesystem::is_regular_file(file, ec)) {
         out.error = "cannot open '" + file.string() + "': not a regular file";
         return out;
+    }
+    const std::uintmax_t bytes = std::filesystem::file_size(file, ec);
+    if (!ec && bytes > kMaxMeshFileBytes) {
+        out.error = "'" + file.string() + "' has " + std::to_string(bytes) +
+                    " bytes, more than the limit of " + std::to_string(kMaxMeshFileBytes) +
+                    " (256 MiB) for a model file";
+        return out;
+    }
+    if (!ec) {
+        out.error = declaredCountsError(file, bytes);
+        if (!out.error.empty()) return out;
     }
 
     Assimp::Importer importer;
