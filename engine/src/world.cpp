@@ -615,6 +615,13 @@ void World::runCollisionPipeline() {
     stats_.broad = {};
     broad_phase_->findPairs(flagged_, stats_.broad);
     stats_.broad_phase_s = secondsSince(t);
+    if (flagged_.size() > settings_.max_candidate_pairs) {
+        throw SimulationError(std::to_string(flagged_.size()) + " candidate pairs after step " +
+                              std::to_string(step_count_) + ", more than the limit of " +
+                              std::to_string(settings_.max_candidate_pairs) +
+                              " a step may flag (the bodies' volumes overlap en masse; the "
+                              "narrow phase would test every pair)");
+    }
 
     t = Clock::now();
     colliding_.clear();
@@ -722,14 +729,14 @@ void World::step() {
 void World::checkFiniteState() const {
     for (std::size_t i = 0; i < bodies_.size(); ++i) {
         const Body& b = bodies_[i];
-        const char* quantity = !b.position.allFinite()                 ? "position"
-                               : !b.orientation.coeffs().allFinite()   ? "orientation"
-                               : !b.linear_momentum.allFinite()        ? "linear momentum"
-                               : !b.angular_momentum.allFinite()       ? "angular momentum"
-                                                                       : nullptr;
+        const char* quantity = !b.position.allFinite()               ? "position"
+                               : !b.orientation.coeffs().allFinite() ? "orientation"
+                               : !b.linear_momentum.allFinite()      ? "linear momentum"
+                               : !b.angular_momentum.allFinite()     ? "angular momentum"
+                                                                     : nullptr;
         if (quantity == nullptr) continue;
-        throw SimulationError("body '" + b.name + "' (bodies[" + std::to_string(i) + "]): " +
-                              quantity + " is not finite after step " +
+        throw SimulationError("body '" + b.name + "' (bodies[" + std::to_string(i) +
+                              "]): " + quantity + " is not finite after step " +
                               std::to_string(step_count_) +
                               " (the scene's speeds, spins or forces exceed what double "
                               "precision can integrate)");

@@ -900,6 +900,24 @@ TEST(SceneErrors, OctalAndQuotedNumbersAreRefused) {
     EXPECT_EQ(errorOf("---\n" + world + "  frames: 300\n  steps_per_frame: +2\nbodies:\n"), "");
 }
 
+// Regression: 20,000 coincident spheres were accepted and spent 130 s and 11 GB on frame 0 (10^6
+// would have run for days). A start whose bodies overlap in more pairs than a step may flag is
+// refused at the bodies key; the same count spread out loads.
+TEST(SceneErrors, BodiesOverlappingEnMasseAreRefusedUpFront) {
+    const std::string head =
+        "world:\n  bounds: {min: [-100, -100, -100], max: [100, 100, 100]}\n"
+        "bodies:\n  - shape: sphere\n    radius: 1\n";
+    EXPECT_SCENE_ERROR(head +
+                           "    repeat: {count: 5000, seed: 1, region: {min: [-1, -1, -1], "
+                           "max: [1, 1, 1]}}\n",
+                       "3:1: bodies: ",
+                       "overlap in about 1.24975e+07 pairs at the start, more "
+                       "than the 10000000 a step may flag");
+    EXPECT_EQ(errorOf(head + "    repeat: {count: 5000, seed: 1, region: {min: [-99, -99, -99], "
+                             "max: [99, 99, 99]}}\n"),
+              "");
+}
+
 // Regression: YAML::Load reads the first document only, so everything after a "---" was dropped
 // without a word (a scene split in two lost its second half).
 TEST(SceneErrors, ASecondDocumentIsRefusedWhereItStarts) {

@@ -277,6 +277,41 @@ TEST(World, NonFiniteStateStopsTheStepNamingBodyAndQuantity) {
     }
 }
 
+// Regression: 20,000 coincident spheres flagged 2e8 candidate pairs and spent 130 s and 11 GB on
+// frame 0. A step that flags more than settings.max_candidate_pairs stops with a SimulationError
+// (the scene loader refuses such starts up front; this catches bodies that crowd together later).
+// Here the limit is lowered so that 30 spheres converging on the origin cross it mid-run.
+TEST(World, AStepFlaggingTooManyPairsStops) {
+    for (const collision::BroadPhaseEntry& entry : collision::broadPhaseRegistry()) {
+        SCOPED_TRACE(std::string(entry.name));
+        WorldSettings s = openSpace();
+        s.broad_phase = std::string(entry.name);
+        s.time_step = 0.1;
+        s.max_candidate_pairs = 100;
+        World world(s);
+        const Body ball = makeBody("ball", Shape::sphere(0.5), sphereMass(0.5, 1));
+        for (int i = 0; i < 30; ++i) {
+            const double t = 2 * 3.14159265358979 * i / 30;
+            const Vec3 p(8 * std::cos(t), 8 * std::sin(t), 0.01 * i);
+            world.addBody(movingBody(ball, p, -p, Vec3::Zero()));  // at the origin after 1 s
+        }
+        world.detect();
+        EXPECT_LE(world.flaggedPairs().size(), 100u);
+        int steps = 0;
+        try {
+            for (; steps < 20; ++steps) world.step();
+            ADD_FAILURE() << "no SimulationError";
+        } catch (const SimulationError& e) {
+            const std::string what = e.what();
+            EXPECT_NE(what.find("candidate pairs after step"), std::string::npos) << what;
+            EXPECT_NE(what.find("more than the limit of 100 a step may flag"), std::string::npos)
+                << what;
+        }
+        EXPECT_GT(steps, 3);  // not before they crowd together
+        EXPECT_LT(steps, 12);
+    }
+}
+
 // Regression: reflection flipped the velocity of a body whose AABB crossed a face but never put
 // the body back, so a body crossing the whole world in one step left for good (11 of 30 bodies
 // outside at 1e4 m/s in a 20 m box; one at x = 2e8). Every centre stays inside the bounds at
