@@ -134,9 +134,11 @@ double estimateStartPairs(const std::vector<Body>& bodies) {
         const Real hi[3] = {box[3][i], box[4][i], box[5][i]};
         std::uint64_t count = 0;
         for (std::size_t j = 0; j < n; ++j) {
-            count += static_cast<std::uint64_t>((box[0][j] <= hi[0]) & (lo[0] <= box[3][j]) &
-                                                (box[1][j] <= hi[1]) & (lo[1] <= box[4][j]) &
-                                                (box[2][j] <= hi[2]) & (lo[2] <= box[5][j]));
+            // Bitwise on 0/1 integers: no branch per comparison.
+            const unsigned x = unsigned(box[0][j] <= hi[0]) & unsigned(lo[0] <= box[3][j]);
+            const unsigned y = unsigned(box[1][j] <= hi[1]) & unsigned(lo[1] <= box[4][j]);
+            const unsigned z = unsigned(box[2][j] <= hi[2]) & unsigned(lo[2] <= box[5][j]);
+            count += x & y & z;
         }
         hits += count - 1;  // itself
     }
