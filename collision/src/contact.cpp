@@ -20,6 +20,7 @@
 #include "collision/assert.h"
 #include "epa.h"
 #include "gjk.h"
+#include "shape_measures.h"
 
 namespace collision {
 
@@ -52,27 +53,6 @@ struct Ctx {
 
 // The contact in A's frame (canonical order); world transform and mirroring happen once.
 using Local = ContactOutput;
-
-Real boundingRadius(const Shape& shape) {
-    switch (shape.type) {
-        case ShapeType::Sphere:
-            return shape.radius;
-        case ShapeType::Box:
-            return shape.half_extents.norm();
-        case ShapeType::Capsule:
-            return shape.half_height + shape.radius;
-        case ShapeType::ConvexHull:
-        case ShapeType::Mesh:
-            return ConvexCore::fromShape(shape).boundingRadius();
-    }
-    return 0;
-}
-
-bool isFinite(const Shape& shape, const Pose& pose) {
-    return std::isfinite(shape.radius) && std::isfinite(shape.half_height) &&
-           shape.half_extents.allFinite() && pose.position.allFinite() &&
-           pose.orientation.coeffs().allFinite();
-}
 
 // Canonical order of two shapes: by type, then by a key of pose and dimensions, then by the
 // hull's address (equal keys and hulls mean identical inputs, where the order does not matter).

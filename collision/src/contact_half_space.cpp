@@ -12,6 +12,7 @@
 #include "collision/half_space.h"
 #include "collision/narrow_phase.h"
 #include "gjk.h"
+#include "shape_measures.h"
 
 namespace collision {
 
@@ -22,21 +23,6 @@ namespace {
 constexpr Real kFeatureRelative = std::max(Real(1e-9), Real(64) * kEpsilon);
 // A normal farther than this from unit length is bad input (Failed).
 constexpr Real kUnitTolerance = Real(1e-6);
-
-Real shapeScale(const Shape& shape) {
-    switch (shape.type) {
-        case ShapeType::Sphere:
-            return shape.radius;
-        case ShapeType::Box:
-            return shape.half_extents.norm();
-        case ShapeType::Capsule:
-            return shape.half_height + shape.radius;
-        case ShapeType::ConvexHull:
-        case ShapeType::Mesh:
-            return ConvexCore::fromShape(shape).boundingRadius();
-    }
-    return 0;
-}
 
 // A point of the shape (its frame) with its height above the plane.
 struct Candidate {
@@ -181,7 +167,7 @@ ContactOutput contact(const HalfSpace& a, const Shape& b, const Pose& pose_b) {
     const Mat3 rot = pose_b.rotation();
     const Vec3 n_l = rot.transpose() * n;
     const Real h0 = n.dot(pose_b.position) - a.offset;  // height of b's origin
-    const Real scale = shapeScale(b);
+    const Real scale = boundingRadius(b);
     const Real feature_tol = kFeatureRelative * scale;
     const Real touch_tol = kTouchRelativeTolerance * scale;
 

@@ -19,6 +19,7 @@
 #include "collision/assert.h"
 #include "collision/bvh.h"
 #include "gjk.h"
+#include "shape_measures.h"
 #include "triangle_triangle.h"
 
 namespace collision {
@@ -484,33 +485,11 @@ constexpr PairTable makePairTable() {
 
 constexpr PairTable kPairTable = makePairTable();
 
-// Largest distance of the shape from its local origin: the length scale of its coordinates.
-Real boundingRadius(const Shape& shape) {
-    switch (shape.type) {
-        case ShapeType::Sphere:
-            return shape.radius;
-        case ShapeType::Box:
-            return shape.half_extents.norm();
-        case ShapeType::Capsule:
-            return shape.half_height + shape.radius;
-        case ShapeType::ConvexHull:
-        case ShapeType::Mesh:
-            return ConvexCore::fromShape(shape).boundingRadius();
-    }
-    return 0;
-}
-
 PairContext pairContext(const Shape& a, const Shape& b) {
     PairContext ctx;
     ctx.scale = std::max(boundingRadius(a), boundingRadius(b));
     ctx.tolerance = kTouchRelativeTolerance * ctx.scale;
     return ctx;
-}
-
-bool isFinite(const Shape& shape, const Pose& pose) {
-    return std::isfinite(shape.radius) && std::isfinite(shape.half_height) &&
-           shape.half_extents.allFinite() && pose.position.allFinite() &&
-           pose.orientation.coeffs().allFinite();
 }
 
 // A strict order on (shape, pose) used to run same-type pairs in one canonical order.
