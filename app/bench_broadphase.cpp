@@ -7,12 +7,15 @@
 // set (count and order-independent hash) is compared with an independent reference sweep.
 #include "bench_broadphase.h"
 
+#include <CLI/CLI.hpp>
 #include <fcntl.h>
 #include <malloc.h>
+#include <memory>
 #include <signal.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
+#include <vector>
 
 #include <algorithm>
 #include <cerrno>
@@ -29,6 +32,8 @@
 
 #include "bench_method.h"
 #include "bench_workload.h"
+#include "command.h"
+#include "exit_codes.h"
 #include "output_files.h"
 #include "render/output_file.h"
 
@@ -38,9 +43,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr int kExitOk = 0;
-constexpr int kExitFailure = 1;
-constexpr int kExitBadInput = 2;
 constexpr int kEdgeFrames = 100;  // frames in the "first" and "last" medians
 
 double clockSeconds(clockid_t clock) {
@@ -556,6 +558,46 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
         if (!writeJsonAtomically(*options.json, doc, err)) return kExitFailure;
     }
     return failed ? kExitFailure : kExitOk;
+}
+
+Command addBenchBroadphaseCommand(CLI::App& bench) {
+    struct Flags {
+        BenchOptions options;
+        std::string json;
+        bool in_process = false;
+    };
+    auto f = std::make_shared<Flags>();
+    BenchOptions& o = f->options;
+    CLI::App* cmd = bench.add_subcommand(
+        "broadphase", "cdlab's broad phases beside Bullet and FCL on moving boxes");
+    cmd->add_option("--sizes", o.sizes, "box counts, comma-separated")
+        ->delimiter(',')
+        ->capture_default_str();
+    cmd->add_option("--frames", o.frames, "measured frames per method")->capture_default_str();
+    cmd->add_option("--methods", o.methods,
+                    "comma-separated (default: every AABB broad phase and the default peers)")
+        ->delimiter(',');
+    cmd->add_option("--workload", o.workload,
+                    "uniform, mixed (sizes 1:100), both (those two) or wide (sizes 1:10^4)")
+        ->check(CLI::IsMember({"uniform", "mixed", "both", "wide"}))
+        ->capture_default_str();
+    cmd->add_option("--json", f->json, "also write the rows as JSON to FILE");
+    cmd->add_option("--seed", o.seed, "workload seed")->capture_default_str();
+    cmd->add_option("--budget", o.budget_seconds,
+                    "stop a method after this many seconds of frame time (0: no limit)")
+        ->capture_default_str();
+    cmd->add_option("--clock", o.clock,
+                    "thread: thread CPU time per frame (methods on several threads left out); "
+                    "wall: elapsed time, every method")
+        ->check(CLI::IsMember({"thread", "wall"}))
+        ->capture_default_str();
+    cmd->add_flag("--in-process", f->in_process,
+                  "do not fork per method (no per-method peak memory)");
+    return {cmd, [f]() {
+                if (!f->json.empty()) f->options.json = f->json;
+                f->options.isolate = !f->in_process;
+                return runBenchBroadphase(f->options, std::cout, std::cerr);
+            }};
 }
 
 }  // namespace app

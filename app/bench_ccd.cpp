@@ -4,6 +4,7 @@
 // Rows come out sorted by (method, set, kind), so two runs compare line by line.
 #include "bench_ccd.h"
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -13,10 +14,14 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string>
+#include <vector>
 
-#include "collision/ccd.h"
+#include "collision/ccd/ccd.h"
+#include "command.h"
 #include "engine/scene.h"
 #include "engine/world.h"
 #include "output_files.h"
@@ -414,6 +419,39 @@ int runBenchCcd(const BenchCcdOptions& options, std::ostream& out, std::ostream&
         if (!writeTextReporting(*options.json, doc.dump(2) + "\n", err)) return 1;
     }
     return status;
+}
+
+Command addBenchCcdCommand(CLI::App& bench) {
+    struct Flags {
+        BenchCcdOptions options;
+        std::vector<std::string> dirs;
+        std::string json;
+        std::string scenes;
+        bool no_scenes = false;
+    };
+    auto f = std::make_shared<Flags>();
+    CLI::App* cmd = bench.add_subcommand(
+        "ccd", "vertex-face and edge-edge CCD methods on the sample queries: FN, FP, us/query");
+    cmd->add_option("dirs", f->dirs, "query directories (default tests/data/ccd-sample-queries)");
+    cmd->add_option("--json", f->json, "also write the table as JSON to FILE");
+    cmd->add_option("--method", f->options.method, "conservative, naive or all")
+        ->check(CLI::IsMember({"conservative", "naive", "all"}))
+        ->capture_default_str();
+    cmd->add_option("--scenes", f->scenes,
+                    "folder with tunnel_sphere.yaml and tunnel_bar.yaml (default scenes): "
+                    "CCD cost per frame, off vs on");
+    cmd->add_flag("--no-scenes", f->no_scenes, "skip the tunnelling scenes");
+    return {cmd, [f]() {
+                BenchCcdOptions& o = f->options;
+                for (const std::string& d : f->dirs) o.dirs.emplace_back(d);
+                if (!f->json.empty()) o.json = f->json;
+                if (!f->scenes.empty()) {
+                    o.scenes_dir = f->scenes;
+                    o.scenes_explicit = true;
+                }
+                o.scenes = !f->no_scenes;
+                return runBenchCcd(o, std::cout, std::cerr);
+            }};
 }
 
 }  // namespace app

@@ -11,6 +11,7 @@
 // (signedDistanceReference: closed forms, or the exact projection-overlap reference for boxes).
 #include "bench_convex.h"
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -24,9 +25,10 @@
 #include <string>
 #include <vector>
 
-#include "collision/contact.h"
-#include "collision/contact_reference.h"
-#include "collision/narrow_phase.h"
+#include "collision/narrowphase/contact.h"
+#include "collision/narrowphase/contact_reference.h"
+#include "collision/narrowphase/narrow_phase.h"
+#include "command.h"
 #include "output_files.h"
 
 #ifdef CDLAB_HAVE_BULLET
@@ -545,6 +547,30 @@ int runBenchConvex(const BenchConvexOptions& options, std::ostream& out, std::os
         if (!writeTextReporting(*options.json, doc.dump(2) + "\n", err)) return 1;
     }
     return 0;
+}
+
+Command addBenchConvexCommand(CLI::App& bench) {
+    struct Flags {
+        BenchConvexOptions options;
+        std::string json;
+    };
+    auto f = std::make_shared<Flags>();
+    BenchConvexOptions& o = f->options;
+    CLI::App* cmd = bench.add_subcommand(
+        "convex",
+        "convex contact queries (GJK, EPA, SAT, closed forms) beside Bullet's GJK/EPA: "
+        "us/query, answers compared");
+    cmd->add_option("--queries", o.queries, "random pairs per workload")->capture_default_str();
+    cmd->add_option("--passes", o.passes, "timed passes (fastest kept)")->capture_default_str();
+    cmd->add_option("--seed", o.seed, "pose seed")->capture_default_str();
+    cmd->add_option("--tolerance", o.tolerance,
+                    "relative answer tolerance for counting disagreements")
+        ->capture_default_str();
+    cmd->add_option("--json", f->json, "also write the rows as JSON to FILE");
+    return {cmd, [f]() {
+                if (!f->json.empty()) f->options.json = f->json;
+                return runBenchConvex(f->options, std::cout, std::cerr);
+            }};
 }
 
 }  // namespace app

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "bench_workload.h"
-#include "collision/broad_phase.h"
+#include "collision/broadphase/broad_phase.h"
 
 namespace app {
 

@@ -7,20 +7,25 @@
 // (FCL's triangle test is not exact).
 #include "bench_narrowphase.h"
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
+#include <iostream>
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <ostream>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "bvh_unit_costs.h"
-#include "collision/bvh.h"
+#include "collision/bvh/bvh.h"
+#include "command.h"
 #include "output_files.h"
 
 #ifdef CDLAB_HAVE_FCL
@@ -465,6 +470,34 @@ int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& ou
         return 1;
     }
     return 0;
+}
+
+Command addBenchNarrowphaseCommand(CLI::App& bench) {
+    struct Flags {
+        BenchNarrowphaseOptions options;
+        std::string json;
+    };
+    auto f = std::make_shared<Flags>();
+    BenchNarrowphaseOptions& o = f->options;
+    CLI::App* cmd = bench.add_subcommand(
+        "narrowphase",
+        "mesh-mesh queries on two tori: every BVH volume type beside FCL's "
+        "BVHModel types (build, first contact, all pairs, Nv, Np)");
+    cmd->add_option("--triangles", o.triangles, "triangles per torus")->capture_default_str();
+    cmd->add_flag("--large", o.large, "100k-triangle tori");
+    cmd->add_option("--poses", o.poses, "poses, even: half collide")->capture_default_str();
+    cmd->add_option("--reps", o.reps, "repetitions per pose (fastest counts)")
+        ->capture_default_str();
+    cmd->add_option("--seed", o.seed, "pose seed")->capture_default_str();
+    cmd->add_option("--methods", o.methods,
+                    "comma-separated (default all): volume names (NAME-bu: bottom-up build) "
+                    "and fcl-obbrss, fcl-obb, fcl-rss, fcl-kios, fcl-aabb, fcl-kdop18")
+        ->delimiter(',');
+    cmd->add_option("--json", f->json, "also write the table as JSON to FILE");
+    return {cmd, [f]() {
+                if (!f->json.empty()) f->options.json = f->json;
+                return runBenchNarrowphase(f->options, std::cout, std::cerr);
+            }};
 }
 
 }  // namespace app

@@ -9,9 +9,9 @@
 #include <string_view>
 #include <vector>
 
-#include "collision/bounding_volumes.h"
-#include "collision/broad_phase.h"
+#include "collision/broadphase/broad_phase.h"
 #include "collision/math.h"
+#include "collision/volumes/bounding_volumes.h"
 
 namespace app {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "collision/broad_phase.h"
+#include "collision/broadphase/broad_phase.h"
 #include "engine/world.h"
 
 namespace app {

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <span>
 
-#include "collision/bvh.h"
+#include "collision/bvh/bvh.h"
 
 namespace app {
 

@@ -5,7 +5,11 @@
 // the expect keys below, then file order), so two checks of the same scene print the same table.
 #include "check_command.h"
 
+#include <CLI/CLI.hpp>
+#include <iostream>
+#include <string>
 #include <unistd.h>
+#include <vector>
 
 #include <algorithm>
 #include <array>
@@ -17,7 +21,9 @@
 #include <sstream>
 
 #include "broadphase_check.h"
-#include "collision/broad_phase.h"
+#include "collision/broadphase/broad_phase.h"
+#include "command.h"
+#include "exit_codes.h"
 #include "output_files.h"
 #include "pause_dump.h"
 #include "render/image.h"
@@ -28,10 +34,6 @@ namespace app {
 namespace fs = std::filesystem;
 
 namespace {
-
-constexpr int kExitOk = 0;
-constexpr int kExitFailure = 1;
-constexpr int kExitBadInput = 2;
 
 // A body counts as moving when its centre got this fraction of the world-bounds diagonal away
 // from where it started, and as rotating when its orientation got kMinRotationRad away, at any
@@ -671,6 +673,31 @@ int runCheck(const CheckOptions& options, std::ostream& out, std::ostream& err) 
     out << scenes.size() << " scene" << (scenes.size() == 1 ? "" : "s") << ", " << lines.size()
         << " expectations, " << failed << " failed\n";
     return failed == 0 ? kExitOk : kExitFailure;
+}
+
+Command addCheckCommand(CLI::App& cli) {
+    struct Flags {
+        CheckOptions check;
+        std::vector<std::string> scenes;
+        int frames = 0;
+        std::string out;
+    };
+    auto f = std::make_shared<Flags>();
+    CLI::App* cmd =
+        cli.add_subcommand("check",
+                           "run scenes headless and grade them against their 'expect:' sections: a "
+                           "pass/fail table, exit 0 all pass, 1 any failure, 2 bad input");
+    cmd->add_option("scenes", f->scenes, "scene files (YAML)")->required();
+    cmd->add_option("--frames", f->frames,
+                    "frames to run (overrides expect.frames and the scene)");
+    cmd->add_option("--out", f->out,
+                    "keep pause dumps in DIR (default: a temporary folder, removed)");
+    return {cmd, [cmd, f]() {
+                for (const std::string& sc : f->scenes) f->check.scenes.emplace_back(sc);
+                if (cmd->count("--frames") > 0) f->check.frames = f->frames;
+                if (!f->out.empty()) f->check.out_dir = f->out;
+                return runCheck(f->check, std::cout, std::cerr);
+            }};
 }
 
 }  // namespace app

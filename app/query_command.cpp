@@ -3,18 +3,22 @@
 // Wiring only: trees and queries are collision/bvh.h; mesh loading is engine/mesh_import.h.
 #include "query_command.h"
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
+#include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <ostream>
 #include <span>
 #include <sstream>
+#include <string>
 #include <vector>
 
 #include "bvh_unit_costs.h"
-#include "collision/bvh.h"
+#include "collision/bvh/bvh.h"
+#include "command.h"
 #include "engine/mesh_import.h"
 
 namespace app {
@@ -228,6 +232,21 @@ int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err) 
         return 1;
     }
     return 0;
+}
+
+Command addQueryCommand(CLI::App& cli) {
+    auto query = std::make_shared<QueryOptions>();
+    CLI::App* cmd = cli.add_subcommand(
+        "query",
+        "mesh against mesh through every BVH volume type: answer, triangle pairs, "
+        "BV and triangle tests, build and query time side by side");
+    cmd->add_option("mesh_a", query->mesh_a, "mesh A (any format assimp reads)")->required();
+    cmd->add_option("mesh_b", query->mesh_b, "mesh B")->required();
+    cmd->add_option("--bv", query->bv, "volume type or all")->capture_default_str();
+    cmd->add_option("--pose-b", query->pose_b,
+                    "B's pose in A's frame: x,y,z,qw,qx,qy,qz (default identity)");
+    cmd->add_flag("--json", query->json, "machine-readable output");
+    return {cmd, [query]() { return runQuery(*query, std::cout, std::cerr); }};
 }
 
 }  // namespace app

@@ -3,7 +3,11 @@
 // and renamed, and summary.json, written last, marks a finished run.
 #include "run_command.h"
 
+#include <CLI/CLI.hpp>
+#include <memory>
+#include <string>
 #include <unistd.h>
+#include <vector>
 
 #include <algorithm>
 #include <cstdio>
@@ -16,7 +20,10 @@
 #include <sstream>
 
 #include "broadphase_check.h"
+#include "collision/broadphase/broad_phase.h"
+#include "command.h"
 #include "engine/scene.h"
+#include "exit_codes.h"
 #include "output_files.h"
 #include "pause_dump.h"
 #include "render/image.h"
@@ -28,11 +35,6 @@ namespace app {
 namespace fs = std::filesystem;
 
 namespace {
-
-constexpr int kExitOk = 0;
-constexpr int kExitFailure = 1;
-constexpr int kExitBadInput = 2;
-constexpr int kExitCheckFailed = 3;
 
 class ProgressBar {
 public:
@@ -298,6 +300,82 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         return kExitFailure;
     }
     return kExitOk;
+}
+
+Command addRunCommand(CLI::App& cli) {
+    // The flags' storage lives as long as the returned command (shared with its run function).
+    struct Flags {
+        RunOptions run;
+        std::string out_dir;
+        std::string video;
+        int frames = 0;
+        std::string broad_phase;
+        bool no_timing = false;
+        std::string stats;
+        bool quiet = false;
+        std::vector<std::string> set;
+        std::string trace;
+    };
+    auto f = std::make_shared<Flags>();
+    CLI::App* cmd = cli.add_subcommand("run", "simulate a scene, write PNG frames and a video");
+    cmd->add_option("scene", f->run.scene, "scene file (YAML)")->required();
+    cmd->add_option("--out", f->out_dir, "output directory (default out/<scene name>)");
+    cmd->add_option("--frames", f->frames, "number of frames (overrides the scene)");
+    CLI::Option* video_opt =
+        cmd->add_option("--video", f->video, "video file (default <out>/<scene name>.mp4)");
+    cmd->add_flag("--no-video", f->run.no_video, "do not write a video")->excludes(video_opt);
+    cmd->add_flag("--no-frames", f->run.no_frames, "do not write per-frame PNGs");
+    cmd->add_option("--broadphase", f->broad_phase,
+                    "broad phase (overrides the scene): " + collision::broadPhaseNames());
+    cmd->add_option("--pause-at", f->run.pause_at,
+                    "pause at FRAME: write pause_FRAME.png (every bounding volume) and "
+                    "pause_FRAME.json (repeatable)")
+        ->expected(1)
+        ->take_all();
+    cmd->add_flag("--no-hud-timing", f->no_timing,
+                  "leave the step time out of the HUD so frames are bit-identical");
+    cmd->add_flag("--draw-structure", f->run.draw_structure,
+                  "draw the broad phase's own structure: grid/hash cells, hierarchical-grid "
+                  "cells by level, SAP intervals, tree and octree nodes by depth");
+    cmd->add_flag("--check-broadphase", f->run.check_broad_phase,
+                  "verify every step's pairs against the brute-force reference; stop with a "
+                  "report (exit 3) at the first mismatch");
+    cmd->add_option("--stats", f->stats, "write per-frame counters and stage times to FILE.csv");
+    cmd->add_flag("--quiet", f->quiet, "no progress bar");
+    cmd->add_option("--set", f->set,
+                    "KEY=VALUE: replace a scene value before validation, KEY a dotted path "
+                    "(world.time_step, bodies.2.radius); repeatable")
+        ->expected(1)
+        ->take_all();
+    cmd->add_option("--trace", f->trace,
+                    "write every frame's body poses and confirmed pairs to FILE (JSON lines)");
+    return {cmd, [cmd, f]() {
+                RunOptions& run = f->run;
+                // A flag given with an empty value ("--broadphase ''") is an error, not "unset".
+                for (const char* name : {"--out", "--video", "--broadphase", "--stats", "--trace"}) {
+                    if (cmd->count(name) > 0 && cmd->get_option(name)->as<std::string>().empty()) {
+                        std::cerr << name << ": must not be empty\n";
+                        return kExitBadInput;
+                    }
+                }
+                if (!f->out_dir.empty()) run.out_dir = f->out_dir;
+                if (!f->video.empty()) run.video = f->video;
+                if (cmd->count("--frames") > 0) run.frames = f->frames;
+                if (!f->broad_phase.empty()) run.broad_phase = f->broad_phase;
+                if (!f->stats.empty()) run.stats_csv = f->stats;
+                for (const std::string& kv : f->set) {
+                    const std::size_t eq = kv.find('=');
+                    if (eq == std::string::npos || eq == 0) {
+                        std::cerr << "--set '" << kv << "': expected KEY=VALUE\n";
+                        return kExitBadInput;
+                    }
+                    run.overrides.push_back({kv.substr(0, eq), kv.substr(eq + 1)});
+                }
+                if (!f->trace.empty()) run.trace = f->trace;
+                run.hud_timing = !f->no_timing;
+                run.progress = !f->quiet;
+                return runScene(run, std::cout, std::cerr);
+            }};
 }
 
 }  // namespace app

@@ -6,8 +6,13 @@
 // two time steps). Everything but the wall-clock times is deterministic.
 #include "sweep_command.h"
 
+#include <CLI/CLI.hpp>
+#include <iostream>
 #include <malloc.h>
+#include <memory>
+#include <string>
 #include <sys/wait.h>
+#include <vector>
 
 #include <algorithm>
 #include <cmath>
@@ -19,7 +24,9 @@
 #include <sstream>
 #include <utility>
 
-#include "collision/contact.h"
+#include "collision/narrowphase/contact.h"
+#include "command.h"
+#include "exit_codes.h"
 #include "output_files.h"
 #include "render/chart.h"
 #include "render/image.h"
@@ -30,10 +37,6 @@ namespace app {
 namespace fs = std::filesystem;
 
 namespace {
-
-constexpr int kExitOk = 0;
-constexpr int kExitFailure = 1;
-constexpr int kExitBadInput = 2;
 
 using PairKey = std::pair<collision::ProxyId, collision::ProxyId>;
 struct Vec3Like {
@@ -841,6 +844,52 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
         return kExitFailure;
     }
     return kExitOk;
+}
+
+Command addSweepCommand(CLI::App& cli) {
+    struct Flags {
+        SweepOptions sweep;
+        std::string out;
+        double duration = 0;
+        std::string float_binary;
+        bool no_timing = false;
+    };
+    auto f = std::make_shared<Flags>();
+    CLI::App* cmd = cli.add_subcommand(
+        "sweep",
+        "run one scene under every combination of choices; measure cost and accuracy "
+        "against a fine reference run; write results.csv, report.md and charts");
+    cmd->add_option("scene", f->sweep.scene, "scene file (YAML)")->required();
+    cmd->add_option("--vary", f->sweep.vary,
+                    "KEY=V1,V2,... (repeatable): a dotted scene key and its values, e.g. "
+                    "broadphase=sap,hgrid or world.time_step=0.01,0.002")
+        ->expected(1)
+        ->take_all();
+    cmd->add_option("--reference", f->sweep.reference,
+                    "KEY=VALUE override for the reference run (repeatable)")
+        ->expected(1)
+        ->take_all();
+    cmd->add_option("--reference-refine", f->sweep.reference_refine,
+                    "the reference's time step is the scene's divided by this")
+        ->capture_default_str();
+    cmd->add_option("--duration", f->duration,
+                    "simulated seconds per run (default: the scene's frames)");
+    cmd->add_option("--out", f->out, "output directory (default out/sweep_<scene>)");
+    cmd->add_option("--float-binary", f->float_binary,
+                    "a cdlab built with -DCDLAB_USE_FLOAT=ON: compare every run's frames "
+                    "with it (float_vs_double.csv, a report section)");
+    cmd->add_flag("--keep-traces", f->sweep.keep_traces,
+                  "keep DIR/traces/ (both builds' frames) after the float comparison");
+    cmd->add_flag("--no-report-timing", f->no_timing,
+                  "leave wall-clock times out of report.md so it is bit-identical");
+    return {cmd, [cmd, f]() {
+                SweepOptions& sweep = f->sweep;
+                if (!f->out.empty()) sweep.out_dir = f->out;
+                if (cmd->count("--duration") > 0) sweep.duration = f->duration;
+                sweep.report_timing = !f->no_timing;
+                if (!f->float_binary.empty()) sweep.float_binary = f->float_binary;
+                return runSweep(sweep, std::cout, std::cerr);
+            }};
 }
 
 }  // namespace app

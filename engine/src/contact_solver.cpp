@@ -14,7 +14,7 @@
 #include <limits>
 #include <utility>
 
-#include "collision/narrow_phase.h"
+#include "collision/narrowphase/narrow_phase.h"
 
 namespace engine {
 

@@ -5,8 +5,8 @@
 #include <span>
 #include <vector>
 
-#include "collision/broad_phase.h"
-#include "collision/contact.h"
+#include "collision/broadphase/broad_phase.h"
+#include "collision/narrowphase/contact.h"
 #include "engine/body.h"
 
 namespace engine {

@@ -30,9 +30,9 @@
 #include <tuple>
 #include <utility>
 
-#include "collision/broad_phase.h"
-#include "collision/bvh.h"
-#include "collision/convex_hull.h"
+#include "collision/broadphase/broad_phase.h"
+#include "collision/bvh/bvh.h"
+#include "collision/geometry/convex_hull.h"
 #include "engine/mass_properties.h"
 #include "engine/mesh_import.h"
 

@@ -12,9 +12,9 @@
 #include <stdexcept>
 #include <utility>
 
-#include "collision/bvh.h"
-#include "collision/ccd.h"
-#include "collision/narrow_phase.h"
+#include "collision/bvh/bvh.h"
+#include "collision/ccd/ccd.h"
+#include "collision/narrowphase/narrow_phase.h"
 #include "contact_solver.h"
 
 namespace engine {

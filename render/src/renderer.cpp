@@ -15,9 +15,9 @@
 #include <map>
 #include <vector>
 
-#include "collision/bounding_volumes.h"
-#include "collision/narrow_phase.h"
-#include "collision/shape.h"
+#include "collision/geometry/shape.h"
+#include "collision/narrowphase/narrow_phase.h"
+#include "collision/volumes/bounding_volumes.h"
 #include "font.h"
 
 namespace render {

@@ -12,8 +12,8 @@
 #include <string>
 
 #include "bench_narrowphase.h"
-#include "collision/bvh.h"
 #include "cli_run.h"
+#include "collision/bvh/bvh.h"
 
 namespace {
 

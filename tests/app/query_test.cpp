@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "collision/bvh.h"
+#include "collision/bvh/bvh.h"
 #include "engine/mesh_import.h"
 #include "query_command.h"
 

@@ -1,6 +1,6 @@
 // Fitted volumes contain their shapes; world AABBs are exact; OBB SAT agrees with a sampled
 // reference and treats touching as overlap.
-#include "collision/bounding_volumes.h"
+#include "collision/volumes/bounding_volumes.h"
 
 #include <gtest/gtest.h>
 
@@ -8,8 +8,8 @@
 #include <limits>
 #include <optional>
 
-#include "collision/convex_hull.h"
-#include "collision/shape.h"
+#include "collision/geometry/convex_hull.h"
+#include "collision/geometry/shape.h"
 #include "test_random.h"
 
 namespace collision {

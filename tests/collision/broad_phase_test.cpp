@@ -1,7 +1,7 @@
 // Differential tests: every broad phase in the registry reports exactly its brute-force
 // reference's pair set on every frame of random and adversarial coherent-motion scenes,
 // including touching and zero-size boxes and proxies leaving and re-entering.
-#include "collision/broad_phase.h"
+#include "collision/broadphase/broad_phase.h"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // (draw.bvh_depth) and the contact witnesses (draw.contacts): the node states of two interlocked
 // tori against a brute-force computation written here from the tree's public nodes, for every
 // volume type; mesh-convex marks; the witnesses of each pair kind.
-#include "collision/bvh_level.h"
+#include "collision/bvh/bvh_level.h"
 
 #include <gtest/gtest.h>
 
@@ -13,13 +13,13 @@
 #include <tuple>
 #include <vector>
 
-#include "bvh_volumes.h"
-#include "collision/contact.h"
-#include "collision/convex_hull.h"
-#include "collision/narrow_phase.h"
-#include "gjk.h"
+#include "collision/geometry/convex_hull.h"
+#include "collision/narrowphase/contact.h"
+#include "collision/narrowphase/narrow_phase.h"
+#include "geometry/triangle_distance.h"
+#include "narrowphase/gjk.h"
 #include "test_meshes.h"
-#include "triangle_distance.h"
+#include "volumes/bvh_volumes.h"
 
 namespace {
 

@@ -2,7 +2,7 @@
 // against the brute-force triangle-pair reference (random, touching and coplanar poses),
 // containment of every fitted volume (validate), metamorphic translation and scaling, and the
 // lookup by name.
-#include "collision/bvh.h"
+#include "collision/bvh/bvh.h"
 
 #include <gtest/gtest.h>
 

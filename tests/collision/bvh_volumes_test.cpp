@@ -2,7 +2,7 @@
 // in collision/src/bvh_volumes.h): the LSS's segment-distance overlap test against an independent
 // reference and closed forms (parallel, crossing, touching, zero length, 1e6 from the origin,
 // near-parallel), its distance lower bound, and its fit's containment and tightness.
-#include "bvh_volumes.h"
+#include "volumes/bvh_volumes.h"
 
 #include <gtest/gtest.h>
 

@@ -9,9 +9,9 @@
 #include <limits>
 #include <vector>
 
-#include "collision/ccd.h"
-#include "collision/narrow_phase.h"
-#include "collision/shape.h"
+#include "collision/ccd/ccd.h"
+#include "collision/geometry/shape.h"
+#include "collision/narrowphase/narrow_phase.h"
 #include "test_random.h"
 
 namespace collision {

@@ -6,10 +6,10 @@
 #include <cmath>
 #include <memory>
 
-#include "collision/bvh.h"
-#include "collision/ccd.h"
-#include "collision/convex_hull.h"
-#include "collision/shape.h"
+#include "collision/bvh/bvh.h"
+#include "collision/ccd/ccd.h"
+#include "collision/geometry/convex_hull.h"
+#include "collision/geometry/shape.h"
 #include "test_meshes.h"
 #include "test_random.h"
 

@@ -7,8 +7,8 @@
 #include <cmath>
 #include <limits>
 
-#include "collision/bounding_volumes.h"
-#include "collision/ccd.h"
+#include "collision/ccd/ccd.h"
+#include "collision/volumes/bounding_volumes.h"
 #include "test_random.h"
 
 namespace collision {

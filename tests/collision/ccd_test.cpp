@@ -1,7 +1,7 @@
 // CCD queries: sphere time of impact against closed forms, and the conservative vertex-face /
 // edge-edge queries against the exact ground truth of the Wang et al. 2021 sample queries
 // (tests/data/ccd-sample-queries, MIT), beside the naive cubic baseline.
-#include "collision/ccd.h"
+#include "collision/ccd/ccd.h"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // brute-force projection-overlap reference (contact_reference.h): exact for box/hull pairs (every
 // SAT axis of A - B is a candidate), an upper bound for pairs with a round shape. The reference
 // itself is first checked against closed forms.
-#include "collision/contact_reference.h"
+#include "collision/narrowphase/contact_reference.h"
 
 #include <gtest/gtest.h>
 
@@ -12,8 +12,8 @@
 #include <sstream>
 #include <vector>
 
-#include "collision/contact.h"
-#include "collision/convex_hull.h"
+#include "collision/geometry/convex_hull.h"
+#include "collision/narrowphase/contact.h"
 #include "test_random.h"
 #include "test_scale.h"
 

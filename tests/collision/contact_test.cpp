@@ -3,7 +3,7 @@
 // capsule-capsule) on random pairs that collide 30-70 % of the time; GJK/EPA (boxes and spheres
 // given as hulls) against the same closed forms and against box-box SAT; mirror symmetry,
 // agreement with collide(), exact touching, metamorphic translation and scaling.
-#include "collision/contact.h"
+#include "collision/narrowphase/contact.h"
 
 #include <gtest/gtest.h>
 
@@ -14,11 +14,11 @@
 #include <memory>
 #include <vector>
 
-#include "collision/contact_reference.h"
-#include "collision/convex_hull.h"
-#include "collision/narrow_phase.h"
+#include "collision/geometry/convex_hull.h"
+#include "collision/narrowphase/contact_reference.h"
+#include "collision/narrowphase/narrow_phase.h"
 // Private narrow-phase headers (collision/src is on the test include path) for the caps.
-#include "epa.h"
+#include "narrowphase/epa.h"
 #include "test_random.h"
 
 namespace {

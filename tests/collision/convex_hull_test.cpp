@@ -1,6 +1,6 @@
 // tests/collision/convex_hull_test.cpp -- quickhull: containment, orientation, topology,
 // degenerate inputs, duplicates, translation far from the origin.
-#include "collision/convex_hull.h"
+#include "collision/geometry/convex_hull.h"
 
 #include <gtest/gtest.h>
 

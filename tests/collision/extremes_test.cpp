@@ -14,11 +14,11 @@
 #include <memory>
 #include <string>
 
-#include "collision/ccd.h"
-#include "collision/contact.h"
-#include "collision/convex_hull.h"
-#include "collision/narrow_phase.h"
-#include "triangle_triangle.h"
+#include "collision/ccd/ccd.h"
+#include "collision/geometry/convex_hull.h"
+#include "collision/narrowphase/contact.h"
+#include "collision/narrowphase/narrow_phase.h"
+#include "geometry/triangle_triangle.h"
 
 namespace {
 
@@ -353,7 +353,7 @@ TEST(Extremes, VertexFaceCcdFarFromOriginZeroAndExtremeMotion) {
                 EXPECT_GE(r.t, 0) << what;
                 // Early by at most the acceptance width over the closing speed. A Hit box's
                 // image is within the acceptance width max(tolerance * size, 4 err) of contact,
-                // plus err for the rounding of its corners (ccd_inclusion.cpp: err = 64 u M,
+                // plus err for the rounding of its corners (ccd/inclusion.cpp: err = 64 u M,
                 // u = eps / 2, M the largest input coordinate); the vertex closes on the face at
                 // |z0 - z1| per unit t. So t >= t_true - (1e-6 size + 192 u M) / |z0 - z1|,
                 // size the largest extent of the 8 points' bounding box. Stated with 256 u M.

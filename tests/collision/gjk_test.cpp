@@ -6,7 +6,7 @@
 #include <memory>
 
 // Private narrow-phase header (collision/src is not on the test's include path).
-#include "gjk.h"
+#include "narrowphase/gjk.h"
 #include "test_random.h"
 
 namespace {

@@ -3,7 +3,7 @@
 // force over the shape's vertex set (box, hull) or cap centres (capsule) and dense samples of
 // its surface, on random poses that are separated, penetrating and exactly touching; features
 // in closed-form cases; swapped order mirrors; translation by 1e6 and scales 1e-4..1e4.
-#include "collision/half_space.h"
+#include "collision/narrowphase/half_space.h"
 
 #include <gtest/gtest.h>
 
@@ -14,8 +14,8 @@
 #include <numbers>
 #include <vector>
 
-#include "collision/convex_hull.h"
-#include "collision/narrow_phase.h"
+#include "collision/geometry/convex_hull.h"
+#include "collision/narrowphase/narrow_phase.h"
 #include "test_random.h"
 
 namespace {

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "collision/bvh.h"
-#include "collision/convex_hull.h"
-#include "collision/narrow_phase.h"
+#include "collision/bvh/bvh.h"
+#include "collision/geometry/convex_hull.h"
+#include "collision/narrowphase/narrow_phase.h"
 #include "test_meshes.h"
 #include "test_random.h"
 

@@ -1,7 +1,7 @@
 // tests/collision/narrow_phase_test.cpp -- collide(): analytic cases, exact touching, swap
 // symmetry, metamorphic (translate 1e6, scale 1e-4..1e4), closed forms against GJK on random
 // pairs, meshes against brute force.
-#include "collision/narrow_phase.h"
+#include "collision/narrowphase/narrow_phase.h"
 
 #include <gtest/gtest.h>
 
@@ -10,11 +10,11 @@
 #include <memory>
 #include <vector>
 
-#include "collision/bvh.h"
+#include "collision/bvh/bvh.h"
 
 // Private narrow-phase headers (collision/src is not on the test's include path).
-#include "gjk.h"
-#include "triangle_triangle.h"
+#include "geometry/triangle_triangle.h"
+#include "narrowphase/gjk.h"
 #include "test_random.h"
 
 namespace {

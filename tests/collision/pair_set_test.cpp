@@ -1,6 +1,6 @@
 // The broad phases' flat pair set against std::set on random insert/erase churn, including
 // erasing absent keys, re-inserting present ones, long probe runs and growth.
-#include "pair_set.h"
+#include "broadphase/pair_set.h"
 
 #include <gtest/gtest.h>
 

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <numbers>
 
-#include "collision/shape.h"
+#include "collision/geometry/shape.h"
 
 namespace cdlab_test {
 

@@ -8,8 +8,8 @@
 #include <cstdint>
 
 // Private narrow-phase headers (collision/src is not on the test's include path).
-#include "predicates.h"
-#include "triangle_triangle.h"
+#include "geometry/predicates.h"
+#include "geometry/triangle_triangle.h"
 #include "test_random.h"
 
 namespace {

@@ -8,7 +8,7 @@
 #include <numbers>
 #include <vector>
 
-#include "collision/convex_hull.h"
+#include "collision/geometry/convex_hull.h"
 
 namespace engine {
 namespace {

@@ -10,7 +10,7 @@
 #include <numbers>
 #include <string>
 
-#include "collision/bvh.h"
+#include "collision/bvh/bvh.h"
 #include "engine/mass_properties.h"
 
 namespace engine {

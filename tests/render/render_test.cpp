@@ -15,11 +15,11 @@
 #include <vector>
 
 #include "../collision/test_meshes.h"
-#include "collision/bvh_level.h"
-#include "collision/convex_hull.h"
+#include "collision/bvh/bvh_level.h"
 #include "collision/debug_draw.h"
-#include "collision/narrow_phase.h"
-#include "collision/shape.h"
+#include "collision/geometry/convex_hull.h"
+#include "collision/geometry/shape.h"
+#include "collision/narrowphase/narrow_phase.h"
 #include "engine/body.h"
 #include "engine/scene.h"
 #include "engine/world.h"

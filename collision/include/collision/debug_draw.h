@@ -4,8 +4,8 @@
 
 #include <string_view>
 
-#include "collision/bounding_volumes.h"
 #include "collision/math.h"
+#include "collision/volumes/bounding_volumes.h"
 
 namespace collision {
 

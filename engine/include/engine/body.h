@@ -6,9 +6,9 @@
 #include <cstdint>
 #include <string>
 
-#include "collision/bounding_volumes.h"
+#include "collision/geometry/shape.h"
 #include "collision/math.h"
-#include "collision/shape.h"
+#include "collision/volumes/bounding_volumes.h"
 
 namespace engine {
 

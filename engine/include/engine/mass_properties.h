@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "collision/shape.h"
+#include "collision/geometry/shape.h"
 #include "engine/body.h"
 
 namespace engine {

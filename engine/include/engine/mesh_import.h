@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <string>
 
-#include "collision/shape.h"
+#include "collision/geometry/shape.h"
 
 namespace engine {
 

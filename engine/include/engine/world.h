@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "collision/bounding_volumes.h"
-#include "collision/broad_phase.h"
-#include "collision/bvh.h"
-#include "collision/ccd.h"
+#include "collision/broadphase/broad_phase.h"
+#include "collision/bvh/bvh.h"
+#include "collision/ccd/ccd.h"
+#include "collision/volumes/bounding_volumes.h"
 #include "engine/body.h"
 
 namespace engine {

@@ -6,7 +6,7 @@
 #include <memory>
 #include <string>
 
-#include "collision/bvh_level.h"
+#include "collision/bvh/bvh_level.h"
 #include "collision/debug_draw.h"
 #include "engine/scene.h"
 #include "engine/world.h"

@@ -1,0 +1,28 @@
+// app/command.h -- a cdlab subcommand as main() sees it: each command registers its flags on the
+// command line (addXCommand in its own file) and is run if it was the one chosen.
+#pragma once
+
+#include <functional>
+
+namespace CLI {
+class App;
+}
+
+namespace app {
+
+struct Command {
+    CLI::App* cli = nullptr;   ///< the subcommand, to ask whether it was parsed
+    std::function<int()> run;  ///< runs it with the parsed flags; returns the exit code
+};
+
+Command addRunCommand(CLI::App& cli);
+Command addCheckCommand(CLI::App& cli);
+Command addQueryCommand(CLI::App& cli);
+Command addSweepCommand(CLI::App& cli);
+/// The `bench` subcommands, registered on `cdlab bench`.
+Command addBenchBroadphaseCommand(CLI::App& bench);
+Command addBenchCcdCommand(CLI::App& bench);
+Command addBenchConvexCommand(CLI::App& bench);
+Command addBenchNarrowphaseCommand(CLI::App& bench);
+
+}  // namespace app

@@ -1,0 +1,81 @@
+// collision/broadphase/broad_phase.h -- the seam where broad phases are swapped, and their
+// registry. A broad phase holds proxies (one per body, by id) with their bounding volumes and
+// reports the candidate pairs whose volumes overlap. Every implementation reports the same pair set
+// as its brute-force reference: pairs sorted by (a, b), a < b, no duplicates, touching counts.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "collision/volumes/bounding_volumes.h"
+
+namespace collision {
+
+class DebugDraw;
+
+using ProxyId = std::int32_t;
+
+/// A candidate pair; always a < b.
+struct ProxyPair {
+    ProxyId a = 0;
+    ProxyId b = 0;
+    friend bool operator==(const ProxyPair&, const ProxyPair&) = default;
+    friend auto operator<=>(const ProxyPair&, const ProxyPair&) = default;
+};
+
+/// The volumes a broad phase may look at. Each broad phase uses the one it is built on.
+struct ProxyVolumes {
+    Aabb aabb;
+    BoundingSphere sphere;
+    Obb obb;
+};
+
+/// Cost-model counters of one findPairs call (F = Nv·Cv + Np·Cp + Nu·Cu).
+struct BroadPhaseCounters {
+    std::int64_t volume_tests = 0;     ///< Nv: bounding-volume overlap tests made
+    std::int64_t pairs_flagged = 0;    ///< pairs reported
+    std::int64_t volumes_updated = 0;  ///< Nu: proxies whose volumes changed since the last call
+    std::int64_t swaps = 0;            ///< insertion-sort swaps (SAP), 0 elsewhere
+};
+
+class BroadPhase {
+public:
+    virtual ~BroadPhase() = default;
+
+    /// Registry name ("brute", "sphere", "sap", ...).
+    virtual std::string_view name() const = 0;
+    /// Adds a proxy. `id` must not be present; ids need not be dense but should be small.
+    virtual void insert(ProxyId id, const ProxyVolumes& volumes) = 0;
+    /// Removes a present proxy.
+    virtual void remove(ProxyId id) = 0;
+    /// Replaces a present proxy's volumes.
+    virtual void move(ProxyId id, const ProxyVolumes& volumes) = 0;
+    /// Writes every overlapping pair into `pairs` (cleared first), sorted, unique.
+    virtual void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) = 0;
+    /// Draws the broad phase's own structure (cells, intervals, nodes). Default: nothing.
+    virtual void draw(DebugDraw& /*draw*/) const {}
+    /// Checks internal invariants; returns an empty string when they hold, else what is broken.
+    virtual std::string validate() const { return {}; }
+};
+
+/// One row of the registry: the scene loader and the CLI both look broad phases up here.
+struct BroadPhaseEntry {
+    std::string_view name;
+    std::string_view description;
+    std::string_view volume;     ///< "aabb", "sphere" or "obb": the volume it decides on
+    std::string_view reference;  ///< name of the brute-force broad phase it must equal
+    std::unique_ptr<BroadPhase> (*create)();
+    int threads = 1;  ///< threads it runs on (timing it by thread CPU time needs 1)
+};
+
+std::span<const BroadPhaseEntry> broadPhaseRegistry();
+/// nullptr when no broad phase has that name.
+const BroadPhaseEntry* findBroadPhase(std::string_view name);
+/// Comma-separated registry names, for error messages and --help.
+std::string broadPhaseNames();
+
+}  // namespace collision

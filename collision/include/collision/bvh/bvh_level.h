@@ -1,0 +1,78 @@
+// collision/bvh/bvh_level.h -- one level of a mesh body's hierarchy, each node coloured by the
+// contact state it takes part in, and the witnesses of confirmed contacts: what a renderer draws
+// for `draw.bvh_depth` and `draw.contacts` (through DebugDraw, as broad phases draw themselves).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "collision/bvh/bvh.h"
+#include "collision/debug_draw.h"
+#include "collision/geometry/shape.h"
+#include "collision/math.h"
+
+namespace collision {
+
+/// State of one node of a drawn level: the highest over the pairs it was marked with.
+enum class BvhNodeState : std::uint8_t {
+    Apart,        ///< its volume overlaps nothing of another body at that level
+    Overlapping,  ///< it overlaps a node of the other hierarchy at the same level (or the other
+                  ///< convex body's volume), but its subtree holds no triangle of a confirmed pair
+    Confirmed,    ///< its subtree holds a triangle of a confirmed triangle pair
+};
+
+/// The cut of one mesh body's hierarchy at a depth (MeshBvh::levelNodes), a state per node.
+struct BvhLevel {
+    int depth = -1;
+    std::vector<BvhLevelNode> nodes;
+    std::vector<BvhNodeState> states;  ///< same size as nodes
+};
+
+/// The cut of `tree` at `depth`, every node Apart. Empty for depth < 0.
+BvhLevel makeBvhLevel(const MeshBvh& tree, int depth);
+
+/// Marks one mesh-mesh pair: A (tree_a at pose_a, world) and B (tree_b at pose_b), hierarchies
+/// of one volume type (asserted; nothing marked if not), levels made from them at one depth.
+/// Both nodes of every pair of MeshBvh::levelOverlaps (under B's pose in A's frame) become at
+/// least Overlapping; every node whose subtree holds triangle a (of A) or b (of B) of a pair of
+/// `confirmed` (mesh indices, e.g. collidingTrianglePairs) becomes Confirmed. States only rise,
+/// so a body's nodes end at their highest state over all its pairs. O(n_a n_b) in the cut sizes.
+void markBvhLevels(BvhLevel& level_a, const MeshBvh& tree_a, const Pose& pose_a, BvhLevel& level_b,
+                   const MeshBvh& tree_b, const Pose& pose_b,
+                   std::span<const TrianglePair> confirmed);
+
+/// Marks one mesh-convex pair: the mesh (tree at `pose`, its level) against `convex` at
+/// `pose_convex`. Nodes whose volumes overlap the volume of the tree's type fitted around the
+/// convex shape's box in its own frame (support points along its axes, grown by the narrow
+/// phase's touching tolerance: the box the narrow phase's hierarchy cull uses, up to the size of
+/// that tolerance) become at least Overlapping (MeshBvh::levelOverlapsBox); nodes holding one of
+/// `confirmed` (mesh triangle indices, e.g. collidingTriangles) become Confirmed.
+void markBvhLevel(BvhLevel& level, const MeshBvh& tree, const Pose& pose, const Shape& convex,
+                  const Pose& pose_convex, std::span<const std::int32_t> confirmed);
+
+/// Draws a node of a level in world space (body at `pose`): its sphere as a wire sphere, any
+/// other volume as the box BvhLevelNode::box.
+void drawBvhLevelNode(DebugDraw& draw, const BvhLevelNode& node, const Pose& pose,
+                      const Color& color);
+
+/// A witness of a confirmed contact, world frame.
+struct ContactWitness {
+    Vec3 point_a = Vec3::Zero();
+    Vec3 point_b = Vec3::Zero();
+    Vec3 normal = Vec3::Zero();  ///< unit, or zero when undefined
+};
+
+/// Witnesses of a colliding pair (what `draw.contacts` shows), empty when it does not collide:
+/// - convex-convex: contact()'s witness points and normal (one);
+/// - mesh-mesh: one per triangle pair of collidingTrianglePairs: the closest points of
+///   distanceTriangleTriangle, which for intersecting triangles are a point the two share up to
+///   rounding (where an edge of one pierces the other); the normal is A's triangle's face normal
+///   (right-hand rule on its corners: outward for a closed counter-clockwise mesh). Meshes are
+///   surfaces, so no penetration direction exists; the face normal is the honest direction.
+/// - mesh-convex: one per triangle of collidingTriangles: contact() of that triangle (as a flat
+///   hull, in the mesh's pose) against the convex shape: its witness points and normal, A to B.
+std::vector<ContactWitness> contactWitnesses(const Shape& a, const Pose& pose_a, const Shape& b,
+                                             const Pose& pose_b);
+
+}  // namespace collision

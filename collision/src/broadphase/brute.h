@@ -1,0 +1,31 @@
+// collision/src/broadphase/brute.h -- the references: every pair tested, O(n^2).
+#pragma once
+
+#include "broadphase/proxy_table.h"
+#include "collision/broadphase/broad_phase.h"
+
+namespace collision {
+
+/// Tests every pair of present proxies with one volume kind. The ground truth every other broad
+/// phase is compared against; never used for speed.
+class BruteForceBroadPhase : public BroadPhase {
+public:
+    enum class Volume { Aabb, Sphere, Obb };
+    explicit BruteForceBroadPhase(Volume volume)
+        : volume_(volume),
+          table_(volume == Volume::Aabb     ? ProxyTable::kAabb
+                 : volume == Volume::Sphere ? ProxyTable::kSphere
+                                            : ProxyTable::kObb) {}
+
+    std::string_view name() const override;
+    void insert(ProxyId id, const ProxyVolumes& v) override { table_.insert(id, v); }
+    void remove(ProxyId id) override { table_.remove(id); }
+    void move(ProxyId id, const ProxyVolumes& v) override { table_.move(id, v); }
+    void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
+
+private:
+    Volume volume_;
+    ProxyTable table_;
+};
+
+}  // namespace collision

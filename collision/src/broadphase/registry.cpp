@@ -1,0 +1,78 @@
+// collision/src/broadphase/registry.cpp -- the broad-phase registry: one row per broad phase.
+// The scene loader, the CLI and the differential tests all read this table.
+#include "collision/broadphase/broad_phase.h"
+
+#include "broadphase/brute.h"
+#include "broadphase/grid.h"
+#include "broadphase/hgrid.h"
+#include "broadphase/obb.h"
+#include "broadphase/octree.h"
+#include "broadphase/sap.h"
+#include "broadphase/sap1.h"
+#include "broadphase/sphere.h"
+#include "broadphase/tree.h"
+
+namespace collision {
+
+namespace {
+
+using Brute = BruteForceBroadPhase;
+
+const BroadPhaseEntry kRegistry[] = {
+    {"brute", "all pairs of AABBs (reference)", "aabb", "brute",
+     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<Brute>(Brute::Volume::Aabb); }},
+    {"sphere", "bounding spheres, pruned by a sort along x", "sphere", "sphere-brute",
+     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<SphereBroadPhase>(); }},
+    {"sphere-brute", "all pairs of bounding spheres (reference)", "sphere", "sphere-brute",
+     []() -> std::unique_ptr<BroadPhase> {
+         return std::make_unique<Brute>(Brute::Volume::Sphere);
+     }},
+    {"sap", "sweep-and-prune on AABBs, insertion-sort coherence (I-COLLIDE)", "aabb", "brute",
+     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<SweepAndPrune>(); }},
+    {"sap1", "single-axis sort and sweep, axis of greatest spread, insertion-sort coherence",
+     "aabb", "brute",
+     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<SortAndSweep1>(); }},
+    {"grid", "uniform grid over the bodies, cell size from the median body size", "aabb", "brute",
+     []() -> std::unique_ptr<BroadPhase> {
+         return std::make_unique<GridBroadPhase>(GridBroadPhase::Mode::Dense);
+     }},
+    {"hash", "spatial hash: unbounded uniform grid of hashed cells", "aabb", "brute",
+     []() -> std::unique_ptr<BroadPhase> {
+         return std::make_unique<GridBroadPhase>(GridBroadPhase::Mode::Hashed);
+     }},
+    {"hgrid", "hierarchical hash grid (Mirtich TR-97-23 §2.2)", "aabb", "brute",
+     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<HierarchicalGrid>(); }},
+    {"hgrid2", "hgrid on two threads (a helper thread from 4096 proxies; same pairs)", "aabb",
+     "brute",
+     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<HierarchicalGrid>(true); }, 2},
+    {"tree", "dynamic AABB tree: fat leaves, SAH insertion, rotations", "aabb", "brute",
+     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<DynamicAabbTree>(); }},
+    {"octree", "loose octree (k = 2)", "aabb", "brute",
+     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<LooseOctree>(); }},
+    {"obb", "OBB separating-axis test after a sweep over the OBBs' AABBs", "obb", "obb-brute",
+     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<ObbBroadPhase>(); }},
+    {"obb-brute", "all pairs of OBBs, separating-axis test (reference)", "obb", "obb-brute",
+     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<Brute>(Brute::Volume::Obb); }},
+};
+
+}  // namespace
+
+std::span<const BroadPhaseEntry> broadPhaseRegistry() { return kRegistry; }
+
+const BroadPhaseEntry* findBroadPhase(std::string_view name) {
+    for (const BroadPhaseEntry& e : kRegistry) {
+        if (e.name == name) return &e;
+    }
+    return nullptr;
+}
+
+std::string broadPhaseNames() {
+    std::string out;
+    for (const BroadPhaseEntry& e : kRegistry) {
+        if (!out.empty()) out += ", ";
+        out += e.name;
+    }
+    return out;
+}
+
+}  // namespace collision

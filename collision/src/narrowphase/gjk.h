@@ -1,0 +1,80 @@
+// collision/src/narrowphase/gjk.h -- GJK distance between convex shapes (van den Bergen 1999; RTCD
+// 9.5) and a bounded EPA that only decides "touching or penetrating" (narrow phase, private). Every
+// convex pair without a closed form goes through collideConvexCores.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "collision/geometry/shape.h"
+#include "collision/math.h"
+#include "collision/narrowphase/narrow_phase.h"
+
+namespace collision {
+
+/// A convex set given by its support mapping, optionally inflated by `radius`: spheres are a point
+/// and capsules a segment plus radius, which keeps GJK exact on their round parts.
+struct ConvexCore {
+    enum class Kind : std::uint8_t { Point, Segment, Triangle, Box, Points };
+    Kind kind = Kind::Point;
+    std::array<Vec3, 3> v{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};  ///< point/segment/triangle
+    Vec3 half_extents = Vec3::Zero();                                 ///< box
+    const Vec3* points = nullptr;  ///< point cloud (hull vertices), not owned
+    std::int32_t point_count = 0;
+    Real radius = 0;  ///< inflation, >= 0
+
+    /// The core of a convex shape in its local frame (a mesh gives its convex hull). The core
+    /// borrows the shape's hull vertices: the shape must outlive it.
+    static ConvexCore fromShape(const Shape& shape);
+    static ConvexCore triangle(const Vec3& a, const Vec3& b, const Vec3& c);
+
+    /// Support point of the core (without radius) in direction `dir` (any length, may be zero).
+    Vec3 support(const Vec3& dir) const;
+    /// Largest distance of the inflated set from the local origin.
+    Real boundingRadius() const;
+};
+
+/// B's placement in A's frame: point_in_a = rotation * point_in_b + position.
+struct RelativePose {
+    Mat3 rotation = Mat3::Identity();
+    Vec3 position = Vec3::Zero();
+};
+
+/// pose_a^-1 * pose_b, subtracting positions first so that far-from-origin poses lose nothing
+/// to the translation (metamorphic tests translate scenes by 1e6).
+RelativePose relativePose(const Pose& pose_a, const Pose& pose_b);
+
+enum class GjkState : std::uint8_t { Separated, Overlapping, Failed };
+
+struct GjkOutput {
+    GjkState state = GjkState::Failed;
+    Real distance = 0;     ///< between the cores (radii ignored) when Separated: an upper bound
+    Real lower_bound = 0;  ///< proven lower bound on the core distance (may be <= 0)
+    std::int32_t iterations = 0;
+    std::int32_t simplex_count = 0;  ///< final simplex, for the EPA decision
+    std::array<Vec3, 4> simplex{};   ///< vertices of A - B, in A's frame
+};
+
+/// Iteration cap of GJK and of the EPA decision.
+inline constexpr int kGjkMaxIterations = 64;
+/// GJK stops when |v|^2 - v.w <= kGjkRelativeTolerance * |v|^2, which bounds the relative error of
+/// the distance |v| by kGjkRelativeTolerance (van den Bergen 1999 §4). Near contact rounding stops
+/// it earlier (no progress or a repeated support point), with the error then set by rounding.
+inline constexpr Real kGjkRelativeTolerance = Real(1e-12);
+
+/// Distance between the cores of `a` (in its frame) and `b` placed by `b_in_a`. Overlapping when
+/// the origin is enclosed by the simplex up to rounding (relative to `scale`). Failed only when
+/// the iteration cap is hit; never NaN for finite input.
+GjkOutput gjkDistance(const ConvexCore& a, const ConvexCore& b, const RelativePose& b_in_a,
+                      Real scale);
+
+/// The touching convention applied to a signed distance (negative = penetration depth).
+CollideOutput classifySignedDistance(Real signed_distance, Real tolerance);
+
+/// The narrow-phase answer for two convex cores with radii: GJK, then signed distance
+/// = core distance - radii, or the bounded EPA decision when the cores overlap and the radii are
+/// below `tolerance`. Touching when |signed distance| <= tolerance.
+CollideOutput collideConvexCores(const ConvexCore& a, const ConvexCore& b,
+                                 const RelativePose& b_in_a, Real tolerance, Real scale);
+
+}  // namespace collision
