@@ -1,6 +1,6 @@
-// collision/src/narrowphase/epa.h -- GJK distance that keeps witness points (van den Bergen 1999)
-// and EPA penetration depth with normal and witness points (van den Bergen 2001; RTCD 9.5), both on
-// the ConvexCore support mappings of gjk.h. Used by contact() (contact.cpp); private to collision.
+// collision/src/narrowphase/epa.h -- EPA penetration depth with normal and witness points (van den
+// Bergen 2001; RTCD 9.5) on the ConvexCore support mappings of gjk.h, started from gjkWitness's
+// final simplex. Used by contact() (contact.cpp); private to collision.
 #pragma once
 
 #include <algorithm>
@@ -11,41 +11,6 @@
 #include "narrowphase/gjk.h"
 
 namespace collision {
-
-/// A vertex of the configuration-space obstacle A - B with the support points that made it,
-/// all in A's frame: w = a - b. No default member values (EPA keeps arrays of them and must not
-/// pay for zeroing); value-initialise (`{}`) where zeros are needed.
-struct SupportVertex {
-    Vec3 w;
-    Vec3 a;
-    Vec3 b;
-};
-
-/// A GJK simplex of up to four support vertices.
-struct WitnessSimplex {
-    std::array<SupportVertex, 4> v{};
-    std::int32_t n = 0;
-};
-
-struct GjkWitnessOutput {
-    GjkState state = GjkState::Failed;
-    /// Core distance (radii ignored) when Separated; |v| of the last iterate when Failed.
-    Real distance = 0;
-    /// Closest points of the cores, A's frame: the same barycentric combination of the simplex's
-    /// support points (van den Bergen 1999 §3). Valid when Separated (and as a best guess when
-    /// Failed).
-    Vec3 point_a = Vec3::Zero();
-    Vec3 point_b = Vec3::Zero();
-    std::int32_t iterations = 0;
-    WitnessSimplex simplex;  ///< final simplex: the EPA start when Overlapping
-};
-
-/// GJK distance between the cores of `a` (its frame) and `b` placed by `b_in_a`, with witnesses.
-/// Tolerance and guarantee as gjkDistance (gjk.h): relative error of the distance at most
-/// kGjkRelativeTolerance or rounding near contact; Overlapping when the origin is in the simplex
-/// up to rounding relative to `scale`; Failed after kGjkMaxIterations. Never NaN for finite input.
-GjkWitnessOutput gjkWitness(const ConvexCore& a, const ConvexCore& b, const RelativePose& b_in_a,
-                            Real scale);
 
 enum class EpaState : std::uint8_t { Converged, Failed };
 

@@ -1,5 +1,7 @@
 // collision/src/narrowphase/gjk.cpp -- GJK distance (van den Bergen 1999, "A Fast and Robust GJK
-// Implementation for Collision Detection of Convex Objects"; RTCD 9.5) and the bounded EPA
+// Implementation for Collision Detection of Convex Objects"; RTCD 9.5), one loop for both vertex
+// types: w = a - b alone, or with a and b kept so the closest point's barycentric weights give
+// witness points (§3). And the bounded EPA
 // decision (van den Bergen 2001 "Proximity Queries and Penetration Depth Computation on 3D Game
 // Objects") used when the cores overlap.
 // Invariants: |v| decreases strictly every GJK iteration or GJK stops; both loops run at most
@@ -10,8 +12,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include "collision/assert.h"
+#include "geometry/closest_points.h"
 
 namespace collision {
 
@@ -20,194 +24,151 @@ namespace {
 // Below these multiples of kEpsilon * (size of the simplex) a length is rounding noise.
 constexpr Real kOverlapRelative = Real(32) * kEpsilon;
 constexpr Real kDuplicateRelative = Real(8) * kEpsilon;
-constexpr Real kDegenerateRelative = Real(1e3) * kEpsilon;
 
 Real signOrPlus(Real x) { return x < 0 ? Real(-1) : Real(1); }
 
-// Support mapping of the configuration-space obstacle A - B, in A's frame.
-struct MinkowskiDifference {
-    const ConvexCore& a;
-    const ConvexCore& b;
-    const RelativePose& b_in_a;
+const Vec3& pointOf(const Vec3& v) { return v; }
+const Vec3& pointOf(const SupportVertex& v) { return v.w; }
 
-    Vec3 support(const Vec3& dir) const {
-        const Vec3 dir_in_b = b_in_a.rotation.transpose() * (-dir);
-        const Vec3 on_b = b_in_a.rotation * b.support(dir_in_b) + b_in_a.position;
-        return a.support(dir) - on_b;
-    }
-};
-
-// Closest point to the origin on segment ab, RTCD 5.1.2; weights of a and b.
-Vec3 closestOnSegment(const Vec3& a, const Vec3& b, Real& wa, Real& wb) {
-    const Vec3 ab = b - a;
-    const Real len2 = ab.squaredNorm();
-    const Real t_num = -a.dot(ab);
-    if (t_num <= 0 || !(len2 > 0)) {
-        wa = 1;
-        wb = 0;
-        return a;
-    }
-    if (t_num >= len2) {
-        wa = 0;
-        wb = 1;
-        return b;
-    }
-    const Real t = t_num / len2;
-    wa = 1 - t;
-    wb = t;
-    return a + t * ab;
-}
-
-// Closest point to the origin on triangle abc, RTCD 5.1.5 (Voronoi regions); barycentric weights.
-Vec3 closestOnTriangle(const Vec3& a, const Vec3& b, const Vec3& c, std::array<Real, 3>& w) {
-    const Vec3 ab = b - a;
-    const Vec3 ac = c - a;
-    const Real d1 = -ab.dot(a);
-    const Real d2 = -ac.dot(a);
-    if (d1 <= 0 && d2 <= 0) {
-        w = {1, 0, 0};
-        return a;
-    }
-    const Real d3 = -ab.dot(b);
-    const Real d4 = -ac.dot(b);
-    if (d3 >= 0 && d4 <= d3) {
-        w = {0, 1, 0};
-        return b;
-    }
-    const Real vc = d1 * d4 - d3 * d2;
-    if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-        const Real t = d1 / (d1 - d3);  // d1 >= 0 >= d3 and not both zero here
-        w = {1 - t, t, 0};
-        return a + t * ab;
-    }
-    const Real d5 = -ab.dot(c);
-    const Real d6 = -ac.dot(c);
-    if (d6 >= 0 && d5 <= d6) {
-        w = {0, 0, 1};
-        return c;
-    }
-    const Real vb = d5 * d2 - d1 * d6;
-    if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-        const Real t = d2 / (d2 - d6);
-        w = {1 - t, 0, t};
-        return a + t * ac;
-    }
-    const Real va = d3 * d6 - d5 * d4;
-    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
-        const Real t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        w = {0, 1 - t, t};
-        return b + t * (c - b);
-    }
-    const Real denom = va + vb + vc;
-    const Real area_scale = ab.squaredNorm() * ac.squaredNorm();
-    if (!(denom > kDegenerateRelative * area_scale)) {
-        // Sliver triangle: the regions above are unreliable; take the best edge.
-        std::array<Real, 3> best{1, 0, 0};
-        Vec3 best_p = a;
-        Real wa = 0;
-        Real wb = 0;
-        const Vec3 p_ab = closestOnSegment(a, b, wa, wb);
-        best = {wa, wb, 0};
-        best_p = p_ab;
-        const Vec3 p_bc = closestOnSegment(b, c, wa, wb);
-        if (p_bc.squaredNorm() < best_p.squaredNorm()) {
-            best = {0, wa, wb};
-            best_p = p_bc;
-        }
-        const Vec3 p_ca = closestOnSegment(c, a, wa, wb);
-        if (p_ca.squaredNorm() < best_p.squaredNorm()) {
-            best = {wb, 0, wa};
-            best_p = p_ca;
-        }
-        w = best;
-        return best_p;
-    }
-    // Face region: the origin's projection onto the plane, x = n (n.a) / |n|^2, with its
-    // signed-area coordinates as weights. For slivers far from the origin this is much more
-    // accurate than a + v ab + t ac, whose error grows like |a|^2 / area and can stall GJK at a
-    // wrong distance (a 3e-5-thin box touching a 5-unit box came out 6e-6 apart).
-    const Vec3 n = ab.cross(ac);
-    const Real nn = n.squaredNorm();
-    if (nn > 0) {
-        const Vec3 x = n * (n.dot(a) / nn);
-        const Real wa = n.dot((b - x).cross(c - x)) / nn;
-        const Real wb = n.dot((c - x).cross(a - x)) / nn;
-        w = {wa, wb, 1 - wa - wb};
-        return x;
-    }
-    const Real v = vb / denom;
-    const Real t = vc / denom;
-    w = {1 - v - t, v, t};
-    return a + ab * v + ac * t;
-}
-
+template <class Vertex>
 struct Simplex {
-    std::array<Vec3, 4> w{};
+    std::array<Vertex, 4> v{};
     int n = 0;
 };
 
-// Replaces the simplex by the sub-simplex supporting its closest point to the origin and returns
-// that point. Sets `enclosed` when a tetrahedron contains the origin (RTCD 5.1.6).
-Vec3 closestOnSimplex(Simplex& s, bool& enclosed) {
+// Replaces the simplex by the sub-simplex supporting its closest point to the origin (the
+// vertices of positive weight), sets `weight` to their weights, and returns that point
+// (closest_points.h). Sets `enclosed`, leaving the simplex as it is, when a tetrahedron contains
+// the origin.
+template <class Vertex>
+Vec3 closestOnSimplex(Simplex<Vertex>& s, std::array<Real, 4>& weight, bool& enclosed) {
     enclosed = false;
-    std::array<Real, 4> weight{0, 0, 0, 0};
-    Vec3 p = s.w[0];
+    weight = {0, 0, 0, 0};
+    Vec3 p = pointOf(s.v[0]);
     if (s.n == 1) {
         weight[0] = 1;
     } else if (s.n == 2) {
-        p = closestOnSegment(s.w[0], s.w[1], weight[0], weight[1]);
+        p = closestOnSegment(pointOf(s.v[0]), pointOf(s.v[1]), weight[0], weight[1]);
     } else if (s.n == 3) {
         std::array<Real, 3> w3{};
-        p = closestOnTriangle(s.w[0], s.w[1], s.w[2], w3);
+        p = closestOnTriangle(pointOf(s.v[0]), pointOf(s.v[1]), pointOf(s.v[2]), w3);
         weight = {w3[0], w3[1], w3[2], 0};
     } else {
-        // Test each face whose plane separates the origin from the opposite vertex.
-        static constexpr int kFaces[4][4] = {
-            {0, 1, 2, 3}, {0, 2, 3, 1}, {0, 3, 1, 2}, {1, 3, 2, 0}};
-        Real best = std::numeric_limits<Real>::infinity();
-        bool any_outside = false;
-        for (const auto& f : kFaces) {
-            const Vec3& a = s.w[f[0]];
-            const Vec3& b = s.w[f[1]];
-            const Vec3& c = s.w[f[2]];
-            const Vec3& d = s.w[f[3]];
-            const Vec3 n = (b - a).cross(c - a);
-            const Real sign_p = -a.dot(n);
-            const Real sign_d = (d - a).dot(n);
-            const bool degenerate =
-                std::abs(sign_d) <= kDegenerateRelative * n.norm() * (d - a).norm();
-            if (!degenerate && sign_p * sign_d >= 0) continue;  // origin on d's side
-            any_outside = true;
-            std::array<Real, 3> w3{};
-            const Vec3 q = closestOnTriangle(a, b, c, w3);
-            const Real q2 = q.squaredNorm();
-            if (q2 < best) {
-                best = q2;
-                p = q;
-                weight = {0, 0, 0, 0};
-                weight[f[0]] = w3[0];
-                weight[f[1]] = w3[1];
-                weight[f[2]] = w3[2];
-            }
-        }
-        if (!any_outside) {
-            enclosed = true;
-            return Vec3::Zero();
-        }
+        p = closestOnTetrahedron({pointOf(s.v[0]), pointOf(s.v[1]), pointOf(s.v[2]),
+                                  pointOf(s.v[3])},
+                                 weight, enclosed);
+        if (enclosed) return p;
     }
-    Simplex reduced;
+    Simplex<Vertex> reduced;
+    std::array<Real, 4> reduced_weight{0, 0, 0, 0};
     for (int i = 0; i < s.n; ++i) {
-        if (weight[i] > 0) reduced.w[reduced.n++] = s.w[i];
+        if (weight[i] > 0) {
+            reduced_weight[reduced.n] = weight[i];
+            reduced.v[reduced.n++] = s.v[i];
+        }
     }
-    if (reduced.n == 0) reduced.w[reduced.n++] = s.w[0];
+    if (reduced.n == 0) {
+        reduced.v[reduced.n++] = s.v[0];
+        reduced_weight[0] = 1;
+    }
     s = reduced;
+    weight = reduced_weight;
     return p;
 }
 
-Real maxNorm(const Simplex& s) {
+template <class Vertex>
+Real maxNorm(const Simplex<Vertex>& s) {
     Real m = 0;
-    for (int i = 0; i < s.n; ++i) m = std::max(m, s.w[i].norm());
+    for (int i = 0; i < s.n; ++i) m = std::max(m, pointOf(s.v[i]).norm());
     return m;
+}
+
+// The result of the one GJK loop below, for either vertex type.
+template <class Vertex>
+struct GjkRun {
+    GjkState state = GjkState::Failed;
+    Real distance = 0;
+    Real lower_bound = -std::numeric_limits<Real>::infinity();
+    std::int32_t iterations = 0;
+    Simplex<Vertex> simplex;
+    Vec3 closest = Vec3::Zero();  // the simplex's point nearest the origin (v)
+    // Witness points (SupportVertex only): the weights of `closest` applied to the simplex's
+    // support points, updated whenever |v| decreases.
+    Vec3 point_a = Vec3::Zero();
+    Vec3 point_b = Vec3::Zero();
+};
+
+// GJK distance (van den Bergen 1999; RTCD 9.5). Invariant: |v| decreases strictly every
+// iteration or the loop stops; at most kGjkMaxIterations iterations, then Failed.
+template <class Vertex>
+GjkRun<Vertex> runGjk(const ConvexCore& a, const ConvexCore& b, const RelativePose& b_in_a,
+                      Real scale) {
+    constexpr bool kWitness = !std::is_same_v<Vertex, Vec3>;
+    const MinkowskiDifference cso{a, b, b_in_a};
+    GjkRun<Vertex> out;
+    const Real tiny = std::max(kOverlapRelative * scale, std::numeric_limits<Real>::min());
+    Simplex<Vertex>& s = out.simplex;
+    // Any point of A - B starts the search; -position points from B's origin towards A's.
+    s.v[0] = cso.supportVertex<Vertex>(-b_in_a.position);
+    s.n = 1;
+    Vec3 v = pointOf(s.v[0]);
+    if constexpr (kWitness) {
+        out.point_a = s.v[0].a;
+        out.point_b = s.v[0].b;
+    }
+    auto finish = [&](GjkState state, Real distance) {
+        out.state = state;
+        out.distance = distance;
+        out.closest = v;
+        return out;
+    };
+
+    for (int iter = 0; iter < kGjkMaxIterations; ++iter) {
+        out.iterations = iter + 1;
+        const Real vv = v.squaredNorm();
+        const Real noise = std::max(kOverlapRelative * maxNorm(s), tiny);
+        if (vv <= noise * noise) {
+            out.lower_bound = std::max(out.lower_bound, Real(0));
+            return finish(GjkState::Overlapping, 0);
+        }
+        const Vertex w = cso.supportVertex<Vertex>(-v);
+        const Real vw = v.dot(pointOf(w));
+        // Every point x of A - B has v.x >= v.w, so distance >= v.w / |v| (a separating plane).
+        out.lower_bound = std::max(out.lower_bound, vw / std::sqrt(vv));
+        // van den Bergen 1999 §4: |v|^2 - v.w bounds |v|^2 - |v| dist(origin, A - B).
+        if (vv - vw <= kGjkRelativeTolerance * vv) return finish(GjkState::Separated, std::sqrt(vv));
+        const Real dup = kDuplicateRelative * std::max(pointOf(w).norm(), maxNorm(s));
+        for (int i = 0; i < s.n; ++i) {
+            if ((pointOf(s.v[i]) - pointOf(w)).squaredNorm() <= dup * dup) {
+                // No new support point: |v| is as good as rounding allows.
+                return finish(GjkState::Separated, std::sqrt(vv));
+            }
+        }
+        const Simplex<Vertex> before = s;
+        s.v[s.n++] = w;
+        std::array<Real, 4> weight{};
+        bool enclosed = false;
+        const Vec3 v_next = closestOnSimplex(s, weight, enclosed);
+        if (enclosed) {
+            out.lower_bound = std::max(out.lower_bound, Real(0));
+            return finish(GjkState::Overlapping, 0);
+        }
+        if (!(v_next.squaredNorm() < vv)) {
+            // |v| must decrease strictly (van den Bergen 1999 §4); rounding stalled it.
+            s = before;
+            return finish(GjkState::Separated, std::sqrt(vv));
+        }
+        v = v_next;
+        if constexpr (kWitness) {
+            out.point_a.setZero();
+            out.point_b.setZero();
+            for (int i = 0; i < s.n; ++i) {
+                out.point_a += weight[i] * s.v[i].a;
+                out.point_b += weight[i] * s.v[i].b;
+            }
+        }
+    }
+    return finish(GjkState::Failed, v.norm());
 }
 
 // ---- Bounded EPA: decides whether the penetration depth of the cores exceeds `threshold`. ----
@@ -247,11 +208,11 @@ struct EpaPolytope {
     }
 };
 
-ContactState epaDecide(const MinkowskiDifference& cso, const Simplex& start, Real threshold,
+ContactState epaDecide(const MinkowskiDifference& cso, const Simplex<Vec3>& start, Real threshold,
                        Real scale, std::int32_t& iterations) {
     EpaPolytope poly;
     poly.eps = std::max(Real(64) * kEpsilon * scale, std::numeric_limits<Real>::min());
-    for (int i = 0; i < start.n; ++i) poly.w[poly.vertex_count++] = start.w[i];
+    for (int i = 0; i < start.n; ++i) poly.w[poly.vertex_count++] = start.v[i];
 
     // Direction probes: any direction n with support h(n) <= threshold proves depth <= threshold.
     auto probe = [&](const Vec3& dir, Vec3& w_out) {
@@ -485,74 +446,29 @@ RelativePose relativePose(const Pose& pose_a, const Pose& pose_b) {
 
 GjkOutput gjkDistance(const ConvexCore& a, const ConvexCore& b, const RelativePose& b_in_a,
                       Real scale) {
-    const MinkowskiDifference cso{a, b, b_in_a};
+    const GjkRun<Vec3> run = runGjk<Vec3>(a, b, b_in_a, scale);
     GjkOutput out;
-    out.lower_bound = -std::numeric_limits<Real>::infinity();
-    const Real tiny = std::max(kOverlapRelative * scale, std::numeric_limits<Real>::min());
+    out.state = run.state;
+    out.distance = run.distance;
+    out.lower_bound = run.lower_bound;
+    out.iterations = run.iterations;
+    out.closest = run.closest;
+    out.simplex_count = run.simplex.n;
+    for (int i = 0; i < run.simplex.n; ++i) out.simplex[i] = run.simplex.v[i];
+    return out;
+}
 
-    Simplex s;
-    // Any point of A - B starts the search; -position points from B's origin towards A's.
-    s.w[0] = cso.support(-b_in_a.position);
-    s.n = 1;
-    Vec3 v = s.w[0];
-    auto overlapping = [&]() {
-        out.state = GjkState::Overlapping;
-        out.distance = 0;
-        out.lower_bound = std::max(out.lower_bound, Real(0));
-        out.simplex_count = s.n;
-        for (int i = 0; i < s.n; ++i) out.simplex[i] = s.w[i];
-    };
-    auto separated = [&](Real vv) {
-        out.state = GjkState::Separated;
-        out.distance = std::sqrt(vv);
-        out.simplex_count = s.n;
-        for (int i = 0; i < s.n; ++i) out.simplex[i] = s.w[i];
-    };
-
-    for (int iter = 0; iter < kGjkMaxIterations; ++iter) {
-        out.iterations = iter + 1;
-        const Real vv = v.squaredNorm();
-        const Real noise = std::max(kOverlapRelative * maxNorm(s), tiny);
-        if (vv <= noise * noise) {
-            overlapping();
-            return out;
-        }
-        const Vec3 w = cso.support(-v);
-        const Real vw = v.dot(w);
-        // Every point x of A - B has v.x >= v.w, so distance >= v.w / |v| (a separating plane).
-        out.lower_bound = std::max(out.lower_bound, vw / std::sqrt(vv));
-        if (vv - vw <= kGjkRelativeTolerance * vv) {
-            separated(vv);
-            return out;
-        }
-        const Real dup = kDuplicateRelative * std::max(w.norm(), maxNorm(s));
-        for (int i = 0; i < s.n; ++i) {
-            if ((s.w[i] - w).squaredNorm() <= dup * dup) {
-                // No new support point: |v| is as good as rounding allows.
-                separated(vv);
-                return out;
-            }
-        }
-        const Simplex before = s;
-        s.w[s.n++] = w;
-        bool enclosed = false;
-        const Vec3 v_next = closestOnSimplex(s, enclosed);
-        if (enclosed) {
-            overlapping();
-            return out;
-        }
-        if (!(v_next.squaredNorm() < vv)) {
-            // |v| must decrease strictly (van den Bergen 1999 §4); rounding stalled it.
-            s = before;
-            separated(vv);
-            return out;
-        }
-        v = v_next;
-    }
-    out.state = GjkState::Failed;
-    out.distance = v.norm();
-    out.simplex_count = s.n;
-    for (int i = 0; i < s.n; ++i) out.simplex[i] = s.w[i];
+GjkWitnessOutput gjkWitness(const ConvexCore& a, const ConvexCore& b, const RelativePose& b_in_a,
+                            Real scale) {
+    const GjkRun<SupportVertex> run = runGjk<SupportVertex>(a, b, b_in_a, scale);
+    GjkWitnessOutput out;
+    out.state = run.state;
+    out.distance = run.distance;
+    out.point_a = run.point_a;
+    out.point_b = run.point_b;
+    out.iterations = run.iterations;
+    out.simplex.n = run.simplex.n;
+    for (int i = 0; i < run.simplex.n; ++i) out.simplex.v[i] = run.simplex.v[i];
     return out;
 }
 
@@ -583,9 +499,9 @@ CollideOutput collideConvexCores(const ConvexCore& a, const ConvexCore& b,
             if (radii > tolerance) {
                 out.state = ContactState::Penetrating;  // depth >= radii
             } else {
-                Simplex start;
+                Simplex<Vec3> start;
                 start.n = g.simplex_count;
-                for (int i = 0; i < g.simplex_count; ++i) start.w[i] = g.simplex[i];
+                for (int i = 0; i < g.simplex_count; ++i) start.v[i] = g.simplex[i];
                 const MinkowskiDifference cso{a, b, b_in_a};
                 std::int32_t epa_iterations = 0;
                 out.state = epaDecide(cso, start, tolerance - radii, scale, epa_iterations);

@@ -1,10 +1,13 @@
-// collision/src/narrowphase/gjk.h -- GJK distance between convex shapes (van den Bergen 1999; RTCD
-// 9.5) and a bounded EPA that only decides "touching or penetrating" (narrow phase, private). Every
-// convex pair without a closed form goes through collideConvexCores.
+// collision/src/narrowphase/gjk.h -- the one GJK (van den Bergen 1999; RTCD 9.5) between convex
+// cores, as a distance (gjkDistance: collide() and conservative advancement) or with witness
+// points (gjkWitness: contact()), and a bounded EPA that only decides "touching or penetrating"
+// (narrow phase, private). Every convex pair without a closed form goes through
+// collideConvexCores.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <type_traits>
 
 #include "collision/geometry/shape.h"
 #include "collision/math.h"
@@ -53,6 +56,9 @@ struct GjkOutput {
     std::int32_t iterations = 0;
     std::int32_t simplex_count = 0;  ///< final simplex, for the EPA decision
     std::array<Vec3, 4> simplex{};   ///< vertices of A - B, in A's frame
+    /// The point of the final simplex nearest the origin (GJK's v), A's frame: the closest
+    /// point of A - B when Separated (a - b of the closest pair).
+    Vec3 closest = Vec3::Zero();
 };
 
 /// Iteration cap of GJK and of the EPA decision.
@@ -67,6 +73,64 @@ inline constexpr Real kGjkRelativeTolerance = Real(1e-12);
 /// the iteration cap is hit; never NaN for finite input.
 GjkOutput gjkDistance(const ConvexCore& a, const ConvexCore& b, const RelativePose& b_in_a,
                       Real scale);
+
+/// A vertex of the configuration-space obstacle A - B with the support points that made it,
+/// all in A's frame: w = a - b. No default member values (EPA keeps arrays of them and must not
+/// pay for zeroing); value-initialise (`{}`) where zeros are needed.
+struct SupportVertex {
+    Vec3 w;
+    Vec3 a;
+    Vec3 b;
+};
+
+/// A GJK simplex of up to four support vertices.
+struct WitnessSimplex {
+    std::array<SupportVertex, 4> v{};
+    std::int32_t n = 0;
+};
+
+// Support mapping of the configuration-space obstacle A - B, in A's frame. A GJK vertex is the
+// point w = a - b alone (Vec3), or with the support points a and b that made it (SupportVertex)
+// when witness points are wanted.
+struct MinkowskiDifference {
+    const ConvexCore& a;
+    const ConvexCore& b;
+    const RelativePose& b_in_a;
+
+    Vec3 support(const Vec3& dir) const { return supportVertex<Vec3>(dir); }
+
+    template <class Vertex>
+    Vertex supportVertex(const Vec3& dir) const {
+        const Vec3 dir_in_b = b_in_a.rotation.transpose() * (-dir);
+        const Vec3 on_b = b_in_a.rotation * b.support(dir_in_b) + b_in_a.position;
+        const Vec3 on_a = a.support(dir);
+        if constexpr (std::is_same_v<Vertex, Vec3>) {
+            return on_a - on_b;
+        } else {
+            return SupportVertex{on_a - on_b, on_a, on_b};
+        }
+    }
+};
+
+struct GjkWitnessOutput {
+    GjkState state = GjkState::Failed;
+    /// Core distance (radii ignored) when Separated; |v| of the last iterate when Failed.
+    Real distance = 0;
+    /// Closest points of the cores, A's frame: the same barycentric combination of the simplex's
+    /// support points (van den Bergen 1999 §3). Valid when Separated (and as a best guess when
+    /// Failed).
+    Vec3 point_a = Vec3::Zero();
+    Vec3 point_b = Vec3::Zero();
+    std::int32_t iterations = 0;
+    WitnessSimplex simplex;  ///< final simplex: the EPA start when Overlapping
+};
+
+/// GJK distance between the cores of `a` (its frame) and `b` placed by `b_in_a`, with witnesses.
+/// Tolerance and guarantee as gjkDistance (gjk.h): relative error of the distance at most
+/// kGjkRelativeTolerance or rounding near contact; Overlapping when the origin is in the simplex
+/// up to rounding relative to `scale`; Failed after kGjkMaxIterations. Never NaN for finite input.
+GjkWitnessOutput gjkWitness(const ConvexCore& a, const ConvexCore& b, const RelativePose& b_in_a,
+                            Real scale);
 
 /// The touching convention applied to a signed distance (negative = penetration depth).
 CollideOutput classifySignedDistance(Real signed_distance, Real tolerance);
