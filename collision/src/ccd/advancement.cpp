@@ -15,52 +15,6 @@ namespace collision {
 
 namespace {
 
-// Closest point to the origin of segment ab (RTCD 5.1.2).
-Vec3 closestOnSegmentToOrigin(const Vec3& a, const Vec3& b) {
-    const Vec3 ab = b - a;
-    const Real len2 = ab.squaredNorm();
-    if (!(len2 > 0)) return a;
-    const Real t = std::clamp(-a.dot(ab) / len2, Real(0), Real(1));
-    return a + t * ab;
-}
-
-// Closest point to the origin of triangle abc (RTCD 5.1.5, Voronoi regions).
-Vec3 closestOnTriangleToOrigin(const Vec3& a, const Vec3& b, const Vec3& c) {
-    const Vec3 ab = b - a;
-    const Vec3 ac = c - a;
-    const Vec3 ap = -a;
-    const Real d1 = ab.dot(ap), d2 = ac.dot(ap);
-    if (d1 <= 0 && d2 <= 0) return a;
-    const Vec3 bp = -b;
-    const Real d3 = ab.dot(bp), d4 = ac.dot(bp);
-    if (d3 >= 0 && d4 <= d3) return b;
-    const Real vc = d1 * d4 - d3 * d2;
-    if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
-    const Vec3 cp = -c;
-    const Real d5 = ab.dot(cp), d6 = ac.dot(cp);
-    if (d6 >= 0 && d5 <= d6) return c;
-    const Real vb = d5 * d2 - d1 * d6;
-    if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
-    const Real va = d3 * d6 - d5 * d4;
-    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
-        return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
-    }
-    const Real denom = va + vb + vc;
-    if (!(std::abs(denom) > 0)) return closestOnSegmentToOrigin(a, b);  // degenerate: any edge
-    return a + ab * (vb / denom) + ac * (vc / denom);
-}
-
-// The closest point of GJK's final simplex (points of A - B in A's frame) to the origin: the
-// GJK direction v (v = a - b for the closest pair, so B lies along -v from A).
-Vec3 simplexClosestPoint(const GjkOutput& g) {
-    switch (g.simplex_count) {
-        case 1: return g.simplex[0];
-        case 2: return closestOnSegmentToOrigin(g.simplex[0], g.simplex[1]);
-        case 3: return closestOnTriangleToOrigin(g.simplex[0], g.simplex[1], g.simplex[2]);
-        default: return Vec3::Zero();
-    }
-}
-
 // max over x in the shape of dir.x, for a local direction (any length).
 Real supportValue(const Shape& shape, const Vec3& dir_local) {
     return supportPoint(shape, dir_local).dot(dir_local);
@@ -214,7 +168,7 @@ ToiOutput timeOfImpact(const ToiInput& input) {
         const GjkOutput g = gjkDistance(core_a, core_b, relativePose(pa, pb), scale);
         Vec3 n = Vec3::Zero();
         if (g.state != GjkState::Overlapping) {
-            const Vec3 v = simplexClosestPoint(g);  // A's frame, points from B to A
+            const Vec3& v = g.closest;  // A's frame, points from B to A
             const Real len = v.norm();
             if (len > kEpsilon * scale) n = pa.orientation * (-v / len);
         }
