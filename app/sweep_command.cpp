@@ -24,7 +24,6 @@
 #include <sstream>
 #include <utility>
 
-#include "collision/narrowphase/contact.h"
 #include "command.h"
 #include "exit_codes.h"
 #include "output_files.h"
@@ -120,19 +119,11 @@ SweepRun measure(const engine::Scene& scene, double duration, FirstContacts& fir
         for (const collision::ProxyPair& p : world.pushedPairs()) {
             first.try_emplace(PairKey{p.a, p.b}, step_start);
         }
-        const auto bodies = world.bodies();
         for (const collision::ProxyPair& p : world.collidingPairs()) {
             first.try_emplace(PairKey{p.a, p.b}, double(world.time()));
-            // Depth of convex pairs (a mesh would answer as its hull, an overestimate).
-            const engine::Body& a = bodies[p.a];
-            const engine::Body& b = bodies[p.b];
-            if (!a.shape.isConvex() || !b.shape.isConvex()) continue;
-            const collision::ContactOutput c =
-                collision::contact(a.shape, a.pose(), b.shape, b.pose());
-            if (c.state == collision::ContactState::Penetrating) {
-                run.max_penetration = std::max(run.max_penetration, -double(c.signed_distance));
-            }
         }
+        // Depth of convex pairs (a mesh would answer as its hull, an overestimate).
+        run.max_penetration = std::max(run.max_penetration, double(world.deepestPenetration()));
     };
     record(double(world.time()));
     double energy_scale = 0;

@@ -16,7 +16,6 @@
 #include <vector>
 
 #include "collision/geometry/shape.h"
-#include "collision/narrowphase/narrow_phase.h"
 #include "collision/volumes/bounding_volumes.h"
 #include "font.h"
 
@@ -498,8 +497,6 @@ struct Renderer::Impl {
     /// Tessellates and draws every body that may show, in batches.
     void drawBodies(const engine::World& world, const CameraFrame& cam,
                     const FrameOptions& options);
-    void buildHierarchyLevels(const engine::World& world, int depth, GlDebugDraw& debug);
-    void buildContacts(const engine::World& world, GlDebugDraw& debug);
     void buildLines(const engine::World& world, const CameraFrame& cam,
                     const FrameOptions& options);
     /// Draws the triangle buffer and empties it.
@@ -720,110 +717,21 @@ void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& c
         debug.drawLine(e.point, e.point + e.normal * size, kToiColor);
     }
 
+    // What the narrow phase confirmed: the World derives it and decides what to draw.
+    engine::ContactDrawStyle style;
+    style.node_apart = nodeColor(collision::BvhNodeState::Apart);
+    style.node_overlapping = nodeColor(collision::BvhNodeState::Overlapping);
+    style.node_confirmed = nodeColor(collision::BvhNodeState::Confirmed);
+    style.contact = kContactColor;
+    style.cross_fraction = kContactCrossFraction;
+    style.normal_fraction = kContactNormalFraction;
     if (options.draw.bvh_depth >= 0) {
         debug.setTarget(bvh_lines);
-        buildHierarchyLevels(world, options.draw.bvh_depth, debug);
+        world.drawHierarchyLevels(debug, options.draw.bvh_depth, style);
     }
     if (options.draw.contacts) {
         debug.setTarget(contact_lines);
-        buildContacts(world, debug);
-    }
-}
-
-namespace {
-
-bool finitePose(const engine::Body& body) {
-    return body.position.allFinite() && body.orientation.coeffs().allFinite();
-}
-
-// The body's hierarchy when it is a mesh that has one (the scene loader always builds one).
-const collision::MeshBvh* meshTree(const engine::Body& body) {
-    const collision::Shape& s = body.shape;
-    return s.type == collision::ShapeType::Mesh && s.mesh && s.bvh && finitePose(body) ? s.bvh.get()
-                                                                                       : nullptr;
-}
-
-}  // namespace
-
-// Each mesh body's cut at `depth`, marked over the broad phase's flagged pairs (a pair the broad
-// phase does not flag has disjoint bounding volumes, but a node volume may reach outside its
-// body's bounding volume: such near misses stay green). Confirmed triangles come from the narrow
-// phase's own queries, run again here on the colliding pairs only.
-void Renderer::Impl::buildHierarchyLevels(const engine::World& world, int depth,
-                                          GlDebugDraw& debug) {
-    const auto bodies = world.bodies();
-    std::vector<collision::BvhLevel> levels(bodies.size());
-    for (std::size_t i = 0; i < bodies.size(); ++i) {
-        if (const collision::MeshBvh* tree = meshTree(bodies[i])) {
-            levels[i] = collision::makeBvhLevel(*tree, depth);
-        }
-    }
-    const auto colliding = world.collidingPairs();
-    for (const collision::ProxyPair& p : world.flaggedPairs()) {
-        const auto ia = static_cast<std::size_t>(p.a);
-        const auto ib = static_cast<std::size_t>(p.b);
-        if (ia >= bodies.size() || ib >= bodies.size()) continue;
-        const engine::Body& a = bodies[ia];
-        const engine::Body& b = bodies[ib];
-        if (!finitePose(a) || !finitePose(b)) continue;
-        const bool confirmed = std::binary_search(colliding.begin(), colliding.end(), p);
-        const collision::MeshBvh* tree_a = meshTree(a);
-        const collision::MeshBvh* tree_b = meshTree(b);
-        if (tree_a && tree_b) {
-            if (!tree_a->sameVolumeType(*tree_b)) continue;
-            const std::vector<collision::TrianglePair> pairs =
-                confirmed ? collision::collidingTrianglePairs(a.shape, a.pose(), b.shape, b.pose())
-                          : std::vector<collision::TrianglePair>{};
-            collision::markBvhLevels(levels[ia], *tree_a, a.pose(), levels[ib], *tree_b, b.pose(),
-                                     pairs);
-        } else if (tree_a && b.shape.isConvex()) {
-            const std::vector<std::int32_t> tris =
-                confirmed ? collision::collidingTriangles(a.shape, a.pose(), b.shape, b.pose())
-                          : std::vector<std::int32_t>{};
-            collision::markBvhLevel(levels[ia], *tree_a, a.pose(), b.shape, b.pose(), tris);
-        } else if (tree_b && a.shape.isConvex()) {
-            const std::vector<std::int32_t> tris =
-                confirmed ? collision::collidingTriangles(b.shape, b.pose(), a.shape, a.pose())
-                          : std::vector<std::int32_t>{};
-            collision::markBvhLevel(levels[ib], *tree_b, b.pose(), a.shape, a.pose(), tris);
-        }
-    }
-    for (std::size_t i = 0; i < bodies.size(); ++i) {
-        const Pose pose = bodies[i].pose();
-        for (std::size_t k = 0; k < levels[i].nodes.size(); ++k) {
-            collision::drawBvhLevelNode(debug, levels[i].nodes[k], pose,
-                                        nodeColor(levels[i].states[k]));
-        }
-    }
-}
-
-// Every colliding pair's witnesses (collision::contactWitnesses): a cross at each witness point
-// and the normal from A's witness, sized by the smaller body so marks stay on the pair.
-void Renderer::Impl::buildContacts(const engine::World& world, GlDebugDraw& debug) {
-    const auto bodies = world.bodies();
-    for (const collision::ProxyPair& p : world.collidingPairs()) {
-        const auto ia = static_cast<std::size_t>(p.a);
-        const auto ib = static_cast<std::size_t>(p.b);
-        if (ia >= bodies.size() || ib >= bodies.size()) continue;
-        const engine::Body& a = bodies[ia];
-        const engine::Body& b = bodies[ib];
-        if (!finitePose(a) || !finitePose(b)) continue;
-        const Real size = std::min(a.local_bounds.sphere.radius, b.local_bounds.sphere.radius);
-        const Real cross = kContactCrossFraction * size;
-        for (const collision::ContactWitness& w :
-             collision::contactWitnesses(a.shape, a.pose(), b.shape, b.pose())) {
-            for (const Vec3& point : {w.point_a, w.point_b}) {
-                if (!point.allFinite()) continue;
-                for (int axis = 0; axis < 3; ++axis) {
-                    const Vec3 d = Vec3::Unit(axis) * cross;
-                    debug.drawLine(point - d, point + d, kContactColor);
-                }
-            }
-            if (w.point_a.allFinite() && w.normal.allFinite()) {
-                debug.drawLine(w.point_a, w.point_a + w.normal * (kContactNormalFraction * size),
-                               kContactColor);
-            }
-        }
+        world.drawContacts(debug, style);
     }
 }
 

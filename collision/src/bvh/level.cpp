@@ -1,6 +1,6 @@
 // collision/src/bvh/level.cpp -- a level of a mesh hierarchy marked by contact state, and the
-// witnesses of confirmed contacts (drawing aids; read-only use of the hierarchy and the narrow
-// phase). Invariant: a level's nodes partition the mesh's triangles (MeshBvh::levelNodes), so
+// detail of confirmed contacts: triangles, witnesses, depth (read-only use of the hierarchy and
+// the narrow phase). Invariant: a level's nodes partition the mesh's triangles (MeshBvh::levelNodes), so
 // every confirmed triangle marks exactly one node, and states only rise, so the marks of a body's
 // pairs commute: the result does not depend on pair order.
 #include "collision/bvh/bvh_level.h"
@@ -68,11 +68,11 @@ std::array<Vec3, 3> corners(const TriangleMesh& mesh, std::int32_t t) {
 }
 
 void meshMeshWitnesses(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b,
-                       std::vector<ContactWitness>& out) {
+                       std::span<const TrianglePair> pairs, std::vector<ContactWitness>& out) {
     // In A's frame (B moved by the relative pose), then to world once: no precision lost to a
     // far-away origin.
     const RelativePose b_in_a = relativePose(pose_a, pose_b);
-    for (const TrianglePair& pair : collidingTrianglePairs(a, pose_a, b, pose_b)) {
+    for (const TrianglePair& pair : pairs) {
         const std::array<Vec3, 3> ta = corners(*a.mesh, pair.a);
         std::array<Vec3, 3> tb = corners(*b.mesh, pair.b);
         for (Vec3& v : tb) v = b_in_a.rotation * v + b_in_a.position;
@@ -88,8 +88,9 @@ void meshMeshWitnesses(const Shape& a, const Pose& pose_a, const Shape& b, const
 
 // `mesh` is A of the output.
 void meshConvexWitnesses(const Shape& mesh, const Pose& pose_mesh, const Shape& convex,
-                         const Pose& pose_convex, std::vector<ContactWitness>& out) {
-    for (const std::int32_t t : collidingTriangles(mesh, pose_mesh, convex, pose_convex)) {
+                         const Pose& pose_convex, std::span<const std::int32_t> triangles,
+                         std::vector<ContactWitness>& out) {
+    for (const std::int32_t t : triangles) {
         const std::array<Vec3, 3> c = corners(*mesh.mesh, t);
         auto flat = std::make_shared<ConvexPolytope>();
         flat->vertices = {c[0], c[1], c[2]};
@@ -164,26 +165,36 @@ void drawBvhLevelNode(DebugDraw& draw, const BvhLevelNode& node, const Pose& pos
     }
 }
 
-std::vector<ContactWitness> contactWitnesses(const Shape& a, const Pose& pose_a, const Shape& b,
-                                             const Pose& pose_b) {
-    std::vector<ContactWitness> out;
+PairContacts pairContacts(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b) {
+    PairContacts out;
     const bool mesh_a = a.type == ShapeType::Mesh && a.mesh;
     const bool mesh_b = b.type == ShapeType::Mesh && b.mesh;
     if (mesh_a && mesh_b) {
-        meshMeshWitnesses(a, pose_a, b, pose_b, out);
+        out.triangle_pairs = collidingTrianglePairs(a, pose_a, b, pose_b);
+        meshMeshWitnesses(a, pose_a, b, pose_b, out.triangle_pairs, out.witnesses);
     } else if (mesh_a) {
-        meshConvexWitnesses(a, pose_a, b, pose_b, out);
+        out.triangles = collidingTriangles(a, pose_a, b, pose_b);
+        meshConvexWitnesses(a, pose_a, b, pose_b, out.triangles, out.witnesses);
     } else if (mesh_b) {
-        meshConvexWitnesses(b, pose_b, a, pose_a, out);
-        for (ContactWitness& w : out) {  // mirror: A is the convex shape
+        out.triangles = collidingTriangles(b, pose_b, a, pose_a);
+        meshConvexWitnesses(b, pose_b, a, pose_a, out.triangles, out.witnesses);
+        for (ContactWitness& w : out.witnesses) {  // mirror: A is the convex shape
             std::swap(w.point_a, w.point_b);
             w.normal = -w.normal;
         }
     } else {
         const ContactOutput res = contact(a, pose_a, b, pose_b);
-        if (isColliding(res.state)) out.push_back({res.point_a, res.point_b, res.normal});
+        if (isColliding(res.state)) out.witnesses.push_back({res.point_a, res.point_b, res.normal});
+        if (res.state == ContactState::Penetrating && a.isConvex() && b.isConvex()) {
+            out.penetration = -res.signed_distance;
+        }
     }
     return out;
+}
+
+std::vector<ContactWitness> contactWitnesses(const Shape& a, const Pose& pose_a, const Shape& b,
+                                             const Pose& pose_b) {
+    return pairContacts(a, pose_a, b, pose_b).witnesses;
 }
 
 }  // namespace collision

@@ -12,7 +12,9 @@
 
 #include "collision/broadphase/broad_phase.h"
 #include "collision/bvh/bvh.h"
+#include "collision/bvh/bvh_level.h"
 #include "collision/ccd/ccd.h"
+#include "collision/debug_draw.h"
 #include "collision/volumes/bounding_volumes.h"
 #include "engine/body.h"
 
@@ -129,6 +131,16 @@ struct StepStats {
 
 class ContactSolver;
 
+/// Colours and sizes of World::drawHierarchyLevels and World::drawContacts: the caller's palette.
+struct ContactDrawStyle {
+    collision::Color node_apart;        ///< hierarchy nodes by collision::BvhNodeState
+    collision::Color node_overlapping;
+    collision::Color node_confirmed;
+    collision::Color contact;           ///< witness crosses and normals
+    Real cross_fraction = Real(0.06);   ///< cross half-length, of the pair's smaller bounding radius
+    Real normal_fraction = Real(0.5);   ///< normal length, of the same radius
+};
+
 /// The state left what double precision represents: a body's position, orientation or momentum
 /// is no longer finite. what() names the body, the quantity and the step; the world is left as
 /// it was after the step that broke it, and stepping it further is meaningless.
@@ -178,6 +190,26 @@ public:
     /// FNV-1a over the bit patterns of every body's state: equal hashes = bit-identical states.
     std::uint64_t stateHash() const;
 
+    /// The detail of every colliding pair, in collidingPairs() order: confirmed triangles,
+    /// witnesses and depth (collision::pairContacts). Derived by the narrow phase's own queries
+    /// the first time it is asked for after a step or detect(), then kept until the next one, so
+    /// every reader (drawing, the sweep) shares one computation. Not thread-safe.
+    std::span<const collision::PairContacts> contactDetails() const;
+    /// The deepest penetration over the colliding pairs of two convex shapes (contact()), 0 when
+    /// none; computes only those pairs' details.
+    Real deepestPenetration() const;
+    /// Draws every mesh body's hierarchy cut at `depth` (draw.bvh_depth), each node coloured by
+    /// its highest state over the flagged pairs: Overlapping where its volume overlaps the other
+    /// body's (collision::markBvhLevels, markBvhLevel), Confirmed where its subtree holds a
+    /// confirmed triangle (contactDetails()). A flagged pair is not confirmed when its bounding
+    /// volumes overlap but its shapes do not; a pair not flagged leaves its nodes Apart even if a
+    /// node's volume reaches outside the body's bounding volume.
+    void drawHierarchyLevels(collision::DebugDraw& draw, int depth,
+                             const ContactDrawStyle& style) const;
+    /// Draws the witnesses of every colliding pair (draw.contacts): a cross at each witness point
+    /// and the normal from A's, sized by the smaller body so the marks stay on the pair.
+    void drawContacts(collision::DebugDraw& draw, const ContactDrawStyle& style) const;
+
 private:
     void integrate(Real dt, const Vec3& gravity);
     void integrateExplicitEuler(Real dt, const Vec3& gravity);
@@ -190,6 +222,8 @@ private:
     void resolveContinuous();
     void findResponsePairs(Real margin_fraction);
     void runCollisionPipeline();
+    enum class DetailLevel : std::uint8_t { None, Convex, All };
+    void computeDetails(DetailLevel level) const;
 
     WorldSettings settings_;
     std::vector<Body> bodies_;
@@ -220,6 +254,9 @@ private:
     std::vector<Vec3> pseudo_linear_;
     std::vector<Vec3> pseudo_angular_;
     StepStats stats_;
+    // contactDetails(): derived on request, dropped by the next collision pipeline run.
+    mutable std::vector<collision::PairContacts> details_;
+    mutable DetailLevel details_level_ = DetailLevel::None;
     Real time_ = 0;
     std::int64_t step_count_ = 0;
     bool proxies_inserted_ = false;

@@ -63,15 +63,32 @@ struct ContactWitness {
     Vec3 normal = Vec3::Zero();  ///< unit, or zero when undefined
 };
 
-/// Witnesses of a colliding pair (what `draw.contacts` shows), empty when it does not collide:
-/// - convex-convex: contact()'s witness points and normal (one);
-/// - mesh-mesh: one per triangle pair of collidingTrianglePairs: the closest points of
-///   distanceTriangleTriangle, which for intersecting triangles are a point the two share up to
-///   rounding (where an edge of one pierces the other); the normal is A's triangle's face normal
-///   (right-hand rule on its corners: outward for a closed counter-clockwise mesh). Meshes are
-///   surfaces, so no penetration direction exists; the face normal is the honest direction.
-/// - mesh-convex: one per triangle of collidingTriangles: contact() of that triangle (as a flat
-///   hull, in the mesh's pose) against the convex shape: its witness points and normal, A to B.
+/// What the narrow phase confirms of one pair in detail, derived by its own queries: what
+/// `draw.contacts` and `draw.bvh_depth` show and what `cdlab sweep` measures as depth. Empty when
+/// the pair does not collide.
+struct PairContacts {
+    /// Mesh-mesh: collidingTrianglePairs(a, b) (mesh indices).
+    std::vector<TrianglePair> triangle_pairs;
+    /// Mesh-convex (either order): collidingTriangles(mesh, convex), the mesh's triangles.
+    std::vector<std::int32_t> triangles;
+    /// Witnesses, A to B:
+    /// - convex-convex: contact()'s witness points and normal (one);
+    /// - mesh-mesh: one per triangle pair: the closest points of distanceTriangleTriangle, which
+    ///   for intersecting triangles are a point the two share up to rounding (where an edge of
+    ///   one pierces the other); the normal is A's triangle's face normal (right-hand rule on its
+    ///   corners: outward for a closed counter-clockwise mesh). Meshes are surfaces, so no
+    ///   penetration direction exists; the face normal is the honest direction.
+    /// - mesh-convex: one per triangle: contact() of that triangle (as a flat hull, in the mesh's
+    ///   pose) against the convex shape: its witness points and normal.
+    std::vector<ContactWitness> witnesses;
+    /// Convex-convex: contact()'s penetration depth when Penetrating, else 0. 0 for meshes.
+    Real penetration = 0;
+};
+
+/// The detail of the pair (a at pose_a, b at pose_b), world frame.
+PairContacts pairContacts(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b);
+
+/// pairContacts(a, pose_a, b, pose_b).witnesses.
 std::vector<ContactWitness> contactWitnesses(const Shape& a, const Pose& pose_a, const Shape& b,
                                              const Pose& pose_b);
 
