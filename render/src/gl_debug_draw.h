@@ -1,0 +1,87 @@
+// render/src/gl_debug_draw.h -- the vertex buffers a frame fills (eye-relative floats, in a fixed
+// order every frame) and the collision::DebugDraw that records lines into them: what the broad
+// phases, the World and the volume overlays draw through. Private to render.
+#pragma once
+
+#include <GL/gl.h>
+
+#include <vector>
+
+#include "camera.h"
+#include "collision/debug_draw.h"
+#include "collision/volumes/bounding_volumes.h"
+
+namespace render {
+
+/// Lines behind a body show through this faintly.
+inline constexpr float kHiddenLineAlpha = 0.3f;
+
+
+struct TriangleBuffer {
+    std::vector<float> positions;
+    std::vector<float> normals;
+
+    void clear() {
+        positions.clear();
+        normals.clear();
+    }
+    void add(const Vec3& p_eye, const Vec3& n_world) {
+        positions.insert(positions.end(), {float(p_eye.x()), float(p_eye.y()), float(p_eye.z())});
+        normals.insert(normals.end(), {float(n_world.x()), float(n_world.y()), float(n_world.z())});
+    }
+    GLsizei count() const { return GLsizei(positions.size() / 3); }
+};
+
+struct LineBuffer {
+    std::vector<float> positions;
+    std::vector<float> colors;
+    std::vector<float> faint_colors;  ///< same colours at kHiddenLineAlpha
+
+    void clear() {
+        positions.clear();
+        colors.clear();
+        faint_colors.clear();
+    }
+    void add(const Vec3& a_eye, const Vec3& b_eye, const Color& c) {
+        positions.insert(positions.end(), {float(a_eye.x()), float(a_eye.y()), float(a_eye.z()),
+                                           float(b_eye.x()), float(b_eye.y()), float(b_eye.z())});
+        colors.insert(colors.end(), {c.r, c.g, c.b, c.a, c.r, c.g, c.b, c.a});
+        const float fa = c.a * kHiddenLineAlpha;
+        faint_colors.insert(faint_colors.end(), {c.r, c.g, c.b, fa, c.r, c.g, c.b, fa});
+    }
+    GLsizei count() const { return GLsizei(positions.size() / 3); }
+};
+
+/// Segments around a circle of `radius` centred at `center` so that each spans about
+/// `px_per_segment` framebuffer pixels, a multiple of 4 in [lo, hi].
+int segmentsFor(const CameraFrame& cam, const Vec3& center, Real radius, Real px_per_segment,
+                int lo, int hi);
+
+// The DebugDraw that the broad phase and the volume overlays draw through: it records lines.
+class GlDebugDraw final : public collision::DebugDraw {
+public:
+    GlDebugDraw(const CameraFrame& cam, LineBuffer& target) : cam_(cam), target_(&target) {}
+
+    /// Where lines go from now on; sphere silhouettes go to `outlines` (thinner lines) when given.
+    void setTarget(LineBuffer& target, LineBuffer* outlines = nullptr) {
+        target_ = &target;
+        outlines_ = outlines;
+    }
+
+    void drawLine(const Vec3& a, const Vec3& b, const Color& color) override {
+        target_->add(cam_.toEye(a), cam_.toEye(b), color);
+    }
+
+    /// Three great circles and the silhouette (gl_debug_draw.cpp).
+    void drawSphere(const collision::BoundingSphere& sphere, const Color& color) override;
+
+private:
+    /// center + cos(t) u + sin(t) v over a full turn in n segments.
+    void circle(const Vec3& center, const Vec3& u, const Vec3& v, int n, const Color& color);
+
+    const CameraFrame& cam_;
+    LineBuffer* target_;
+    LineBuffer* outlines_ = nullptr;
+};
+
+}  // namespace render
