@@ -1,0 +1,482 @@
+// engine/src/scene_bodies.cpp -- the scene's `bodies`: shapes (hull and mesh geometry imported
+// once per (file, scale, shape) and shared), poses, motion, mass, and `repeat` populations.
+// Conventions: `position` is the body's centre of mass (hull and mesh vertices are re-centred
+// on it); `euler_deg: [x, y, z]` is intrinsic X, then Y, then Z, i.e. R = Rx(x) Ry(y) Rz(z);
+// `angular_velocity` is in the world frame.
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <iomanip>
+#include <map>
+#include <memory>
+#include <numbers>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string_view>
+#include <utility>
+
+#include "collision/broadphase/broad_phase.h"
+#include "collision/bvh/bvh.h"
+#include "collision/geometry/convex_hull.h"
+#include "engine/mass_properties.h"
+#include "engine/mesh_import.h"
+#include "scene_parser.h"
+
+namespace engine::scene_parsing {
+
+const PreparedShape& SceneParser::prepareMeshShape(ShapeType type, const std::string& file,
+                                                   Real scale, const Entry& file_entry,
+                                                   const std::string& path,
+                                                   const std::string& bvh_name) {
+    fs::path resolved = fs::path(file);
+    if (resolved.is_relative()) resolved = base_dir_ / resolved;
+    std::error_code ec;
+    fs::path canonical = fs::weakly_canonical(resolved, ec);
+    if (ec) canonical = resolved.lexically_normal();
+    const auto key = std::make_tuple(canonical.string(), scale, static_cast<int>(type));
+    if (const auto it = mesh_cache_.find(key); it != mesh_cache_.end()) return it->second;
+
+    // Errors about the file are reported at the `file:` key. One import per file, at scale 1,
+    // shared by every hull and mesh body made from it: assimp is the slow part (under ASan one OBJ
+    // import costs about half a second, so a scene with many scales of one file took seconds).
+    auto import_it = import_cache_.find(canonical.string());
+    if (import_it == import_cache_.end()) {
+        import_it = import_cache_
+                        .emplace(canonical.string(),
+                                 std::make_shared<const MeshImportOutput>(importMesh(resolved, 1)))
+                        .first;
+    }
+    // Scaling after the import gives importMesh(file, scale)'s mesh unless rounding at an extreme
+    // scale made a kept triangle degenerate (vertices merge, or the area vanishes) or the file
+    // only works at its scale (a failed import); then that scale is imported on its own, so the
+    // welding and degenerate-triangle rules and the error messages are importMesh's exactly.
+    MeshImportOutput imported = *import_it->second;
+    bool exact = imported.ok;
+    for (Vec3& v : imported.mesh.vertices) {
+        v *= scale;
+        exact = exact && v.allFinite();
+    }
+    for (const auto& t : imported.mesh.triangles) {
+        if (!exact) break;
+        const Vec3& a = imported.mesh.vertices[t[0]];
+        const Vec3& b = imported.mesh.vertices[t[1]];
+        const Vec3& c = imported.mesh.vertices[t[2]];
+        exact = a != b && b != c && a != c && (b - a).cross(c - a).squaredNorm() > 0;
+    }
+    if (!exact) {
+        imported = importMesh(resolved, scale);
+        if (!imported.ok) fail(file_entry.key_node, path, imported.error);
+    }
+    const collision::ConvexHullOutput hull = collision::computeConvexHull(imported.mesh.vertices);
+    if (!hull.ok) {
+        // A flat or degenerate point set is the file's shape, not a failure of the hull: say so.
+        const std::size_t n = imported.mesh.vertices.size();
+        const std::string counts = std::to_string(n) + (n == 1 ? " vertex" : " vertices") + ", " +
+                                   std::to_string(imported.mesh.triangles.size()) + " triangle" +
+                                   (imported.mesh.triangles.size() == 1 ? "" : "s");
+        std::string flat;
+        if (hull.error == "points are coplanar" || n == 3) {
+            flat = "lie in one plane";
+        } else if (hull.error == "points are collinear" || n == 2) {
+            flat = "lie on one line";
+        } else if (hull.error == "all points coincide" || n < 2) {
+            flat = "coincide";
+        }
+        if (!flat.empty()) {
+            fail(
+                file_entry.key_node, path,
+                "'" + resolved.string() + "' has no volume: its points " + flat + " (" + counts +
+                    "); a body is a solid, so its " +
+                    (type == ShapeType::ConvexHull ? "hull" : "mesh's hull (for mass properties)") +
+                    " needs points in three dimensions");
+        }
+        fail(file_entry.key_node, path,
+             "cannot build the convex hull of '" + resolved.string() + "': " + hull.error);
+    }
+    // Mass properties of the solid the body is (the hull, or the mesh's own volume), then move
+    // the geometry so that the local origin is the centre of mass.
+    Shape raw =
+        type == ShapeType::ConvexHull
+            ? Shape::convexHull(std::make_shared<const collision::ConvexPolytope>(hull.hull))
+            : Shape::triangleMesh(std::make_shared<const collision::TriangleMesh>(imported.mesh),
+                                  std::make_shared<const collision::ConvexPolytope>(hull.hull),
+                                  nullptr);  // only for the mass properties: no hierarchy
+    const MassPropertiesOutput mp = computeMassProperties(raw, 1);
+    if (!mp.ok) fail(file_entry.key_node, path, "'" + resolved.string() + "': " + mp.error);
+    const Vec3 com = mp.props.center_of_mass;
+    collision::ConvexPolytope centred_hull = hull.hull;
+    for (Vec3& v : centred_hull.vertices) v -= com;
+    PreparedShape prepared;
+    prepared.unit = mp.props;
+    if (type == ShapeType::ConvexHull) {
+        prepared.shape = Shape::convexHull(
+            std::make_shared<const collision::ConvexPolytope>(std::move(centred_hull)));
+    } else {
+        collision::TriangleMesh centred_mesh = imported.mesh;
+        for (Vec3& v : centred_mesh.vertices) v -= com;
+        // The hierarchy is built once here, in the body frame, and shared by every body made
+        // from this file (rigid motion needs no rebuild).
+        auto mesh = std::make_shared<const collision::TriangleMesh>(std::move(centred_mesh));
+        std::shared_ptr<const collision::MeshBvh> bvh = collision::buildMeshBvh(bvh_name, *mesh);
+        prepared.shape = Shape::triangleMesh(
+            std::move(mesh),
+            std::make_shared<const collision::ConvexPolytope>(std::move(centred_hull)),
+            std::move(bvh));
+    }
+    return mesh_cache_.emplace(key, std::move(prepared)).first->second;
+}
+
+std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
+                                         const Scene& scene) {
+    const std::string path = indexPath("bodies", index);
+    const std::vector<Entry> es =
+        entries(n, path, std::vector<std::string_view>(std::begin(kBodyKeys), std::end(kBodyKeys)));
+
+    // The shape first: it decides which keys apply.
+    const Entry& shape_entry = require(es, "shape", n, path);
+    const std::string shape_name = readString(shape_entry.value, childPath(path, "shape"));
+    ShapeType type = ShapeType::Sphere;
+    std::vector<std::string_view> shape_keys;
+    if (shape_name == "sphere") {
+        type = ShapeType::Sphere;
+        shape_keys = {"radius"};
+    } else if (shape_name == "box") {
+        type = ShapeType::Box;
+        shape_keys = {"half_extents"};
+    } else if (shape_name == "capsule") {
+        type = ShapeType::Capsule;
+        shape_keys = {"radius", "half_height"};
+    } else if (shape_name == "hull" || shape_name == "mesh") {
+        type = shape_name == "hull" ? ShapeType::ConvexHull : ShapeType::Mesh;
+        shape_keys = {"file", "scale"};
+    } else {
+        fail(shape_entry.value, childPath(path, "shape"),
+             "unknown shape '" + shape_name +
+                 "' (expected one of: " + join({"sphere", "box", "capsule", "hull", "mesh"}) + ")");
+    }
+    constexpr std::string_view kShapeSpecific[] = {"radius", "half_height", "half_extents", "file",
+                                                   "scale"};
+    for (const Entry& e : es) {
+        for (const std::string_view k : kShapeSpecific) {
+            if (e.key != k) continue;
+            bool applies = false;
+            for (const std::string_view s : shape_keys) applies = applies || s == k;
+            if (!applies) {
+                fail(e.key_node, childPath(path, e.key),
+                     "does not apply to shape '" + shape_name + "'");
+            }
+        }
+    }
+    // Pairs that exclude each other: reported at whichever comes second in the file.
+    constexpr std::pair<std::string_view, std::string_view> kExclusive[] = {
+        {"mass", "density"}, {"orientation_wxyz", "euler_deg"}};
+    for (const auto& [a, b] : kExclusive) {
+        const Entry* ea = find(es, a);
+        const Entry* eb = find(es, b);
+        if (ea != nullptr && eb != nullptr) {
+            const Entry* second = ea->key_node.Mark().pos > eb->key_node.Mark().pos ? ea : eb;
+            fail(second->key_node, childPath(path, second->key),
+                 "give either '" + std::string(a) + "' or '" + std::string(b) + "', not both");
+        }
+    }
+
+    std::string name = shape_name + std::to_string(index);
+    Vec3 position = Vec3::Zero();
+    Quat orientation = Quat::Identity();
+    Vec3 velocity = Vec3::Zero();
+    Vec3 angular_velocity = Vec3::Zero();
+    Real radius = 0;
+    Real half_height = 0;
+    Vec3 half_extents = Vec3::Zero();
+    Real scale = 1;
+    const Entry* file_entry = nullptr;
+    const Entry* mass_entry = nullptr;
+    const Entry* density_entry = nullptr;
+    Real mass = 0;
+    Real density = 1000;
+    bool is_static = false;
+    Real restitution = scene.world.restitution;
+    Real friction = scene.world.friction;
+
+    const Entry* repeat_entry = find(es, "repeat");
+    if (repeat_entry != nullptr) {
+        for (const Entry& e : es) {
+            for (const std::string_view k : kGeneratedKeys) {
+                if (e.key == k) {
+                    fail(e.key_node, childPath(path, e.key),
+                         "does not apply with 'repeat' (repeat generates it)");
+                }
+            }
+        }
+    } else {
+        require(es, "position", n, path);
+    }
+    for (const std::string_view k : shape_keys) {
+        if (k != "scale") require(es, k, n, path);
+    }
+    for (const Entry& e : es) {
+        const std::string p = childPath(path, e.key);
+        const YAML::Node& v = e.value;
+        if (e.key == "name") {
+            name = readString(v, p);
+        } else if (e.key == "radius") {
+            radius = readReal(v, p);
+            if (!(radius > 0)) fail(v, p, "must be > 0");
+        } else if (e.key == "half_height") {
+            half_height = readReal(v, p);
+            if (!(half_height >= 0)) fail(v, p, "must be >= 0");
+        } else if (e.key == "half_extents") {
+            half_extents = readVec3(v, p);
+            for (int a = 0; a < 3; ++a) {
+                if (!(half_extents[a] >= 0)) fail(v[a], indexPath(p, a), "must be >= 0");
+            }
+        } else if (e.key == "file") {
+            readString(v, p);
+            if (v.Scalar().empty()) fail(v, p, "must not be empty");
+            file_entry = &e;
+        } else if (e.key == "scale") {
+            scale = readReal(v, p);
+            if (!(scale > 0)) fail(v, p, "must be > 0");
+            // The hull and mass properties multiply up to three coordinates: at 1e300 they
+            // overflowed ("points are coplanar"), at 1e-300 underflowed ("no triangles").
+            if (!(scale >= kMinMeshScale && scale <= kMaxMeshScale)) {
+                fail(v, p,
+                     "must be in [" + formatLimit(kMinMeshScale) + ", " +
+                         formatLimit(kMaxMeshScale) +
+                         "]: beyond, products of the scaled coordinates over- or underflow");
+            }
+        } else if (e.key == "position") {
+            position = readVec3(v, p);
+            if (!scene.world.bounds.contains(position)) {
+                fail(v, p, "is outside the world bounds");
+            }
+        } else if (e.key == "orientation_wxyz") {
+            if (!v.IsSequence() || v.size() != 4) fail(v, p, "expected a list of 4 numbers");
+            Real q[4];
+            for (std::size_t i = 0; i < 4; ++i) q[i] = readReal(v[i], indexPath(p, i));
+            const Quat raw(q[0], q[1], q[2], q[3]);
+            const Real len = raw.norm();
+            if (!(len > kMinQuaternionNorm) || !std::isfinite(len)) {
+                fail(v, p, "must be a non-zero quaternion (it is normalised)");
+            }
+            orientation = Quat(raw.coeffs() / len);
+        } else if (e.key == "euler_deg") {
+            const Vec3 deg = readVec3(v, p);
+            const Vec3 rad = deg * (std::numbers::pi_v<Real> / 180);
+            // Intrinsic X, then Y, then Z: R = Rx Ry Rz.
+            orientation = Quat(Eigen::AngleAxis<Real>(rad.x(), Vec3::UnitX())) *
+                          Quat(Eigen::AngleAxis<Real>(rad.y(), Vec3::UnitY())) *
+                          Quat(Eigen::AngleAxis<Real>(rad.z(), Vec3::UnitZ()));
+            orientation.normalize();
+        } else if (e.key == "velocity") {
+            velocity = readVec3(v, p);
+            const std::string problem = speedProblem(velocity.stableNorm(), scene.world);
+            if (!problem.empty()) fail(v, p, problem);
+        } else if (e.key == "angular_velocity") {
+            angular_velocity = readVec3(v, p);
+            const std::string problem = spinProblem(angular_velocity.stableNorm(), scene.world);
+            if (!problem.empty()) fail(v, p, problem);
+        } else if (e.key == "mass") {
+            mass = readReal(v, p);
+            if (!(mass > 0)) fail(v, p, "must be > 0 (kg)");
+            mass_entry = &e;
+        } else if (e.key == "density") {
+            density = readReal(v, p);
+            if (!(density > 0)) fail(v, p, "must be > 0 (kg/m^3)");
+            density_entry = &e;
+        } else if (e.key == "static") {
+            is_static = readBool(v, p);
+        } else if (e.key == "restitution") {
+            restitution = readReal(v, p);
+            if (!(restitution >= 0 && restitution <= 1)) fail(v, p, "must be in [0, 1]");
+        } else if (e.key == "friction") {
+            friction = readReal(v, p);
+            if (!(friction >= 0)) fail(v, p, "must be >= 0");
+        }
+    }
+    if (is_static) {
+        for (const Entry& e : es) {
+            if (e.key == "velocity" || e.key == "angular_velocity") {
+                fail(e.key_node, childPath(path, e.key), "a static body does not move");
+            }
+        }
+    }
+
+    // Geometry and its properties at density 1 (mass = volume).
+    Shape shape;
+    MassProperties unit;
+    // Mass problems are reported at `mass` or `density`, else at the shape's size key.
+    const Entry* mass_at = mass_entry != nullptr      ? mass_entry
+                           : density_entry != nullptr ? density_entry
+                                                      : find(es, shape_keys.front());
+    const std::string mass_path = childPath(path, mass_at->key);
+    const YAML::Node mass_node = mass_at->value;
+    if (type == ShapeType::ConvexHull || type == ShapeType::Mesh) {
+        const PreparedShape& prepared =
+            prepareMeshShape(type, file_entry->value.Scalar(), scale, *file_entry,
+                             childPath(path, "file"), scene.world.mesh_bvh);
+        shape = prepared.shape;
+        unit = prepared.unit;
+    } else {
+        shape = type == ShapeType::Sphere ? Shape::sphere(radius)
+                : type == ShapeType::Box  ? Shape::box(half_extents)
+                                          : Shape::capsule(radius, half_height);
+        const MassPropertiesOutput mp = computeMassProperties(shape, 1);
+        if (mp.ok) {
+            unit = mp.props;
+        } else if (type == ShapeType::Box) {
+            // A flat or degenerate box: only an explicit mass defines it. Thin-plate / rod limit
+            // of the cuboid formula, with a floor so that the inertia stays invertible.
+            if (mass_entry == nullptr) {
+                fail(find(es, "half_extents")->value, childPath(path, "half_extents"),
+                     "a box with zero volume needs 'mass' (a density gives it no mass)");
+            }
+            const Vec3 h2 = half_extents.cwiseProduct(half_extents);
+            const Real l = std::max(half_extents.maxCoeff(), Real(1e-3));
+            const Real floor2 = (kMinGyrationFraction * l) * (kMinGyrationFraction * l);
+            const Vec3 moments = (Vec3(h2.y() + h2.z(), h2.z() + h2.x(), h2.x() + h2.y()) / 3)
+                                     .cwiseMax(Vec3::Constant(floor2));
+            unit.mass = 1;  // per kg: scaled by the mass below
+            unit.inertia = moments.asDiagonal();
+        } else {
+            fail(mass_node, mass_path, mp.error);
+        }
+    }
+    const Real scale_to = mass_entry != nullptr ? mass / unit.mass : density;
+    MassProperties props = unit;
+    props.mass = unit.mass * scale_to;
+    props.inertia = unit.inertia * scale_to;
+    if (mass_entry != nullptr) props.mass = mass;
+    const Mat3 inv = props.inertia.inverse();
+    if (!std::isfinite(props.mass) || !(props.mass > 0) || !props.inertia.allFinite() ||
+        !inv.allFinite() || !(props.inertia.diagonal().minCoeff() > 0)) {
+        std::ostringstream what;
+        what << "gives degenerate mass properties (mass " << props.mass
+             << " kg): the body is too small, too large, too light or too heavy";
+        fail(mass_node, mass_path, what.str());
+    }
+
+    Body body = makeBody(std::move(name), std::move(shape), props);
+    body.restitution = restitution;
+    body.friction = friction;
+    auto place = [&props, is_static](Body& b, const Vec3& p, const Quat& q, const Vec3& v,
+                                     const Vec3& w) {
+        b.position = p;
+        b.orientation = q;
+        b.linear_momentum = props.mass * v;
+        const Mat3 r = q.toRotationMatrix();
+        b.angular_momentum = r * props.inertia * r.transpose() * w;
+        if (is_static) setStatic(b);
+    };
+    if (repeat_entry == nullptr) {
+        place(body, position, orientation, velocity, angular_velocity);
+        return {std::move(body)};
+    }
+    return repeatBody(body, *repeat_entry, childPath(path, "repeat"), scene, place);
+}
+
+template <typename Place>
+std::vector<Body> SceneParser::repeatBody(const Body& base, const Entry& entry,
+                                          const std::string& path, const Scene& scene,
+                                          Place&& place) const {
+    const YAML::Node& n = entry.value;
+    if (!n.IsMap())
+        fail(n, path,
+             "expected a mapping with keys: " +
+                 join({"count", "seed", "region", "speed", "spin", "random_orientation"}));
+    const std::vector<Entry> es = entries(
+        n, path, std::vector<std::string_view>(std::begin(kRepeatKeys), std::end(kRepeatKeys)));
+    const Entry& count_entry = require(es, "count", n, path);
+    const int count = readInt(count_entry.value, childPath(path, "count"));
+    if (count < 1 || count > kMaxRepeat) {
+        fail(count_entry.value, childPath(path, "count"),
+             "must be in 1.." + std::to_string(kMaxRepeat));
+    }
+    if (scene.bodies.size() + static_cast<std::size_t>(count) > kMaxBodies) {
+        fail(count_entry.value, childPath(path, "count"),
+             std::to_string(count) + " more bodies after " + std::to_string(scene.bodies.size()) +
+                 " would pass the limit of " + std::to_string(kMaxBodies) + " bodies in a scene");
+    }
+    std::uint64_t seed = 1;
+    collision::Aabb region = scene.world.bounds;
+    Real speed = 0;
+    Real spin = 0;
+    bool random_orientation = true;
+    for (const Entry& e : es) {
+        const std::string p = childPath(path, e.key);
+        if (e.key == "seed") {
+            const int s = readInt(e.value, p);
+            if (s < 0) fail(e.value, p, "must be >= 0");
+            seed = static_cast<std::uint64_t>(s);
+        } else if (e.key == "region") {
+            const std::vector<Entry> r = entries(e.value, p, {"min", "max"});
+            region.min = readVec3(require(r, "min", e.value, p).value, childPath(p, "min"));
+            region.max = readVec3(require(r, "max", e.value, p).value, childPath(p, "max"));
+            for (int a = 0; a < 3; ++a) {
+                if (!(region.min[a] <= region.max[a])) {
+                    fail(e.value, p, "min must be <= max on every axis");
+                }
+            }
+            if (!scene.world.bounds.contains(region.min) ||
+                !scene.world.bounds.contains(region.max)) {
+                fail(e.value, p, "must lie inside the world bounds");
+            }
+        } else if (e.key == "speed") {
+            speed = readReal(e.value, p);
+            if (!(speed >= 0)) fail(e.value, p, "must be >= 0 (m/s)");
+            const std::string problem = speedProblem(speed, scene.world);
+            if (!problem.empty()) fail(e.value, p, problem);
+        } else if (e.key == "spin") {
+            spin = readReal(e.value, p);
+            if (!(spin >= 0)) fail(e.value, p, "must be >= 0 (rad/s)");
+            const std::string problem = spinProblem(spin, scene.world);
+            if (!problem.empty()) fail(e.value, p, problem);
+        } else if (e.key == "random_orientation") {
+            random_orientation = readBool(e.value, p);
+        }
+    }
+    // splitmix64: the same bodies from the same seed on every platform.
+    std::uint64_t state = seed * 0x9E3779B97F4A7C15ull + 0x632BE59BD9B4E019ull;
+    auto uniform = [&state]() {
+        std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        z ^= z >> 31;
+        return Real(z >> 11) * Real(0x1.0p-53);
+    };
+    auto direction = [&uniform]() {
+        // Uniform on the sphere: z uniform in [-1, 1], azimuth uniform (Archimedes).
+        const Real z = 2 * uniform() - 1;
+        const Real phi = 2 * std::numbers::pi_v<Real> * uniform();
+        const Real r = std::sqrt(std::max(Real(0), 1 - z * z));
+        return Vec3(r * std::cos(phi), r * std::sin(phi), z);
+    };
+    std::vector<Body> out;
+    out.reserve(static_cast<std::size_t>(count));
+    for (int k = 0; k < count; ++k) {
+        Body b = base;
+        b.name = base.name + "_" + std::to_string(k);
+        const Vec3 t(uniform(), uniform(), uniform());
+        const Vec3 p = region.min + (region.max - region.min).cwiseProduct(t);
+        Quat q = Quat::Identity();
+        if (random_orientation) {
+            // Shoemake's uniform random rotation.
+            const Real u1 = uniform(), u2 = uniform(), u3 = uniform();
+            const Real a = std::sqrt(1 - u1), c = std::sqrt(u1);
+            const Real tau = 2 * std::numbers::pi_v<Real>;
+            q = Quat(a * std::sin(tau * u2), a * std::cos(tau * u2), c * std::sin(tau * u3),
+                     c * std::cos(tau * u3))
+                    .normalized();
+        }
+        const Vec3 v = direction() * (speed * uniform());
+        const Vec3 w = direction() * (spin * uniform());
+        place(b, p, q, v, w);
+        out.push_back(std::move(b));
+    }
+    return out;
+}
+
+}  // namespace engine::scene_parsing
