@@ -37,7 +37,7 @@ BvhUnitCosts measureBvhUnitCosts(const collision::MeshBvh& a, const collision::M
     std::int64_t nv = 0;
     std::int64_t np = 0;
     for (const collision::Pose& pose : poses) {
-        samples.push_back(a.recordTests(b, pose));
+        samples.push_back(collision::recordTests(a, b, pose));
         nv += static_cast<std::int64_t>(samples.back().node_pairs.size());
         np += static_cast<std::int64_t>(samples.back().triangle_pairs.size());
     }
@@ -87,7 +87,7 @@ BvhUnitCosts measureBvhUnitCosts(const collision::MeshBvh& a, const collision::M
             return static_cast<std::int64_t>(s.node_pairs.size());
         },
         [&](std::size_t k, int repeats) {
-            return a.replayVolumeTests(b, poses[k], samples[k], repeats);
+            return collision::replayVolumeTests(a, b, poses[k], samples[k], repeats);
         },
         &costs.bv_overlaps);
     const double tri_seconds = timeReplays(
@@ -96,7 +96,7 @@ BvhUnitCosts measureBvhUnitCosts(const collision::MeshBvh& a, const collision::M
             return static_cast<std::int64_t>(s.triangle_pairs.size());
         },
         [&](std::size_t k, int repeats) {
-            return a.replayTriangleTests(b, poses[k], samples[k], repeats);
+            return collision::replayTriangleTests(a, b, poses[k], samples[k], repeats);
         },
         &costs.triangle_hits);
     costs.bv_test_ns = 1e9 * bv_seconds / static_cast<double>(costs.bv_tests_timed);

@@ -7,6 +7,7 @@
 #include <span>
 
 #include "collision/bvh/bvh.h"
+#include "collision/bvh/bvh_replay.h"
 
 namespace app {
 
@@ -24,7 +25,7 @@ struct BvhUnitCosts {
 };
 
 /// Records the node pairs and triangle pairs that a.intersect(b, pose) tests at every pose
-/// (MeshBvh::recordTests), repeats those lists until a batch holds at least `bv_target` volume
+/// (collision::recordTests), repeats those lists until a batch holds at least `bv_target` volume
 /// tests and `triangle_target` triangle tests (each pose's list the same number of times, so
 /// poses weigh as their Nv and Np do in F), and times the replays in chunks of about one query's
 /// tests, each the fastest of 3 runs. None of this is inside a query's timed path. `a` and `b`

@@ -409,9 +409,9 @@ void World::resolveContinuous() {
         // continuous OBB test's culling (a ring may pass around a rod). Any other pair: the
         // convex shapes, a mesh standing for its convex hull (conservative: may stop early).
         const collision::Bvh<collision::Obb>* tree_a =
-            a.shape.bvh != nullptr ? a.shape.bvh->obbTree() : nullptr;
+            a.shape.bvh != nullptr ? collision::treeOf<collision::Obb>(*a.shape.bvh) : nullptr;
         const collision::Bvh<collision::Obb>* tree_b =
-            b.shape.bvh != nullptr ? b.shape.bvh->obbTree() : nullptr;
+            b.shape.bvh != nullptr ? collision::treeOf<collision::Obb>(*b.shape.bvh) : nullptr;
         auto query = [&]() {
             if (tree_a == nullptr || tree_b == nullptr) return collision::timeOfImpact(in);
             collision::MeshToiInput mi;

@@ -3,6 +3,7 @@
 // containment of every fitted volume (validate), metamorphic translation and scaling, and the
 // lookup by name.
 #include "collision/bvh/bvh.h"
+#include "collision/bvh/bvh_replay.h"
 
 #include <gtest/gtest.h>
 
@@ -685,27 +686,28 @@ TEST(Bvh, RecordedTestsReplayAsTheQueryMadeThem) {
             const Pose& pose = differentialPoses()[k];
             BvhQueryStats stats;
             const auto pairs = a->intersect(*b, pose, &stats);
-            const collision::BvhTestSample sample = a->recordTests(*b, pose);
+            const collision::BvhTestSample sample = collision::recordTests(*a, *b, pose);
             const auto nv = static_cast<std::int64_t>(sample.node_pairs.size());
             const auto np = static_cast<std::int64_t>(sample.triangle_pairs.size());
             EXPECT_EQ(nv, stats.bv_tests) << name << " pose " << k;
             EXPECT_EQ(np, stats.triangle_tests) << name << " pose " << k;
-            EXPECT_EQ(a->replayVolumeTests(*b, pose, sample, 1), (nv - 1) / 2 + np)
+            EXPECT_EQ(collision::replayVolumeTests(*a, *b, pose, sample, 1), (nv - 1) / 2 + np)
                 << name << " pose " << k;
-            EXPECT_EQ(a->replayVolumeTests(*b, pose, sample, 3), 3 * ((nv - 1) / 2 + np));
-            EXPECT_EQ(a->replayTriangleTests(*b, pose, sample, 1),
+            EXPECT_EQ(collision::replayVolumeTests(*a, *b, pose, sample, 3),
+                      3 * ((nv - 1) / 2 + np));
+            EXPECT_EQ(collision::replayTriangleTests(*a, *b, pose, sample, 1),
                       static_cast<std::int64_t>(pairs.size()))
                 << name << " pose " << k;
-            EXPECT_EQ(a->replayTriangleTests(*b, pose, sample, 2),
+            EXPECT_EQ(collision::replayTriangleTests(*a, *b, pose, sample, 2),
                       2 * static_cast<std::int64_t>(pairs.size()));
             colliding += pairs.empty() ? 0 : 1;
         }
         // A sample of other trees (an index past this tree's nodes) is refused, not read.
         collision::BvhTestSample bad;
         bad.node_pairs.push_back({a->nodeCount(), 0});
-        EXPECT_EQ(a->replayVolumeTests(*b, Pose{}, bad, 1), -1);
+        EXPECT_EQ(collision::replayVolumeTests(*a, *b, Pose{}, bad, 1), -1);
         bad.triangle_pairs.push_back({0, b->triangleCount()});
-        EXPECT_EQ(a->replayTriangleTests(*b, Pose{}, bad, 1), -1);
+        EXPECT_EQ(collision::replayTriangleTests(*a, *b, Pose{}, bad, 1), -1);
     }
     EXPECT_GT(colliding, 0);
     EXPECT_LT(colliding, 6 * 9);

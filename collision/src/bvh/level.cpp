@@ -1,14 +1,17 @@
-// collision/src/bvh/level.cpp -- a level of a mesh hierarchy marked by contact state, and the
-// detail of confirmed contacts: triangles, witnesses, depth (read-only use of the hierarchy and
-// the narrow phase). Invariant: a level's nodes partition the mesh's triangles (MeshBvh::levelNodes), so
-// every confirmed triangle marks exactly one node, and states only rise, so the marks of a body's
-// pairs commute: the result does not depend on pair order.
+// collision/src/bvh/level.cpp -- the cut of a hierarchy at a depth, marked by contact state, and
+// the detail of confirmed contacts: triangles, witnesses, depth (read-only use of the hierarchy
+// and the narrow phase). Invariant: a level's nodes partition the mesh's triangles (levelNodes),
+// so every confirmed triangle marks exactly one node, and states only rise, so the marks of a
+// body's pairs commute: the result does not depend on pair order.
 #include "collision/bvh/bvh_level.h"
 
 #include <algorithm>
 #include <array>
 #include <memory>
+#include <type_traits>
 
+#include "bvh/traversal.h"
+#include "bvh/typed.h"
 #include "collision/assert.h"
 #include "collision/narrowphase/contact.h"
 #include "collision/narrowphase/narrow_phase.h"
@@ -102,12 +105,160 @@ void meshConvexWitnesses(const Shape& mesh, const Pose& pose_mesh, const Shape& 
     }
 }
 
+// What levelNodes() draws for a node volume (bvh.h, BvhLevelNode): the sphere itself, or a box
+// containing the volume.
+void setLevelShape(const BoundingSphere& v, BvhLevelNode& out) {
+    out.is_sphere = true;
+    out.sphere = v;
+}
+void setLevelShape(const Aabb& v, BvhLevelNode& out) {
+    out.box.center = v.center();
+    out.box.half_extents = (v.max - v.min) * Real(0.5);
+}
+void setLevelShape(const Obb& v, BvhLevelNode& out) { out.box = v; }
+template <int K>
+void setLevelShape(const Kdop<K>& v, BvhLevelNode& out) {
+    // Slabs 0..2 are the unit axes (kKdopDirections): their box contains the k-DOP.
+    const Vec3 lo(v.min[0], v.min[1], v.min[2]);
+    const Vec3 hi(v.max[0], v.max[1], v.max[2]);
+    out.box.center = (lo + hi) * Real(0.5);
+    out.box.half_extents = (hi - lo) * Real(0.5);
+}
+void setLevelShape(const Rss& v, BvhLevelNode& out) {
+    out.box.center = v.center;
+    out.box.axes = v.axes;
+    out.box.half_extents =
+        Vec3(v.half_lengths[0] + v.radius, v.half_lengths[1] + v.radius, v.radius);
+}
+
+void setLevelShape(const Lss& v, BvhLevelNode& out) {
+    // The capsule's box: the segment's axis first, any two unit vectors across it.
+    const Vec3 u = v.axis.normalized();
+    const Vec3 helper = std::abs(u.x()) < Real(0.9) ? Vec3(Vec3::UnitX()) : Vec3(Vec3::UnitY());
+    const Vec3 w1 = u.cross(helper).normalized();
+    out.box.center = v.center;
+    out.box.axes.col(0) = u;
+    out.box.axes.col(1) = w1;
+    out.box.axes.col(2) = u.cross(w1);
+    out.box.half_extents = Vec3(v.half_length + v.radius, v.radius, v.radius);
+}
+
+// The cut of `tree` at `depth` (levelNodes), in depth-first order.
+template <class BV>
+std::vector<BvhLevelNode> levelNodesOf(const Bvh<BV>& tree, int depth) {
+    std::vector<BvhLevelNode> out;
+    const auto& nodes = tree.nodes();
+    if (depth < 0 || nodes.empty()) return out;
+    std::vector<std::pair<std::int32_t, int>> stack{{0, 0}};
+    std::vector<std::int32_t> subtree;
+    while (!stack.empty()) {
+        const auto [index, d] = stack.back();
+        stack.pop_back();
+        const auto& node = nodes[static_cast<std::size_t>(index)];
+        if (d < depth && !node.isLeaf()) {
+            stack.push_back({node.right, d + 1});  // left (index + 1) pops first
+            stack.push_back({index + 1, d + 1});
+            continue;
+        }
+        BvhLevelNode level;
+        level.node = index;
+        level.depth = d;
+        setLevelShape(node.volume, level);
+        subtree.assign(1, index);
+        while (!subtree.empty()) {
+            const std::int32_t i = subtree.back();
+            subtree.pop_back();
+            const auto& n = nodes[static_cast<std::size_t>(i)];
+            if (n.isLeaf()) {
+                for (std::int32_t k = n.first; k < n.first + n.count; ++k) {
+                    level.triangles.push_back(tree.leafTriangleId(k));
+                }
+            } else {
+                subtree.push_back(i + 1);
+                subtree.push_back(n.right);
+            }
+        }
+        std::sort(level.triangles.begin(), level.triangles.end());
+        out.push_back(std::move(level));
+    }
+    return out;
+}
+
+// Depth-first indices of the cut (levelNodesOf without the triangle lists).
+template <class BV>
+std::vector<std::int32_t> levelIndices(const Bvh<BV>& tree, int depth) {
+    std::vector<std::int32_t> out;
+    const auto& nodes = tree.nodes();
+    if (depth < 0 || nodes.empty()) return out;
+    std::vector<std::pair<std::int32_t, int>> stack{{0, 0}};
+    while (!stack.empty()) {
+        const auto [index, d] = stack.back();
+        stack.pop_back();
+        const auto& node = nodes[static_cast<std::size_t>(index)];
+        if (d < depth && !node.isLeaf()) {
+            stack.push_back({node.right, d + 1});
+            stack.push_back({index + 1, d + 1});
+        } else {
+            out.push_back(index);
+        }
+    }
+    return out;
+}
+
 }  // namespace
+
+std::vector<BvhLevelNode> levelNodes(const MeshBvh& tree, int depth) {
+    return withTree(tree, std::vector<BvhLevelNode>{},
+                    [&](const auto& typed) { return levelNodesOf(typed, depth); });
+}
+
+std::vector<BvhLevelPair> levelOverlaps(const MeshBvh& a, int depth, const MeshBvh& b,
+                                        const Mat3& rotation, const Vec3& translation) {
+    return withTreePair(a, b, std::vector<BvhLevelPair>{}, [&](const auto& ta, const auto& tb) {
+        using BV = std::remove_cvref_t<decltype(ta.nodes()[0].volume)>;
+        std::vector<BvhLevelPair> out;
+        const BvhTransform x = makeBvhTransform(rotation, translation, ta.scale(), tb.scale());
+        const std::vector<std::int32_t> cut_a = levelIndices(ta, depth);
+        const std::vector<std::int32_t> cut_b = levelIndices(tb, depth);
+        for (std::size_t i = 0; i < cut_a.size(); ++i) {
+            const BV& va = ta.nodes()[static_cast<std::size_t>(cut_a[i])].volume;
+            for (std::size_t j = 0; j < cut_b.size(); ++j) {
+                const BV& vb = tb.nodes()[static_cast<std::size_t>(cut_b[j])].volume;
+                if (BvTraits<BV>::overlaps(va, vb, x)) {
+                    out.push_back({static_cast<std::int32_t>(i), static_cast<std::int32_t>(j)});
+                }
+            }
+        }
+        return out;
+    });
+}
+
+std::vector<std::int32_t> levelOverlapsBox(const MeshBvh& tree, int depth, const Vec3& box_min,
+                                           const Vec3& box_max, const Mat3& rotation,
+                                           const Vec3& translation) {
+    return withTree(tree, std::vector<std::int32_t>{}, [&](const auto& typed) {
+        using BV = std::remove_cvref_t<decltype(typed.nodes()[0].volume)>;
+        std::vector<std::int32_t> out;
+        if (typed.nodes().empty()) return out;
+        // The volume and transform of MeshBvh::visitNearBox.
+        const Real box_scale =
+            (box_max - box_min).maxCoeff() +
+            std::max(box_min.cwiseAbs().maxCoeff(), box_max.cwiseAbs().maxCoeff());
+        const BV volume = BvTraits<BV>::fit(boxSurfaceCorners(box_min, box_max));
+        const BvhTransform x = makeBvhTransform(rotation, translation, typed.scale(), box_scale);
+        const std::vector<std::int32_t> cut = levelIndices(typed, depth);
+        for (std::size_t i = 0; i < cut.size(); ++i) {
+            const BV& v = typed.nodes()[static_cast<std::size_t>(cut[i])].volume;
+            if (BvTraits<BV>::overlaps(v, volume, x)) out.push_back(static_cast<std::int32_t>(i));
+        }
+        return out;
+    });
+}
 
 BvhLevel makeBvhLevel(const MeshBvh& tree, int depth) {
     BvhLevel level;
     level.depth = depth;
-    level.nodes = tree.levelNodes(depth);
+    level.nodes = levelNodes(tree, depth);
     level.states.assign(level.nodes.size(), BvhNodeState::Apart);
     return level;
 }
@@ -120,7 +271,7 @@ void markBvhLevels(BvhLevel& level_a, const MeshBvh& tree_a, const Pose& pose_a,
     if (!tree_a.sameVolumeType(tree_b)) return;
     const RelativePose b_in_a = relativePose(pose_a, pose_b);
     for (const BvhLevelPair& p :
-         tree_a.levelOverlaps(level_a.depth, tree_b, b_in_a.rotation, b_in_a.position)) {
+         levelOverlaps(tree_a, level_a.depth, tree_b, b_in_a.rotation, b_in_a.position)) {
         raise(level_a, static_cast<std::size_t>(p.a), BvhNodeState::Overlapping);
         raise(level_b, static_cast<std::size_t>(p.b), BvhNodeState::Overlapping);
     }
@@ -148,7 +299,7 @@ void markBvhLevel(BvhLevel& level, const MeshBvh& tree, const Pose& pose, const 
     hi.array() += kTouchRelativeTolerance * size;
     const RelativePose b_in_a = relativePose(pose, pose_convex);
     for (const std::int32_t i :
-         tree.levelOverlapsBox(level.depth, lo, hi, b_in_a.rotation, b_in_a.position)) {
+         levelOverlapsBox(tree, level.depth, lo, hi, b_in_a.rotation, b_in_a.position)) {
         raise(level, static_cast<std::size_t>(i), BvhNodeState::Overlapping);
     }
     if (confirmed.empty()) return;

@@ -268,39 +268,10 @@ public:
     virtual bool visit(std::int32_t id, const std::array<Vec3, 3>& corners) = 0;
 };
 
-/// One node of a tree's cut at a depth (MeshBvh::levelNodes): read-only, for drawing the
-/// hierarchy and inspecting one level of it.
-struct BvhLevelNode {
-    std::int32_t node = 0;  ///< depth-first index in the tree (root 0)
-    int depth = 0;          ///< root 0; less than the cut's depth only for a leaf above it
-    std::vector<std::int32_t> triangles;  ///< mesh indices of the subtree's triangles, sorted
-    /// What to draw, in the mesh's frame: sphere volumes are `sphere` (is_sphere); every other
-    /// type is `box`: exact for aabb and obb, the box of the three axis slabs for k-DOPs (contains
-    /// the k-DOP), the rectangle's box grown by the radius on all three axes for rss, and the
-    /// capsule's box for lss.
-    bool is_sphere = false;
-    BoundingSphere sphere;
-    Obb box;
-};
-
-/// An overlapping pair of nodes of two cuts: indices into the two levelNodes() lists.
-struct BvhLevelPair {
-    std::int32_t a = 0;
-    std::int32_t b = 0;
-    auto operator<=>(const BvhLevelPair&) const = default;
-};
-
-/// The node pairs and triangle pairs one all-pairs query tests, in the order it tests them
-/// (MeshBvh::recordTests): a sample of the real work of a query, for measuring the cost model's
-/// unit costs Cv and Cp by replaying it (MeshBvh::replayVolumeTests, replayTriangleTests).
-struct BvhTestSample {
-    std::vector<std::array<std::int32_t, 2>> node_pairs;  ///< (node of A, node of B), node indices
-    /// (triangle of A, triangle of B) as leaf-order positions (Bvh::leafTriangle), in [0,
-    /// triangleCount()) of each tree
-    std::vector<std::array<std::int32_t, 2>> triangle_pairs;
-};
-
-/// A Bvh of a volume type chosen at run time by name (CLI, scenes, benchmarks, mesh shapes).
+/// A Bvh of a volume type chosen at run time by name (CLI, scenes, benchmarks, mesh shapes):
+/// build (buildMeshBvh), query, refit, validate. What else works on a hierarchy takes it as an
+/// argument: the cut of a level for drawing (bvh_level.h), the replay of a query's tests for the
+/// cost model (bvh_replay.h), the typed tree (treeOf).
 class MeshBvh {
 public:
     virtual ~MeshBvh() = default;
@@ -324,9 +295,6 @@ public:
     /// Bvh::refit (a deforming mesh): returns the nodes updated. Not for a tree shared by shapes
     /// that other threads query.
     virtual std::int32_t refit(const TriangleMesh& mesh) = 0;
-    /// The typed tree when this hierarchy's volume type is `obb`, else null (mesh-mesh CCD,
-    /// timeOfImpactMeshes in ccd.h, runs on OBB trees).
-    virtual const Bvh<Obb>* obbTree() const { return nullptr; }
     /// True when `b` holds the same volume type (the tandem queries need it).
     virtual bool sameVolumeType(const MeshBvh& b) const = 0;
     /// The tandem traversal with a visitor: every intersecting triangle pair (exact triangle test,
@@ -346,39 +314,6 @@ public:
     virtual bool visitNearBox(const Vec3& box_min, const Vec3& box_max, const Mat3& rotation,
                               const Vec3& translation, TriangleVisitor& visitor,
                               BvhQueryStats* stats = nullptr) const = 0;
-    /// Every node pair and triangle pair that intersect(b, b_in_a) tests, in its order
-    /// (node_pairs.size() is its Nv, triangle_pairs.size() its Np). The same traversal with a
-    /// recorder; the queries themselves record nothing. `b` must hold the same volume type
-    /// (asserted; empty if not). Memory O(Nv + Np).
-    virtual BvhTestSample recordTests(const MeshBvh& b, const Pose& b_in_a) const = 0;
-    /// Runs the node-volume tests of `sample`, `repeats` times, exactly as the traversal does them
-    /// (B's node volume moved into A's frame once per run of pairs with the same B node, then the
-    /// overlap test, with its slack) and nothing else, for timing Cv. Returns the number of tests
-    /// that found an overlap (all repeats); -1 when an index of `sample` is out of range.
-    virtual std::int64_t replayVolumeTests(const MeshBvh& b, const Pose& b_in_a,
-                                           const BvhTestSample& sample, int repeats) const = 0;
-    /// Runs the triangle tests of `sample`, `repeats` times, as the traversal does them (B's
-    /// triangle moved into A's frame, then the exact triangle-triangle test), for timing Cp.
-    /// Returns the number of intersecting pairs (all repeats); -1 when an index is out of range.
-    virtual std::int64_t replayTriangleTests(const MeshBvh& b, const Pose& b_in_a,
-                                             const BvhTestSample& sample, int repeats) const = 0;
-    /// The cut of the tree at `depth` (root 0): every node at that depth and every leaf above
-    /// it, in depth-first order, so their subtrees partition the triangles. Empty for depth < 0
-    /// or an empty tree; a depth beyond the leaves gives the leaves. O(n).
-    virtual std::vector<BvhLevelNode> levelNodes(int depth) const = 0;
-    /// Every pair (i, j) of levelNodes(depth) of this tree and of `b` (same volume type,
-    /// asserted; empty if not) whose volumes overlap with B placed by p_a = rotation p_b +
-    /// translation: the node-pair test of the tandem traversal, with its slack. Sorted.
-    /// O(n_a n_b) in the sizes of the cuts (a drawing aid, not a query).
-    virtual std::vector<BvhLevelPair> levelOverlaps(int depth, const MeshBvh& b,
-                                                    const Mat3& rotation,
-                                                    const Vec3& translation) const = 0;
-    /// Indices into levelNodes(depth) whose volumes overlap the volume visitNearBox fits around
-    /// the box [box_min, box_max] of a frame placed by p_a = rotation p_b + translation, with
-    /// visitNearBox's test. Sorted.
-    virtual std::vector<std::int32_t> levelOverlapsBox(int depth, const Vec3& box_min,
-                                                       const Vec3& box_max, const Mat3& rotation,
-                                                       const Vec3& translation) const = 0;
 };
 
 /// The volume type mesh shapes use unless a scene chooses another (`world.mesh_bvh`): the fastest
@@ -388,6 +323,11 @@ inline constexpr std::string_view kDefaultMeshBvh = "obb";
 /// The names of BvhVolumeTypes, in order: sphere, aabb, obb, kdop6, kdop14, kdop18, kdop26,
 /// rss, lss.
 const std::vector<std::string_view>& bvhVolumeNames();
+
+/// The typed tree of `tree` when it holds volume type BV, else null (mesh-mesh CCD,
+/// timeOfImpactMeshes in ccd.h, runs on OBB trees: treeOf<Obb>).
+template <class BV>
+const Bvh<BV>* treeOf(const MeshBvh& tree);
 
 /// Builds the tree of the named volume type; nullptr for an unknown name.
 std::unique_ptr<MeshBvh> buildMeshBvh(std::string_view volume_name, const TriangleMesh& mesh,

@@ -1,0 +1,52 @@
+// collision/src/bvh/typed.h -- calling a function template with the typed trees behind MeshBvh
+// handles (treeOf over every type of BvhVolumeTypes): how the free functions on hierarchies
+// (replay, levels) reach Bvh<BV> without a virtual per operation. Private to collision.
+#pragma once
+
+#include <tuple>
+#include <utility>
+
+#include "collision/assert.h"
+#include "collision/bvh/bvh.h"
+
+namespace collision {
+
+/// f(tree) with `tree`'s typed Bvh<BV>; `fallback` for a handle of no known type.
+template <class R, class F>
+R withTree(const MeshBvh& tree, R fallback, F&& f) {
+    R out = std::move(fallback);
+    std::apply(
+        [&](auto... bv) {
+            bool done = false;
+            (
+                [&] {
+                    using BV = decltype(bv);
+                    if (done) return;
+                    if (const Bvh<BV>* typed = treeOf<BV>(tree)) {
+                        out = f(*typed);
+                        done = true;
+                    }
+                }(),
+                ...);
+        },
+        BvhVolumeTypes{});
+    return out;
+}
+
+/// The typed tree of `b` when it holds the same volume type as `like`, else null.
+template <class BV>
+const Bvh<BV>* sameTypeTree(const Bvh<BV>& /*like*/, const MeshBvh& b) {
+    return treeOf<BV>(b);
+}
+
+/// f(a, b) with the typed trees of `a` and `b`, which must hold the same volume type (asserted;
+/// `fallback` if not).
+template <class R, class F>
+R withTreePair(const MeshBvh& a, const MeshBvh& b, R fallback, F&& f) {
+    CDLAB_ASSERT(a.sameVolumeType(b), "BVH query between different volume types");
+    if (!a.sameVolumeType(b)) return fallback;
+    return withTree(a, std::move(fallback),
+                    [&](const auto& tree_a) { return f(tree_a, *sameTypeTree(tree_a, b)); });
+}
+
+}  // namespace collision
