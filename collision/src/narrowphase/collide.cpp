@@ -458,41 +458,6 @@ PairContext pairContext(const Shape& a, const Shape& b) {
     return ctx;
 }
 
-// A strict order on (shape, pose) used to run same-type pairs in one canonical order.
-bool canonicalLess(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b) {
-    const std::array<Real, 14> ka{pose_a.position.x(),
-                                  pose_a.position.y(),
-                                  pose_a.position.z(),
-                                  pose_a.orientation.w(),
-                                  pose_a.orientation.x(),
-                                  pose_a.orientation.y(),
-                                  pose_a.orientation.z(),
-                                  a.radius,
-                                  a.half_height,
-                                  a.half_extents.x(),
-                                  a.half_extents.y(),
-                                  a.half_extents.z(),
-                                  0,
-                                  0};
-    const std::array<Real, 14> kb{pose_b.position.x(),
-                                  pose_b.position.y(),
-                                  pose_b.position.z(),
-                                  pose_b.orientation.w(),
-                                  pose_b.orientation.x(),
-                                  pose_b.orientation.y(),
-                                  pose_b.orientation.z(),
-                                  b.radius,
-                                  b.half_height,
-                                  b.half_extents.x(),
-                                  b.half_extents.y(),
-                                  b.half_extents.z(),
-                                  0,
-                                  0};
-    if (ka != kb) return ka < kb;
-    if (a.hull != b.hull) return std::less<const ConvexPolytope*>()(a.hull.get(), b.hull.get());
-    return std::less<const TriangleMesh*>()(a.mesh.get(), b.mesh.get());
-}
-
 }  // namespace
 
 CollideOutput collide(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b) {

@@ -1,0 +1,280 @@
+// collision/src/narrowphase/contact_box_box.cpp -- contact() of two boxes: the separating-axis
+// test over 15 axes (Gottschalk 1996; RTCD 4.4.1) with a bias towards face axes, and the
+// manifold of the incident face clipped against the reference face (RTCD 8.3.4), reduced to
+// four points.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include "collision/assert.h"
+#include "geometry/closest_points.h"
+#include "narrowphase/contact_pairs.h"
+
+namespace collision::contact_pairs {
+
+namespace {
+
+// Sutherland-Hodgman (RTCD 8.3.4): keeps the part of polygon `in` with coord[axis] * sign <= limit.
+int clipPolygon(const std::array<Vec3, 8>& in, int n, int axis, Real sign, Real limit,
+                std::array<Vec3, 8>& out) {
+    int m = 0;
+    for (int i = 0; i < n; ++i) {
+        const Vec3& p = in[static_cast<std::size_t>(i)];
+        const Vec3& q = in[static_cast<std::size_t>((i + 1) % n)];
+        const Real dp = sign * p[axis] - limit;
+        const Real dq = sign * q[axis] - limit;
+        if (dp <= 0 && m < 8) out[static_cast<std::size_t>(m++)] = p;
+        if ((dp < 0 && dq > 0) || (dp > 0 && dq < 0)) {
+            const Real t = dp / (dp - dq);
+            Vec3 x = p + t * (q - p);
+            x[axis] = sign * limit;  // exactly on the plane
+            if (m < 8) out[static_cast<std::size_t>(m++)] = x;
+        }
+    }
+    return m;
+}
+
+// Face contact: reference box R (half extents hr, its frame), reference face on axis k with
+// outward sign s; incident box I (half extents hi) placed by i_in_r. Writes points of I inside
+// the reference face's slab with their depths below the face (>= -tolerance), in R's frame.
+int clipFaceContact(const Vec3& hr, int k, Real s, const Vec3& hi, const RelativePose& i_in_r,
+                    Real tolerance, std::array<Vec3, 8>& points, std::array<Real, 8>& depths) {
+    // Incident face: the face of I most anti-parallel to the reference normal.
+    const Vec3 n_in_i = i_in_r.rotation.transpose() * (s * Vec3::Unit(k));
+    int m = 0;
+    n_in_i.cwiseAbs().maxCoeff(&m);
+    const Real sm = -signOrPlus(n_in_i[m]);
+    const int u = (m + 1) % 3;
+    const int v = (m + 2) % 3;
+    std::array<Vec3, 8> poly{};
+    const std::array<Real, 4> su{-1, 1, 1, -1};
+    const std::array<Real, 4> sv{-1, -1, 1, 1};
+    for (int c = 0; c < 4; ++c) {
+        Vec3 corner;
+        corner[m] = sm * hi[m];
+        corner[u] = su[static_cast<std::size_t>(c)] * hi[u];
+        corner[v] = sv[static_cast<std::size_t>(c)] * hi[v];
+        poly[static_cast<std::size_t>(c)] = i_in_r.rotation * corner + i_in_r.position;
+    }
+    int n = 4;
+    std::array<Vec3, 8> tmp{};
+    const int a1 = (k + 1) % 3;
+    const int a2 = (k + 2) % 3;
+    n = clipPolygon(poly, n, a1, 1, hr[a1], tmp);
+    n = clipPolygon(tmp, n, a1, -1, hr[a1], poly);
+    n = clipPolygon(poly, n, a2, 1, hr[a2], tmp);
+    n = clipPolygon(tmp, n, a2, -1, hr[a2], poly);
+    int kept = 0;
+    for (int i = 0; i < n; ++i) {
+        const Vec3& p = poly[static_cast<std::size_t>(i)];
+        const Real depth = hr[k] - s * p[k];
+        if (depth >= -tolerance) {
+            points[static_cast<std::size_t>(kept)] = p;
+            depths[static_cast<std::size_t>(kept)] = depth;
+            ++kept;
+        }
+    }
+    return kept;
+}
+
+}  // namespace
+
+// Keeps at most 4 of n points: the deepest, the farthest from it, the one spanning the largest
+// triangle with those two, and the one adding the most area outside that triangle (Gregorius,
+// "Robust Contact Creation for Physics Simulations", GDC 2015). Returns the chosen indices.
+int reduceManifold(const Vec3* p, const Real* depth, int n, const Vec3& normal,
+                   std::array<int, 4>& chosen) {
+    if (n <= 4) {
+        for (int i = 0; i < n; ++i) chosen[static_cast<std::size_t>(i)] = i;
+        return n;
+    }
+    auto at = [&](int i) -> const Vec3& { return p[i]; };
+    int i0 = 0;
+    for (int i = 1; i < n; ++i) {
+        if (depth[i] > depth[i0]) i0 = i;
+    }
+    int i1 = -1;
+    Real best = -1;
+    for (int i = 0; i < n; ++i) {
+        const Real d = (at(i) - at(i0)).squaredNorm();
+        if (i != i0 && d > best) {
+            best = d;
+            i1 = i;
+        }
+    }
+    int i2 = -1;
+    Real best_area = -1;
+    Real orientation = 1;
+    for (int i = 0; i < n; ++i) {
+        if (i == i0 || i == i1) continue;
+        const Real area = (at(i1) - at(i0)).cross(at(i) - at(i0)).dot(normal);
+        if (std::abs(area) > best_area) {
+            best_area = std::abs(area);
+            i2 = i;
+            orientation = signOrPlus(area);
+        }
+    }
+    int i3 = -1;
+    Real best_out = 0;
+    const std::array<int, 3> tri{i0, i1, i2};
+    for (int i = 0; i < n; ++i) {
+        if (i == i0 || i == i1 || i == i2) continue;
+        for (int e = 0; e < 3; ++e) {
+            const Vec3& s = at(tri[static_cast<std::size_t>(e)]);
+            const Vec3& t = at(tri[static_cast<std::size_t>((e + 1) % 3)]);
+            // Negative signed area w.r.t. the triangle's orientation: outside edge e.
+            const Real area = -orientation * (t - s).cross(at(i) - s).dot(normal);
+            if (area > best_out) {
+                best_out = area;
+                i3 = i;
+            }
+        }
+    }
+    chosen = {i0, i1, i2, i3};
+    return i3 < 0 ? 3 : 4;
+}
+
+// Returns false when the SAT proves a gap larger than the tolerance (GJK then measures it).
+bool boxBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx, Local& out) {
+    const Mat3& rot = rel.rotation;
+    const Vec3& t = rel.position;
+    const Vec3& ea = a.half_extents;
+    const Vec3& eb = b.half_extents;
+    // Best face axis and best edge axis: largest separation (least penetration).
+    Real best_face = -std::numeric_limits<Real>::infinity();
+    int face_kind = 0;  // 0: face of A, 1: face of B
+    int face_axis = 0;
+    Real best_edge = -std::numeric_limits<Real>::infinity();
+    int edge_i = 0;
+    int edge_j = 0;
+    Vec3 edge_axis = Vec3::Zero();
+    for (int i = 0; i < 3; ++i) {
+        const Real sep = std::abs(t[i]) - ea[i] - eb.dot(rot.row(i).transpose().cwiseAbs());
+        if (sep > best_face) {
+            best_face = sep;
+            face_kind = 0;
+            face_axis = i;
+        }
+    }
+    for (int j = 0; j < 3; ++j) {
+        const Vec3 axis = rot.col(j);
+        const Real sep = std::abs(t.dot(axis)) - ea.dot(axis.cwiseAbs()) - eb[j];
+        if (sep > best_face) {
+            best_face = sep;
+            face_kind = 1;
+            face_axis = j;
+        }
+    }
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+            const Vec3 axis = Vec3::Unit(i).cross(rot.col(j));
+            const Real len2 = axis.squaredNorm();
+            if (!(len2 >= kSatAxisMin)) continue;
+            const Real len = std::sqrt(len2);
+            const Vec3 unit = axis / len;
+            const Real sep = std::abs(t.dot(unit)) - ea.dot(unit.cwiseAbs()) -
+                             eb.dot((rot.transpose() * unit).cwiseAbs());
+            if (sep > best_edge) {
+                best_edge = sep;
+                edge_i = i;
+                edge_j = j;
+                edge_axis = unit;
+            }
+        }
+    }
+    const bool use_edge = best_edge > best_face + kEdgeBias * ctx.scale;
+    const Real best = use_edge ? best_edge : best_face;
+    if (best > ctx.tolerance) return false;
+    const Real tol = kFeatureRelative * ctx.scale;
+
+    if (use_edge) {
+        const Vec3 n = signOrPlus(t.dot(edge_axis)) * edge_axis;
+        // A's edge along axis i at the support signs of n; B's along its axis j at -n.
+        Vec3 ca = ea.cwiseProduct(Vec3(signOrPlus(n.x()), signOrPlus(n.y()), signOrPlus(n.z())));
+        const Vec3 n_b = rot.transpose() * (-n);
+        Vec3 cb =
+            eb.cwiseProduct(Vec3(signOrPlus(n_b.x()), signOrPlus(n_b.y()), signOrPlus(n_b.z())));
+        Vec3 pa0 = ca;
+        Vec3 pa1 = ca;
+        pa0[edge_i] = -ea[edge_i];
+        pa1[edge_i] = ea[edge_i];
+        Vec3 pb0 = cb;
+        Vec3 pb1 = cb;
+        pb0[edge_j] = -eb[edge_j];
+        pb1[edge_j] = eb[edge_j];
+        pb0 = rot * pb0 + t;
+        pb1 = rot * pb1 + t;
+        const SegmentParameters st =
+            closestSegmentSegment(pa0, pa1, pb0, pb1, kEpsilon * ctx.scale);
+        out.normal = n;
+        out.signed_distance = best;
+        out.point_a = pa0 + st.s * (pa1 - pa0);
+        out.point_b = pb0 + st.t * (pb1 - pb0);
+        out.feature_a = boxFeature(ea, out.point_a, tol);
+        out.feature_b = boxFeature(eb, toB(rel, out.point_b), tol);
+        setSingleManifold(out);
+        return true;
+    }
+
+    std::array<Vec3, 8> points{};
+    std::array<Real, 8> depths{};
+    int count = 0;
+    Vec3 n;
+    if (face_kind == 0) {
+        const Real s = signOrPlus(t[face_axis]);
+        n = s * Vec3::Unit(face_axis);
+        count = clipFaceContact(ea, face_axis, s, eb, rel, ctx.tolerance, points, depths);
+    } else {
+        const Vec3 axis = rot.col(face_axis);
+        const Real s = signOrPlus(t.dot(axis));
+        n = s * axis;
+        // B is the reference: work in B's frame with A as the incident box.
+        RelativePose a_in_b;
+        a_in_b.rotation = rot.transpose();
+        a_in_b.position = -(rot.transpose() * t);
+        count = clipFaceContact(eb, face_axis, -s, ea, a_in_b, ctx.tolerance, points, depths);
+        for (int i = 0; i < count; ++i) {
+            points[static_cast<std::size_t>(i)] = rot * points[static_cast<std::size_t>(i)] + t;
+        }
+    }
+    // Points deeper than the contact lie beyond the far side of a thin reference box.
+    const Real max_depth = std::max(Real(0), -best) + kFeatureRelative * ctx.scale;
+    int within = 0;
+    for (int i = 0; i < count; ++i) {
+        if (depths[static_cast<std::size_t>(i)] <= max_depth) {
+            points[static_cast<std::size_t>(within)] = points[static_cast<std::size_t>(i)];
+            depths[static_cast<std::size_t>(within)] = depths[static_cast<std::size_t>(i)];
+            ++within;
+        }
+    }
+    count = within;
+    if (count == 0) return false;  // rounding at a grazing contact: let GJK/EPA answer
+    std::array<int, 4> chosen{};
+    const int kept = reduceManifold(points.data(), depths.data(), count, n, chosen);
+    out.normal = n;
+    out.signed_distance = best;
+    out.manifold_size = kept;
+    int deepest = 0;
+    for (int m = 0; m < kept; ++m) {
+        const auto i = static_cast<std::size_t>(chosen[static_cast<std::size_t>(m)]);
+        const Real d = depths[i];
+        ManifoldPoint& mp = out.manifold[static_cast<std::size_t>(m)];
+        mp.depth = std::max(d, Real(0));
+        if (face_kind == 0) {
+            mp.point_b = points[i];
+            mp.point_a = points[i] + d * n;  // projected onto A's reference face
+        } else {
+            mp.point_a = points[i];
+            mp.point_b = points[i] - d * n;  // projected onto B's reference face
+        }
+        if (d > out.manifold[static_cast<std::size_t>(deepest)].depth) deepest = m;
+    }
+    out.point_a = out.manifold[static_cast<std::size_t>(deepest)].point_a;
+    out.point_b = out.manifold[static_cast<std::size_t>(deepest)].point_b;
+    out.feature_a = boxFeature(ea, out.point_a, tol);
+    out.feature_b = boxFeature(eb, toB(rel, out.point_b), tol);
+    return true;
+}
+
+}  // namespace collision::contact_pairs

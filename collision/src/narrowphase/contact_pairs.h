@@ -1,0 +1,90 @@
+// collision/src/narrowphase/contact_pairs.h -- the pieces of contact() (contact.h), private to
+// collision: its tolerances, the context every pair routine gets, the witness features, and one
+// routine per pair family, each in its own file and each computing in the canonically-first
+// shape's frame. contact.cpp dispatches to them through a [ShapeType][ShapeType] table.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <limits>
+
+#include "collision/narrowphase/contact.h"
+#include "narrowphase/gjk.h"
+
+namespace collision::contact_pairs {
+
+
+// Below kNormalRelative * scale a GJK distance is too small for (pb - pa) / d to be a reliable
+// direction (its rounding error is ~ kEpsilon * scale / d radians): EPA decides the normal.
+inline constexpr Real kNormalRelative = std::max(Real(1e-8), Real(1e3) * kEpsilon);
+// A direction shorter than kDirectionRelative * scale is undefined (coincident centres etc.).
+inline constexpr Real kDirectionRelative = Real(16) * kEpsilon;
+// Witness points within kFeatureRelative * scale of a face plane / edge / vertex lie on it.
+inline constexpr Real kFeatureRelative = std::max(Real(1e-9), Real(64) * kEpsilon);
+// Width of the band around the touching thresholds where collide() decides the state.
+inline constexpr Real kReconcileBand = Real(1e-6);
+// Capsule axes closer to parallel than sin = kParallelSin have no common perpendicular to use.
+inline constexpr Real kParallelSin = Real(1e-6);
+// Box SAT: only the cross-product axes of exactly parallel edges (|e_a x e_b|^2 below
+// kSatAxisMin, the smallest normal number) are skipped, as in collideBoxBox (which says why);
+// an edge axis must beat the best face axis by kEdgeBias * scale to be chosen (faces give
+// stable multi-point manifolds; Box2D / Bullet do the same).
+inline constexpr Real kSatAxisMin = std::numeric_limits<Real>::min();
+inline constexpr Real kEdgeBias = std::max(Real(1e-9), Real(64) * kEpsilon);
+
+inline Real signOrPlus(Real x) { return x < 0 ? Real(-1) : Real(1); }
+
+struct Ctx {
+    Real scale = 0;
+    Real tolerance = 0;
+};
+
+// The contact in A's frame (canonical order); world transform and mirroring happen once.
+using Local = ContactOutput;
+
+// ---- Witness features (numbering in contact.h; contact_features.cpp). ----
+
+Feature boxFeature(const Vec3& half, const Vec3& p, Real tol);
+Feature capsuleFeature(Real half_height, const Vec3& core_point, Real tol);
+Feature hullFeature(const ConvexPolytope& hull, const Vec3& p, Real tol);
+/// The feature of a convex core (ConvexCore of the shape) that holds `core_point`.
+Feature coreFeature(const Shape& shape, const Vec3& core_point, Real tol);
+
+/// A point of A's frame in B's frame.
+inline Vec3 toB(const RelativePose& b_in_a, const Vec3& p_in_a) {
+    return b_in_a.rotation.transpose() * (p_in_a - b_in_a.position);
+}
+
+/// A one-point manifold at the witness points (round shapes, edge contacts).
+void setSingleManifold(Local& out);
+
+/// Boxes and hulls that are not box-box: the manifold of their touching faces, clipped
+/// (contact_manifold.cpp). False when the contact is not face to face.
+bool polytopeManifold(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
+                      Local& out);
+
+/// Up to 4 of the n manifold points (indices in `chosen`, returns how many): the deepest and
+/// those spanning the largest area (contact_box_box.cpp).
+int reduceManifold(const Vec3* p, const Real* depth, int n, const Vec3& normal,
+                   std::array<int, 4>& chosen);
+
+// ---- The pair routines, in A's frame (canonical order). ----
+
+/// Closed forms (contact_round.cpp, RTCD 5.1): sphere-sphere, sphere-capsule, capsule-capsule,
+/// sphere-box.
+void sphereSphere(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
+                  Local& out);
+void sphereCapsule(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
+                   Local& out);
+void capsuleCapsule(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
+                    Local& out);
+void sphereBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx, Local& out);
+/// Box-box: SAT over 15 axes, manifold by clipping (contact_box_box.cpp). False when the SAT
+/// proves a gap larger than the tolerance (GJK then measures it).
+bool boxBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx, Local& out);
+/// Any convex pair: GJK with witnesses, EPA when the cores overlap (contact_convex.cpp).
+void convexConvex(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
+                  Local& out);
+
+}  // namespace collision::contact_pairs
