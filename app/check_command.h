@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "checkers.h"
 #include "engine/scene.h"
 
 namespace app {
@@ -17,13 +18,6 @@ struct CheckOptions {
     std::optional<int> frames;  ///< overrides expect.frames and the scene's frame count
     /// Where pause dumps are written; default: a temporary folder removed afterwards.
     std::optional<std::filesystem::path> out_dir;
-};
-
-/// One graded expectation of one scene.
-struct CheckRow {
-    std::string expectation;  ///< e.g. "pair ball0-crate1 colliding in 10..20 (every)"
-    bool pass = false;
-    std::string reason;  ///< why it failed (empty on pass); may carry a measured value
 };
 
 /// Runs `scene` for `frames` frames (frame 0 = initial state) and grades every expectation.
