@@ -219,7 +219,13 @@ private:
     void checkFiniteState() const;
     void updateVolumes();
     void updateVolume(std::size_t i);
+    // The continuous stage (world_continuous.cpp), in its order.
     void resolveContinuous();
+    void buildSweeps();
+    void findSweptPairs();
+    void queryTimesOfImpact();
+    void stopAtImpacts();
+    void applyImpactImpulses();
     void findResponsePairs(Real margin_fraction);
     void runCollisionPipeline();
     enum class DetailLevel : std::uint8_t { None, Convex, All };
