@@ -1,5 +1,6 @@
-// engine/src/world.cpp -- the fixed step: integrators, the continuous (CCD) stage, bounds
-// reflection and the collision pipeline.
+// engine/src/world.cpp -- the fixed step: integrators, bounds reflection, the collision pipeline
+// and the contact solver's pairs (the continuous stage is world_continuous.cpp, the contact
+// detail and debug drawing world_contacts.cpp).
 // Bodies are processed in id order and pairs come out of the broad phase sorted (the CCD stage
 // sorts its candidate pairs and its events by (t, a, b)), so every step does the same
 // floating-point operations in the same order: runs are bit-identical.
