@@ -3,6 +3,7 @@
 // coloured by state and contact witnesses (as Box2D's b2World_Draw, the world decides what its
 // debug drawing shows; a renderer only draws lines).
 #include <algorithm>
+#include <span>
 #include <vector>
 
 #include "engine/world.h"
@@ -20,6 +21,14 @@ const collision::MeshBvh* meshTree(const Body& body) {
     const collision::Shape& s = body.shape;
     return s.type == collision::ShapeType::Mesh && s.mesh && s.bvh && finitePose(body) ? s.bvh.get()
                                                                                        : nullptr;
+}
+
+// Both bodies of the pair exist and have finite poses.
+bool drawable(std::span<const Body> bodies, const collision::ProxyPair& p) {
+    const auto ia = static_cast<std::size_t>(p.a);
+    const auto ib = static_cast<std::size_t>(p.b);
+    return ia < bodies.size() && ib < bodies.size() && finitePose(bodies[ia]) &&
+           finitePose(bodies[ib]);
 }
 
 collision::Color nodeColor(collision::BvhNodeState state, const ContactDrawStyle& style) {
@@ -73,12 +82,11 @@ void World::drawHierarchyLevels(collision::DebugDraw& draw, int depth,
         }
     }
     for (const collision::ProxyPair& p : flagged_) {
+        if (!drawable(bodies_, p)) continue;
         const auto ia = static_cast<std::size_t>(p.a);
         const auto ib = static_cast<std::size_t>(p.b);
-        if (ia >= bodies_.size() || ib >= bodies_.size()) continue;
         const Body& a = bodies_[ia];
         const Body& b = bodies_[ib];
-        if (!finitePose(a) || !finitePose(b)) continue;
         const collision::MeshBvh* tree_a = meshTree(a);
         const collision::MeshBvh* tree_b = meshTree(b);
         if (!tree_a && !tree_b) continue;
@@ -116,12 +124,9 @@ void World::drawContacts(collision::DebugDraw& draw, const ContactDrawStyle& sty
     const std::span<const collision::PairContacts> details = contactDetails();
     for (std::size_t k = 0; k < colliding_.size(); ++k) {
         const collision::ProxyPair& p = colliding_[k];
-        const auto ia = static_cast<std::size_t>(p.a);
-        const auto ib = static_cast<std::size_t>(p.b);
-        if (ia >= bodies_.size() || ib >= bodies_.size()) continue;
-        const Body& a = bodies_[ia];
-        const Body& b = bodies_[ib];
-        if (!finitePose(a) || !finitePose(b)) continue;
+        if (!drawable(bodies_, p)) continue;
+        const Body& a = bodies_[static_cast<std::size_t>(p.a)];
+        const Body& b = bodies_[static_cast<std::size_t>(p.b)];
         const Real size = std::min(a.local_bounds.sphere.radius, b.local_bounds.sphere.radius);
         const Real cross = style.cross_fraction * size;
         for (const collision::ContactWitness& w : details[k].witnesses) {

@@ -141,14 +141,9 @@ void World::queryTimesOfImpact() {
         auto query = [&]() {
             if (tree_a == nullptr || tree_b == nullptr) return collision::timeOfImpact(in);
             collision::MeshToiInput mi;
+            static_cast<collision::ToiQuery&>(mi) = in;
             mi.a = tree_a;
             mi.b = tree_b;
-            mi.sweep_a = in.sweep_a;
-            mi.sweep_b = in.sweep_b;
-            mi.target_gap = in.target_gap;
-            mi.tolerance = in.tolerance;
-            mi.relative_tolerance = in.relative_tolerance;
-            mi.max_iterations = in.max_iterations;
             return collision::timeOfImpactMeshes(mi).toi;
         };
         collision::ToiOutput out = query();

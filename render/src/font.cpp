@@ -168,36 +168,39 @@ void drawText(Image& image, int x, int y, std::string_view text, int scale, cons
     drawGlyphs(image, x, y, text, scale, color);
 }
 
-void fillRect(Image& image, int x, int y, int w, int h, const Rgb& color) {
+namespace {
+
+// Calls f(pixel) for every pixel of the rectangle (x, y, w, h) that lies inside the image.
+template <class F>
+void forEachPixel(Image& image, int x, int y, int w, int h, F&& f) {
     const int x0 = std::max(x, 0);
     const int y0 = std::max(y, 0);
     const int x1 = std::min(x + w, image.width);
     const int y1 = std::min(y + h, image.height);
     for (int py = y0; py < y1; ++py) {
         std::uint8_t* p = &image.rgb[(std::size_t(py) * image.width + x0) * 3];
-        for (int px = x0; px < x1; ++px, p += 3) {
-            p[0] = color[0];
-            p[1] = color[1];
-            p[2] = color[2];
-        }
+        for (int px = x0; px < x1; ++px, p += 3) f(p);
     }
+}
+
+}  // namespace
+
+void fillRect(Image& image, int x, int y, int w, int h, const Rgb& color) {
+    forEachPixel(image, x, y, w, h, [&](std::uint8_t* p) {
+        p[0] = color[0];
+        p[1] = color[1];
+        p[2] = color[2];
+    });
 }
 
 void blendRect(Image& image, int x, int y, int w, int h, const Rgb& color, float alpha) {
     // Fixed-point weights so the result is the same on every compiler and flag set.
     const int a = static_cast<int>(std::lround(std::clamp(alpha, 0.0f, 1.0f) * 256.0f));
-    const int x0 = std::max(x, 0);
-    const int y0 = std::max(y, 0);
-    const int x1 = std::min(x + w, image.width);
-    const int y1 = std::min(y + h, image.height);
-    for (int py = y0; py < y1; ++py) {
-        std::uint8_t* p = &image.rgb[(std::size_t(py) * image.width + x0) * 3];
-        for (int px = x0; px < x1; ++px, p += 3) {
-            for (int k = 0; k < 3; ++k) {
-                p[k] = static_cast<std::uint8_t>((p[k] * (256 - a) + color[k] * a + 128) >> 8);
-            }
+    forEachPixel(image, x, y, w, h, [&](std::uint8_t* p) {
+        for (int k = 0; k < 3; ++k) {
+            p[k] = static_cast<std::uint8_t>((p[k] * (256 - a) + color[k] * a + 128) >> 8);
         }
-    }
+    });
 }
 
 }  // namespace render::font

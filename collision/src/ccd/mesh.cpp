@@ -96,15 +96,12 @@ MeshToiOutput timeOfImpactMeshes(const MeshToiInput& input) {
                 for (std::int32_t i = na.first; i < na.first + na.count; ++i) {
                     for (std::int32_t j = nb.first; j < nb.first + nb.count; ++j) {
                         ToiInput in;
+                        static_cast<ToiQuery&>(in) = input;
                         in.a = shapeOf(a, shapes_a, i);
                         in.b = shapeOf(b, shapes_b, j);
                         in.sweep_a = sa;
                         in.sweep_b = sb;
                         in.t_max = s_best;
-                        in.target_gap = input.target_gap;
-                        in.tolerance = input.tolerance;
-                        in.relative_tolerance = input.relative_tolerance;
-                        in.max_iterations = input.max_iterations;
                         ++out.triangle_queries;
                         const ToiOutput r = timeOfImpact(in);
                         if (r.state == CcdState::Separated) continue;

@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "geometry/closest_points.h"
+#include "narrowphase/epa_polytope.h"
 
 namespace collision {
 
@@ -20,44 +21,10 @@ constexpr Real kDuplicateRelative = Real(8) * kEpsilon;
 
 // ---- EPA polytope ----
 
-// Set entirely by Polytope::addFace; no default values, so the face array costs no zeroing.
-struct Face {
-    std::array<int, 3> v;
-    Vec3 normal;  // unit outward; zero when degenerate
-    Real dist;    // normal . vertex
-    bool valid;
-};
-
-constexpr int kMaxVertices = kEpaMaxIterations + 4;
-constexpr int kMaxFaces = 2 * kMaxVertices;
-
-struct Polytope {
-    // Only the first vertex_count / face_count entries are set (no zeroing of ~22 kB per call).
-    std::array<SupportVertex, kMaxVertices> vert;
-    int vertex_count = 0;
-    std::array<Face, kMaxFaces> faces;
-    int face_count = 0;
-    Real eps = 0;
-
-    bool addFace(int i, int j, int k) {
-        if (face_count >= kMaxFaces) return false;
-        Face& f = faces[static_cast<std::size_t>(face_count++)];
-        f.v = {i, j, k};
-        f.valid = true;
-        const Vec3& p = vert[static_cast<std::size_t>(i)].w;
-        const Vec3 n = (vert[static_cast<std::size_t>(j)].w - p)
-                           .cross(vert[static_cast<std::size_t>(k)].w - p);
-        const Real len = n.norm();
-        if (len > eps * eps) {
-            f.normal = n / len;
-            f.dist = f.normal.dot(p);
-        } else {
-            f.normal.setZero();
-            f.dist = std::numeric_limits<Real>::infinity();
-        }
-        return true;
-    }
-};
+using Polytope = EpaPolytope<SupportVertex, kEpaMaxIterations + 4>;
+using Face = Polytope::Face;
+constexpr int kMaxVertices = Polytope::kMaxVertices;
+constexpr int kMaxFaces = Polytope::kMaxFaces;
 
 // Writes the output for face f: the origin's projection n * dist expressed in the face's
 // vertices, and the same weights applied to their support points.

@@ -16,6 +16,7 @@
 
 #include "collision/assert.h"
 #include "geometry/closest_points.h"
+#include "narrowphase/epa_polytope.h"
 
 namespace collision {
 
@@ -26,9 +27,6 @@ constexpr Real kOverlapRelative = Real(32) * kEpsilon;
 constexpr Real kDuplicateRelative = Real(8) * kEpsilon;
 
 Real signOrPlus(Real x) { return x < 0 ? Real(-1) : Real(1); }
-
-const Vec3& pointOf(const Vec3& v) { return v; }
-const Vec3& pointOf(const SupportVertex& v) { return v.w; }
 
 template <class Vertex>
 struct Simplex {
@@ -173,46 +171,13 @@ GjkRun<Vertex> runGjk(const ConvexCore& a, const ConvexCore& b, const RelativePo
 
 // ---- Bounded EPA: decides whether the penetration depth of the cores exceeds `threshold`. ----
 
-struct EpaFace {
-    std::array<int, 3> v{};
-    Vec3 normal = Vec3::Zero();  // unit, outward; zero for a degenerate face
-    Real dist = 0;               // normal . vertex: signed distance of the plane from the origin
-    bool valid = true;
-};
-
-constexpr int kEpaMaxVertices = kGjkMaxIterations + 4;
-constexpr int kEpaMaxFaces = 2 * kEpaMaxVertices;
-
-struct EpaPolytope {
-    std::array<Vec3, kEpaMaxVertices> w{};
-    int vertex_count = 0;
-    std::array<EpaFace, kEpaMaxFaces> faces{};
-    int face_count = 0;
-    Real eps = 0;
-
-    bool addFace(int i, int j, int k) {
-        if (face_count >= kEpaMaxFaces) return false;
-        EpaFace& f = faces[face_count++];
-        f.v = {i, j, k};
-        f.valid = true;
-        const Vec3 n = (w[j] - w[i]).cross(w[k] - w[i]);
-        const Real len = n.norm();
-        if (len > eps * eps) {
-            f.normal = n / len;
-            f.dist = f.normal.dot(w[i]);
-        } else {
-            f.normal = Vec3::Zero();
-            f.dist = std::numeric_limits<Real>::infinity();
-        }
-        return true;
-    }
-};
+using DecidePolytope = EpaPolytope<Vec3, kGjkMaxIterations + 4>;
 
 ContactState epaDecide(const MinkowskiDifference& cso, const Simplex<Vec3>& start, Real threshold,
                        Real scale, std::int32_t& iterations) {
-    EpaPolytope poly;
+    DecidePolytope poly;
     poly.eps = std::max(Real(64) * kEpsilon * scale, std::numeric_limits<Real>::min());
-    for (int i = 0; i < start.n; ++i) poly.w[poly.vertex_count++] = start.v[i];
+    for (int i = 0; i < start.n; ++i) poly.vert[poly.vertex_count++] = start.v[i];
 
     // Direction probes: any direction n with support h(n) <= threshold proves depth <= threshold.
     auto probe = [&](const Vec3& dir, Vec3& w_out) {
@@ -223,7 +188,7 @@ ContactState epaDecide(const MinkowskiDifference& cso, const Simplex<Vec3>& star
     // Blow a lower-dimensional simplex up to a tetrahedron (the CSO is 3-D unless it is flat, and
     // a flat CSO has penetration depth zero).
     while (poly.vertex_count < 4) {
-        const Vec3 w0 = poly.w[0];
+        const Vec3 w0 = poly.vert[0];
         std::array<Vec3, 6> dirs{};
         int dir_count = 0;
         if (poly.vertex_count == 1) {
@@ -231,7 +196,7 @@ ContactState epaDecide(const MinkowskiDifference& cso, const Simplex<Vec3>& star
                     -Vec3::UnitY(), Vec3::UnitZ(),  -Vec3::UnitZ()};
             dir_count = 6;
         } else if (poly.vertex_count == 2) {
-            const Vec3 e = poly.w[1] - w0;
+            const Vec3 e = poly.vert[1] - w0;
             int axis = 0;
             e.cwiseAbs().minCoeff(&axis);
             const Vec3 d1 = e.cross(Vec3::Unit(axis)).normalized();
@@ -239,7 +204,7 @@ ContactState epaDecide(const MinkowskiDifference& cso, const Simplex<Vec3>& star
             dirs = {d1, -d1, d2, -d2, Vec3::Zero(), Vec3::Zero()};
             dir_count = 4;
         } else {
-            const Vec3 n = (poly.w[1] - w0).cross(poly.w[2] - w0);
+            const Vec3 n = (poly.vert[1] - w0).cross(poly.vert[2] - w0);
             const Real len = n.norm();
             if (!(len > poly.eps * poly.eps)) return ContactState::Touching;
             dirs = {n / len, -n / len, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
@@ -253,13 +218,13 @@ ContactState epaDecide(const MinkowskiDifference& cso, const Simplex<Vec3>& star
             if (poly.vertex_count == 1) {
                 off = (w - w0).norm();
             } else if (poly.vertex_count == 2) {
-                const Vec3 e = poly.w[1] - w0;
+                const Vec3 e = poly.vert[1] - w0;
                 off = e.cross(w - w0).norm() / e.norm();
             } else {
                 off = std::abs(dirs[k].dot(w - w0));
             }
             if (off > poly.eps) {
-                poly.w[poly.vertex_count++] = w;
+                poly.vert[poly.vertex_count++] = w;
                 grown = true;
             }
         }
@@ -267,8 +232,8 @@ ContactState epaDecide(const MinkowskiDifference& cso, const Simplex<Vec3>& star
     }
 
     // Outward orientation of the initial tetrahedron (see RTCD 5.1.6 face order).
-    if ((poly.w[1] - poly.w[0]).cross(poly.w[2] - poly.w[0]).dot(poly.w[3] - poly.w[0]) > 0) {
-        std::swap(poly.w[1], poly.w[2]);
+    if ((poly.vert[1] - poly.vert[0]).cross(poly.vert[2] - poly.vert[0]).dot(poly.vert[3] - poly.vert[0]) > 0) {
+        std::swap(poly.vert[1], poly.vert[2]);
     }
     poly.addFace(0, 1, 2);
     poly.addFace(0, 3, 1);
@@ -279,12 +244,12 @@ ContactState epaDecide(const MinkowskiDifference& cso, const Simplex<Vec3>& star
         ++iterations;
         int best = -1;
         for (int f = 0; f < poly.face_count; ++f) {
-            const EpaFace& face = poly.faces[f];
+            const DecidePolytope::Face& face = poly.faces[f];
             if (!face.valid || face.normal.isZero()) continue;
             if (best < 0 || face.dist < poly.faces[best].dist) best = f;
         }
         if (best < 0) return ContactState::Failed;
-        const EpaFace closest = poly.faces[best];
+        const DecidePolytope::Face closest = poly.faces[best];
         // The origin lies inside the polytope (inside the CSO), so depth >= closest plane
         // distance; and depth <= h(n) for every probed n (van den Bergen 2001 §4).
         if (closest.dist > threshold) return ContactState::Penetrating;
@@ -300,20 +265,20 @@ ContactState epaDecide(const MinkowskiDifference& cso, const Simplex<Vec3>& star
         // the same vertex until the cap and came out Failed.
         const Real dup = kDuplicateRelative * std::max(w.norm(), scale);
         for (int i = 0; i < poly.vertex_count; ++i) {
-            if ((poly.w[i] - w).squaredNorm() <= dup * dup) return ContactState::Touching;
+            if ((poly.vert[i] - w).squaredNorm() <= dup * dup) return ContactState::Touching;
         }
-        if (poly.vertex_count >= kEpaMaxVertices) return ContactState::Failed;
+        if (poly.vertex_count >= DecidePolytope::kMaxVertices) return ContactState::Failed;
         const int new_index = poly.vertex_count;
-        poly.w[poly.vertex_count++] = w;
+        poly.vert[poly.vertex_count++] = w;
 
         // Remove the faces w sees; the horizon is their boundary (edges whose twin survives).
-        std::array<std::array<int, 2>, 3 * kEpaMaxFaces> edges{};
+        std::array<std::array<int, 2>, 3 * DecidePolytope::kMaxFaces> edges{};
         int edge_count = 0;
         for (int f = 0; f < poly.face_count; ++f) {
-            EpaFace& face = poly.faces[f];
+            DecidePolytope::Face& face = poly.faces[f];
             if (!face.valid) continue;
             const bool visible =
-                face.normal.isZero() || face.normal.dot(w - poly.w[face.v[0]]) > poly.eps * 0.5;
+                face.normal.isZero() || face.normal.dot(w - poly.vert[face.v[0]]) > poly.eps * 0.5;
             if (!visible) continue;
             face.valid = false;
             for (int e = 0; e < 3; ++e) {
@@ -454,7 +419,7 @@ GjkOutput gjkDistance(const ConvexCore& a, const ConvexCore& b, const RelativePo
     out.iterations = run.iterations;
     out.closest = run.closest;
     out.simplex_count = run.simplex.n;
-    for (int i = 0; i < run.simplex.n; ++i) out.simplex[i] = run.simplex.v[i];
+    std::copy_n(run.simplex.v.begin(), run.simplex.n, out.simplex.begin());
     return out;
 }
 
@@ -464,11 +429,11 @@ GjkWitnessOutput gjkWitness(const ConvexCore& a, const ConvexCore& b, const Rela
     GjkWitnessOutput out;
     out.state = run.state;
     out.distance = run.distance;
+    out.iterations = run.iterations;
     out.point_a = run.point_a;
     out.point_b = run.point_b;
-    out.iterations = run.iterations;
     out.simplex.n = run.simplex.n;
-    for (int i = 0; i < run.simplex.n; ++i) out.simplex.v[i] = run.simplex.v[i];
+    out.simplex.v = run.simplex.v;
     return out;
 }
 

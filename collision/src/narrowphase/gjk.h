@@ -89,6 +89,10 @@ struct WitnessSimplex {
     std::int32_t n = 0;
 };
 
+/// The point of A - B of a GJK vertex of either kind.
+inline const Vec3& pointOf(const Vec3& v) { return v; }
+inline const Vec3& pointOf(const SupportVertex& v) { return v.w; }
+
 // Support mapping of the configuration-space obstacle A - B, in A's frame. A GJK vertex is the
 // point w = a - b alone (Vec3), or with the support points a and b that made it (SupportVertex)
 // when witness points are wanted.

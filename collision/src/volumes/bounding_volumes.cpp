@@ -13,6 +13,7 @@
 #include "collision/geometry/shape.h"
 #include "collision/narrowphase/narrow_phase.h"
 #include "volumes/box_sat.h"
+#include "volumes/covariance.h"
 
 namespace collision {
 
@@ -140,40 +141,15 @@ BoundingSphere minimalEnclosingSphere(const std::vector<Vec3>& input) {
 Obb fitObbPrincipal(const ConvexPolytope& hull) {
     const std::vector<Vec3>& v = hull.vertices;
     CDLAB_ASSERT(!v.empty(), "OBB of an empty hull");
-    // Covariance of the hull's surface, area weighted (Gottschalk 1996 §3, RTCD 4.4.3):
-    // for each triangle (p,q,r) with area A and centroid m,
-    //   C += A/12 (9 m m^T + p p^T + q q^T + r r^T);  C = C/A_total - mu mu^T.
-    // Computed about the first vertex to keep the sums small far from the origin.
+    // Covariance of the hull's surface, area weighted, about its first vertex.
     const Vec3 origin = v[0];
-    Mat3 second = Mat3::Zero();
-    Vec3 mu = Vec3::Zero();
-    Real area_total = 0;
-    for (const auto& f : hull.faces) {
-        const Vec3 p = v[f[0]] - origin;
-        const Vec3 q = v[f[1]] - origin;
-        const Vec3 r = v[f[2]] - origin;
-        const Real area = Real(0.5) * (q - p).cross(r - p).norm();
-        const Vec3 m = (p + q + r) / Real(3);
-        second += area / Real(12) *
-                  (Real(9) * m * m.transpose() + p * p.transpose() + q * q.transpose() +
-                   r * r.transpose());
-        mu += area * m;
-        area_total += area;
-    }
-    Mat3 cov;
-    if (area_total > 0) {
-        mu /= area_total;
-        cov = second / area_total - mu * mu.transpose();
-    } else {
-        mu.setZero();
-        for (const Vec3& p : v) mu += p - origin;
-        mu /= Real(v.size());
-        cov.setZero();
-        for (const Vec3& p : v) {
-            const Vec3 d = p - origin - mu;
-            cov += d * d.transpose();
-        }
-    }
+    const Mat3 cov = surfaceCovariance(
+        origin, hull.faces.size(),
+        [&](std::size_t k) {
+            const auto& f = hull.faces[k];
+            return std::array<Vec3, 3>{v[f[0]], v[f[1]], v[f[2]]};
+        },
+        v);
     Eigen::SelfAdjointEigenSolver<Mat3> solver(cov);
     Mat3 axes = Mat3::Identity();
     if (solver.info() == Eigen::Success && solver.eigenvectors().allFinite()) {

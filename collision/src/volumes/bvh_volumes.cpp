@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "collision/assert.h"
+#include "volumes/covariance.h"
 
 namespace collision {
 
@@ -59,42 +60,16 @@ Mat3 axesOfCovariance(const Mat3& cov) {
     return axes;
 }
 
-// Principal axes of the triangles (consecutive corner triples), area weighted (Gottschalk 1996
-// §3, RTCD 4.4.3): C += A/12 (9 m m^T + p p^T + q q^T + r r^T), C = C/A - mu mu^T, about the first
-// corner so the sums stay small far from the origin. Zero total area (degenerate triangles) falls
-// back to the covariance of the corners. Columns: largest variance first; right-handed.
+// Principal axes of the triangles (consecutive corner triples), area weighted, about the first
+// corner (surfaceCovariance). Columns: largest variance first; right-handed.
 Mat3 principalAxes(const std::vector<Vec3>& corners) {
     const Vec3 origin = corners[0];
-    Mat3 second = Mat3::Zero();
-    Vec3 mu = Vec3::Zero();
-    Real area_total = 0;
-    for (std::size_t k = 0; k + 2 < corners.size(); k += 3) {
-        const Vec3 p = corners[k] - origin;
-        const Vec3 q = corners[k + 1] - origin;
-        const Vec3 r = corners[k + 2] - origin;
-        const Real area = Real(0.5) * (q - p).cross(r - p).norm();
-        const Vec3 m = (p + q + r) / Real(3);
-        second += area / Real(12) *
-                  (Real(9) * m * m.transpose() + p * p.transpose() + q * q.transpose() +
-                   r * r.transpose());
-        mu += area * m;
-        area_total += area;
-    }
-    Mat3 cov;
-    if (area_total > 0) {
-        mu /= area_total;
-        cov = second / area_total - mu * mu.transpose();
-    } else {
-        mu.setZero();
-        for (const Vec3& p : corners) mu += p - origin;
-        mu /= Real(corners.size());
-        cov.setZero();
-        for (const Vec3& p : corners) {
-            const Vec3 d = p - origin - mu;
-            cov += d * d.transpose();
-        }
-    }
-    return axesOfCovariance(cov);
+    return axesOfCovariance(surfaceCovariance(
+        origin, corners.size() / 3,
+        [&](std::size_t k) {
+            return std::array<Vec3, 3>{corners[3 * k], corners[3 * k + 1], corners[3 * k + 2]};
+        },
+        corners));
 }
 
 TriangleMoments triangleMoments(const Vec3& p0, const Vec3& q0, const Vec3& r0,

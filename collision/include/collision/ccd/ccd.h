@@ -124,10 +124,8 @@ struct Sweep {
 /// Default acceptance tolerance of timeOfImpact, relative to the smaller shape's bounding radius.
 inline constexpr Real kToiRelativeTolerance = Real(1e-3);
 
-/// Input of timeOfImpact.
-struct ToiInput {
-    const Shape* a = nullptr;  ///< convex shapes (a Mesh stands for its convex hull: conservative)
-    const Shape* b = nullptr;
+/// What a time-of-impact query asks, whatever the shapes: the motions and the acceptance.
+struct ToiQuery {
     Sweep sweep_a;
     Sweep sweep_b;
     Real t_max = 1;       ///< search [0, t_max] of the step, t_max in [0, 1]
@@ -143,7 +141,13 @@ struct ToiInput {
     /// which the advancement approaches only step by step unless the motion is a pure
     /// translation (then Failed at the iteration cap).
     Real relative_tolerance = kToiRelativeTolerance;
-    int max_iterations = 64;  ///< cap on distance queries; reaching it returns Failed
+    int max_iterations = 64;  ///< cap on distance queries (per triangle pair for meshes)
+};
+
+/// Input of timeOfImpact.
+struct ToiInput : ToiQuery {
+    const Shape* a = nullptr;  ///< convex shapes (a Mesh stands for its convex hull: conservative)
+    const Shape* b = nullptr;
 };
 
 /// Result of the rigid-body time-of-impact queries, world frame.
@@ -202,17 +206,9 @@ class Bvh;
 
 /// Input of timeOfImpactMeshes: two OBB trees (Gottschalk's OBBTree, bvh.h) in their meshes'
 /// local frames, each moving by its sweep.
-struct MeshToiInput {
+struct MeshToiInput : ToiQuery {
     const Bvh<Obb>* a = nullptr;
     const Bvh<Obb>* b = nullptr;
-    Sweep sweep_a;
-    Sweep sweep_b;
-    Real t_max = 1;       ///< search [0, t_max] of the step, t_max in [0, 1]
-    Real target_gap = 0;  ///< m, >= 0, as ToiInput::target_gap
-    Real tolerance = 0;   ///< m, >= 0, as ToiInput::tolerance (0: relative to each pair)
-    /// As ToiInput::relative_tolerance, used when tolerance is 0.
-    Real relative_tolerance = kToiRelativeTolerance;
-    int max_iterations = 64;  ///< per triangle pair, as ToiInput::max_iterations
 };
 
 /// Result of timeOfImpactMeshes, with its witness features and cost counters.
