@@ -83,13 +83,8 @@ Real maxNorm(const Simplex<Vertex>& s) {
 
 // The result of the one GJK loop below, for either vertex type.
 template <class Vertex>
-struct GjkRun {
-    GjkState state = GjkState::Failed;
-    Real distance = 0;
-    Real lower_bound = -std::numeric_limits<Real>::infinity();
-    std::int32_t iterations = 0;
+struct GjkRun : GjkSummary {
     Simplex<Vertex> simplex;
-    Vec3 closest = Vec3::Zero();  // the simplex's point nearest the origin (v)
     // Witness points (SupportVertex only): the weights of `closest` applied to the simplex's
     // support points, updated whenever |v| decreases.
     Vec3 point_a = Vec3::Zero();
@@ -104,6 +99,7 @@ GjkRun<Vertex> runGjk(const ConvexCore& a, const ConvexCore& b, const RelativePo
     constexpr bool kWitness = !std::is_same_v<Vertex, Vec3>;
     const MinkowskiDifference cso{a, b, b_in_a};
     GjkRun<Vertex> out;
+    out.lower_bound = -std::numeric_limits<Real>::infinity();
     const Real tiny = std::max(kOverlapRelative * scale, std::numeric_limits<Real>::min());
     Simplex<Vertex>& s = out.simplex;
     // Any point of A - B starts the search; -position points from B's origin towards A's.
@@ -413,11 +409,7 @@ GjkOutput gjkDistance(const ConvexCore& a, const ConvexCore& b, const RelativePo
                       Real scale) {
     const GjkRun<Vec3> run = runGjk<Vec3>(a, b, b_in_a, scale);
     GjkOutput out;
-    out.state = run.state;
-    out.distance = run.distance;
-    out.lower_bound = run.lower_bound;
-    out.iterations = run.iterations;
-    out.closest = run.closest;
+    static_cast<GjkSummary&>(out) = run;
     out.simplex_count = run.simplex.n;
     std::copy_n(run.simplex.v.begin(), run.simplex.n, out.simplex.begin());
     return out;
@@ -427,9 +419,7 @@ GjkWitnessOutput gjkWitness(const ConvexCore& a, const ConvexCore& b, const Rela
                             Real scale) {
     const GjkRun<SupportVertex> run = runGjk<SupportVertex>(a, b, b_in_a, scale);
     GjkWitnessOutput out;
-    out.state = run.state;
-    out.distance = run.distance;
-    out.iterations = run.iterations;
+    static_cast<GjkSummary&>(out) = run;
     out.point_a = run.point_a;
     out.point_b = run.point_b;
     out.simplex.n = run.simplex.n;

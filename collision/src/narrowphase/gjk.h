@@ -49,16 +49,22 @@ RelativePose relativePose(const Pose& pose_a, const Pose& pose_b);
 
 enum class GjkState : std::uint8_t { Separated, Overlapping, Failed };
 
-struct GjkOutput {
+/// What every GJK run reports (gjkDistance, gjkWitness).
+struct GjkSummary {
     GjkState state = GjkState::Failed;
-    Real distance = 0;     ///< between the cores (radii ignored) when Separated: an upper bound
+    /// Between the cores (radii ignored) when Separated: an upper bound; |v| of the last iterate
+    /// when Failed; 0 when Overlapping.
+    Real distance = 0;
     Real lower_bound = 0;  ///< proven lower bound on the core distance (may be <= 0)
     std::int32_t iterations = 0;
-    std::int32_t simplex_count = 0;  ///< final simplex, for the EPA decision
-    std::array<Vec3, 4> simplex{};   ///< vertices of A - B, in A's frame
     /// The point of the final simplex nearest the origin (GJK's v), A's frame: the closest
     /// point of A - B when Separated (a - b of the closest pair).
     Vec3 closest = Vec3::Zero();
+};
+
+struct GjkOutput : GjkSummary {
+    std::int32_t simplex_count = 0;  ///< final simplex, for the EPA decision
+    std::array<Vec3, 4> simplex{};   ///< vertices of A - B, in A's frame
 };
 
 /// Iteration cap of GJK and of the EPA decision.
@@ -116,16 +122,12 @@ struct MinkowskiDifference {
     }
 };
 
-struct GjkWitnessOutput {
-    GjkState state = GjkState::Failed;
-    /// Core distance (radii ignored) when Separated; |v| of the last iterate when Failed.
-    Real distance = 0;
+struct GjkWitnessOutput : GjkSummary {
     /// Closest points of the cores, A's frame: the same barycentric combination of the simplex's
     /// support points (van den Bergen 1999 §3). Valid when Separated (and as a best guess when
     /// Failed).
     Vec3 point_a = Vec3::Zero();
     Vec3 point_b = Vec3::Zero();
-    std::int32_t iterations = 0;
     WitnessSimplex simplex;  ///< final simplex: the EPA start when Overlapping
 };
 

@@ -206,17 +206,20 @@ template struct BvTraits<Kdop<26>>;
 
 namespace {
 
-// The points as coordinates along `axes` relative to `origin`, and their box in that frame
-// (which holds the origin).
+// The corners as coordinates along `axes` relative to the first corner (`origin`), and their box
+// in that frame (which holds the origin).
 struct AxesFramePoints {
+    Vec3 origin;
     std::vector<Vec3> points;
     Vec3 lo = Vec3::Zero();
     Vec3 hi = Vec3::Zero();
 };
 
-AxesFramePoints inAxesFrame(const std::vector<Vec3>& corners, const Mat3& axes,
-                            const Vec3& origin) {
+AxesFramePoints inAxesFrame(const std::vector<Vec3>& corners, const Mat3& axes) {
+    CDLAB_ASSERT(!corners.empty(), "fitting a volume to no points");
     AxesFramePoints out;
+    out.origin = corners[0];
+    const Vec3& origin = out.origin;
     out.points.reserve(corners.size());
     for (const Vec3& p : corners) {
         out.points.push_back(axes.transpose() * (p - origin));
@@ -234,13 +237,12 @@ Rss BvTraits<Rss>::fit(const std::vector<Vec3>& corners) {
 }
 
 Rss BvTraits<Rss>::fitWithAxes(const std::vector<Vec3>& corners, const Mat3& axes) {
-    CDLAB_ASSERT(!corners.empty(), "fitting a volume to no points");
     // Larsen et al. 2000 §4: the rectangle spans the two largest principal axes; the radius is
     // half the thickness along the third. The rectangle is then shrunk as far as every point's
     // own slack sqrt(r^2 - dz^2) allows on each axis, and the radius re-measured exactly, so
     // points near the rounded corners are covered by construction.
-    const Vec3 origin = corners[0];
-    const AxesFramePoints frame = inAxesFrame(corners, axes, origin);
+    const AxesFramePoints frame = inAxesFrame(corners, axes);
+    const Vec3& origin = frame.origin;
     const std::vector<Vec3>& local = frame.points;
     const Vec3& lo = frame.lo;
     const Vec3& hi = frame.hi;
@@ -281,15 +283,14 @@ Lss BvTraits<Lss>::fit(const std::vector<Vec3>& corners) {
 }
 
 Lss BvTraits<Lss>::fitWithAxes(const std::vector<Vec3>& corners, const Mat3& axes) {
-    CDLAB_ASSERT(!corners.empty(), "fitting a volume to no points");
     // Larsen et al. 2000 §4 for the line: the segment runs along the largest principal axis
     // through the centre of the points' box across it; the radius is the largest distance across
     // the axis. The segment is then shrunk as far as every point's own slack sqrt(r^2 - d^2)
     // allows (as for the RSS), and the radius re-measured as the exact largest distance of a
     // point from the final segment, so the volume contains every corner by construction
     // (conservative whatever the axis; the axis only decides how tight it is).
-    const Vec3 origin = corners[0];
-    const AxesFramePoints frame = inAxesFrame(corners, axes, origin);
+    const AxesFramePoints frame = inAxesFrame(corners, axes);
+    const Vec3& origin = frame.origin;
     const std::vector<Vec3>& local = frame.points;
     const Vec3& lo = frame.lo;
     const Vec3& hi = frame.hi;
