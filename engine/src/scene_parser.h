@@ -91,6 +91,8 @@ struct PreparedShape {
 };
 
 class SceneParser {
+    friend class ExpectReader;  // scene_expect.cpp: reads through fail() and the typed reads
+
 public:
     SceneParser(std::string display_name, fs::path base_dir)
         : file_(std::move(display_name)), base_dir_(std::move(base_dir)) {}
