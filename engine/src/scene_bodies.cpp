@@ -129,17 +129,14 @@ const PreparedShape& SceneParser::prepareMeshShape(ShapeType type, const std::st
     return mesh_cache_.emplace(key, std::move(prepared)).first->second;
 }
 
-std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
-                                         const Scene& scene) {
-    const std::string path = indexPath("bodies", index);
-    const std::vector<Entry> es =
-        entries(n, path, std::vector<std::string_view>(std::begin(kBodyKeys), std::end(kBodyKeys)));
-
-    // The shape first: it decides which keys apply.
+// The shape a `bodies` entry names, and the keys that apply to it; a key of another shape, or
+// both keys of an exclusive pair, is an error at that key.
+ShapeType SceneParser::bodyShape(const std::vector<Entry>& es, const YAML::Node& n,
+                                 const std::string& path, std::string& shape_name,
+                                 std::vector<std::string_view>& shape_keys) const {
     const Entry& shape_entry = require(es, "shape", n, path);
-    const std::string shape_name = readString(shape_entry.value, childPath(path, "shape"));
+    shape_name = readString(shape_entry.value, childPath(path, "shape"));
     ShapeType type = ShapeType::Sphere;
-    std::vector<std::string_view> shape_keys;
     if (shape_name == "sphere") {
         type = ShapeType::Sphere;
         shape_keys = {"radius"};
@@ -182,25 +179,18 @@ std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
                  "give either '" + std::string(a) + "' or '" + std::string(b) + "', not both");
         }
     }
+    return type;
+}
 
-    std::string name = shape_name + std::to_string(index);
-    Vec3 position = Vec3::Zero();
-    Quat orientation = Quat::Identity();
-    Vec3 velocity = Vec3::Zero();
-    Vec3 angular_velocity = Vec3::Zero();
-    Real radius = 0;
-    Real half_height = 0;
-    Vec3 half_extents = Vec3::Zero();
-    Real scale = 1;
-    const Entry* file_entry = nullptr;
-    const Entry* mass_entry = nullptr;
-    const Entry* density_entry = nullptr;
-    Real mass = 0;
-    Real density = 1000;
-    bool is_static = false;
-    Real restitution = scene.world.restitution;
-    Real friction = scene.world.friction;
-
+// Every value of a `bodies` entry, read and checked at its key, before the shape is built.
+BodyValues SceneParser::readBodyValues(const std::vector<Entry>& es, const YAML::Node& n,
+                                       const std::string& path, std::string default_name,
+                                       const std::vector<std::string_view>& shape_keys,
+                                       const Scene& scene) const {
+    BodyValues b;
+    b.name = std::move(default_name);
+    b.restitution = scene.world.restitution;
+    b.friction = scene.world.friction;
     const Entry* repeat_entry = find(es, "repeat");
     if (repeat_entry != nullptr) {
         for (const Entry& e : es) {
@@ -221,36 +211,36 @@ std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
         const std::string p = childPath(path, e.key);
         const YAML::Node& v = e.value;
         if (e.key == "name") {
-            name = readString(v, p);
+            b.name = readString(v, p);
         } else if (e.key == "radius") {
-            radius = readReal(v, p);
-            if (!(radius > 0)) fail(v, p, "must be > 0");
+            b.radius = readReal(v, p);
+            if (!(b.radius > 0)) fail(v, p, "must be > 0");
         } else if (e.key == "half_height") {
-            half_height = readReal(v, p);
-            if (!(half_height >= 0)) fail(v, p, "must be >= 0");
+            b.half_height = readReal(v, p);
+            if (!(b.half_height >= 0)) fail(v, p, "must be >= 0");
         } else if (e.key == "half_extents") {
-            half_extents = readVec3(v, p);
+            b.half_extents = readVec3(v, p);
             for (int a = 0; a < 3; ++a) {
-                if (!(half_extents[a] >= 0)) fail(v[a], indexPath(p, a), "must be >= 0");
+                if (!(b.half_extents[a] >= 0)) fail(v[a], indexPath(p, a), "must be >= 0");
             }
         } else if (e.key == "file") {
             readString(v, p);
             if (v.Scalar().empty()) fail(v, p, "must not be empty");
-            file_entry = &e;
+            b.file_entry = &e;
         } else if (e.key == "scale") {
-            scale = readReal(v, p);
-            if (!(scale > 0)) fail(v, p, "must be > 0");
+            b.scale = readReal(v, p);
+            if (!(b.scale > 0)) fail(v, p, "must be > 0");
             // The hull and mass properties multiply up to three coordinates: at 1e300 they
             // overflowed ("points are coplanar"), at 1e-300 underflowed ("no triangles").
-            if (!(scale >= kMinMeshScale && scale <= kMaxMeshScale)) {
+            if (!(b.scale >= kMinMeshScale && b.scale <= kMaxMeshScale)) {
                 fail(v, p,
                      "must be in [" + formatLimit(kMinMeshScale) + ", " +
                          formatLimit(kMaxMeshScale) +
                          "]: beyond, products of the scaled coordinates over- or underflow");
             }
         } else if (e.key == "position") {
-            position = readVec3(v, p);
-            if (!scene.world.bounds.contains(position)) {
+            b.position = readVec3(v, p);
+            if (!scene.world.bounds.contains(b.position)) {
                 fail(v, p, "is outside the world bounds");
             }
         } else if (e.key == "orientation_wxyz") {
@@ -262,80 +252,87 @@ std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
             if (!(len > kMinQuaternionNorm) || !std::isfinite(len)) {
                 fail(v, p, "must be a non-zero quaternion (it is normalised)");
             }
-            orientation = Quat(raw.coeffs() / len);
+            b.orientation = Quat(raw.coeffs() / len);
         } else if (e.key == "euler_deg") {
             const Vec3 deg = readVec3(v, p);
             const Vec3 rad = deg * (std::numbers::pi_v<Real> / 180);
             // Intrinsic X, then Y, then Z: R = Rx Ry Rz.
-            orientation = Quat(Eigen::AngleAxis<Real>(rad.x(), Vec3::UnitX())) *
+            b.orientation = Quat(Eigen::AngleAxis<Real>(rad.x(), Vec3::UnitX())) *
                           Quat(Eigen::AngleAxis<Real>(rad.y(), Vec3::UnitY())) *
                           Quat(Eigen::AngleAxis<Real>(rad.z(), Vec3::UnitZ()));
-            orientation.normalize();
+            b.orientation.normalize();
         } else if (e.key == "velocity") {
-            velocity = readVec3(v, p);
-            const std::string problem = speedProblem(velocity.stableNorm(), scene.world);
+            b.velocity = readVec3(v, p);
+            const std::string problem = speedProblem(b.velocity.stableNorm(), scene.world);
             if (!problem.empty()) fail(v, p, problem);
         } else if (e.key == "angular_velocity") {
-            angular_velocity = readVec3(v, p);
-            const std::string problem = spinProblem(angular_velocity.stableNorm(), scene.world);
+            b.angular_velocity = readVec3(v, p);
+            const std::string problem = spinProblem(b.angular_velocity.stableNorm(), scene.world);
             if (!problem.empty()) fail(v, p, problem);
         } else if (e.key == "mass") {
-            mass = readReal(v, p);
-            if (!(mass > 0)) fail(v, p, "must be > 0 (kg)");
-            mass_entry = &e;
+            b.mass = readReal(v, p);
+            if (!(b.mass > 0)) fail(v, p, "must be > 0 (kg)");
+            b.mass_entry = &e;
         } else if (e.key == "density") {
-            density = readReal(v, p);
-            if (!(density > 0)) fail(v, p, "must be > 0 (kg/m^3)");
-            density_entry = &e;
+            b.density = readReal(v, p);
+            if (!(b.density > 0)) fail(v, p, "must be > 0 (kg/m^3)");
+            b.density_entry = &e;
         } else if (e.key == "static") {
-            is_static = readBool(v, p);
+            b.is_static = readBool(v, p);
         } else if (e.key == "restitution") {
-            restitution = readReal(v, p);
-            if (!(restitution >= 0 && restitution <= 1)) fail(v, p, "must be in [0, 1]");
+            b.restitution = readReal(v, p);
+            if (!(b.restitution >= 0 && b.restitution <= 1)) fail(v, p, "must be in [0, 1]");
         } else if (e.key == "friction") {
-            friction = readReal(v, p);
-            if (!(friction >= 0)) fail(v, p, "must be >= 0");
+            b.friction = readReal(v, p);
+            if (!(b.friction >= 0)) fail(v, p, "must be >= 0");
         }
     }
-    if (is_static) {
+    if (b.is_static) {
         for (const Entry& e : es) {
             if (e.key == "velocity" || e.key == "angular_velocity") {
                 fail(e.key_node, childPath(path, e.key), "a static body does not move");
             }
         }
     }
+    return b;
+}
 
-    // Geometry and its properties at density 1 (mass = volume).
-    Shape shape;
+// The body's shape and mass properties: geometry at density 1 (mass = volume), then scaled to
+// the entry's mass or density. Problems are reported at `mass` or `density`, else at the shape's
+// size key.
+MassProperties SceneParser::bodyMassProperties(const std::vector<Entry>& es,
+                                               const std::string& path, ShapeType type,
+                                               const std::vector<std::string_view>& shape_keys,
+                                               const BodyValues& b, const Scene& scene,
+                                               Shape& shape) {
     MassProperties unit;
-    // Mass problems are reported at `mass` or `density`, else at the shape's size key.
-    const Entry* mass_at = mass_entry != nullptr      ? mass_entry
-                           : density_entry != nullptr ? density_entry
+    const Entry* mass_at = b.mass_entry != nullptr      ? b.mass_entry
+                           : b.density_entry != nullptr ? b.density_entry
                                                       : find(es, shape_keys.front());
     const std::string mass_path = childPath(path, mass_at->key);
     const YAML::Node mass_node = mass_at->value;
     if (type == ShapeType::ConvexHull || type == ShapeType::Mesh) {
         const PreparedShape& prepared =
-            prepareMeshShape(type, file_entry->value.Scalar(), scale, *file_entry,
+            prepareMeshShape(type, b.file_entry->value.Scalar(), b.scale, *b.file_entry,
                              childPath(path, "file"), scene.world.mesh_bvh);
         shape = prepared.shape;
         unit = prepared.unit;
     } else {
-        shape = type == ShapeType::Sphere ? Shape::sphere(radius)
-                : type == ShapeType::Box  ? Shape::box(half_extents)
-                                          : Shape::capsule(radius, half_height);
+        shape = type == ShapeType::Sphere ? Shape::sphere(b.radius)
+                : type == ShapeType::Box  ? Shape::box(b.half_extents)
+                                          : Shape::capsule(b.radius, b.half_height);
         const MassPropertiesOutput mp = computeMassProperties(shape, 1);
         if (mp.ok) {
             unit = mp.props;
         } else if (type == ShapeType::Box) {
             // A flat or degenerate box: only an explicit mass defines it. Thin-plate / rod limit
             // of the cuboid formula, with a floor so that the inertia stays invertible.
-            if (mass_entry == nullptr) {
+            if (b.mass_entry == nullptr) {
                 fail(find(es, "half_extents")->value, childPath(path, "half_extents"),
                      "a box with zero volume needs 'mass' (a density gives it no mass)");
             }
-            const Vec3 h2 = half_extents.cwiseProduct(half_extents);
-            const Real l = std::max(half_extents.maxCoeff(), Real(1e-3));
+            const Vec3 h2 = b.half_extents.cwiseProduct(b.half_extents);
+            const Real l = std::max(b.half_extents.maxCoeff(), Real(1e-3));
             const Real floor2 = (kMinGyrationFraction * l) * (kMinGyrationFraction * l);
             const Vec3 moments = (Vec3(h2.y() + h2.z(), h2.z() + h2.x(), h2.x() + h2.y()) / 3)
                                      .cwiseMax(Vec3::Constant(floor2));
@@ -345,11 +342,11 @@ std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
             fail(mass_node, mass_path, mp.error);
         }
     }
-    const Real scale_to = mass_entry != nullptr ? mass / unit.mass : density;
+    const Real scale_to = b.mass_entry != nullptr ? b.mass / unit.mass : b.density;
     MassProperties props = unit;
     props.mass = unit.mass * scale_to;
     props.inertia = unit.inertia * scale_to;
-    if (mass_entry != nullptr) props.mass = mass;
+    if (b.mass_entry != nullptr) props.mass = b.mass;
     const Mat3 inv = props.inertia.inverse();
     if (!std::isfinite(props.mass) || !(props.mass > 0) || !props.inertia.allFinite() ||
         !inv.allFinite() || !(props.inertia.diagonal().minCoeff() > 0)) {
@@ -358,12 +355,29 @@ std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
              << " kg): the body is too small, too large, too light or too heavy";
         fail(mass_node, mass_path, what.str());
     }
+    return props;
+}
 
-    Body body = makeBody(std::move(name), std::move(shape), props);
-    body.restitution = restitution;
-    body.friction = friction;
-    auto place = [&props, is_static](Body& b, const Vec3& p, const Quat& q, const Vec3& v,
-                                     const Vec3& w) {
+std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
+                                         const Scene& scene) {
+    const std::string path = indexPath("bodies", index);
+    const std::vector<Entry> es =
+        entries(n, path, std::vector<std::string_view>(std::begin(kBodyKeys), std::end(kBodyKeys)));
+    // The shape first: it decides which keys apply.
+    std::string shape_name;
+    std::vector<std::string_view> shape_keys;
+    const ShapeType type = bodyShape(es, n, path, shape_name, shape_keys);
+    BodyValues values =
+        readBodyValues(es, n, path, shape_name + std::to_string(index), shape_keys, scene);
+    Shape shape;
+    const MassProperties props =
+        bodyMassProperties(es, path, type, shape_keys, values, scene, shape);
+
+    Body body = makeBody(std::move(values.name), std::move(shape), props);
+    body.restitution = values.restitution;
+    body.friction = values.friction;
+    auto place = [&props, is_static = values.is_static](Body& b, const Vec3& p, const Quat& q,
+                                                          const Vec3& v, const Vec3& w) {
         b.position = p;
         b.orientation = q;
         b.linear_momentum = props.mass * v;
@@ -371,12 +385,15 @@ std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
         b.angular_momentum = r * props.inertia * r.transpose() * w;
         if (is_static) setStatic(b);
     };
+    const Entry* repeat_entry = find(es, "repeat");
     if (repeat_entry == nullptr) {
-        place(body, position, orientation, velocity, angular_velocity);
+        place(body, values.position, values.orientation, values.velocity,
+              values.angular_velocity);
         return {std::move(body)};
     }
     return repeatBody(body, *repeat_entry, childPath(path, "repeat"), scene, place);
 }
+
 
 template <typename Place>
 std::vector<Body> SceneParser::repeatBody(const Body& base, const Entry& entry,

@@ -84,6 +84,27 @@ struct Entry {
     YAML::Node value;
 };
 
+// The values of one `bodies` entry as read and checked, before its shape is built.
+struct BodyValues {
+    std::string name;
+    Vec3 position = Vec3::Zero();
+    Quat orientation = Quat::Identity();
+    Vec3 velocity = Vec3::Zero();
+    Vec3 angular_velocity = Vec3::Zero();
+    Real radius = 0;
+    Real half_height = 0;
+    Vec3 half_extents = Vec3::Zero();
+    Real scale = 1;
+    const Entry* file_entry = nullptr;
+    const Entry* mass_entry = nullptr;
+    const Entry* density_entry = nullptr;
+    Real mass = 0;
+    Real density = 1000;
+    bool is_static = false;
+    Real restitution = 0;
+    Real friction = 0;
+};
+
 // Geometry imported for hull and mesh bodies: re-centred shape and its properties at density 1.
 struct PreparedShape {
     Shape shape;
@@ -130,6 +151,16 @@ private:
     void parseDraw(const YAML::Node& n, Scene& scene) const;
     /// One body, or the `repeat.count` bodies a `repeat` entry generates.
     std::vector<Body> parseBody(const YAML::Node& n, std::size_t index, const Scene& scene);
+    ShapeType bodyShape(const std::vector<Entry>& es, const YAML::Node& n, const std::string& path,
+                        std::string& shape_name, std::vector<std::string_view>& shape_keys) const;
+    BodyValues readBodyValues(const std::vector<Entry>& es, const YAML::Node& n,
+                              const std::string& path, std::string default_name,
+                              const std::vector<std::string_view>& shape_keys,
+                              const Scene& scene) const;
+    MassProperties bodyMassProperties(const std::vector<Entry>& es, const std::string& path,
+                                      ShapeType type,
+                                      const std::vector<std::string_view>& shape_keys,
+                                      const BodyValues& b, const Scene& scene, Shape& shape);
     /// `bvh_name`: the volume type of a mesh's hierarchy (validated by parseWorld).
     const PreparedShape& prepareMeshShape(ShapeType type, const std::string& file, Real scale,
                                           const Entry& file_entry, const std::string& path,
