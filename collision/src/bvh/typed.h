@@ -11,26 +11,31 @@
 
 namespace collision {
 
+namespace typed_detail {
+
+// out = f(tree as Bvh<BV>) when `tree` holds BV.
+template <class BV, class R, class F>
+bool tryTree(const MeshBvh& tree, R& out, F& f) {
+    const Bvh<BV>* typed = treeOf<BV>(tree);
+    if (typed == nullptr) return false;
+    out = f(*typed);
+    return true;
+}
+
+template <class R, class F, class... BV>
+R withTreeOf(const MeshBvh& tree, R fallback, F& f, std::tuple<BV...>* /*types*/) {
+    R out = std::move(fallback);
+    (tryTree<BV>(tree, out, f) || ...);
+    return out;
+}
+
+}  // namespace typed_detail
+
 /// f(tree) with `tree`'s typed Bvh<BV>; `fallback` for a handle of no known type.
 template <class R, class F>
 R withTree(const MeshBvh& tree, R fallback, F&& f) {
-    R out = std::move(fallback);
-    std::apply(
-        [&](auto... bv) {
-            bool done = false;
-            (
-                [&] {
-                    using BV = decltype(bv);
-                    if (done) return;
-                    if (const Bvh<BV>* typed = treeOf<BV>(tree)) {
-                        out = f(*typed);
-                        done = true;
-                    }
-                }(),
-                ...);
-        },
-        BvhVolumeTypes{});
-    return out;
+    return typed_detail::withTreeOf(tree, std::move(fallback), f,
+                                    static_cast<BvhVolumeTypes*>(nullptr));
 }
 
 /// The typed tree of `b` when it holds the same volume type as `like`, else null.
