@@ -127,8 +127,11 @@ GjkRun<Vertex> runGjk(const ConvexCore& a, const ConvexCore& b, const RelativePo
         }
         const Vertex w = cso.supportVertex<Vertex>(-v);
         const Real vw = v.dot(pointOf(w));
-        // Every point x of A - B has v.x >= v.w, so distance >= v.w / |v| (a separating plane).
-        out.lower_bound = std::max(out.lower_bound, vw / std::sqrt(vv));
+        if constexpr (!kWitness) {
+            // Every point x of A - B has v.x >= v.w, so distance >= v.w / |v| (a separating
+            // plane). Only the distance query reports it (collide() decides with it).
+            out.lower_bound = std::max(out.lower_bound, vw / std::sqrt(vv));
+        }
         // van den Bergen 1999 §4: |v|^2 - v.w bounds |v|^2 - |v| dist(origin, A - B).
         if (vv - vw <= kGjkRelativeTolerance * vv) return finish(GjkState::Separated, std::sqrt(vv));
         const Real dup = kDuplicateRelative * std::max(pointOf(w).norm(), maxNorm(s));

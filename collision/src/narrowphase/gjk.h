@@ -55,7 +55,9 @@ struct GjkSummary {
     /// Between the cores (radii ignored) when Separated: an upper bound; |v| of the last iterate
     /// when Failed; 0 when Overlapping.
     Real distance = 0;
-    Real lower_bound = 0;  ///< proven lower bound on the core distance (may be <= 0)
+    /// Proven lower bound on the core distance (may be <= 0); gjkDistance only (gjkWitness
+    /// leaves -inf, or 0 when Overlapping).
+    Real lower_bound = 0;
     std::int32_t iterations = 0;
     /// The point of the final simplex nearest the origin (GJK's v), A's frame: the closest
     /// point of A - B when Separated (a - b of the closest pair).
