@@ -350,6 +350,128 @@ std::string methodList() {
     return out;
 }
 
+// The workloads and methods the options ask for; an error message and false when any option is
+// bad (checked before any work).
+bool resolveBenchOptions(const BenchOptions& options, std::ostream& err,
+                         std::vector<WorkloadKind>& kinds,
+                         std::vector<const BenchMethodEntry*>& methods) {
+    if (options.workload == "both") {
+        kinds = {WorkloadKind::Uniform, WorkloadKind::Mixed};
+    } else if (const auto kind = parseWorkloadKind(options.workload)) {
+        kinds = {*kind};
+    } else {
+        err << "--workload: '" << options.workload << "' is not uniform, mixed, both or wide\n";
+        return false;
+    }
+    if (options.sizes.empty()) {
+        err << "--sizes: no sizes given\n";
+        return false;
+    }
+    // Past 10^7 boxes the workload alone needs gigabytes (2e9 ended in an uncaught bad_alloc).
+    constexpr int kMaxBenchBoxes = 10000000;
+    for (int n : options.sizes) {
+        if (n < 2 || n > kMaxBenchBoxes) {
+            err << "--sizes: " << n << " boxes; need at least 2 and at most " << kMaxBenchBoxes
+                << "\n";
+            return false;
+        }
+    }
+    if (options.frames < 1) {
+        err << "--frames: " << options.frames << "; need at least 1\n";
+        return false;
+    }
+    if (options.clock != "thread" && options.clock != "wall") {
+        err << "--clock: '" << options.clock << "' is not thread or wall\n";
+        return false;
+    }
+    if (options.methods.empty()) {
+        for (const BenchMethodEntry& m : benchMethods()) {
+            if (m.default_set) methods.push_back(&m);
+        }
+    } else {
+        for (const std::string& name : options.methods) {
+            const BenchMethodEntry* m = findBenchMethod(name);
+            if (m == nullptr) {
+                err << "--methods: unknown method '" << name
+                    << "' (AABB-based cdlab broad phases and the peers compiled in: "
+                    << methodList() << ")\n";
+                return false;
+            }
+            methods.push_back(m);
+        }
+    }
+    if (options.json) {
+        // Prove the JSON file writable now rather than after an hour of measuring.
+        try {
+            render::checkOutputWritable(*options.json);
+        } catch (const render::RenderError& e) {
+            err << e.what() << '\n';
+            return false;
+        }
+    }
+    return true;
+}
+
+// Every frame's pair count and hash by an independent sort-and-sweep: what each method must match.
+std::vector<PairSummary> referencePairs(const MovingBoxes& workload, int frames) {
+    std::vector<PairSummary> reference(static_cast<std::size_t>(frames) + 1);
+    MovingBoxes boxes = workload;
+    PairReference sweep;
+    reference[0] = sweep.count(boxes);
+    for (int f = 1; f <= frames; ++f) {
+        boxes.step();
+        reference[static_cast<std::size_t>(f)] = sweep.count(boxes);
+    }
+    return reference;
+}
+
+// One workload's rows: each method's ratio to the best peer, the table, the fastest cdlab
+// method, and notes on stopped runs and pair caches.
+void reportWorkload(std::ostream& out, std::vector<Row>& rows, const BenchOptions& options) {
+    double best_peer = std::numeric_limits<double>::infinity();
+    const Row* best = nullptr;
+    for (const Row& row : rows) {
+        if (row.peer && !row.skipped && !row.result.failed &&
+            row.result.median_ms < best_peer) {
+            best_peer = row.result.median_ms;
+            best = &row;
+        }
+    }
+    const Row* fastest = nullptr;
+    for (Row& row : rows) {
+        if (row.skipped || row.result.failed) continue;
+        if (best != nullptr) row.ratio = row.result.median_ms / best_peer;
+        if (!row.peer &&
+            (fastest == nullptr || row.result.median_ms < fastest->result.median_ms)) {
+            fastest = &row;
+        }
+    }
+    printTable(out, rows, options.frames);
+    if (fastest != nullptr) {
+        out << "fastest cdlab: " << fastest->method << " "
+            << format("%.4f", fastest->result.median_ms) << " ms/frame";
+        if (best != nullptr) {
+            out << "; best peer: " << best->method << " " << format("%.4f", best_peer)
+                << " ms/frame; ratio " << format("%.2f", fastest->ratio) << "x";
+        }
+        out << '\n';
+    }
+    for (const Row& row : rows) {
+        const RunResult& r = row.result;
+        if (row.skipped || r.failed) continue;
+        if (r.budget_hit) {
+            out << "  * " << row.method << ": stopped after " << r.frames_run
+                << " frames (--budget " << options.budget_seconds << " s of frame time)\n";
+        }
+        if (r.raw_pairs_last >= 0) {
+            out << "  " << row.method << ": pair cache held " << r.raw_pairs_last
+                << " pairs in the last frame (exact: " << r.pairs_last
+                << "; filtered untimed)\n";
+        }
+    }
+    out.flush();
+}
+
 }  // namespace
 
 BenchOptions smallBenchOptions() {
@@ -362,61 +484,8 @@ BenchOptions smallBenchOptions() {
 int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostream& err) {
     // Validate everything before any work.
     std::vector<WorkloadKind> kinds;
-    if (options.workload == "both") {
-        kinds = {WorkloadKind::Uniform, WorkloadKind::Mixed};
-    } else if (const auto kind = parseWorkloadKind(options.workload)) {
-        kinds = {*kind};
-    } else {
-        err << "--workload: '" << options.workload << "' is not uniform, mixed, both or wide\n";
-        return kExitBadInput;
-    }
-    if (options.sizes.empty()) {
-        err << "--sizes: no sizes given\n";
-        return kExitBadInput;
-    }
-    // Past 10^7 boxes the workload alone needs gigabytes (2e9 ended in an uncaught bad_alloc).
-    constexpr int kMaxBenchBoxes = 10000000;
-    for (int n : options.sizes) {
-        if (n < 2 || n > kMaxBenchBoxes) {
-            err << "--sizes: " << n << " boxes; need at least 2 and at most " << kMaxBenchBoxes
-                << "\n";
-            return kExitBadInput;
-        }
-    }
-    if (options.frames < 1) {
-        err << "--frames: " << options.frames << "; need at least 1\n";
-        return kExitBadInput;
-    }
-    if (options.clock != "thread" && options.clock != "wall") {
-        err << "--clock: '" << options.clock << "' is not thread or wall\n";
-        return kExitBadInput;
-    }
     std::vector<const BenchMethodEntry*> methods;
-    if (options.methods.empty()) {
-        for (const BenchMethodEntry& m : benchMethods()) {
-            if (m.default_set) methods.push_back(&m);
-        }
-    } else {
-        for (const std::string& name : options.methods) {
-            const BenchMethodEntry* m = findBenchMethod(name);
-            if (m == nullptr) {
-                err << "--methods: unknown method '" << name
-                    << "' (AABB-based cdlab broad phases and the peers compiled in: "
-                    << methodList() << ")\n";
-                return kExitBadInput;
-            }
-            methods.push_back(m);
-        }
-    }
-    if (options.json) {
-        // Prove the JSON file writable now rather than after an hour of measuring.
-        try {
-            render::checkOutputWritable(*options.json);
-        } catch (const render::RenderError& e) {
-            err << e.what() << '\n';
-            return kExitBadInput;
-        }
-    }
+    if (!resolveBenchOptions(options, err, kinds, methods)) return kExitBadInput;
 
     out << "cdlab bench broadphase: " << options.frames << " frames per method; time = "
         << (options.clock == "wall" ? "elapsed (wall-clock) time" : "thread CPU time")
@@ -434,16 +503,7 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
         for (int n : options.sizes) {
             const double t_ref = threadCpuSeconds();
             const MovingBoxes workload(kind, n, options.seed);
-            std::vector<PairSummary> reference(static_cast<std::size_t>(options.frames) + 1);
-            {
-                MovingBoxes boxes = workload;
-                PairReference sweep;
-                reference[0] = sweep.count(boxes);
-                for (int f = 1; f <= options.frames; ++f) {
-                    boxes.step();
-                    reference[static_cast<std::size_t>(f)] = sweep.count(boxes);
-                }
-            }
+            const std::vector<PairSummary> reference = referencePairs(workload, options.frames);
             const double per_body_first = double(reference.front().pairs) / n;
             const double per_body_last = double(reference.back().pairs) / n;
             char head[400];
@@ -502,48 +562,7 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
                 }
                 rows.push_back(std::move(row));
             }
-            double best_peer = std::numeric_limits<double>::infinity();
-            const Row* best = nullptr;
-            for (const Row& row : rows) {
-                if (row.peer && !row.skipped && !row.result.failed &&
-                    row.result.median_ms < best_peer) {
-                    best_peer = row.result.median_ms;
-                    best = &row;
-                }
-            }
-            const Row* fastest = nullptr;
-            for (Row& row : rows) {
-                if (row.skipped || row.result.failed) continue;
-                if (best != nullptr) row.ratio = row.result.median_ms / best_peer;
-                if (!row.peer &&
-                    (fastest == nullptr || row.result.median_ms < fastest->result.median_ms)) {
-                    fastest = &row;
-                }
-            }
-            printTable(out, rows, options.frames);
-            if (fastest != nullptr) {
-                out << "fastest cdlab: " << fastest->method << " "
-                    << format("%.4f", fastest->result.median_ms) << " ms/frame";
-                if (best != nullptr) {
-                    out << "; best peer: " << best->method << " " << format("%.4f", best_peer)
-                        << " ms/frame; ratio " << format("%.2f", fastest->ratio) << "x";
-                }
-                out << '\n';
-            }
-            for (const Row& row : rows) {
-                const RunResult& r = row.result;
-                if (row.skipped || r.failed) continue;
-                if (r.budget_hit) {
-                    out << "  * " << row.method << ": stopped after " << r.frames_run
-                        << " frames (--budget " << options.budget_seconds << " s of frame time)\n";
-                }
-                if (r.raw_pairs_last >= 0) {
-                    out << "  " << row.method << ": pair cache held " << r.raw_pairs_last
-                        << " pairs in the last frame (exact: " << r.pairs_last
-                        << "; filtered untimed)\n";
-                }
-            }
-            out.flush();
+            reportWorkload(out, rows, options);
             for (Row& row : rows) all_rows.push_back(std::move(row));
         }
     }

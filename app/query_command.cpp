@@ -54,6 +54,89 @@ double timePerCall(Fn&& fn) {
     return elapsed / calls;
 }
 
+// The rows as JSON (every volume type's own pair list, so a reader can compare them).
+void writeQueryJson(std::ostream& out, const std::filesystem::path (&paths)[2],
+                    const collision::TriangleMesh (&meshes)[2], const collision::Pose& pose_b,
+                    const std::vector<Row>& rows, bool agree) {
+    nlohmann::json j;
+    j["mesh_a"] = {{"path", paths[0].string()}, {"triangles", meshes[0].triangles.size()}};
+    j["mesh_b"] = {{"path", paths[1].string()}, {"triangles", meshes[1].triangles.size()}};
+    const auto& q = pose_b.orientation;
+    j["pose_b"] = {pose_b.position.x(),
+                   pose_b.position.y(),
+                   pose_b.position.z(),
+                   q.w(),
+                   q.x(),
+                   q.y(),
+                   q.z()};
+    j["volumes_agree"] = agree;
+    nlohmann::json results = nlohmann::json::array();
+    for (const Row& r : rows) {
+        // Every type writes its own list (sorted by (a, b)), so a reader can compare them.
+        nlohmann::json pairs = nlohmann::json::array();
+        for (const collision::TrianglePair& p : r.pairs) pairs.push_back({p.a, p.b});
+        results.push_back({
+            {"bv", std::string(r.bv)},
+            {"colliding", r.colliding},
+            {"triangle_pair_count", r.pairs.size()},
+            {"triangle_pairs", std::move(pairs)},
+            {"nodes", r.nodes},
+            {"build_ms", r.build_ms},
+            {"first_contact",
+             {{"bv_tests", r.first.bv_tests},
+              {"triangle_tests", r.first.triangle_tests},
+              {"time_us", r.first_us}}},
+            {"all_pairs",
+             {{"bv_tests", r.all.bv_tests},
+              {"triangle_tests", r.all.triangle_tests},
+              {"time_us", r.all_us}}},
+            {"unit_costs",
+             {{"bv_test_ns", r.unit.bv_test_ns},
+              {"triangle_test_ns", r.unit.triangle_test_ns},
+              {"bv_tests_timed", r.unit.bv_tests_timed},
+              {"triangle_tests_timed", r.unit.triangle_tests_timed},
+              {"triangle_tests_from_query", r.unit.triangles_from_queries},
+              // F = Nv Cv + Np Cp for the all-pairs query, beside its measured time_us.
+              {"all_pairs_model_us",
+               1e-3 * (static_cast<double>(r.all.bv_tests) * r.unit.bv_test_ns +
+                       static_cast<double>(r.all.triangle_tests) * r.unit.triangle_test_ns)}}},
+        });
+    }
+    j["results"] = results;
+    out << j.dump(2) << "\n";
+}
+
+// The rows as a table, with the cost counters and unit costs.
+void writeQueryTable(std::ostream& out, const std::filesystem::path (&paths)[2],
+                     const collision::TriangleMesh (&meshes)[2], const std::vector<Row>& rows) {
+    out << "A: " << paths[0].string() << " (" << meshes[0].triangles.size()
+        << " triangles)  B: " << paths[1].string() << " (" << meshes[1].triangles.size()
+        << " triangles)\n";
+    out << std::left << std::setw(8) << "bv" << std::right << std::setw(10) << "answer"
+        << std::setw(8) << "pairs" << std::setw(10) << "first Nv" << std::setw(10) << "first Np"
+        << std::setw(10) << "all Nv" << std::setw(10) << "all Np" << std::setw(11) << "build ms"
+        << std::setw(11) << "first us" << std::setw(11) << "all us" << std::setw(8) << "Cv ns"
+        << std::setw(8) << "Cp ns"
+        << "\n";
+    out << std::fixed;
+    for (const Row& r : rows) {
+        out << std::left << std::setw(8) << r.bv << std::right << std::setw(10)
+            << (r.colliding ? "colliding" : "apart") << std::setw(8) << r.pairs.size()
+            << std::setw(10) << r.first.bv_tests << std::setw(10) << r.first.triangle_tests
+            << std::setw(10) << r.all.bv_tests << std::setw(10) << r.all.triangle_tests
+            << std::setprecision(2) << std::setw(11) << r.build_ms << std::setw(11)
+            << r.first_us << std::setw(11) << r.all_us << std::setprecision(1) << std::setw(8)
+            << r.unit.bv_test_ns << std::setw(8) << r.unit.triangle_test_ns
+            << (r.unit.triangles_from_queries ? "" : "*") << "\n";
+    }
+    out << "(Nv: BV tests, Np: triangle tests; build: both trees; Cv, Cp: ns per BV test and\n"
+           " per triangle test, timed by replaying the all-pairs query's own tests";
+    bool random_cp = false;
+    for (const Row& r : rows) random_cp = random_cp || !r.unit.triangles_from_queries;
+    if (random_cp) out << ";\n * the query tested no triangles: Cp on random triangle pairs";
+    out << ")\n";
+}
+
 }  // namespace
 
 std::optional<collision::Pose> parsePose(std::string_view text, std::string* error) {
@@ -153,79 +236,9 @@ int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err) 
     }
 
     if (options.json) {
-        nlohmann::json j;
-        j["mesh_a"] = {{"path", paths[0].string()}, {"triangles", meshes[0].triangles.size()}};
-        j["mesh_b"] = {{"path", paths[1].string()}, {"triangles", meshes[1].triangles.size()}};
-        const auto& q = pose_b.orientation;
-        j["pose_b"] = {pose_b.position.x(),
-                       pose_b.position.y(),
-                       pose_b.position.z(),
-                       q.w(),
-                       q.x(),
-                       q.y(),
-                       q.z()};
-        j["volumes_agree"] = agree;
-        nlohmann::json results = nlohmann::json::array();
-        for (const Row& r : rows) {
-            // Every type writes its own list (sorted by (a, b)), so a reader can compare them.
-            nlohmann::json pairs = nlohmann::json::array();
-            for (const collision::TrianglePair& p : r.pairs) pairs.push_back({p.a, p.b});
-            results.push_back({
-                {"bv", std::string(r.bv)},
-                {"colliding", r.colliding},
-                {"triangle_pair_count", r.pairs.size()},
-                {"triangle_pairs", std::move(pairs)},
-                {"nodes", r.nodes},
-                {"build_ms", r.build_ms},
-                {"first_contact",
-                 {{"bv_tests", r.first.bv_tests},
-                  {"triangle_tests", r.first.triangle_tests},
-                  {"time_us", r.first_us}}},
-                {"all_pairs",
-                 {{"bv_tests", r.all.bv_tests},
-                  {"triangle_tests", r.all.triangle_tests},
-                  {"time_us", r.all_us}}},
-                {"unit_costs",
-                 {{"bv_test_ns", r.unit.bv_test_ns},
-                  {"triangle_test_ns", r.unit.triangle_test_ns},
-                  {"bv_tests_timed", r.unit.bv_tests_timed},
-                  {"triangle_tests_timed", r.unit.triangle_tests_timed},
-                  {"triangle_tests_from_query", r.unit.triangles_from_queries},
-                  // F = Nv Cv + Np Cp for the all-pairs query, beside its measured time_us.
-                  {"all_pairs_model_us",
-                   1e-3 * (static_cast<double>(r.all.bv_tests) * r.unit.bv_test_ns +
-                           static_cast<double>(r.all.triangle_tests) * r.unit.triangle_test_ns)}}},
-            });
-        }
-        j["results"] = results;
-        out << j.dump(2) << "\n";
+        writeQueryJson(out, paths, meshes, pose_b, rows, agree);
     } else {
-        out << "A: " << paths[0].string() << " (" << meshes[0].triangles.size()
-            << " triangles)  B: " << paths[1].string() << " (" << meshes[1].triangles.size()
-            << " triangles)\n";
-        out << std::left << std::setw(8) << "bv" << std::right << std::setw(10) << "answer"
-            << std::setw(8) << "pairs" << std::setw(10) << "first Nv" << std::setw(10) << "first Np"
-            << std::setw(10) << "all Nv" << std::setw(10) << "all Np" << std::setw(11) << "build ms"
-            << std::setw(11) << "first us" << std::setw(11) << "all us" << std::setw(8) << "Cv ns"
-            << std::setw(8) << "Cp ns"
-            << "\n";
-        out << std::fixed;
-        for (const Row& r : rows) {
-            out << std::left << std::setw(8) << r.bv << std::right << std::setw(10)
-                << (r.colliding ? "colliding" : "apart") << std::setw(8) << r.pairs.size()
-                << std::setw(10) << r.first.bv_tests << std::setw(10) << r.first.triangle_tests
-                << std::setw(10) << r.all.bv_tests << std::setw(10) << r.all.triangle_tests
-                << std::setprecision(2) << std::setw(11) << r.build_ms << std::setw(11)
-                << r.first_us << std::setw(11) << r.all_us << std::setprecision(1) << std::setw(8)
-                << r.unit.bv_test_ns << std::setw(8) << r.unit.triangle_test_ns
-                << (r.unit.triangles_from_queries ? "" : "*") << "\n";
-        }
-        out << "(Nv: BV tests, Np: triangle tests; build: both trees; Cv, Cp: ns per BV test and\n"
-               " per triangle test, timed by replaying the all-pairs query's own tests";
-        bool random_cp = false;
-        for (const Row& r : rows) random_cp = random_cp || !r.unit.triangles_from_queries;
-        if (random_cp) out << ";\n * the query tested no triangles: Cp on random triangle pairs";
-        out << ")\n";
+        writeQueryTable(out, paths, meshes, rows);
     }
     if (!agree) {
         err << "error: the volume types disagree on the triangle pairs (a BVH bug)\n";

@@ -132,9 +132,12 @@ std::string frameName(int frame) {
 
 }  // namespace
 
-int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
-    // 1. Everything that can be wrong with the input is found before any output is written.
-    engine::Scene scene;
+namespace {
+
+// The scene with the command line's overrides applied, and the pause frames; an error message
+// and kExitBadInput when anything is wrong with the input (before any output is written).
+int loadRunScene(const RunOptions& options, std::ostream& err, engine::Scene& scene,
+                 std::set<int>& pauses) {
     try {
         scene = engine::loadScene(options.scene, options.overrides);
     } catch (const engine::SceneError& e) {
@@ -156,7 +159,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         }
         scene.world.broad_phase = *options.broad_phase;
     }
-    const std::set<int> pauses(options.pause_at.begin(), options.pause_at.end());
+    pauses = std::set<int>(options.pause_at.begin(), options.pause_at.end());
     for (int f : pauses) {
         if (f < 0 || f >= scene.frames) {
             err << "--pause-at " << f << ": frame out of range (the run has frames 0.."
@@ -164,6 +167,62 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
             return kExitBadInput;
         }
     }
+    return kExitOk;
+}
+
+// Every output folder made and every output path proven writable (and not a device, FIFO, link
+// or directory) before the first step, not after the whole simulation; an earlier run's outputs
+// in `out_dir` cleared. Throws render::RenderError.
+void prepareOutputs(const RunOptions& options, const fs::path& out_dir, bool want_video,
+                    const fs::path& video_path) {
+    prepareOutputDir(out_dir);
+    if (want_video && video_path.has_parent_path()) prepareOutputDir(video_path.parent_path());
+    if (options.stats_csv && options.stats_csv->has_parent_path()) {
+        prepareOutputDir(options.stats_csv->parent_path());
+    }
+    if (options.trace && options.trace->has_parent_path()) {
+        prepareOutputDir(options.trace->parent_path());
+    }
+    if (options.stats_csv) render::checkOutputWritable(*options.stats_csv);
+    if (options.trace) render::checkOutputWritable(*options.trace);
+    if (want_video) render::checkOutputWritable(video_path);
+    clearPreviousRun(out_dir);
+}
+
+// What summary.json records of a run that completed.
+struct RunTotals {
+    std::int64_t flagged = 0;    ///< flagged pairs summed over frames
+    std::int64_t colliding = 0;  ///< colliding pairs summed over frames
+    double step_seconds = 0;
+};
+
+std::string summaryJson(const RunOptions& options, const engine::Scene& scene,
+                        const engine::World& world, const RunTotals& totals, bool want_video,
+                        const fs::path& video_path) {
+    nlohmann::ordered_json summary;
+    summary["scene"] = options.scene.string();
+    summary["broadphase"] = scene.world.broad_phase;
+    summary["frames"] = scene.frames;
+    summary["steps"] = world.stepCount();
+    summary["time"] = world.time();
+    summary["bodies"] = world.bodies().size();
+    summary["state_hash"] = world.stateHash();
+    summary["flagged_pair_frames"] = totals.flagged;
+    summary["colliding_pair_frames"] = totals.colliding;
+    summary["mean_step_ms"] =
+        world.stepCount() > 0 ? 1e3 * totals.step_seconds / double(world.stepCount()) : 0.0;
+    summary["video"] = want_video ? video_path.string() : "";
+    summary["checked_broadphase"] = options.check_broad_phase;
+    return summary.dump(1) + "\n";
+}
+
+}  // namespace
+
+int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
+    // 1. Everything that can be wrong with the input is found before any output is written.
+    engine::Scene scene;
+    std::set<int> pauses;
+    if (const int code = loadRunScene(options, err, scene, pauses); code != kExitOk) return code;
     const fs::path out_dir =
         options.out_dir.empty() ? fs::path("out") / scene.name : options.out_dir;
     const bool want_video = !options.no_video;
@@ -174,21 +233,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
     }
 
     try {
-        prepareOutputDir(out_dir);
-        if (want_video && video_path.has_parent_path()) prepareOutputDir(video_path.parent_path());
-        if (options.stats_csv && options.stats_csv->has_parent_path()) {
-            prepareOutputDir(options.stats_csv->parent_path());
-        }
-        if (options.trace && options.trace->has_parent_path()) {
-            prepareOutputDir(options.trace->parent_path());
-        }
-        // Every output path proven writable (and not a device, FIFO, link or directory) before
-        // the first step, not after the whole simulation.
-        if (options.stats_csv) render::checkOutputWritable(*options.stats_csv);
-        if (options.trace) render::checkOutputWritable(*options.trace);
-        if (want_video) render::checkOutputWritable(video_path);
-        clearPreviousRun(out_dir);
-
+        prepareOutputs(options, out_dir, want_video, video_path);
         engine::World world = engine::makeWorld(scene);
         render::Renderer renderer(scene.output.width, scene.output.height);
         std::unique_ptr<render::VideoWriter> video;
@@ -210,9 +255,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         if (options.stats_csv) stats_text = kStatsHeader;
         std::string trace_text;
         ProgressBar progress(options.progress && ::isatty(STDERR_FILENO), scene.frames);
-        std::int64_t flagged_total = 0;
-        std::int64_t colliding_total = 0;
-        double step_seconds = 0;
+        RunTotals totals;
         for (int frame = 0; frame < scene.frames; ++frame) {
             FrameStats frame_stats;
             auto checkStep = [&](int step) -> bool {
@@ -238,14 +281,14 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
                         return kExitFailure;
                     }
                     frame_stats.add(world.lastStats());
-                    step_seconds += world.lastStats().total_s;
+                    totals.step_seconds += world.lastStats().total_s;
                     if (!checkStep(static_cast<int>(world.stepCount()))) return kExitCheckFailed;
                 }
             }
             if (options.stats_csv) stats_text += statsRow(frame, world, frame_stats);
             if (options.trace) trace_text += traceLine(frame, world);
-            flagged_total += static_cast<std::int64_t>(world.flaggedPairs().size());
-            colliding_total += static_cast<std::int64_t>(world.collidingPairs().size());
+            totals.flagged += static_cast<std::int64_t>(world.flaggedPairs().size());
+            totals.colliding += static_cast<std::int64_t>(world.collidingPairs().size());
             frame_options.hud_text =
                 scene.draw.hud ? render::hudLine(world, frame, options.hud_timing) : "";
             if (!options.no_frames || video) {
@@ -266,21 +309,8 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         if (options.stats_csv) writeTextAtomically(*options.stats_csv, stats_text);
         if (options.trace) writeTextAtomically(*options.trace, trace_text);
 
-        nlohmann::ordered_json summary;
-        summary["scene"] = options.scene.string();
-        summary["broadphase"] = scene.world.broad_phase;
-        summary["frames"] = scene.frames;
-        summary["steps"] = world.stepCount();
-        summary["time"] = world.time();
-        summary["bodies"] = world.bodies().size();
-        summary["state_hash"] = world.stateHash();
-        summary["flagged_pair_frames"] = flagged_total;
-        summary["colliding_pair_frames"] = colliding_total;
-        summary["mean_step_ms"] =
-            world.stepCount() > 0 ? 1e3 * step_seconds / double(world.stepCount()) : 0.0;
-        summary["video"] = want_video ? video_path.string() : "";
-        summary["checked_broadphase"] = options.check_broad_phase;
-        writeTextAtomically(out_dir / "summary.json", summary.dump(1) + "\n");
+        writeTextAtomically(out_dir / "summary.json",
+                            summaryJson(options, scene, world, totals, want_video, video_path));
 
         out << "wrote " << (options.no_frames ? 0 : scene.frames) << " frames to "
             << out_dir.string();

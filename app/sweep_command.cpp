@@ -149,54 +149,54 @@ bool parseVary(const std::string& text, std::string& key, std::vector<std::strin
     return true;
 }
 
-int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) {
-    // The axes of the sweep.
-    std::vector<std::pair<std::string, std::vector<std::string>>> axes;
+namespace {
+
+using Axes = std::vector<std::pair<std::string, std::vector<std::string>>>;
+
+// The axes of --vary and the overrides of --reference; an error message and false when one is
+// malformed or a key is given twice.
+bool parseSweepOptions(const SweepOptions& options, std::ostream& err, Axes& axes,
+                       std::vector<engine::SceneOverride>& reference_overrides) {
     for (const std::string& v : options.vary) {
         std::string key, error;
         std::vector<std::string> values;
         if (!parseVary(v, key, values, error)) {
             err << "--vary " << error << "\n";
-            return kExitBadInput;
+            return false;
         }
         for (const auto& axis : axes) {
             if (axis.first == key) {
                 err << "--vary " << key << ": given twice; list every value in one --vary (" << key
                     << "=A,B,...)\n";
-                return kExitBadInput;
+                return false;
             }
         }
         axes.emplace_back(key, values);
     }
-    std::vector<engine::SceneOverride> reference_overrides;
     for (const std::string& v : options.reference) {
         std::string key, error;
         std::vector<std::string> values;
         if (!parseVary(v, key, values, error) || values.size() != 1) {
             err << "--reference " << (error.empty() ? "'" + v + "': expected KEY=VALUE" : error)
                 << "\n";
-            return kExitBadInput;
+            return false;
         }
         reference_overrides.push_back({key, values[0], "--reference"});
     }
     if (!(options.reference_refine >= 1) || !std::isfinite(options.reference_refine)) {
         err << "--reference-refine: must be a finite number >= 1\n";
-        return kExitBadInput;
+        return false;
     }
     if (options.duration && !(*options.duration > 0 && std::isfinite(*options.duration))) {
         err << "--duration: must be a finite number > 0\n";
-        return kExitBadInput;
+        return false;
     }
 
-    if (options.float_binary) {
-        std::error_code ec;
-        if (!fs::is_regular_file(*options.float_binary, ec)) {
-            err << "--float-binary " << options.float_binary->string()
-                << ": no such file (build one with cmake -DCDLAB_USE_FLOAT=ON)\n";
-            return kExitBadInput;
-        }
-    }
-    // Every combination is loaded (and so validated) before anything runs.
+    return true;
+}
+
+// Every combination of the axes' values, in axis order (one empty combination without axes).
+std::vector<std::vector<engine::SceneOverride>> combinations(const Axes& axes) {
     std::vector<std::vector<engine::SceneOverride>> combos{{}};
     for (const auto& [key, values] : axes) {
         std::vector<std::vector<engine::SceneOverride>> next;
@@ -208,6 +208,79 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
         }
         combos = std::move(next);
     }
+    return combos;
+}
+
+// One bar chart per column of charts() (timings only with report_timing), reference last.
+void writeCharts(const SweepOptions& options, const fs::path& out_dir,
+                 const std::vector<SweepRun>& runs, const SweepRun& reference) {
+    for (const Chart& c : charts()) {
+        if (c.timing && !options.report_timing) continue;
+        render::BarChart chart;
+        chart.title = c.title;
+        chart.log_scale = c.log_scale;
+        for (const SweepRun& r : runs) chart.bars.push_back({r.label, r.*(c.field), false});
+        chart.bars.push_back({"reference", reference.*(c.field), true});
+        render::writePng(out_dir / c.file, render::drawBarChart(chart));
+    }
+}
+
+// Every combination run again through the float build (--float-binary): float_vs_double.csv
+// and its chart, and the comparisons for the report.
+std::vector<FloatRun> compareFloatBuild(
+    const SweepOptions& options, const std::vector<std::vector<engine::SceneOverride>>& combos,
+    const fs::path& out_dir, std::ostream& out) {
+    std::vector<FloatRun> floats;
+    const fs::path traces = out_dir / "traces";
+    prepareOutputDir(traces);
+    std::string csv =
+        "run,frames,first_pair_difference,pair_frames_differing,max_position_deviation,"
+        "final_position_deviation,max_orientation_deviation,error\n";
+    render::BarChart chart;
+    chart.title = "float vs double: max position deviation (m, log scale)";
+    chart.log_scale = true;
+    for (std::size_t i = 0; i < combos.size(); ++i) {
+        floats.push_back(compareFloat(options, combos[i], traces, i));
+        const TraceComparison& c = floats.back().comparison;
+        out << "[float " << i + 1 << "/" << combos.size() << "] " << floats.back().label
+            << ": "
+            << (c.error.empty() ? "max deviation " + fmt(c.max_position_deviation) +
+                                      " m, pairs differ in " +
+                                      std::to_string(c.pair_frames_differing) + " frames"
+                                : c.error)
+            << "\n";
+        csv += csvField(floats.back().label) + "," + std::to_string(c.frames) + "," +
+               std::to_string(c.first_pair_difference) + "," +
+               std::to_string(c.pair_frames_differing) + "," +
+               fmt(c.max_position_deviation, "%.6g") + "," +
+               fmt(c.final_position_deviation, "%.6g") + "," +
+               fmt(c.max_orientation_deviation, "%.6g") + "," + csvField(c.error) + "\n";
+        chart.bars.push_back({floats.back().label, c.max_position_deviation, false});
+    }
+    writeTextAtomically(out_dir / "float_vs_double.csv", csv);
+    if (!options.keep_traces) fs::remove_all(traces);
+    render::writePng(out_dir / "float_deviation.png", render::drawBarChart(chart));
+    return floats;
+}
+
+}  // namespace
+
+int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) {
+    // The axes of the sweep.
+    Axes axes;
+    std::vector<engine::SceneOverride> reference_overrides;
+    if (!parseSweepOptions(options, err, axes, reference_overrides)) return kExitBadInput;
+    if (options.float_binary) {
+        std::error_code ec;
+        if (!fs::is_regular_file(*options.float_binary, ec)) {
+            err << "--float-binary " << options.float_binary->string()
+                << ": no such file (build one with cmake -DCDLAB_USE_FLOAT=ON)\n";
+            return kExitBadInput;
+        }
+    }
+    // Every combination is loaded (and so validated) before anything runs.
+    // Every combination is loaded (and so validated) before anything runs.
+    const std::vector<std::vector<engine::SceneOverride>> combos = combinations(axes);
     engine::Scene base;
     std::vector<engine::Scene> scenes;
     try {
@@ -282,47 +355,10 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
             runs.push_back(std::move(run));
         }
 
-        for (const Chart& c : charts()) {
-            if (c.timing && !options.report_timing) continue;
-            render::BarChart chart;
-            chart.title = c.title;
-            chart.log_scale = c.log_scale;
-            for (const SweepRun& r : runs) chart.bars.push_back({r.label, r.*(c.field), false});
-            chart.bars.push_back({"reference", reference.*(c.field), true});
-            render::writePng(out_dir / c.file, render::drawBarChart(chart));
-        }
-        std::vector<FloatRun> floats;
-        if (options.float_binary) {
-            const fs::path traces = out_dir / "traces";
-            prepareOutputDir(traces);
-            std::string csv =
-                "run,frames,first_pair_difference,pair_frames_differing,max_position_deviation,"
-                "final_position_deviation,max_orientation_deviation,error\n";
-            render::BarChart chart;
-            chart.title = "float vs double: max position deviation (m, log scale)";
-            chart.log_scale = true;
-            for (std::size_t i = 0; i < combos.size(); ++i) {
-                floats.push_back(compareFloat(options, combos[i], traces, i));
-                const TraceComparison& c = floats.back().comparison;
-                out << "[float " << i + 1 << "/" << combos.size() << "] " << floats.back().label
-                    << ": "
-                    << (c.error.empty() ? "max deviation " + fmt(c.max_position_deviation) +
-                                              " m, pairs differ in " +
-                                              std::to_string(c.pair_frames_differing) + " frames"
-                                        : c.error)
-                    << "\n";
-                csv += csvField(floats.back().label) + "," + std::to_string(c.frames) + "," +
-                       std::to_string(c.first_pair_difference) + "," +
-                       std::to_string(c.pair_frames_differing) + "," +
-                       fmt(c.max_position_deviation, "%.6g") + "," +
-                       fmt(c.final_position_deviation, "%.6g") + "," +
-                       fmt(c.max_orientation_deviation, "%.6g") + "," + csvField(c.error) + "\n";
-                chart.bars.push_back({floats.back().label, c.max_position_deviation, false});
-            }
-            writeTextAtomically(out_dir / "float_vs_double.csv", csv);
-            if (!options.keep_traces) fs::remove_all(traces);
-            render::writePng(out_dir / "float_deviation.png", render::drawBarChart(chart));
-        }
+        writeCharts(options, out_dir, runs, reference);
+        const std::vector<FloatRun> floats =
+            options.float_binary ? compareFloatBuild(options, combos, out_dir, out)
+                                 : std::vector<FloatRun>{};
         writeTextAtomically(out_dir / "results.csv", csvTable(runs));
         writeTextAtomically(out_dir / "report.md",
                             markdownReport(options, base, duration, runs, reference, floats));
