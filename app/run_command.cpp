@@ -382,7 +382,8 @@ Command addRunCommand(CLI::App& cli) {
     return {cmd, [cmd, f]() {
                 RunOptions& run = f->run;
                 // A flag given with an empty value ("--broadphase ''") is an error, not "unset".
-                for (const char* name : {"--out", "--video", "--broadphase", "--stats", "--trace"}) {
+                for (const char* name :
+                     {"--out", "--video", "--broadphase", "--stats", "--trace"}) {
                     if (cmd->count(name) > 0 && cmd->get_option(name)->as<std::string>().empty()) {
                         std::cerr << name << ": must not be empty\n";
                         return kExitBadInput;

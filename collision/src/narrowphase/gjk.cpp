@@ -133,7 +133,9 @@ GjkRun<Vertex> runGjk(const ConvexCore& a, const ConvexCore& b, const RelativePo
             out.lower_bound = std::max(out.lower_bound, vw / std::sqrt(vv));
         }
         // van den Bergen 1999 §4: |v|^2 - v.w bounds |v|^2 - |v| dist(origin, A - B).
-        if (vv - vw <= kGjkRelativeTolerance * vv) return finish(GjkState::Separated, std::sqrt(vv));
+        if (vv - vw <= kGjkRelativeTolerance * vv) {
+            return finish(GjkState::Separated, std::sqrt(vv));
+        }
         const Real dup = kDuplicateRelative * std::max(pointOf(w).norm(), maxNorm(s));
         for (int i = 0; i < s.n; ++i) {
             if ((pointOf(s.v[i]) - pointOf(w)).squaredNorm() <= dup * dup) {
@@ -231,7 +233,8 @@ ContactState epaDecide(const MinkowskiDifference& cso, const Simplex<Vec3>& star
     }
 
     // Outward orientation of the initial tetrahedron (see RTCD 5.1.6 face order).
-    if ((poly.vert[1] - poly.vert[0]).cross(poly.vert[2] - poly.vert[0]).dot(poly.vert[3] - poly.vert[0]) > 0) {
+    const Vec3& v0 = poly.vert[0];
+    if ((poly.vert[1] - v0).cross(poly.vert[2] - v0).dot(poly.vert[3] - v0) > 0) {
         std::swap(poly.vert[1], poly.vert[2]);
     }
     poly.addFace(0, 1, 2);

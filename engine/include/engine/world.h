@@ -133,12 +133,13 @@ class ContactSolver;
 
 /// Colours and sizes of World::drawHierarchyLevels and World::drawContacts: the caller's palette.
 struct ContactDrawStyle {
-    collision::Color node_apart;        ///< hierarchy nodes by collision::BvhNodeState
+    collision::Color node_apart;  ///< hierarchy nodes by collision::BvhNodeState
     collision::Color node_overlapping;
     collision::Color node_confirmed;
-    collision::Color contact;           ///< witness crosses and normals
-    Real cross_fraction = Real(0.06);   ///< cross half-length, of the pair's smaller bounding radius
-    Real normal_fraction = Real(0.5);   ///< normal length, of the same radius
+    collision::Color contact;  ///< witness crosses and normals
+    /// Cross half-length and normal length, as fractions of the pair's smaller bounding radius.
+    Real cross_fraction = Real(0.06);
+    Real normal_fraction = Real(0.5);
 };
 
 /// The state left what double precision represents: a body's position, orientation or momentum
