@@ -22,6 +22,7 @@
 #include "geometry/shape_measures.h"
 #include "geometry/triangle_triangle.h"
 #include "narrowphase/gjk.h"
+#include "narrowphase/pair_table.h"
 
 namespace collision {
 
@@ -422,15 +423,12 @@ struct PairEntry {
     bool swapped = false;  ///< call fn(b, a): the routine is written for (column, row) types
 };
 
-using PairTable = std::array<std::array<PairEntry, kShapeTypeCount>, kShapeTypeCount>;
-
-constexpr PairTable makePairTable() {
-    PairTable table{};
+constexpr PairTable<PairEntry> makePairTable() {
+    PairTable<PairEntry> table{};
+    // Each routine is written for one order; the other order calls it swapped.
     auto set = [&table](ShapeType first, ShapeType second, PairFn fn) {
-        const auto i = static_cast<std::size_t>(first);
-        const auto j = static_cast<std::size_t>(second);
-        table[i][j] = PairEntry{fn, false};
-        if (i != j) table[j][i] = PairEntry{fn, true};
+        pairEntry(table, first, second) = PairEntry{fn, false};
+        if (first != second) pairEntry(table, second, first) = PairEntry{fn, true};
     };
     constexpr std::array<ShapeType, 4> kConvex{ShapeType::Sphere, ShapeType::Box,
                                                ShapeType::Capsule, ShapeType::ConvexHull};
@@ -449,7 +447,7 @@ constexpr PairTable makePairTable() {
     return table;
 }
 
-constexpr PairTable kPairTable = makePairTable();
+constexpr PairTable<PairEntry> kPairTable = makePairTable();
 
 PairContext pairContext(const Shape& a, const Shape& b) {
     PairContext ctx;
@@ -466,8 +464,7 @@ CollideOutput collide(const Shape& a, const Pose& pose_a, const Shape& b, const 
         failed.state = ContactState::Failed;
         return failed;
     }
-    const PairEntry& entry =
-        kPairTable[static_cast<std::size_t>(a.type)][static_cast<std::size_t>(b.type)];
+    const PairEntry& entry = pairEntry(kPairTable, a.type, b.type);
     CDLAB_ASSERT(entry.fn != nullptr, "pair table hole");
     bool swap = entry.swapped;
     if (a.type == b.type) swap = canonicalLess(b, pose_b, a, pose_a);

@@ -20,6 +20,7 @@
 
 #include "geometry/shape_measures.h"
 #include "narrowphase/contact_pairs.h"
+#include "narrowphase/pair_table.h"
 
 namespace collision {
 
@@ -49,32 +50,25 @@ void boxBoxOrConvex(const Shape& a, const Shape& b, const RelativePose& rel, con
     }
 }
 
-using ContactTable = std::array<std::array<ContactFn, kShapeTypeCount>, kShapeTypeCount>;
-
 // Rows: the canonically-first shape's type (canonicalLess orders by type, so the first type is
 // never above the second; a mesh is its convex hull here). GJK and EPA wherever no closed form
 // exists.
-constexpr ContactTable makeContactTable() {
-    ContactTable table{};
-    for (auto& row : table) row.fill(convexConvex);
-    auto set = [&](ShapeType a, ShapeType b, ContactFn fn) {
-        table[static_cast<std::size_t>(a)][static_cast<std::size_t>(b)] = fn;
-    };
-    set(ShapeType::Sphere, ShapeType::Sphere, sphereSphere);
-    set(ShapeType::Sphere, ShapeType::Box, sphereBox);
-    set(ShapeType::Sphere, ShapeType::Capsule, sphereCapsule);
-    set(ShapeType::Capsule, ShapeType::Capsule, capsuleCapsule);
-    set(ShapeType::Box, ShapeType::Box, boxBoxOrConvex);
+constexpr PairTable<ContactFn> makeContactTable() {
+    PairTable<ContactFn> table = filledPairTable<ContactFn>(convexConvex);
+    pairEntry(table, ShapeType::Sphere, ShapeType::Sphere) = sphereSphere;
+    pairEntry(table, ShapeType::Sphere, ShapeType::Box) = sphereBox;
+    pairEntry(table, ShapeType::Sphere, ShapeType::Capsule) = sphereCapsule;
+    pairEntry(table, ShapeType::Capsule, ShapeType::Capsule) = capsuleCapsule;
+    pairEntry(table, ShapeType::Box, ShapeType::Box) = boxBoxOrConvex;
     return table;
 }
 
-constexpr ContactTable kContactTable = makeContactTable();
+constexpr PairTable<ContactFn> kContactTable = makeContactTable();
 
 Local contactLocal(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx) {
     Local out;
     out.state = ContactState::Touching;  // classified later unless Failed
-    kContactTable[static_cast<std::size_t>(a.type)][static_cast<std::size_t>(b.type)](a, b, rel,
-                                                                                     ctx, out);
+    pairEntry(kContactTable, a.type, b.type)(a, b, rel, ctx, out);
     return out;
 }
 

@@ -29,10 +29,7 @@ constexpr Real kDuplicateRelative = Real(8) * kEpsilon;
 Real signOrPlus(Real x) { return x < 0 ? Real(-1) : Real(1); }
 
 template <class Vertex>
-struct Simplex {
-    std::array<Vertex, 4> v{};
-    int n = 0;
-};
+using Simplex = GjkSimplex<Vertex>;
 
 // Replaces the simplex by the sub-simplex supporting its closest point to the origin (the
 // vertices of positive weight), sets `weight` to their weights, and returns that point
@@ -81,15 +78,14 @@ Real maxNorm(const Simplex<Vertex>& s) {
     return m;
 }
 
-// The result of the one GJK loop below, for either vertex type.
-template <class Vertex>
-struct GjkRun : GjkSummary {
-    Simplex<Vertex> simplex;
-    // Witness points (SupportVertex only): the weights of `closest` applied to the simplex's
-    // support points, updated whenever |v| decreases.
-    Vec3 point_a = Vec3::Zero();
-    Vec3 point_b = Vec3::Zero();
+// The result of the one GJK loop below: with witness points it is GjkWitnessOutput itself (the
+// weights of `closest` applied to the simplex's support points, updated whenever |v|
+// decreases); without, the summary and the simplex of w's.
+struct GjkDistanceRun : GjkSummary {
+    Simplex<Vec3> simplex;
 };
+template <class Vertex>
+using GjkRun = std::conditional_t<std::is_same_v<Vertex, Vec3>, GjkDistanceRun, GjkWitnessOutput>;
 
 // GJK distance (van den Bergen 1999; RTCD 9.5). Invariant: |v| decreases strictly every
 // iteration or the loop stops; at most kGjkMaxIterations iterations, then Failed.
@@ -423,14 +419,7 @@ GjkOutput gjkDistance(const ConvexCore& a, const ConvexCore& b, const RelativePo
 
 GjkWitnessOutput gjkWitness(const ConvexCore& a, const ConvexCore& b, const RelativePose& b_in_a,
                             Real scale) {
-    const GjkRun<SupportVertex> run = runGjk<SupportVertex>(a, b, b_in_a, scale);
-    GjkWitnessOutput out;
-    static_cast<GjkSummary&>(out) = run;
-    out.point_a = run.point_a;
-    out.point_b = run.point_b;
-    out.simplex.n = run.simplex.n;
-    out.simplex.v = run.simplex.v;
-    return out;
+    return runGjk<SupportVertex>(a, b, b_in_a, scale);
 }
 
 CollideOutput classifySignedDistance(Real signed_distance, Real tolerance) {

@@ -92,10 +92,12 @@ struct SupportVertex {
 };
 
 /// A GJK simplex of up to four support vertices.
-struct WitnessSimplex {
-    std::array<SupportVertex, 4> v{};
+template <class Vertex>
+struct GjkSimplex {
+    std::array<Vertex, 4> v{};
     std::int32_t n = 0;
 };
+using WitnessSimplex = GjkSimplex<SupportVertex>;
 
 /// The point of A - B of a GJK vertex of either kind.
 inline const Vec3& pointOf(const Vec3& v) { return v; }

@@ -12,6 +12,7 @@
 #include <string>
 #include <string_view>
 #include <tuple>
+#include <type_traits>
 #include <vector>
 
 #include "collision/geometry/shape.h"
@@ -53,49 +54,31 @@ struct Lss {
     Real radius = 0;
 };
 
-/// Every node-volume type of the generic BVH, in display order. Append here (plus a BvName
-/// specialisation and the traits in collision/src/bvh_volumes.h) to add a volume type.
+/// Every node-volume type of the generic BVH, in display order. Append here (plus its name in
+/// kBvhVolumeNames and its traits in collision/src/volumes/bvh_volumes.h) to add a volume type.
 using BvhVolumeTypes =
     std::tuple<BoundingSphere, Aabb, Obb, Kdop<6>, Kdop<14>, Kdop<18>, Kdop<26>, Rss, Lss>;
 
-/// The name of a volume type, as the CLI and scene files spell it.
+/// The volume types' names as the CLI and scene files spell them, in BvhVolumeTypes order.
+inline constexpr std::array<std::string_view, std::tuple_size_v<BvhVolumeTypes>> kBvhVolumeNames{
+    "sphere", "aabb", "obb", "kdop6", "kdop14", "kdop18", "kdop26", "rss", "lss"};
+
+namespace bvh_detail {
+// Position of T in a std::tuple of types (a type not in it does not compile).
+template <class T, class Tuple>
+struct TypeIndex;
+template <class T, class... Rest>
+struct TypeIndex<T, std::tuple<T, Rest...>> : std::integral_constant<std::size_t, 0> {};
+template <class T, class First, class... Rest>
+struct TypeIndex<T, std::tuple<First, Rest...>>
+    : std::integral_constant<std::size_t, 1 + TypeIndex<T, std::tuple<Rest...>>::value> {};
+}  // namespace bvh_detail
+
+/// The name of a volume type (BvName<BV>::value), from kBvhVolumeNames.
 template <class BV>
-struct BvName;
-template <>
-struct BvName<BoundingSphere> {
-    static constexpr std::string_view value = "sphere";
-};
-template <>
-struct BvName<Aabb> {
-    static constexpr std::string_view value = "aabb";
-};
-template <>
-struct BvName<Obb> {
-    static constexpr std::string_view value = "obb";
-};
-template <>
-struct BvName<Kdop<6>> {
-    static constexpr std::string_view value = "kdop6";
-};
-template <>
-struct BvName<Kdop<14>> {
-    static constexpr std::string_view value = "kdop14";
-};
-template <>
-struct BvName<Kdop<18>> {
-    static constexpr std::string_view value = "kdop18";
-};
-template <>
-struct BvName<Kdop<26>> {
-    static constexpr std::string_view value = "kdop26";
-};
-template <>
-struct BvName<Rss> {
-    static constexpr std::string_view value = "rss";
-};
-template <>
-struct BvName<Lss> {
-    static constexpr std::string_view value = "lss";
+struct BvName {
+    static constexpr std::string_view value =
+        kBvhVolumeNames[bvh_detail::TypeIndex<BV, BvhVolumeTypes>::value];
 };
 
 /// How the top-down build splits a node's triangles (along the longest axis of the bounding box
