@@ -550,11 +550,7 @@ int runBenchConvex(const BenchConvexOptions& options, std::ostream& out, std::os
 }
 
 Command addBenchConvexCommand(CLI::App& bench) {
-    struct Flags {
-        BenchConvexOptions options;
-        std::string json;
-    };
-    auto f = std::make_shared<Flags>();
+    auto f = std::make_shared<OptionsWithJson<BenchConvexOptions>>();
     BenchConvexOptions& o = f->options;
     CLI::App* cmd = bench.add_subcommand(
         "convex",
@@ -567,10 +563,7 @@ Command addBenchConvexCommand(CLI::App& bench) {
                     "relative answer tolerance for counting disagreements")
         ->capture_default_str();
     cmd->add_option("--json", f->json, "also write the rows as JSON to FILE");
-    return {cmd, [f]() {
-                if (!f->json.empty()) f->options.json = f->json;
-                return runBenchConvex(f->options, std::cout, std::cerr);
-            }};
+    return {cmd, [f]() { return runBenchConvex(f->resolved(), std::cout, std::cerr); }};
 }
 
 }  // namespace app

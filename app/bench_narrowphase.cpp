@@ -473,11 +473,7 @@ int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& ou
 }
 
 Command addBenchNarrowphaseCommand(CLI::App& bench) {
-    struct Flags {
-        BenchNarrowphaseOptions options;
-        std::string json;
-    };
-    auto f = std::make_shared<Flags>();
+    auto f = std::make_shared<OptionsWithJson<BenchNarrowphaseOptions>>();
     BenchNarrowphaseOptions& o = f->options;
     CLI::App* cmd = bench.add_subcommand(
         "narrowphase",
@@ -494,10 +490,7 @@ Command addBenchNarrowphaseCommand(CLI::App& bench) {
                     "and fcl-obbrss, fcl-obb, fcl-rss, fcl-kios, fcl-aabb, fcl-kdop18")
         ->delimiter(',');
     cmd->add_option("--json", f->json, "also write the table as JSON to FILE");
-    return {cmd, [f]() {
-                if (!f->json.empty()) f->options.json = f->json;
-                return runBenchNarrowphase(f->options, std::cout, std::cerr);
-            }};
+    return {cmd, [f]() { return runBenchNarrowphase(f->resolved(), std::cout, std::cerr); }};
 }
 
 }  // namespace app

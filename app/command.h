@@ -3,12 +3,25 @@
 #pragma once
 
 #include <functional>
+#include <string>
 
 namespace CLI {
 class App;
 }
 
 namespace app {
+
+/// The flags' storage of a command whose options take an optional `json` path: CLI11 fills the
+/// string, which becomes the path when given.
+template <class Options>
+struct OptionsWithJson {
+    Options options;
+    std::string json;
+    const Options& resolved() {
+        if (!json.empty()) options.json = json;
+        return options;
+    }
+};
 
 struct Command {
     CLI::App* cli = nullptr;   ///< the subcommand, to ask whether it was parsed
