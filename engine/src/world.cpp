@@ -398,7 +398,7 @@ void World::updateVolumes() {
 
 void World::runCollisionPipeline() {
     details_.clear();  // the contact details of the previous state
-    details_level_ = DetailLevel::None;
+    convex_details_ = mesh_details_ = false;
     Clock::time_point t = Clock::now();
     stats_.broad = {};
     broad_phase_->findPairs(flagged_, stats_.broad);

@@ -45,29 +45,31 @@ collision::Color nodeColor(collision::BvhNodeState state, const ContactDrawStyle
 
 }  // namespace
 
-void World::computeDetails(DetailLevel level) const {
-    if (details_level_ >= level) return;
+void World::computeDetails(bool convex_pairs, bool mesh_pairs) const {
+    const bool do_convex = convex_pairs && !convex_details_;
+    const bool do_mesh = mesh_pairs && !mesh_details_;
+    if (!do_convex && !do_mesh) return;
     details_.resize(colliding_.size());
     for (std::size_t k = 0; k < colliding_.size(); ++k) {
         const Body& a = bodies_[static_cast<std::size_t>(colliding_[k].a)];
         const Body& b = bodies_[static_cast<std::size_t>(colliding_[k].b)];
         if (!finitePose(a) || !finitePose(b)) continue;
         const bool convex = a.shape.isConvex() && b.shape.isConvex();
-        // Convex pairs are done at either level; at All, the mesh pairs follow.
-        const bool done = details_level_ >= DetailLevel::Convex && convex;
-        if (done || (level == DetailLevel::Convex && !convex)) continue;
-        details_[k] = collision::pairContacts(a.shape, a.pose(), b.shape, b.pose());
+        if (convex ? do_convex : do_mesh) {
+            details_[k] = collision::pairContacts(a.shape, a.pose(), b.shape, b.pose());
+        }
     }
-    details_level_ = level;
+    convex_details_ = convex_details_ || do_convex;
+    mesh_details_ = mesh_details_ || do_mesh;
 }
 
 std::span<const collision::PairContacts> World::contactDetails() const {
-    computeDetails(DetailLevel::All);
+    computeDetails(true, true);
     return details_;
 }
 
 Real World::deepestPenetration() const {
-    computeDetails(DetailLevel::Convex);
+    computeDetails(true, false);
     Real deepest = 0;
     for (const collision::PairContacts& d : details_) deepest = std::max(deepest, d.penetration);
     return deepest;
@@ -93,7 +95,8 @@ void World::drawHierarchyLevels(collision::DebugDraw& draw, int depth,
         const auto it = std::lower_bound(colliding_.begin(), colliding_.end(), p);
         const collision::PairContacts* confirmed = nullptr;
         if (it != colliding_.end() && *it == p) {
-            confirmed = &contactDetails()[static_cast<std::size_t>(it - colliding_.begin())];
+            computeDetails(false, true);  // the mesh pairs' triangles; no convex contact() here
+            confirmed = &details_[static_cast<std::size_t>(it - colliding_.begin())];
         }
         if (tree_a && tree_b) {
             if (!tree_a->sameVolumeType(*tree_b)) continue;

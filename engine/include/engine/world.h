@@ -229,8 +229,9 @@ private:
     void applyImpactImpulses();
     void findResponsePairs(Real margin_fraction);
     void runCollisionPipeline();
-    enum class DetailLevel : std::uint8_t { None, Convex, All };
-    void computeDetails(DetailLevel level) const;
+    /// Derives the contact details of the colliding pairs of two convex shapes and/or of the
+    /// pairs with a mesh, each group at most once per state.
+    void computeDetails(bool convex_pairs, bool mesh_pairs) const;
 
     WorldSettings settings_;
     std::vector<Body> bodies_;
@@ -263,7 +264,8 @@ private:
     StepStats stats_;
     // contactDetails(): derived on request, dropped by the next collision pipeline run.
     mutable std::vector<collision::PairContacts> details_;
-    mutable DetailLevel details_level_ = DetailLevel::None;
+    mutable bool convex_details_ = false;  ///< details_ holds the convex pairs' details
+    mutable bool mesh_details_ = false;    ///< details_ holds the mesh pairs' details
     Real time_ = 0;
     std::int64_t step_count_ = 0;
     bool proxies_inserted_ = false;
