@@ -25,6 +25,7 @@ namespace {
 
 using collision::collide;
 using collision::contact;
+using collision::CollideOutput;
 using collision::ContactOutput;
 using collision::ContactState;
 using collision::ConvexPolytope;
@@ -432,8 +433,11 @@ TEST(Contact, EveryConvexPairAgreesWithCollideAndMirrors) {
                 const Pose pb =
                     at(pa.position + rng.uniform(0.1, 1.2) * reach * dir, rng.rotation());
                 const ContactOutput out = contact(zoo[i], pa, zoo[j], pb);
-                ASSERT_EQ(out.state, collide(zoo[i], pa, zoo[j], pb).state)
-                    << i << " " << j << " " << n;
+                const CollideOutput decided = collide(zoo[i], pa, zoo[j], pb);
+                ASSERT_EQ(out.state, decided.state) << i << " " << j << " " << n;
+                if (out.state == ContactState::Separated) {
+                    ASSERT_GE(out.signed_distance, decided.distance) << i << " " << j << " " << n;
+                }
                 expectConsistent(zoo[i], pa, zoo[j], pb, out, 1e-9, "zoo", n);
                 expectMirror(out, contact(zoo[j], pb, zoo[i], pa), n);
                 mix.add(out);
@@ -534,7 +538,8 @@ TEST(Contact, TouchingConventionOnBothSidesOfTheBand) {
 }
 
 // Near-touching poses: B is moved along a random direction to within a few tolerances of
-// contact, where rounding decides; the state must still be collide()'s.
+// contact, where rounding decides; the state must still be collide()'s, and a Separated signed
+// distance never below collide()'s distance.
 TEST(Contact, NearTouchingStateAgreesWithCollide) {
     cdlab_test::Rng rng(7);
     const std::vector<Shape> zoo = shapeZoo(rng);
@@ -551,8 +556,11 @@ TEST(Contact, NearTouchingStateAgreesWithCollide) {
                 const Real tol = collision::kTouchRelativeTolerance * scale;
                 pb.position -= (first.signed_distance - rng.uniform(-3, 3) * tol) * first.normal;
                 const ContactOutput out = contact(zoo[i], pa, zoo[j], pb);
-                ASSERT_EQ(out.state, collide(zoo[i], pa, zoo[j], pb).state)
-                    << i << " " << j << " " << n;
+                const CollideOutput decided = collide(zoo[i], pa, zoo[j], pb);
+                ASSERT_EQ(out.state, decided.state) << i << " " << j << " " << n;
+                if (out.state == ContactState::Separated) {
+                    ASSERT_GE(out.signed_distance, decided.distance) << i << " " << j << " " << n;
+                }
                 ASSERT_TRUE(out.normal.allFinite());
                 expectMirror(out, contact(zoo[j], pb, zoo[i], pa), n);
                 if (out.state == ContactState::Touching) ++touching;

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "collision/assert.h"
@@ -22,19 +23,21 @@
 #include "geometry/shape_measures.h"
 #include "geometry/triangle_triangle.h"
 #include "narrowphase/gjk.h"
+#include "narrowphase/collide_pairs.h"
 #include "narrowphase/pair_table.h"
 
 namespace collision {
 
+PairContext pairContext(const Shape& a, const Shape& b) {
+    PairContext ctx;
+    ctx.scale = std::max(boundingRadius(a), boundingRadius(b));
+    ctx.tolerance = kTouchRelativeTolerance * ctx.scale;
+    return ctx;
+}
+
+namespace collide_pairs {
+
 namespace {
-
-struct PairContext {
-    Real tolerance = 0;  ///< absolute touching tolerance
-    Real scale = 0;      ///< larger bounding radius of the two shapes
-};
-
-using PairFn = CollideOutput (*)(const Shape& a, const Shape& b, const RelativePose& b_in_a,
-                                 const PairContext& ctx);
 
 // Distance between segments p1q1 and p2q2 (closestSegmentSegment, RTCD 5.1.9).
 Real distanceSegmentSegment(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2,
@@ -43,17 +46,19 @@ Real distanceSegmentSegment(const Vec3& p1, const Vec3& q1, const Vec3& p2, cons
     return ((p1 + (q1 - p1) * st.s) - (p2 + (q2 - p2) * st.t)).norm();
 }
 
+}  // namespace
+
 // ---- Closed forms. Signed distance: positive gap, or minus the penetration depth. ----
 
-CollideOutput collideSphereSphere(const Shape& a, const Shape& b, const RelativePose& b_in_a,
-                                  const PairContext& ctx) {
+CollideOutput sphereSphere(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                           const PairContext& ctx) {
     return classifySignedDistance(b_in_a.position.norm() - a.radius - b.radius, ctx.tolerance);
 }
 
 // RTCD 5.1.3 (closest point on an OBB), in the box frame; inside the box the depth is the radius
 // plus the distance to the nearest face.
-CollideOutput collideSphereBox(const Shape& a, const Shape& b, const RelativePose& b_in_a,
-                               const PairContext& ctx) {
+CollideOutput sphereBox(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                        const PairContext& ctx) {
     const Vec3 center = -(b_in_a.rotation.transpose() * b_in_a.position);
     const Vec3& h = b.half_extents;
     const Vec3 closest = center.cwiseMax(-h).cwiseMin(h);
@@ -66,15 +71,15 @@ CollideOutput collideSphereBox(const Shape& a, const Shape& b, const RelativePos
 }
 
 // RTCD 5.1.2: the sphere centre against the capsule's segment, in the capsule frame.
-CollideOutput collideSphereCapsule(const Shape& a, const Shape& b, const RelativePose& b_in_a,
-                                   const PairContext& ctx) {
+CollideOutput sphereCapsule(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                            const PairContext& ctx) {
     const Vec3 center = -(b_in_a.rotation.transpose() * b_in_a.position);
     const Vec3 closest(0, std::clamp(center.y(), -b.half_height, b.half_height), 0);
     return classifySignedDistance((center - closest).norm() - a.radius - b.radius, ctx.tolerance);
 }
 
-CollideOutput collideCapsuleCapsule(const Shape& a, const Shape& b, const RelativePose& b_in_a,
-                                    const PairContext& ctx) {
+CollideOutput capsuleCapsule(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                             const PairContext& ctx) {
     const Vec3 tip_a(0, a.half_height, 0);
     const Vec3 tip_b = b_in_a.rotation.col(1) * b.half_height;
     const Real d = distanceSegmentSegment(-tip_a, tip_a, b_in_a.position - tip_b,
@@ -82,12 +87,29 @@ CollideOutput collideCapsuleCapsule(const Shape& a, const Shape& b, const Relati
     return classifySignedDistance(d - a.radius - b.radius, ctx.tolerance);
 }
 
-// Capsule-box: GJK on segment vs box, inflated by the radius (distance(segment, box) <= r).
-CollideOutput collideCapsuleBox(const Shape& a, const Shape& b, const RelativePose& b_in_a,
-                                const PairContext& ctx) {
-    return collideConvexCores(ConvexCore::fromShape(a), ConvexCore::fromShape(b), b_in_a,
-                              ctx.tolerance, ctx.scale);
+std::optional<ContactState> satBoxState(const BoxSatMeasure& sat, Real tolerance) {
+    if (sat.gap_hi < -tolerance) return ContactState::Penetrating;  // exact depth > tolerance
+    if (sat.gap_lo >= -tolerance && sat.gap_hi <= 0) return ContactState::Touching;
+    return std::nullopt;
 }
+
+CollideOutput refineBoxState(CollideOutput convex, const BoxSatMeasure& sat, Real tolerance) {
+    if (convex.state == ContactState::Separated) {
+        // GJK's |v| is accurate to rounding; the axes' gap is a proven lower bound.
+        convex.distance = std::max(convex.distance, sat.gap_lo);
+    } else if (sat.gap_lo > tolerance) {
+        convex.state = ContactState::Separated;
+        convex.distance = sat.gap_lo;
+    }
+    return convex;
+}
+
+}  // namespace collide_pairs
+
+namespace {
+
+using PairFn = CollideOutput (*)(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                                 const PairContext& ctx);
 
 CollideOutput collideConvexGeneric(const Shape& a, const Shape& b, const RelativePose& b_in_a,
                                    const PairContext& ctx) {
@@ -95,65 +117,21 @@ CollideOutput collideConvexGeneric(const Shape& a, const Shape& b, const Relativ
                               ctx.tolerance, ctx.scale);
 }
 
-// 15-axis separating-axis test in A's frame (RTCD 4.4.1; Gottschalk et al. 1996 §4). For boxes the
-// minimum overlap over these axes is the exact penetration depth (the axes include every face
-// normal of the Minkowski difference), and a positive maximum gap is a lower bound on the
-// distance. Each axis carries a rounding bound (gap error <= 8 eps (|t.L| + ra + rb) / |L|), and
-// only verdicts that survive it are taken here; the rest, and every Separated distance, go to GJK.
-// Only cross axes of exactly parallel edges (|L|^2 below the smallest normal number, so 1/|L| stays
-// exact) are skipped: those are covered by the face axes. Nearly parallel edges are not: at an
-// angle theta the face axes miss the edge axis's gap by up to |e| sin(theta) (two cube ridges of
-// half size s, theta = 1e-7, 1e-7 s apart were Penetrating while the old 1e-6 cut-off skipped
-// their axis; tests/collision/extremes_test.cpp). A tiny |L| costs no accuracy: L = e_i x r_j
-// only permutes entries of r_j, and dist, ra, rb all scale with |L|, so the bound stays
-// 8 eps (|t.L| + ra + rb) / |L|; r's own rounding perturbs B by ~eps * size, as on every axis.
+// Box-box: the box SAT measure decides where it can (satBoxState), GJK otherwise, refined by the
+// axes' proven gap (refineBoxState).
 CollideOutput collideBoxBox(const Shape& a, const Shape& b, const RelativePose& b_in_a,
                             const PairContext& ctx) {
-    constexpr Real kParallelCross = std::numeric_limits<Real>::min();
-    const Mat3& rot = b_in_a.rotation;
-    const Vec3& t = b_in_a.position;
-    const Vec3& ea = a.half_extents;
-    const Vec3& eb = b.half_extents;
-    Real gap_lo = -std::numeric_limits<Real>::infinity();  // max over axes of gap - error
-    Real gap_hi = -std::numeric_limits<Real>::infinity();  // max over axes of gap + error
-    auto testAxis = [&](const Vec3& axis) {
-        const Real len2 = axis.squaredNorm();
-        if (len2 < kParallelCross) return;
-        const Real ra = ea.dot(axis.cwiseAbs());
-        const Real rb = eb.dot((rot.transpose() * axis).cwiseAbs());
-        const Real dist = std::abs(t.dot(axis));
-        const Real inv_len = 1 / std::sqrt(len2);
-        const Real gap = (dist - ra - rb) * inv_len;
-        const Real err = Real(8) * kEpsilon * (dist + ra + rb) * inv_len;
-        gap_lo = std::max(gap_lo, gap - err);
-        gap_hi = std::max(gap_hi, gap + err);
-    };
-    for (int i = 0; i < 3; ++i) testAxis(Vec3::Unit(i));
-    for (int j = 0; j < 3; ++j) testAxis(rot.col(j));
-    for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j) testAxis(Vec3::Unit(i).cross(rot.col(j)));
-    }
-    CollideOutput out;
-    if (gap_hi < -ctx.tolerance) {
-        out.state = ContactState::Penetrating;  // exact depth > tolerance
+    const BoxSatMeasure sat =
+        measureBoxSat(a.half_extents, b_in_a.rotation, b_in_a.position, b.half_extents);
+    if (const auto state = collide_pairs::satBoxState(sat, ctx.tolerance)) {
+        CollideOutput out;
+        out.state = *state;
         return out;
     }
-    if (gap_lo >= -ctx.tolerance && gap_hi <= 0) {
-        out.state = ContactState::Touching;  // depth in [0, tolerance]
-        return out;
-    }
-    // Separated or undecided by the axes: GJK gives the distance (or the EPA decision).
-    out = collideConvexCores(ConvexCore::fromShape(a), ConvexCore::fromShape(b), b_in_a,
-                             ctx.tolerance, ctx.scale);
-    if (out.state == ContactState::Separated) {
-        // GJK's |v| is accurate to rounding; the axes' gap is a proven lower bound.
-        out.distance = std::max(out.distance, gap_lo);
-    } else if (gap_lo > ctx.tolerance) {
-        // The axes prove a gap; a disagreeing GJK can only be rounding.
-        out.state = ContactState::Separated;
-        out.distance = gap_lo;
-    }
-    return out;
+    return collide_pairs::refineBoxState(
+        collideConvexCores(ConvexCore::fromShape(a), ConvexCore::fromShape(b), b_in_a,
+                           ctx.tolerance, ctx.scale),
+        sat, ctx.tolerance);
 }
 
 // ---- Meshes: surfaces, tested triangle by triangle. ----
@@ -432,29 +410,24 @@ constexpr PairTable<PairEntry> makePairTable() {
     };
     constexpr std::array<ShapeType, 4> kConvex{ShapeType::Sphere, ShapeType::Box,
                                                ShapeType::Capsule, ShapeType::ConvexHull};
-    // GJK covers every convex pair first; closed forms override it (Jolt, parry).
+    // GJK covers every convex pair first; closed forms override it (Jolt, parry). Convex pairs
+    // run with the lesser type first, the order canonicalLess and contact() use.
     for (const ShapeType s : kConvex) {
-        for (const ShapeType t : kConvex) set(s, t, collideConvexGeneric);
+        for (const ShapeType t : kConvex) {
+            if (s <= t) set(s, t, collideConvexGeneric);
+        }
         set(ShapeType::Mesh, s, collideMeshConvex);
     }
     set(ShapeType::Mesh, ShapeType::Mesh, collideMeshMesh);
-    set(ShapeType::Sphere, ShapeType::Sphere, collideSphereSphere);
-    set(ShapeType::Sphere, ShapeType::Box, collideSphereBox);
-    set(ShapeType::Sphere, ShapeType::Capsule, collideSphereCapsule);
-    set(ShapeType::Capsule, ShapeType::Capsule, collideCapsuleCapsule);
-    set(ShapeType::Capsule, ShapeType::Box, collideCapsuleBox);
+    set(ShapeType::Sphere, ShapeType::Sphere, collide_pairs::sphereSphere);
+    set(ShapeType::Sphere, ShapeType::Box, collide_pairs::sphereBox);
+    set(ShapeType::Sphere, ShapeType::Capsule, collide_pairs::sphereCapsule);
+    set(ShapeType::Capsule, ShapeType::Capsule, collide_pairs::capsuleCapsule);
     set(ShapeType::Box, ShapeType::Box, collideBoxBox);
     return table;
 }
 
 constexpr PairTable<PairEntry> kPairTable = makePairTable();
-
-PairContext pairContext(const Shape& a, const Shape& b) {
-    PairContext ctx;
-    ctx.scale = std::max(boundingRadius(a), boundingRadius(b));
-    ctx.tolerance = kTouchRelativeTolerance * ctx.scale;
-    return ctx;
-}
 
 }  // namespace
 

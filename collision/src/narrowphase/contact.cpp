@@ -1,15 +1,15 @@
 // collision/src/narrowphase/contact.cpp -- contact(): the full convex query (depth or distance,
 // normal, witness points and features, manifold), dispatched through a [ShapeType][ShapeType]
 // table to one routine per pair family (contact_pairs.h): closed forms for the round pairs and
-// sphere-box (contact_round.cpp), SAT with a clipped manifold for box-box (contact_box_box.cpp),
-// GJK with witnesses and EPA for every other convex pair (contact_convex.cpp).
+// sphere-box (contact_round.cpp), the box SAT with a clipped manifold for box-box
+// (contact_box_box.cpp), GJK with witnesses and EPA for every other convex pair
+// (contact_convex.cpp).
 // Invariants: every routine computes in the canonically-first shape's frame and the world output
 // is made once at the end; contact(b, a) runs the same routine on the same arguments as
-// contact(a, b) and mirrors it, so the two are exact mirrors; the state is the touching
-// convention of narrow_phase.h, and near its thresholds (|signed distance| within
-// kReconcileBand * scale of the touching band) the state is taken from collide() itself, so the
-// two can never disagree by rounding (the signed distance is then moved into the state's range,
-// a change below kReconcileBand * scale).
+// contact(a, b) and mirrors it, so the two are exact mirrors. The state is collide()'s: each
+// routine returns collide()'s decision on the pair (the same closed form, or the same decision
+// on the same GJK run and box SAT measure), and the signed distance is settled into that state's
+// range (settleSignedDistance), so the two queries agree by construction.
 #include "collision/narrowphase/contact.h"
 
 #include <algorithm>
@@ -26,7 +26,6 @@ namespace collision {
 
 using contact_pairs::Ctx;
 using contact_pairs::Local;
-using contact_pairs::kReconcileBand;
 using contact_pairs::boxBox;
 using contact_pairs::convexConvex;
 using contact_pairs::sphereSphere;
@@ -38,17 +37,8 @@ using contact_pairs::setSingleManifold;
 
 namespace {
 
-using ContactFn = void (*)(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
-                           Local& out);
-
-// Box-box by the SAT, or by GJK when the SAT proves a gap larger than the tolerance.
-void boxBoxOrConvex(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
-                    Local& out) {
-    if (!boxBox(a, b, rel, ctx, out)) {
-        out = Local{};
-        convexConvex(a, b, rel, ctx, out);
-    }
-}
+using ContactFn = CollideOutput (*)(const Shape& a, const Shape& b, const RelativePose& rel,
+                                    const Ctx& ctx, Local& out);
 
 // Rows: the canonically-first shape's type (canonicalLess orders by type, so the first type is
 // never above the second; a mesh is its convex hull here). GJK and EPA wherever no closed form
@@ -59,17 +49,35 @@ constexpr PairTable<ContactFn> makeContactTable() {
     pairEntry(table, ShapeType::Sphere, ShapeType::Box) = sphereBox;
     pairEntry(table, ShapeType::Sphere, ShapeType::Capsule) = sphereCapsule;
     pairEntry(table, ShapeType::Capsule, ShapeType::Capsule) = capsuleCapsule;
-    pairEntry(table, ShapeType::Box, ShapeType::Box) = boxBoxOrConvex;
+    pairEntry(table, ShapeType::Box, ShapeType::Box) = boxBox;
     return table;
 }
 
 constexpr PairTable<ContactFn> kContactTable = makeContactTable();
 
-Local contactLocal(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx) {
-    Local out;
-    out.state = ContactState::Touching;  // classified later unless Failed
-    pairEntry(kContactTable, a.type, b.type)(a, b, rel, ctx, out);
-    return out;
+// The details' signed distance moved into the range of collide()'s state: never below collide()'s
+// distance when Separated, within the tolerance when Touching, below it when Penetrating. The
+// routines compute both from the same numbers, so the move is a rounding-sized one wherever the
+// details' own estimate is accurate (a GJK gap against EPA on the pair shifted into contact,
+// say).
+void settleSignedDistance(const CollideOutput& decided, Real tolerance, Local& local) {
+    switch (decided.state) {
+        case ContactState::Separated:
+            local.signed_distance = std::max(local.signed_distance, decided.distance);
+            break;
+        case ContactState::Touching:
+            local.signed_distance = std::clamp(local.signed_distance, -tolerance, tolerance);
+            break;
+        case ContactState::Penetrating:
+            if (!(local.signed_distance < -tolerance)) {
+                local.signed_distance =
+                    std::nextafter(-tolerance, -std::numeric_limits<Real>::infinity());
+            }
+            break;
+        case ContactState::Failed:
+            break;
+    }
+    local.state = decided.state;
 }
 
 }  // namespace
@@ -97,42 +105,13 @@ ContactOutput contact(const Shape& a_in, const Pose& pose_a_in, const Shape& b_i
     const Pose& pose_first = swap ? pose_b_in : pose_a_in;
     const Pose& pose_second = swap ? pose_a_in : pose_b_in;
 
-    Ctx ctx;
-    ctx.scale = std::max(boundingRadius(first), boundingRadius(second));
-    ctx.tolerance = kTouchRelativeTolerance * ctx.scale;
+    const Ctx ctx = pairContext(first, second);
     const RelativePose rel = relativePose(pose_first, pose_second);
-    Local local = contactLocal(first, second, rel, ctx);
-
-    // The touching convention; near its thresholds collide() decides (see the file header).
-    const bool convex = a_in.isConvex() && b_in.isConvex();
-    if (local.state != ContactState::Failed) {
-        local.state = classifySignedDistance(local.signed_distance, ctx.tolerance).state;
-    }
-    const Real band = kReconcileBand * ctx.scale;
-    if (convex && (local.state == ContactState::Failed ||
-                   std::abs(local.signed_distance) <= ctx.tolerance + band)) {
-        const CollideOutput c = collide(first, pose_first, second, pose_second);
-        if (local.state != ContactState::Failed) {
-            switch (c.state) {
-                case ContactState::Separated:
-                    local.signed_distance = std::max(local.signed_distance, c.distance);
-                    break;
-                case ContactState::Touching:
-                    local.signed_distance =
-                        std::clamp(local.signed_distance, -ctx.tolerance, ctx.tolerance);
-                    break;
-                case ContactState::Penetrating:
-                    if (!(local.signed_distance < -ctx.tolerance)) {
-                        local.signed_distance =
-                            std::nextafter(-ctx.tolerance, -std::numeric_limits<Real>::infinity());
-                    }
-                    break;
-                case ContactState::Failed:
-                    break;
-            }
-            local.state = c.state;
-        }
-    }
+    Local local;
+    local.state = ContactState::Touching;  // the routine sets Failed when it cannot
+    const CollideOutput decided =
+        pairEntry(kContactTable, first.type, second.type)(first, second, rel, ctx, local);
+    if (local.state != ContactState::Failed) settleSignedDistance(decided, ctx.tolerance, local);
     // The output never carries NaN or a non-unit normal: anything else is Failed.
     if (local.state == ContactState::Failed || !std::isfinite(local.signed_distance) ||
         !local.normal.allFinite() || !(std::abs(local.normal.squaredNorm() - 1) < Real(1e-6)) ||

@@ -1,11 +1,11 @@
-// collision/src/narrowphase/contact_box_box.cpp -- contact() of two boxes: the separating-axis
-// test over 15 axes (Gottschalk 1996; RTCD 4.4.1) with a bias towards face axes, and the
-// manifold of the incident face clipped against the reference face (RTCD 8.3.4), reduced to
-// four points.
+// collision/src/narrowphase/contact_box_box.cpp -- contact() of two boxes: the box SAT measure
+// (box_sat.h, the one collide() decides from) with a bias towards face axes, and the manifold of
+// the incident face clipped against the reference face (RTCD 8.3.4), reduced to four points.
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "collision/assert.h"
 #include "geometry/closest_points.h"
@@ -135,54 +135,24 @@ int reduceManifold(const Vec3* p, const Real* depth, int n, const Vec3& normal,
     return i3 < 0 ? 3 : 4;
 }
 
-// Returns false when the SAT proves a gap larger than the tolerance (GJK then measures it).
-bool boxBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx, Local& out) {
+namespace {
+
+// The details from the SAT measure: the edge-edge closest points, or the reference face clipped
+// against the incident one. False when the best axis proves a gap larger than the tolerance or
+// the clipped manifold is empty (GJK/EPA then give the details).
+bool satDetails(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
+                const BoxSatMeasure& sat, Local& out) {
     const Mat3& rot = rel.rotation;
     const Vec3& t = rel.position;
     const Vec3& ea = a.half_extents;
     const Vec3& eb = b.half_extents;
-    // Best face axis and best edge axis: largest separation (least penetration).
-    Real best_face = -std::numeric_limits<Real>::infinity();
-    int face_kind = 0;  // 0: face of A, 1: face of B
-    int face_axis = 0;
-    Real best_edge = -std::numeric_limits<Real>::infinity();
-    int edge_i = 0;
-    int edge_j = 0;
-    Vec3 edge_axis = Vec3::Zero();
-    for (int i = 0; i < 3; ++i) {
-        const Real sep = std::abs(t[i]) - ea[i] - eb.dot(rot.row(i).transpose().cwiseAbs());
-        if (sep > best_face) {
-            best_face = sep;
-            face_kind = 0;
-            face_axis = i;
-        }
-    }
-    for (int j = 0; j < 3; ++j) {
-        const Vec3 axis = rot.col(j);
-        const Real sep = std::abs(t.dot(axis)) - ea.dot(axis.cwiseAbs()) - eb[j];
-        if (sep > best_face) {
-            best_face = sep;
-            face_kind = 1;
-            face_axis = j;
-        }
-    }
-    for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j) {
-            const Vec3 axis = Vec3::Unit(i).cross(rot.col(j));
-            const Real len2 = axis.squaredNorm();
-            if (!(len2 >= kSatAxisMin)) continue;
-            const Real len = std::sqrt(len2);
-            const Vec3 unit = axis / len;
-            const Real sep = std::abs(t.dot(unit)) - ea.dot(unit.cwiseAbs()) -
-                             eb.dot((rot.transpose() * unit).cwiseAbs());
-            if (sep > best_edge) {
-                best_edge = sep;
-                edge_i = i;
-                edge_j = j;
-                edge_axis = unit;
-            }
-        }
-    }
+    const Real best_face = sat.face_sep;
+    const int face_kind = sat.face_box;
+    const int face_axis = sat.face_axis;
+    const Real best_edge = sat.edge_sep;
+    const int edge_i = sat.edge_a;
+    const int edge_j = sat.edge_b;
+    const Vec3& edge_axis = sat.edge_axis;
     const bool use_edge = best_edge > best_face + kEdgeBias * ctx.scale;
     const Real best = use_edge ? best_edge : best_face;
     if (best > ctx.tolerance) return false;
@@ -275,6 +245,31 @@ bool boxBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& 
     out.feature_a = boxFeature(ea, out.point_a, tol);
     out.feature_b = boxFeature(eb, toB(rel, out.point_b), tol);
     return true;
+}
+
+}  // namespace
+
+CollideOutput boxBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
+                     Local& out) {
+    const BoxSatMeasure sat =
+        measureBoxSat(a.half_extents, rel.rotation, rel.position, b.half_extents);
+    CollideOutput decision;
+    const std::optional<ContactState> proven = collide_pairs::satBoxState(sat, ctx.tolerance);
+    if (proven) {
+        decision.state = *proven;
+    } else {
+        decision = collide_pairs::refineBoxState(convexConvex(a, b, rel, ctx, out), sat,
+                                                 ctx.tolerance);
+    }
+    Local details;
+    details.state = ContactState::Touching;
+    if (satDetails(a, b, rel, ctx, sat, details)) {
+        details.iterations = out.iterations;
+        out = details;
+    } else if (proven) {
+        convexConvex(a, b, rel, ctx, out);
+    }
+    return decision;
 }
 
 }  // namespace collision::contact_pairs

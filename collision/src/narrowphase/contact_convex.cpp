@@ -1,9 +1,11 @@
 // collision/src/narrowphase/contact_convex.cpp -- contact() of any convex pair: GJK with witness
 // points (gjk.h), EPA when the cores overlap (epa.h), and near touching the normal of EPA on the
-// pair shifted into contact when that normal is stable (face contacts).
+// pair shifted into contact when that normal is stable (face contacts). The state is collide()'s
+// decision (decideConvexCores) on the same GJK run.
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 
 #include "collision/assert.h"
@@ -69,13 +71,19 @@ bool shiftedEpa(const ConvexCore& ca, const ConvexCore& cb, const RelativePose& 
 
 }  // namespace
 
-void convexConvex(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
-                  Local& out) {
+CollideOutput convexConvex(const Shape& a, const Shape& b, const RelativePose& rel,
+                           const Ctx& ctx, Local& out) {
     const ConvexCore ca = ConvexCore::fromShape(a);
     const ConvexCore cb = ConvexCore::fromShape(b);
     const Real radii = ca.radius + cb.radius;
     const GjkWitnessOutput g = gjkWitness(ca, cb, rel, ctx.scale);
-    out.iterations = g.iterations;
+    // collide()'s decision on this very GJK run (its w's are gjkDistance's, bit for bit).
+    std::array<Vec3, 4> simplex{};
+    for (int i = 0; i < g.simplex.n; ++i) simplex[static_cast<std::size_t>(i)] = g.simplex.v[i].w;
+    const CollideOutput decision = decideConvexCores(
+        g, simplex.data(), g.simplex.n, MinkowskiDifference{ca, cb, rel}, radii, ctx.tolerance,
+        ctx.scale);
+    out.iterations = decision.iterations;
     Vec3 core_a;
     Vec3 core_b;
     if (g.state == GjkState::Separated && g.distance > kNormalRelative * ctx.scale) {
@@ -85,7 +93,7 @@ void convexConvex(const Shape& a, const Shape& b, const RelativePose& rel, const
         out.signed_distance = g.distance - radii;
     } else if (g.state == GjkState::Failed) {
         out.state = ContactState::Failed;
-        return;
+        return decision;
     } else {
         const EpaOutput e = epaPenetration(ca, cb, rel, g.simplex, ctx.scale);
         out.iterations += e.iterations;
@@ -108,7 +116,7 @@ void convexConvex(const Shape& a, const Shape& b, const RelativePose& rel, const
             out.signed_distance = -e.depth;
         } else {
             out.state = ContactState::Failed;
-            return;
+            return decision;
         }
         // Either direction runs through a gap or depth of rounding size (a face-to-face touching
         // pair got normals 70 degrees off its face normal): shiftedEpa() measures the contact
@@ -129,7 +137,8 @@ void convexConvex(const Shape& a, const Shape& b, const RelativePose& rel, const
     const Real tol = kFeatureRelative * ctx.scale;
     out.feature_a = coreFeature(a, core_a, tol);
     out.feature_b = coreFeature(b, toB(rel, core_b), tol);
-    out.state = ContactState::Touching;  // placeholder: classified by the caller
+    out.state = ContactState::Touching;  // placeholder: the caller takes the decision's
+    return decision;
 }
 
 }  // namespace collision::contact_pairs

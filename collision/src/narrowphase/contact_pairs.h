@@ -1,7 +1,9 @@
 // collision/src/narrowphase/contact_pairs.h -- the pieces of contact() (contact.h), private to
-// collision: its tolerances, the context every pair routine gets, the witness features, and one
-// routine per pair family, each in its own file and each computing in the canonically-first
-// shape's frame. contact.cpp dispatches to them through a [ShapeType][ShapeType] table.
+// collision: its tolerances, the witness features, and one routine per pair family, each in its
+// own file and each computing in the canonically-first shape's frame. Every routine returns the
+// pair's state as collide() decides it (collide_pairs.h) beside the details it writes, so the two
+// queries agree by construction. contact.cpp dispatches to them through a [ShapeType][ShapeType]
+// table.
 #pragma once
 
 #include <algorithm>
@@ -10,10 +12,10 @@
 #include <limits>
 
 #include "collision/narrowphase/contact.h"
+#include "narrowphase/collide_pairs.h"
 #include "narrowphase/gjk.h"
 
 namespace collision::contact_pairs {
-
 
 // Below kNormalRelative * scale a GJK distance is too small for (pb - pa) / d to be a reliable
 // direction (its rounding error is ~ kEpsilon * scale / d radians): EPA decides the normal.
@@ -22,23 +24,16 @@ inline constexpr Real kNormalRelative = std::max(Real(1e-8), Real(1e3) * kEpsilo
 inline constexpr Real kDirectionRelative = Real(16) * kEpsilon;
 // Witness points within kFeatureRelative * scale of a face plane / edge / vertex lie on it.
 inline constexpr Real kFeatureRelative = std::max(Real(1e-9), Real(64) * kEpsilon);
-// Width of the band around the touching thresholds where collide() decides the state.
-inline constexpr Real kReconcileBand = Real(1e-6);
 // Capsule axes closer to parallel than sin = kParallelSin have no common perpendicular to use.
 inline constexpr Real kParallelSin = Real(1e-6);
-// Box SAT: only the cross-product axes of exactly parallel edges (|e_a x e_b|^2 below
-// kSatAxisMin, the smallest normal number) are skipped, as in collideBoxBox (which says why);
-// an edge axis must beat the best face axis by kEdgeBias * scale to be chosen (faces give
-// stable multi-point manifolds; Box2D / Bullet do the same).
-inline constexpr Real kSatAxisMin = std::numeric_limits<Real>::min();
+// Box SAT (measureBoxSat, box_sat.h): an edge axis must beat the best face axis by
+// kEdgeBias * scale to be chosen (faces give stable multi-point manifolds; Box2D / Bullet do the
+// same).
 inline constexpr Real kEdgeBias = std::max(Real(1e-9), Real(64) * kEpsilon);
 
 inline Real signOrPlus(Real x) { return x < 0 ? Real(-1) : Real(1); }
 
-struct Ctx {
-    Real scale = 0;
-    Real tolerance = 0;
-};
+using Ctx = PairContext;
 
 // The contact in A's frame (canonical order); world transform and mirroring happen once.
 using Local = ContactOutput;
@@ -69,22 +64,25 @@ bool polytopeManifold(const Shape& a, const Shape& b, const RelativePose& rel, c
 int reduceManifold(const Vec3* p, const Real* depth, int n, const Vec3& normal,
                    std::array<int, 4>& chosen);
 
-// ---- The pair routines, in A's frame (canonical order). ----
+// ---- The pair routines, in A's frame (canonical order). Each writes the details to `out`
+// (state Failed when it cannot) and returns collide()'s decision on the pair. ----
 
 /// Closed forms (contact_round.cpp, RTCD 5.1): sphere-sphere, sphere-capsule, capsule-capsule,
 /// sphere-box.
-void sphereSphere(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
-                  Local& out);
-void sphereCapsule(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
-                   Local& out);
-void capsuleCapsule(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
-                    Local& out);
-void sphereBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx, Local& out);
-/// Box-box: SAT over 15 axes, manifold by clipping (contact_box_box.cpp). False when the SAT
-/// proves a gap larger than the tolerance (GJK then measures it).
-bool boxBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx, Local& out);
+CollideOutput sphereSphere(const Shape& a, const Shape& b, const RelativePose& rel,
+                           const Ctx& ctx, Local& out);
+CollideOutput sphereCapsule(const Shape& a, const Shape& b, const RelativePose& rel,
+                            const Ctx& ctx, Local& out);
+CollideOutput capsuleCapsule(const Shape& a, const Shape& b, const RelativePose& rel,
+                             const Ctx& ctx, Local& out);
+CollideOutput sphereBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
+                        Local& out);
+/// Box-box: the box SAT measure, with the manifold by clipping where the best axis is within the
+/// tolerance, GJK otherwise (contact_box_box.cpp).
+CollideOutput boxBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
+                     Local& out);
 /// Any convex pair: GJK with witnesses, EPA when the cores overlap (contact_convex.cpp).
-void convexConvex(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
-                  Local& out);
+CollideOutput convexConvex(const Shape& a, const Shape& b, const RelativePose& rel,
+                           const Ctx& ctx, Local& out);
 
 }  // namespace collision::contact_pairs

@@ -1,6 +1,7 @@
 // collision/src/narrowphase/contact_round.cpp -- contact() in closed form for the round pairs
 // (sphere-sphere, sphere-capsule, capsule-capsule; RTCD 5.1.9) and sphere-box (RTCD 5.1.3), in
-// the canonically-first shape's frame.
+// the canonically-first shape's frame; the state is collide()'s closed form on the same
+// arguments.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -28,17 +29,18 @@ void roundContact(Real ra, Real rb, const Vec3& ca, const Vec3& cb, const Vec3& 
 
 }  // namespace
 
-void sphereSphere(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
-                  Local& out) {
+CollideOutput sphereSphere(const Shape& a, const Shape& b, const RelativePose& rel,
+                           const Ctx& ctx, Local& out) {
     // Coincident centres: A's local +x.
     roundContact(a.radius, b.radius, Vec3::Zero(), rel.position, Vec3::UnitX(), ctx, out);
     out.feature_a = {FeatureType::Face, 0};
     out.feature_b = {FeatureType::Face, 0};
+    return collide_pairs::sphereSphere(a, b, rel, ctx);
 }
 
 // RTCD 5.1.2: sphere centre against the capsule's segment.
-void sphereCapsule(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
-                   Local& out) {
+CollideOutput sphereCapsule(const Shape& a, const Shape& b, const RelativePose& rel,
+                            const Ctx& ctx, Local& out) {
     const Vec3 centre_in_b = toB(rel, Vec3::Zero());
     const Real y = std::clamp(centre_in_b.y(), -b.half_height, b.half_height);
     const Vec3 on_axis = rel.rotation * Vec3(0, y, 0) + rel.position;
@@ -52,10 +54,11 @@ void sphereCapsule(const Shape& a, const Shape& b, const RelativePose& rel, cons
     } else {
         out.feature_b = {FeatureType::Edge, 0};
     }
+    return collide_pairs::sphereCapsule(a, b, rel, ctx);
 }
 
-void capsuleCapsule(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
-                    Local& out) {
+CollideOutput capsuleCapsule(const Shape& a, const Shape& b, const RelativePose& rel,
+                             const Ctx& ctx, Local& out) {
     const Vec3 pa(0, -a.half_height, 0);
     const Vec3 qa(0, a.half_height, 0);
     const Vec3 axis_b = rel.rotation.col(1);
@@ -79,11 +82,12 @@ void capsuleCapsule(const Shape& a, const Shape& b, const RelativePose& rel, con
     const Real tol = kFeatureRelative * ctx.scale;
     out.feature_a = capsuleFeature(a.half_height, ca, tol);
     out.feature_b = capsuleFeature(b.half_height, toB(rel, cb), tol);
+    return collide_pairs::capsuleCapsule(a, b, rel, ctx);
 }
 
 // RTCD 5.1.3: the sphere centre clamped to the box (box frame); inside, the nearest face.
-void sphereBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
-               Local& out) {
+CollideOutput sphereBox(const Shape& a, const Shape& b, const RelativePose& rel,
+                        const Ctx& ctx, Local& out) {
     const Vec3 c = toB(rel, Vec3::Zero());
     const Vec3& h = b.half_extents;
     const Vec3 q = c.cwiseMax(-h).cwiseMin(h);
@@ -103,7 +107,7 @@ void sphereBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ct
             if (outside[k] == 0) probe[k] = std::clamp(q[k], -h[k] + 2 * tol, h[k] - 2 * tol);
         }
         out.feature_b = boxFeature(h, probe, tol);
-        return;
+        return collide_pairs::sphereBox(a, b, rel, ctx);
     }
     // Inside: leave through the nearest face (ties: lowest axis; sign(0) = +).
     int k = 0;
@@ -117,6 +121,7 @@ void sphereBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ct
     on_face[k] = s * h[k];
     out.point_b = rel.rotation * on_face + rel.position;
     out.feature_b = {FeatureType::Face, 2 * k + (s > 0 ? 1 : 0)};
+    return collide_pairs::sphereBox(a, b, rel, ctx);
 }
 
 }  // namespace collision::contact_pairs

@@ -123,11 +123,9 @@ GjkRun<Vertex> runGjk(const ConvexCore& a, const ConvexCore& b, const RelativePo
         }
         const Vertex w = cso.supportVertex<Vertex>(-v);
         const Real vw = v.dot(pointOf(w));
-        if constexpr (!kWitness) {
-            // Every point x of A - B has v.x >= v.w, so distance >= v.w / |v| (a separating
-            // plane). Only the distance query reports it (collide() decides with it).
-            out.lower_bound = std::max(out.lower_bound, vw / std::sqrt(vv));
-        }
+        // Every point x of A - B has v.x >= v.w, so distance >= v.w / |v| (a separating plane);
+        // decideConvexCores uses it when the iteration cap is hit.
+        out.lower_bound = std::max(out.lower_bound, vw / std::sqrt(vv));
         // van den Bergen 1999 §4: |v|^2 - v.w bounds |v|^2 - |v| dist(origin, A - B).
         if (vv - vw <= kGjkRelativeTolerance * vv) {
             return finish(GjkState::Separated, std::sqrt(vv));
@@ -435,10 +433,9 @@ CollideOutput classifySignedDistance(Real signed_distance, Real tolerance) {
     return out;
 }
 
-CollideOutput collideConvexCores(const ConvexCore& a, const ConvexCore& b,
-                                 const RelativePose& b_in_a, Real tolerance, Real scale) {
-    const GjkOutput g = gjkDistance(a, b, b_in_a, scale);
-    const Real radii = a.radius + b.radius;
+CollideOutput decideConvexCores(const GjkSummary& g, const Vec3* simplex, int simplex_count,
+                                const MinkowskiDifference& cso, Real radii, Real tolerance,
+                                Real scale) {
     CollideOutput out;
     switch (g.state) {
         case GjkState::Separated:
@@ -450,9 +447,8 @@ CollideOutput collideConvexCores(const ConvexCore& a, const ConvexCore& b,
                 out.state = ContactState::Penetrating;  // depth >= radii
             } else {
                 Simplex<Vec3> start;
-                start.n = g.simplex_count;
-                for (int i = 0; i < g.simplex_count; ++i) start.v[i] = g.simplex[i];
-                const MinkowskiDifference cso{a, b, b_in_a};
+                start.n = simplex_count;
+                for (int i = 0; i < simplex_count; ++i) start.v[i] = simplex[i];
                 std::int32_t epa_iterations = 0;
                 out.state = epaDecide(cso, start, tolerance - radii, scale, epa_iterations);
                 out.iterations += epa_iterations;
@@ -472,6 +468,13 @@ CollideOutput collideConvexCores(const ConvexCore& a, const ConvexCore& b,
     }
     out.iterations += g.iterations;
     return out;
+}
+
+CollideOutput collideConvexCores(const ConvexCore& a, const ConvexCore& b,
+                                 const RelativePose& b_in_a, Real tolerance, Real scale) {
+    const GjkOutput g = gjkDistance(a, b, b_in_a, scale);
+    return decideConvexCores(g, g.simplex.data(), g.simplex_count, MinkowskiDifference{a, b, b_in_a},
+                             a.radius + b.radius, tolerance, scale);
 }
 
 }  // namespace collision

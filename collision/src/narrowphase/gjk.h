@@ -55,8 +55,9 @@ struct GjkSummary {
     /// Between the cores (radii ignored) when Separated: an upper bound; |v| of the last iterate
     /// when Failed; 0 when Overlapping.
     Real distance = 0;
-    /// Proven lower bound on the core distance (may be <= 0); gjkDistance only (gjkWitness
-    /// leaves -inf, or 0 when Overlapping).
+    /// Lower bound on the core distance from GJK's separating planes (may be <= 0; 0 when
+    /// Overlapping). The same in both queries: gjkDistance and gjkWitness run one loop whose
+    /// iterates (w, v, simplex) are bit-identical; gjkWitness only keeps a and b beside w.
     Real lower_bound = 0;
     std::int32_t iterations = 0;
     /// The point of the final simplex nearest the origin (GJK's v), A's frame: the closest
@@ -145,9 +146,17 @@ GjkWitnessOutput gjkWitness(const ConvexCore& a, const ConvexCore& b, const Rela
 /// The touching convention applied to a signed distance (negative = penetration depth).
 CollideOutput classifySignedDistance(Real signed_distance, Real tolerance);
 
-/// The narrow-phase answer for two convex cores with radii: GJK, then signed distance
-/// = core distance - radii, or the bounded EPA decision when the cores overlap and the radii are
-/// below `tolerance`. Touching when |signed distance| <= tolerance.
+/// The narrow-phase state of two convex cores with radii from a finished GJK run `g` (either
+/// query) and its final simplex of A - B points: signed distance = core distance - radii, or the
+/// bounded EPA decision when the cores overlap and the radii are below `tolerance`, or what GJK's
+/// bounds prove when it hit its cap. Touching when |signed distance| <= tolerance. collide() and
+/// contact() both decide convex pairs here, on bit-identical GJK runs, so their states agree by
+/// construction.
+CollideOutput decideConvexCores(const GjkSummary& g, const Vec3* simplex, int simplex_count,
+                                const MinkowskiDifference& cso, Real radii, Real tolerance,
+                                Real scale);
+
+/// gjkDistance, then decideConvexCores.
 CollideOutput collideConvexCores(const ConvexCore& a, const ConvexCore& b,
                                  const RelativePose& b_in_a, Real tolerance, Real scale);
 

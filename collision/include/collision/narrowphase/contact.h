@@ -82,9 +82,11 @@ struct ContactOutput {
 ///   4e-8 * size into contact when that normal is stable under the shift (face contacts), else
 ///   from GJK's closest points (separated) or EPA (overlapping), whose direction is then only as
 ///   good as rounding allows (~1e-16 * size / gap radians, worse when GJK stalls).
-/// - State: within 1e-6 * size of the touching band the state is collide()'s own and the signed
-///   distance is moved into that state's range (by at most that much). For meshes (their hull
-///   here, triangles in collide()) the states may differ.
+/// - State: collide()'s, by construction: each pair family decides with collide()'s own routine
+///   (the same closed form, or the same decision on the same GJK run and box SAT measure), and
+///   the signed distance is then settled into that state's range (when Separated, never below
+///   collide()'s distance; a rounding-sized move). For meshes the state is that of their hulls
+///   (collide() tests triangles, so the states may differ).
 /// Full convex query of `a` at `pose_a` against `b` at `pose_b`. Convex shapes only (a Mesh
 /// is treated as its convex hull here; triangle-level mesh contact goes through the BVH).
 /// Guarantees: never NaN, never hangs (iteration caps -> Failed); the touching convention above
