@@ -37,69 +37,101 @@ PairContext pairContext(const Shape& a, const Shape& b) {
 
 namespace collide_pairs {
 
-namespace {
-
-// Distance between segments p1q1 and p2q2 (closestSegmentSegment, RTCD 5.1.9).
-Real distanceSegmentSegment(const Vec3& p1, const Vec3& q1, const Vec3& p2, const Vec3& q2,
-                            Real length_epsilon) {
-    const SegmentParameters st = closestSegmentSegment(p1, q1, p2, q2, length_epsilon);
-    return ((p1 + (q1 - p1) * st.s) - (p2 + (q2 - p2) * st.t)).norm();
+RoundCores sphereSphereCores(const RelativePose& b_in_a) {
+    RoundCores cores;
+    cores.on_b = b_in_a.position;
+    cores.distance = (cores.on_b - cores.on_a).norm();
+    return cores;
 }
 
-}  // namespace
+// RTCD 5.1.2: the sphere centre (A's origin) against the capsule's segment.
+RoundCores sphereCapsuleCores(const Shape& capsule_b, const RelativePose& b_in_a) {
+    const Real y = std::clamp(toB(b_in_a, Vec3::Zero()).y(), -capsule_b.half_height,
+                              capsule_b.half_height);
+    RoundCores cores;
+    cores.on_b = b_in_a.rotation * Vec3(0, y, 0) + b_in_a.position;
+    cores.distance = (cores.on_b - cores.on_a).norm();
+    return cores;
+}
 
-// ---- Closed forms. Signed distance: positive gap, or minus the penetration depth. ----
+// RTCD 5.1.9 (closestSegmentSegment) on the two capsules' segments.
+RoundCores capsuleCapsuleCores(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                               const PairContext& ctx) {
+    const Vec3 pa(0, -a.half_height, 0);
+    const Vec3 qa(0, a.half_height, 0);
+    const Vec3 axis_b = b_in_a.rotation.col(1);
+    const Vec3 pb = b_in_a.position - b.half_height * axis_b;
+    const Vec3 qb = b_in_a.position + b.half_height * axis_b;
+    const SegmentParameters st = closestSegmentSegment(pa, qa, pb, qb, kEpsilon * ctx.scale);
+    RoundCores cores;
+    cores.on_a = pa + st.s * (qa - pa);
+    cores.on_b = pb + st.t * (qb - pb);
+    cores.distance = (cores.on_b - cores.on_a).norm();
+    return cores;
+}
+
+// Inside the box the depth is the radius plus the distance to the nearest face.
+SphereBoxCore sphereBoxCore(const Shape& a, const Shape& b, const RelativePose& b_in_a) {
+    SphereBoxCore core;
+    const Vec3& h = b.half_extents;
+    core.centre = toB(b_in_a, Vec3::Zero());
+    core.clamped = core.centre.cwiseMax(-h).cwiseMin(h);
+    const Vec3 outside = core.centre - core.clamped;
+    core.inside = outside.isZero();
+    if (!core.inside) {
+        core.signed_distance = outside.norm() - a.radius;
+        return core;
+    }
+    const Vec3 gap = h - core.centre.cwiseAbs();
+    gap.minCoeff(&core.face_axis);
+    core.signed_distance = -(gap[core.face_axis] + a.radius);
+    return core;
+}
 
 CollideOutput sphereSphere(const Shape& a, const Shape& b, const RelativePose& b_in_a,
                            const PairContext& ctx) {
-    return classifySignedDistance(b_in_a.position.norm() - a.radius - b.radius, ctx.tolerance);
+    return classifySignedDistance(sphereSphereCores(b_in_a).distance - a.radius - b.radius,
+                                  ctx.tolerance);
 }
 
-// RTCD 5.1.3 (closest point on an OBB), in the box frame; inside the box the depth is the radius
-// plus the distance to the nearest face.
 CollideOutput sphereBox(const Shape& a, const Shape& b, const RelativePose& b_in_a,
                         const PairContext& ctx) {
-    const Vec3 center = -(b_in_a.rotation.transpose() * b_in_a.position);
-    const Vec3& h = b.half_extents;
-    const Vec3 closest = center.cwiseMax(-h).cwiseMin(h);
-    const Vec3 outside = center - closest;
-    if (!outside.isZero()) {
-        return classifySignedDistance(outside.norm() - a.radius, ctx.tolerance);
-    }
-    const Real face_gap = (h - center.cwiseAbs()).minCoeff();
-    return classifySignedDistance(-(face_gap + a.radius), ctx.tolerance);
+    return classifySignedDistance(sphereBoxCore(a, b, b_in_a).signed_distance, ctx.tolerance);
 }
 
-// RTCD 5.1.2: the sphere centre against the capsule's segment, in the capsule frame.
 CollideOutput sphereCapsule(const Shape& a, const Shape& b, const RelativePose& b_in_a,
                             const PairContext& ctx) {
-    const Vec3 center = -(b_in_a.rotation.transpose() * b_in_a.position);
-    const Vec3 closest(0, std::clamp(center.y(), -b.half_height, b.half_height), 0);
-    return classifySignedDistance((center - closest).norm() - a.radius - b.radius, ctx.tolerance);
+    return classifySignedDistance(sphereCapsuleCores(b, b_in_a).distance - a.radius - b.radius,
+                                  ctx.tolerance);
 }
 
 CollideOutput capsuleCapsule(const Shape& a, const Shape& b, const RelativePose& b_in_a,
                              const PairContext& ctx) {
-    const Vec3 tip_a(0, a.half_height, 0);
-    const Vec3 tip_b = b_in_a.rotation.col(1) * b.half_height;
-    const Real d = distanceSegmentSegment(-tip_a, tip_a, b_in_a.position - tip_b,
-                                          b_in_a.position + tip_b, kEpsilon * ctx.scale);
-    return classifySignedDistance(d - a.radius - b.radius, ctx.tolerance);
+    return classifySignedDistance(
+        capsuleCapsuleCores(a, b, b_in_a, ctx).distance - a.radius - b.radius, ctx.tolerance);
 }
 
+// The quick tests decide exactly as the per-axis bounds would: gapHi() <= max_sep + err_bound / 2
+// and gapHi() >= max_sep; gapLo() <= max_sep.
 std::optional<ContactState> satBoxState(const BoxSatMeasure& sat, Real tolerance) {
-    if (sat.gap_hi < -tolerance) return ContactState::Penetrating;  // exact depth > tolerance
-    if (sat.gap_lo >= -tolerance && sat.gap_hi <= 0) return ContactState::Touching;
+    if (sat.max_sep + sat.err_bound < -tolerance) return ContactState::Penetrating;
+    if (sat.max_sep > 0) return std::nullopt;
+    const Real gap_hi = sat.gapHi();
+    if (gap_hi < -tolerance) return ContactState::Penetrating;  // exact depth > tolerance
+    if (gap_hi <= 0 && sat.gapLo() >= -tolerance) return ContactState::Touching;
     return std::nullopt;
 }
 
 CollideOutput refineBoxState(CollideOutput convex, const BoxSatMeasure& sat, Real tolerance) {
     if (convex.state == ContactState::Separated) {
         // GJK's |v| is accurate to rounding; the axes' gap is a proven lower bound.
-        convex.distance = std::max(convex.distance, sat.gap_lo);
-    } else if (sat.gap_lo > tolerance) {
-        convex.state = ContactState::Separated;
-        convex.distance = sat.gap_lo;
+        if (sat.max_sep > convex.distance) convex.distance = std::max(convex.distance, sat.gapLo());
+    } else if (sat.max_sep > tolerance) {
+        const Real gap_lo = sat.gapLo();
+        if (gap_lo > tolerance) {
+            convex.state = ContactState::Separated;
+            convex.distance = gap_lo;
+        }
     }
     return convex;
 }

@@ -25,8 +25,32 @@ PairContext pairContext(const Shape& a, const Shape& b);
 
 namespace collide_pairs {
 
-// Closed forms, in A's frame (A the canonically-first shape). Signed distance: positive gap, or
-// minus the penetration depth.
+/// The one computation behind each closed form, in A's frame (A the canonically-first shape):
+/// collide() classifies its signed distance, contact() builds its normal and witnesses from the
+/// same numbers. Round pairs: the closest points of the cores (sphere centres, capsule
+/// segments; RTCD 5.1.2, 5.1.9) and their distance.
+struct RoundCores {
+    Vec3 on_a = Vec3::Zero();
+    Vec3 on_b = Vec3::Zero();
+    Real distance = 0;  ///< |on_b - on_a|
+};
+RoundCores sphereSphereCores(const RelativePose& b_in_a);
+RoundCores sphereCapsuleCores(const Shape& capsule_b, const RelativePose& b_in_a);
+RoundCores capsuleCapsuleCores(const Shape& a, const Shape& b, const RelativePose& b_in_a,
+                               const PairContext& ctx);
+
+/// Sphere A against box B (RTCD 5.1.3), in the box's frame: the sphere centre, its clamp to the
+/// box and, when the centre is inside, the axis of the nearest face.
+struct SphereBoxCore {
+    Vec3 centre = Vec3::Zero();
+    Vec3 clamped = Vec3::Zero();
+    bool inside = false;
+    int face_axis = 0;  ///< inside only; ties: the lowest axis
+    Real signed_distance = 0;
+};
+SphereBoxCore sphereBoxCore(const Shape& a, const Shape& b, const RelativePose& b_in_a);
+
+// Closed forms. Signed distance: positive gap, or minus the penetration depth.
 CollideOutput sphereSphere(const Shape& a, const Shape& b, const RelativePose& b_in_a,
                            const PairContext& ctx);
 CollideOutput sphereBox(const Shape& a, const Shape& b, const RelativePose& b_in_a,

@@ -253,21 +253,19 @@ CollideOutput boxBox(const Shape& a, const Shape& b, const RelativePose& rel, co
                      Local& out) {
     const BoxSatMeasure sat =
         measureBoxSat(a.half_extents, rel.rotation, rel.position, b.half_extents);
-    CollideOutput decision;
-    const std::optional<ContactState> proven = collide_pairs::satBoxState(sat, ctx.tolerance);
-    if (proven) {
+    if (const std::optional<ContactState> proven = collide_pairs::satBoxState(sat, ctx.tolerance)) {
+        if (!satDetails(a, b, rel, ctx, sat, out)) convexConvex(a, b, rel, ctx, out);
+        CollideOutput decision;
         decision.state = *proven;
-    } else {
-        decision = collide_pairs::refineBoxState(convexConvex(a, b, rel, ctx, out), sat,
-                                                 ctx.tolerance);
+        return decision;
     }
+    const CollideOutput decision =
+        collide_pairs::refineBoxState(convexConvex(a, b, rel, ctx, out), sat, ctx.tolerance);
     Local details;
     details.state = ContactState::Touching;
     if (satDetails(a, b, rel, ctx, sat, details)) {
         details.iterations = out.iterations;
         out = details;
-    } else if (proven) {
-        convexConvex(a, b, rel, ctx, out);
     }
     return decision;
 }

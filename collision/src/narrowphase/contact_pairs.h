@@ -46,11 +46,6 @@ Feature hullFeature(const ConvexPolytope& hull, const Vec3& p, Real tol);
 /// The feature of a convex core (ConvexCore of the shape) that holds `core_point`.
 Feature coreFeature(const Shape& shape, const Vec3& core_point, Real tol);
 
-/// A point of A's frame in B's frame.
-inline Vec3 toB(const RelativePose& b_in_a, const Vec3& p_in_a) {
-    return b_in_a.rotation.transpose() * (p_in_a - b_in_a.position);
-}
-
 /// A one-point manifold at the witness points (round shapes, edge contacts).
 void setSingleManifold(Local& out);
 

@@ -1,7 +1,7 @@
 // collision/src/narrowphase/contact_round.cpp -- contact() in closed form for the round pairs
 // (sphere-sphere, sphere-capsule, capsule-capsule; RTCD 5.1.9) and sphere-box (RTCD 5.1.3), in
-// the canonically-first shape's frame; the state is collide()'s closed form on the same
-// arguments.
+// the canonically-first shape's frame, from the same core computation as collide()'s closed
+// forms (collide_pairs.h), whose signed distance both classify.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -15,16 +15,17 @@ namespace collision::contact_pairs {
 
 namespace {
 
-// Both shapes reduce to points/segments inflated by radii: closest core points ca (on A) and cb
-// (on B), direction from A to B. Witness points are the cores' points pushed out by the radii.
-void roundContact(Real ra, Real rb, const Vec3& ca, const Vec3& cb, const Vec3& fallback_normal,
-                  const Ctx& ctx, Local& out) {
-    const Vec3 diff = cb - ca;
-    const Real d = diff.norm();
-    out.normal = d > kDirectionRelative * ctx.scale ? Vec3(diff / d) : fallback_normal;
+// Both shapes reduce to points/segments inflated by radii: the closest core points on_a and on_b
+// (collide()'s own, collide_pairs.h), direction from A to B. Witness points are the cores' points
+// pushed out by the radii.
+void roundContact(Real ra, Real rb, const collide_pairs::RoundCores& cores,
+                  const Vec3& fallback_normal, const Ctx& ctx, Local& out) {
+    const Real d = cores.distance;
+    out.normal = d > kDirectionRelative * ctx.scale ? Vec3((cores.on_b - cores.on_a) / d)
+                                                     : fallback_normal;
     out.signed_distance = d - ra - rb;
-    out.point_a = ca + ra * out.normal;
-    out.point_b = cb - rb * out.normal;
+    out.point_a = cores.on_a + ra * out.normal;
+    out.point_b = cores.on_b - rb * out.normal;
 }
 
 }  // namespace
@@ -32,41 +33,34 @@ void roundContact(Real ra, Real rb, const Vec3& ca, const Vec3& cb, const Vec3& 
 CollideOutput sphereSphere(const Shape& a, const Shape& b, const RelativePose& rel,
                            const Ctx& ctx, Local& out) {
     // Coincident centres: A's local +x.
-    roundContact(a.radius, b.radius, Vec3::Zero(), rel.position, Vec3::UnitX(), ctx, out);
+    roundContact(a.radius, b.radius, collide_pairs::sphereSphereCores(rel), Vec3::UnitX(), ctx,
+                 out);
     out.feature_a = {FeatureType::Face, 0};
     out.feature_b = {FeatureType::Face, 0};
-    return collide_pairs::sphereSphere(a, b, rel, ctx);
+    return classifySignedDistance(out.signed_distance, ctx.tolerance);
 }
 
-// RTCD 5.1.2: sphere centre against the capsule's segment.
 CollideOutput sphereCapsule(const Shape& a, const Shape& b, const RelativePose& rel,
                             const Ctx& ctx, Local& out) {
-    const Vec3 centre_in_b = toB(rel, Vec3::Zero());
-    const Real y = std::clamp(centre_in_b.y(), -b.half_height, b.half_height);
-    const Vec3 on_axis = rel.rotation * Vec3(0, y, 0) + rel.position;
     // Centre on the axis: the sphere leaves along B's local -x (so the normal is B's +x).
-    roundContact(a.radius, b.radius, Vec3::Zero(), on_axis, rel.rotation.col(0), ctx, out);
+    roundContact(a.radius, b.radius, collide_pairs::sphereCapsuleCores(b, rel),
+                 rel.rotation.col(0), ctx, out);
     out.feature_a = {FeatureType::Face, 0};
-    if (centre_in_b.y() < -b.half_height) {
+    const Real y = toB(rel, Vec3::Zero()).y();
+    if (y < -b.half_height) {
         out.feature_b = {FeatureType::Vertex, 0};
-    } else if (centre_in_b.y() > b.half_height) {
+    } else if (y > b.half_height) {
         out.feature_b = {FeatureType::Vertex, 1};
     } else {
         out.feature_b = {FeatureType::Edge, 0};
     }
-    return collide_pairs::sphereCapsule(a, b, rel, ctx);
+    return classifySignedDistance(out.signed_distance, ctx.tolerance);
 }
 
 CollideOutput capsuleCapsule(const Shape& a, const Shape& b, const RelativePose& rel,
                              const Ctx& ctx, Local& out) {
-    const Vec3 pa(0, -a.half_height, 0);
-    const Vec3 qa(0, a.half_height, 0);
+    const collide_pairs::RoundCores cores = collide_pairs::capsuleCapsuleCores(a, b, rel, ctx);
     const Vec3 axis_b = rel.rotation.col(1);
-    const Vec3 pb = rel.position - b.half_height * axis_b;
-    const Vec3 qb = rel.position + b.half_height * axis_b;
-    const SegmentParameters st = closestSegmentSegment(pa, qa, pb, qb, kEpsilon * ctx.scale);
-    const Vec3 ca = pa + st.s * (qa - pa);
-    const Vec3 cb = pb + st.t * (qb - pb);
     // Crossing axes: the common perpendicular (towards B's centre); parallel axes: the component
     // of B's centre off A's axis, else A's local +x.
     Vec3 fallback = Vec3::UnitY().cross(axis_b);
@@ -78,27 +72,26 @@ CollideOutput capsuleCapsule(const Shape& a, const Shape& b, const RelativePose&
         fallback = len > kDirectionRelative * ctx.scale ? Vec3(fallback / len) : Vec3::UnitX();
     }
     if (fallback.dot(rel.position) < 0) fallback = -fallback;
-    roundContact(a.radius, b.radius, ca, cb, fallback, ctx, out);
+    roundContact(a.radius, b.radius, cores, fallback, ctx, out);
     const Real tol = kFeatureRelative * ctx.scale;
-    out.feature_a = capsuleFeature(a.half_height, ca, tol);
-    out.feature_b = capsuleFeature(b.half_height, toB(rel, cb), tol);
-    return collide_pairs::capsuleCapsule(a, b, rel, ctx);
+    out.feature_a = capsuleFeature(a.half_height, cores.on_a, tol);
+    out.feature_b = capsuleFeature(b.half_height, toB(rel, cores.on_b), tol);
+    return classifySignedDistance(out.signed_distance, ctx.tolerance);
 }
 
-// RTCD 5.1.3: the sphere centre clamped to the box (box frame); inside, the nearest face.
-CollideOutput sphereBox(const Shape& a, const Shape& b, const RelativePose& rel,
-                        const Ctx& ctx, Local& out) {
-    const Vec3 c = toB(rel, Vec3::Zero());
+CollideOutput sphereBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
+                        Local& out) {
+    const collide_pairs::SphereBoxCore core = collide_pairs::sphereBoxCore(a, b, rel);
+    const Vec3& c = core.centre;
+    const Vec3& q = core.clamped;
     const Vec3& h = b.half_extents;
-    const Vec3 q = c.cwiseMax(-h).cwiseMin(h);
-    const Vec3 outside = c - q;
     const Real tol = kFeatureRelative * ctx.scale;
     out.feature_a = {FeatureType::Face, 0};
-    if (!outside.isZero()) {
-        const Real d = outside.norm();
-        const Vec3 n_b = -outside / d;  // from the sphere towards the box, B's frame
+    out.signed_distance = core.signed_distance;
+    if (!core.inside) {
+        const Vec3 outside = c - q;
+        const Vec3 n_b = -outside / outside.norm();  // from the sphere towards the box, B's frame
         out.normal = rel.rotation * n_b;
-        out.signed_distance = d - a.radius;
         out.point_a = a.radius * out.normal;
         out.point_b = rel.rotation * q + rel.position;
         // Only the clamped coordinates lie on the box boundary.
@@ -107,21 +100,18 @@ CollideOutput sphereBox(const Shape& a, const Shape& b, const RelativePose& rel,
             if (outside[k] == 0) probe[k] = std::clamp(q[k], -h[k] + 2 * tol, h[k] - 2 * tol);
         }
         out.feature_b = boxFeature(h, probe, tol);
-        return collide_pairs::sphereBox(a, b, rel, ctx);
+    } else {
+        // Leave through the nearest face (sign(0) = +).
+        const int k = core.face_axis;
+        const Real s = signOrPlus(c[k]);
+        out.normal = rel.rotation * Vec3(-s * Vec3::Unit(k));
+        out.point_a = a.radius * out.normal;
+        Vec3 on_face = c;
+        on_face[k] = s * h[k];
+        out.point_b = rel.rotation * on_face + rel.position;
+        out.feature_b = {FeatureType::Face, 2 * k + (s > 0 ? 1 : 0)};
     }
-    // Inside: leave through the nearest face (ties: lowest axis; sign(0) = +).
-    int k = 0;
-    const Vec3 gap = h - c.cwiseAbs();
-    gap.minCoeff(&k);
-    const Real s = signOrPlus(c[k]);
-    out.normal = rel.rotation * Vec3(-s * Vec3::Unit(k));
-    out.signed_distance = -(gap[k] + a.radius);
-    out.point_a = a.radius * out.normal;
-    Vec3 on_face = c;
-    on_face[k] = s * h[k];
-    out.point_b = rel.rotation * on_face + rel.position;
-    out.feature_b = {FeatureType::Face, 2 * k + (s > 0 ? 1 : 0)};
-    return collide_pairs::sphereBox(a, b, rel, ctx);
+    return classifySignedDistance(out.signed_distance, ctx.tolerance);
 }
 
 }  // namespace collision::contact_pairs

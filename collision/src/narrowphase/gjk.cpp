@@ -13,6 +13,7 @@
 #include <cmath>
 #include <limits>
 #include <type_traits>
+#include <variant>
 
 #include "collision/assert.h"
 #include "geometry/closest_points.h"
@@ -84,6 +85,13 @@ Real maxNorm(const Simplex<Vertex>& s) {
 struct GjkDistanceRun : GjkSummary {
     Simplex<Vec3> simplex;
 };
+// (v.w, |v|^2) of each iteration's separating plane; left uninitialised (only the logged
+// entries are read).
+struct PlaneLog {
+    std::array<Real, kGjkMaxIterations> vw;
+    std::array<Real, kGjkMaxIterations> vv;
+};
+
 template <class Vertex>
 using GjkRun = std::conditional_t<std::is_same_v<Vertex, Vec3>, GjkDistanceRun, GjkWitnessOutput>;
 
@@ -106,7 +114,19 @@ GjkRun<Vertex> runGjk(const ConvexCore& a, const ConvexCore& b, const RelativePo
         out.point_a = s.v[0].a;
         out.point_b = s.v[0].b;
     }
+    // The separating planes' lower bound: gjkDistance keeps it as it goes; gjkWitness logs the
+    // planes and evaluates the same expression in the same order only when it is read (Failed,
+    // decideConvexCores), so both report the same value without a square root per iteration.
+    std::conditional_t<kWitness, PlaneLog, std::monostate> planes;
+    int plane_count = 0;
     auto finish = [&](GjkState state, Real distance) {
+        if constexpr (kWitness) {
+            if (state == GjkState::Failed) {
+                for (int i = 0; i < plane_count; ++i) {
+                    out.lower_bound = std::max(out.lower_bound, planes.vw[i] / std::sqrt(planes.vv[i]));
+                }
+            }
+        }
         out.state = state;
         out.distance = distance;
         out.closest = v;
@@ -125,7 +145,13 @@ GjkRun<Vertex> runGjk(const ConvexCore& a, const ConvexCore& b, const RelativePo
         const Real vw = v.dot(pointOf(w));
         // Every point x of A - B has v.x >= v.w, so distance >= v.w / |v| (a separating plane);
         // decideConvexCores uses it when the iteration cap is hit.
-        out.lower_bound = std::max(out.lower_bound, vw / std::sqrt(vv));
+        if constexpr (kWitness) {
+            planes.vw[plane_count] = vw;
+            planes.vv[plane_count] = vv;
+            ++plane_count;
+        } else {
+            out.lower_bound = std::max(out.lower_bound, vw / std::sqrt(vv));
+        }
         // van den Bergen 1999 §4: |v|^2 - v.w bounds |v|^2 - |v| dist(origin, A - B).
         if (vv - vw <= kGjkRelativeTolerance * vv) {
             return finish(GjkState::Separated, std::sqrt(vv));

@@ -43,6 +43,11 @@ struct RelativePose {
     Vec3 position = Vec3::Zero();
 };
 
+/// A point of A's frame in B's frame.
+inline Vec3 toB(const RelativePose& b_in_a, const Vec3& p_in_a) {
+    return b_in_a.rotation.transpose() * (p_in_a - b_in_a.position);
+}
+
 /// pose_a^-1 * pose_b, subtracting positions first so that far-from-origin poses lose nothing
 /// to the translation (metamorphic tests translate scenes by 1e6).
 RelativePose relativePose(const Pose& pose_a, const Pose& pose_b);
@@ -56,8 +61,9 @@ struct GjkSummary {
     /// when Failed; 0 when Overlapping.
     Real distance = 0;
     /// Lower bound on the core distance from GJK's separating planes (may be <= 0; 0 when
-    /// Overlapping). The same in both queries: gjkDistance and gjkWitness run one loop whose
-    /// iterates (w, v, simplex) are bit-identical; gjkWitness only keeps a and b beside w.
+    /// Overlapping). gjkDistance and gjkWitness run one loop whose iterates (w, v, simplex) are
+    /// bit-identical (gjkWitness only keeps a and b beside w); gjkWitness evaluates this bound
+    /// only when Failed (-inf otherwise, Overlapping aside), where it is the same as gjkDistance's.
     Real lower_bound = 0;
     std::int32_t iterations = 0;
     /// The point of the final simplex nearest the origin (GJK's v), A's frame: the closest

@@ -5,6 +5,8 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
+#include <cstddef>
 #include <cmath>
 #include <limits>
 
@@ -63,8 +65,11 @@ inline bool testSat15(const Vec3& a, const Mat3& rot, const Vec3& t, const Vec3&
 /// of half size s, theta = 1e-7, 1e-7 s apart were Penetrating while a 1e-6 cut-off skipped their
 /// axis; tests/collision/extremes_test.cpp).
 struct BoxSatMeasure {
-    Real gap_lo = -std::numeric_limits<Real>::infinity();  ///< max over axes of sep - err
-    Real gap_hi = -std::numeric_limits<Real>::infinity();  ///< max over axes of sep + err
+    static constexpr int kMaxAxes = 15;
+    std::array<Real, kMaxAxes> sep{};  ///< per measured axis
+    std::array<Real, kMaxAxes> mag{};  ///< |t.L| + ra + rb: err = 8 eps mag
+    int axis_count = 0;
+    Real max_sep = -std::numeric_limits<Real>::infinity();   ///< max of face_sep, edge_sep
     Real face_sep = -std::numeric_limits<Real>::infinity();  ///< best of the 6 face axes
     int face_box = 0;                                        ///< 0: a face of A, 1: of B
     int face_axis = 0;
@@ -72,6 +77,23 @@ struct BoxSatMeasure {
     int edge_a = 0;                                          ///< A's edge direction (axis index)
     int edge_b = 0;                                          ///< B's edge direction
     Vec3 edge_axis = Vec3::Zero();                           ///< unit, A's frame
+    /// At least every axis's err, twice over: 16 eps (|t| + |ea| + |eb|) (|L| = 1 up to
+    /// rounding), for the decisions that need no per-axis bound.
+    Real err_bound = 0;
+
+    static Real err(Real m) { return Real(8) * kEpsilon * m; }
+    /// Max over the axes of sep - err: the largest gap the axes prove.
+    Real gapLo() const {
+        Real g = -std::numeric_limits<Real>::infinity();
+        for (int k = 0; k < axis_count; ++k) g = std::max(g, sep[k] - err(mag[k]));
+        return g;
+    }
+    /// Max over the axes of sep + err: below -tolerance, every axis proves the overlap.
+    Real gapHi() const {
+        Real g = -std::numeric_limits<Real>::infinity();
+        for (int k = 0; k < axis_count; ++k) g = std::max(g, sep[k] + err(mag[k]));
+        return g;
+    }
 };
 
 /// Measures the 15 axes in A's box frame: `ea`, `eb` half extents, `rot` B's axes in A's frame,
@@ -80,11 +102,12 @@ inline BoxSatMeasure measureBoxSat(const Vec3& ea, const Mat3& rot, const Vec3& 
                                    const Vec3& eb) {
     constexpr Real kParallelCross = std::numeric_limits<Real>::min();
     BoxSatMeasure m;
-    auto record = [&m](Real dist, Real ra, Real rb) {
+    int n = 0;
+    auto record = [&m, &n](Real dist, Real ra, Real rb) {
         const Real sep = dist - ra - rb;
-        const Real err = Real(8) * kEpsilon * (dist + ra + rb);
-        m.gap_lo = std::max(m.gap_lo, sep - err);
-        m.gap_hi = std::max(m.gap_hi, sep + err);
+        m.sep[static_cast<std::size_t>(n)] = sep;
+        m.mag[static_cast<std::size_t>(n)] = dist + ra + rb;
+        ++n;
         return sep;
     };
     for (int i = 0; i < 3; ++i) {
@@ -120,6 +143,9 @@ inline BoxSatMeasure measureBoxSat(const Vec3& ea, const Mat3& rot, const Vec3& 
             }
         }
     }
+    m.axis_count = n;
+    m.max_sep = std::max(m.face_sep, m.edge_sep);
+    m.err_bound = Real(16) * kEpsilon * (t.norm() + ea.norm() + eb.norm());
     return m;
 }
 
