@@ -261,6 +261,8 @@ CollideOutput boxBox(const Shape& a, const Shape& b, const RelativePose& rel, co
     }
     const CollideOutput decision =
         collide_pairs::refineBoxState(convexConvex(a, b, rel, ctx, out), sat, ctx.tolerance);
+    // satDetails needs its best axis within the tolerance.
+    if (sat.face_sep > ctx.tolerance && sat.edge_sep > ctx.tolerance) return decision;
     Local details;
     details.state = ContactState::Touching;
     if (satDetails(a, b, rel, ctx, sat, details)) {

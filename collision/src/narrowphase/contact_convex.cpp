@@ -77,26 +77,33 @@ CollideOutput convexConvex(const Shape& a, const Shape& b, const RelativePose& r
     const ConvexCore cb = ConvexCore::fromShape(b);
     const Real radii = ca.radius + cb.radius;
     const GjkWitnessOutput g = gjkWitness(ca, cb, rel, ctx.scale);
-    // collide()'s decision on this very GJK run (its w's are gjkDistance's, bit for bit).
-    std::array<Vec3, 4> simplex{};
-    for (int i = 0; i < g.simplex.n; ++i) simplex[static_cast<std::size_t>(i)] = g.simplex.v[i].w;
-    const CollideOutput decision = decideConvexCores(
-        g, simplex.data(), g.simplex.n, MinkowskiDifference{ca, cb, rel}, radii, ctx.tolerance,
-        ctx.scale);
-    out.iterations = decision.iterations;
+    // collide()'s decision on this very GJK run (its w's are gjkDistance's, bit for bit), told
+    // what the full EPA's first iteration found when that ran.
+    auto decide = [&](Real start_closest) {
+        std::array<Vec3, 4> simplex{};
+        for (int i = 0; i < g.simplex.n; ++i) {
+            simplex[static_cast<std::size_t>(i)] = g.simplex.v[static_cast<std::size_t>(i)].w;
+        }
+        return decideConvexCores(g, simplex.data(), g.simplex.n, MinkowskiDifference{ca, cb, rel},
+                                 radii, ctx.tolerance, ctx.scale, start_closest);
+    };
+    out.iterations = g.iterations;
     Vec3 core_a;
     Vec3 core_b;
+    CollideOutput decision;
     if (g.state == GjkState::Separated && g.distance > kNormalRelative * ctx.scale) {
+        decision = decide(std::numeric_limits<Real>::quiet_NaN());
         core_a = g.point_a;
         core_b = g.point_b;
         out.normal = (core_b - core_a).normalized();  // length ~ distance > 0, checked above
         out.signed_distance = g.distance - radii;
     } else if (g.state == GjkState::Failed) {
         out.state = ContactState::Failed;
-        return decision;
+        return decide(std::numeric_limits<Real>::quiet_NaN());
     } else {
         const EpaOutput e = epaPenetration(ca, cb, rel, g.simplex, ctx.scale);
-        out.iterations += e.iterations;
+        decision = decide(e.start_closest);
+        out.iterations += e.iterations + (decision.iterations - g.iterations);
         // EPA started from a simplex without the origin (GJK stopped Separated, tiny gap) ends on
         // a face the origin lies outside of: a negative "depth" whose witnesses are not closest
         // points (point_b - point_a was off signed_distance * normal by more than the gap) and

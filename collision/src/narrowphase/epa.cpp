@@ -125,25 +125,14 @@ EpaOutput epaPenetration(const ConvexCore& a, const ConvexCore& b, const Relativ
         }
     }
 
-    // Outward orientation of the tetrahedron (RTCD 5.1.6 face order).
-    if ((poly.vert[1].w - poly.vert[0].w)
-            .cross(poly.vert[2].w - poly.vert[0].w)
-            .dot(poly.vert[3].w - poly.vert[0].w) > 0) {
-        std::swap(poly.vert[1], poly.vert[2]);
-    }
-    poly.addFace(0, 1, 2);
-    poly.addFace(0, 3, 1);
-    poly.addFace(0, 2, 3);
-    poly.addFace(1, 3, 2);
-
+    const bool started_as_tetrahedron = out.iterations == 0;
+    poly.closeTetrahedron();
     std::array<std::array<int, 2>, 3 * kMaxFaces> edges;  // the first edge_count are set
     for (int iter = 0; iter < kEpaMaxIterations; ++iter) {
         ++out.iterations;
-        int best = -1;
-        for (int f = 0; f < poly.face_count; ++f) {
-            const Face& face = poly.faces[static_cast<std::size_t>(f)];
-            if (!face.valid || face.normal.isZero()) continue;
-            if (best < 0 || face.dist < poly.faces[static_cast<std::size_t>(best)].dist) best = f;
+        const int best = poly.closestFace();
+        if (iter == 0 && started_as_tetrahedron && best >= 0) {
+            out.start_closest = poly.faces[static_cast<std::size_t>(best)].dist;
         }
         if (best < 0) {
             out.state = EpaState::Failed;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <limits>
 
 #include "collision/math.h"
 #include "narrowphase/gjk.h"
@@ -25,6 +26,10 @@ struct EpaOutput {
     Vec3 point_a = Vec3::Zero();  ///< deepest point of core A along normal, A's frame
     Vec3 point_b = Vec3::Zero();  ///< deepest point of core B along -normal, A's frame
     std::int32_t iterations = 0;
+    /// When `start` was a tetrahedron: the distance from the origin of its nearest face, as the
+    /// first iteration found it; NaN otherwise (and when every face is degenerate). For
+    /// decideConvexCores (gjk.h).
+    Real start_closest = std::numeric_limits<Real>::quiet_NaN();
 };
 
 /// EPA iteration cap (expansions of the polytope).

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <utility>
 #include <cstddef>
 #include <limits>
 
@@ -50,6 +51,30 @@ struct EpaPolytope {
             f.dist = std::numeric_limits<Real>::infinity();
         }
         return true;
+    }
+
+    /// Closes the first four vertices (a tetrahedron) into four outward faces (RTCD 5.1.6 face
+    /// order), swapping vertices 1 and 2 when they are wound inwards.
+    void closeTetrahedron() {
+        const Vec3& p0 = point(0);
+        if ((point(1) - p0).cross(point(2) - p0).dot(point(3) - p0) > 0) {
+            std::swap(vert[1], vert[2]);
+        }
+        addFace(0, 1, 2);
+        addFace(0, 3, 1);
+        addFace(0, 2, 3);
+        addFace(1, 3, 2);
+    }
+
+    /// The valid, non-degenerate face nearest the origin (lowest index among equals), or -1.
+    int closestFace() const {
+        int best = -1;
+        for (int f = 0; f < face_count; ++f) {
+            const Face& face = faces[static_cast<std::size_t>(f)];
+            if (!face.valid || face.normal.isZero()) continue;
+            if (best < 0 || face.dist < faces[static_cast<std::size_t>(best)].dist) best = f;
+        }
+        return best;
     }
 };
 

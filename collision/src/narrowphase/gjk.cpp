@@ -252,24 +252,10 @@ ContactState epaDecide(const MinkowskiDifference& cso, const Simplex<Vec3>& star
         if (!grown) return ContactState::Touching;  // flat CSO: zero depth
     }
 
-    // Outward orientation of the initial tetrahedron (see RTCD 5.1.6 face order).
-    const Vec3& v0 = poly.vert[0];
-    if ((poly.vert[1] - v0).cross(poly.vert[2] - v0).dot(poly.vert[3] - v0) > 0) {
-        std::swap(poly.vert[1], poly.vert[2]);
-    }
-    poly.addFace(0, 1, 2);
-    poly.addFace(0, 3, 1);
-    poly.addFace(0, 2, 3);
-    poly.addFace(1, 3, 2);
-
+    poly.closeTetrahedron();
     for (int iter = 0; iter < kGjkMaxIterations; ++iter) {
         ++iterations;
-        int best = -1;
-        for (int f = 0; f < poly.face_count; ++f) {
-            const DecidePolytope::Face& face = poly.faces[f];
-            if (!face.valid || face.normal.isZero()) continue;
-            if (best < 0 || face.dist < poly.faces[best].dist) best = f;
-        }
+        const int best = poly.closestFace();
         if (best < 0) return ContactState::Failed;
         const DecidePolytope::Face closest = poly.faces[best];
         // The origin lies inside the polytope (inside the CSO), so depth >= closest plane
@@ -461,7 +447,7 @@ CollideOutput classifySignedDistance(Real signed_distance, Real tolerance) {
 
 CollideOutput decideConvexCores(const GjkSummary& g, const Vec3* simplex, int simplex_count,
                                 const MinkowskiDifference& cso, Real radii, Real tolerance,
-                                Real scale) {
+                                Real scale, Real start_closest) {
     CollideOutput out;
     switch (g.state) {
         case GjkState::Separated:
@@ -471,6 +457,10 @@ CollideOutput decideConvexCores(const GjkSummary& g, const Vec3* simplex, int si
         case GjkState::Overlapping:
             if (radii > tolerance) {
                 out.state = ContactState::Penetrating;  // depth >= radii
+            } else if (simplex_count == 4 && start_closest > tolerance - radii) {
+                // The bounded EPA's first iteration on these very faces decides so.
+                out.state = ContactState::Penetrating;
+                out.iterations += 1;
             } else {
                 Simplex<Vec3> start;
                 start.n = simplex_count;

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <type_traits>
 
 #include "collision/geometry/shape.h"
@@ -157,10 +158,14 @@ CollideOutput classifySignedDistance(Real signed_distance, Real tolerance);
 /// bounded EPA decision when the cores overlap and the radii are below `tolerance`, or what GJK's
 /// bounds prove when it hit its cap. Touching when |signed distance| <= tolerance. collide() and
 /// contact() both decide convex pairs here, on bit-identical GJK runs, so their states agree by
-/// construction.
+/// construction. `start_closest`, when the caller has it, is the distance from the origin of the
+/// nearest face of the tetrahedron `simplex` closed by EpaPolytope::closeTetrahedron (the full
+/// EPA's first iteration, epa.h): the bounded EPA's first iteration computes the same number from
+/// the same faces, so the decision is the same and that iteration is skipped.
 CollideOutput decideConvexCores(const GjkSummary& g, const Vec3* simplex, int simplex_count,
                                 const MinkowskiDifference& cso, Real radii, Real tolerance,
-                                Real scale);
+                                Real scale,
+                                Real start_closest = std::numeric_limits<Real>::quiet_NaN());
 
 /// gjkDistance, then decideConvexCores.
 CollideOutput collideConvexCores(const ConvexCore& a, const ConvexCore& b,

@@ -64,10 +64,37 @@ inline bool testSat15(const Vec3& a, const Mat3& rot, const Vec3& t, const Vec3&
 /// an angle theta the face axes miss the edge axis's gap by up to |e| sin(theta) (two cube ridges
 /// of half size s, theta = 1e-7, 1e-7 s apart were Penetrating while a 1e-6 cut-off skipped their
 /// axis; tests/collision/extremes_test.cpp).
+// Calls visit(dist, ra, rb, axis, id) for each measured axis (unit L, A's frame): face axes of A
+// (id 0..2), face axes of B (3..5), then the edge axes A_i x B_j (6 + 3 i + j), with dist = |t.L|
+// and ra, rb the boxes' projection radii.
+template <class Visit>
+inline void forEachBoxSatAxis(const Vec3& ea, const Mat3& rot, const Vec3& t, const Vec3& eb,
+                              Visit&& visit) {
+    constexpr Real kParallelCross = std::numeric_limits<Real>::min();
+    for (int i = 0; i < 3; ++i) {
+        visit(std::abs(t[i]), ea[i], eb.dot(rot.row(i).transpose().cwiseAbs()), Vec3::Unit(i), i);
+    }
+    for (int j = 0; j < 3; ++j) {
+        const Vec3 axis = rot.col(j);
+        visit(std::abs(t.dot(axis)), ea.dot(axis.cwiseAbs()), eb[j], axis, 3 + j);
+    }
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+            const Vec3 axis = Vec3::Unit(i).cross(rot.col(j));
+            const Real len2 = axis.squaredNorm();
+            if (!(len2 >= kParallelCross)) continue;
+            const Vec3 unit = axis / std::sqrt(len2);
+            visit(std::abs(t.dot(unit)), ea.dot(unit.cwiseAbs()),
+                  eb.dot((rot.transpose() * unit).cwiseAbs()), unit, 6 + 3 * i + j);
+        }
+    }
+}
+
 struct BoxSatMeasure {
     static constexpr int kMaxAxes = 15;
-    std::array<Real, kMaxAxes> sep{};  ///< per measured axis
-    std::array<Real, kMaxAxes> mag{};  ///< |t.L| + ra + rb: err = 8 eps mag
+    // Only the first axis_count entries are set (no zeroing on the hot path).
+    std::array<Real, kMaxAxes> sep;  ///< per measured axis: |t.L| - ra - rb
+    std::array<Real, kMaxAxes> mag;  ///< |t.L| + ra + rb: that axis's err is 8 eps mag
     int axis_count = 0;
     Real max_sep = -std::numeric_limits<Real>::infinity();   ///< max of face_sep, edge_sep
     Real face_sep = -std::numeric_limits<Real>::infinity();  ///< best of the 6 face axes
@@ -77,21 +104,22 @@ struct BoxSatMeasure {
     int edge_a = 0;                                          ///< A's edge direction (axis index)
     int edge_b = 0;                                          ///< B's edge direction
     Vec3 edge_axis = Vec3::Zero();                           ///< unit, A's frame
-    /// At least every axis's err, twice over: 16 eps (|t| + |ea| + |eb|) (|L| = 1 up to
-    /// rounding), for the decisions that need no per-axis bound.
+    /// At least every axis's err, twice over: 16 eps (|t|_1 + |ea|_1 + |eb|_1), since
+    /// |t.L| + ra + rb <= |t| + |ea| + |eb| for |L| = 1 (up to rounding); for the decisions that
+    /// need no per-axis bound.
     Real err_bound = 0;
 
-    static Real err(Real m) { return Real(8) * kEpsilon * m; }
     /// Max over the axes of sep - err: the largest gap the axes prove.
-    Real gapLo() const {
-        Real g = -std::numeric_limits<Real>::infinity();
-        for (int k = 0; k < axis_count; ++k) g = std::max(g, sep[k] - err(mag[k]));
-        return g;
-    }
+    Real gapLo() const { return gap(-1); }
     /// Max over the axes of sep + err: below -tolerance, every axis proves the overlap.
-    Real gapHi() const {
+    Real gapHi() const { return gap(1); }
+
+private:
+    Real gap(Real sign) const {
         Real g = -std::numeric_limits<Real>::infinity();
-        for (int k = 0; k < axis_count; ++k) g = std::max(g, sep[k] + err(mag[k]));
+        for (std::size_t k = 0; k < static_cast<std::size_t>(axis_count); ++k) {
+            g = std::max(g, sep[k] + sign * (Real(8) * kEpsilon * mag[k]));
+        }
         return g;
     }
 };
@@ -100,52 +128,28 @@ struct BoxSatMeasure {
 /// `t` B's centre there.
 inline BoxSatMeasure measureBoxSat(const Vec3& ea, const Mat3& rot, const Vec3& t,
                                    const Vec3& eb) {
-    constexpr Real kParallelCross = std::numeric_limits<Real>::min();
     BoxSatMeasure m;
-    int n = 0;
-    auto record = [&m, &n](Real dist, Real ra, Real rb) {
+    forEachBoxSatAxis(ea, rot, t, eb, [&m](Real dist, Real ra, Real rb, const Vec3& axis, int id) {
         const Real sep = dist - ra - rb;
-        m.sep[static_cast<std::size_t>(n)] = sep;
-        m.mag[static_cast<std::size_t>(n)] = dist + ra + rb;
-        ++n;
-        return sep;
-    };
-    for (int i = 0; i < 3; ++i) {
-        const Real sep = record(std::abs(t[i]), ea[i], eb.dot(rot.row(i).transpose().cwiseAbs()));
-        if (sep > m.face_sep) {
-            m.face_sep = sep;
-            m.face_box = 0;
-            m.face_axis = i;
-        }
-    }
-    for (int j = 0; j < 3; ++j) {
-        const Vec3 axis = rot.col(j);
-        const Real sep = record(std::abs(t.dot(axis)), ea.dot(axis.cwiseAbs()), eb[j]);
-        if (sep > m.face_sep) {
-            m.face_sep = sep;
-            m.face_box = 1;
-            m.face_axis = j;
-        }
-    }
-    for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j) {
-            const Vec3 axis = Vec3::Unit(i).cross(rot.col(j));
-            const Real len2 = axis.squaredNorm();
-            if (!(len2 >= kParallelCross)) continue;
-            const Vec3 unit = axis / std::sqrt(len2);
-            const Real sep = record(std::abs(t.dot(unit)), ea.dot(unit.cwiseAbs()),
-                                    eb.dot((rot.transpose() * unit).cwiseAbs()));
-            if (sep > m.edge_sep) {
-                m.edge_sep = sep;
-                m.edge_a = i;
-                m.edge_b = j;
-                m.edge_axis = unit;
+        m.sep[static_cast<std::size_t>(m.axis_count)] = sep;
+        m.mag[static_cast<std::size_t>(m.axis_count)] = dist + ra + rb;
+        ++m.axis_count;
+        if (id < 6) {
+            if (sep > m.face_sep) {
+                m.face_sep = sep;
+                m.face_box = id < 3 ? 0 : 1;
+                m.face_axis = id % 3;
             }
+        } else if (sep > m.edge_sep) {
+            m.edge_sep = sep;
+            m.edge_a = (id - 6) / 3;
+            m.edge_b = (id - 6) % 3;
+            m.edge_axis = axis;
         }
-    }
-    m.axis_count = n;
+    });
     m.max_sep = std::max(m.face_sep, m.edge_sep);
-    m.err_bound = Real(16) * kEpsilon * (t.norm() + ea.norm() + eb.norm());
+    m.err_bound = Real(16) * kEpsilon *
+                  (t.lpNorm<1>() + ea.lpNorm<1>() + eb.lpNorm<1>());  // 1-norms >= 2-norms
     return m;
 }
 
