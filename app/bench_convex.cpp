@@ -28,6 +28,8 @@
 #include "collision/narrowphase/contact.h"
 #include "collision/narrowphase/contact_reference.h"
 #include "collision/narrowphase/narrow_phase.h"
+#include "collision/test_random.h"
+#include "collision/test_shapes.h"
 #include "command.h"
 #include "output_files.h"
 
@@ -75,40 +77,8 @@ struct Workload {
     Want want;
 };
 
-class Random {
-public:
-    explicit Random(std::uint64_t seed) : engine_(seed) {}
-    Real uniform(Real lo, Real hi) { return std::uniform_real_distribution<Real>(lo, hi)(engine_); }
-    Vec3 vec(Real lo, Real hi) { return Vec3(uniform(lo, hi), uniform(lo, hi), uniform(lo, hi)); }
-    Quat rotation() {  // Shoemake
-        const Real u1 = uniform(0, 1);
-        const Real u2 = uniform(0, 2 * Real(M_PI));
-        const Real u3 = uniform(0, 2 * Real(M_PI));
-        const Real a = std::sqrt(1 - u1);
-        const Real b = std::sqrt(u1);
-        return Quat(a * std::sin(u2), a * std::cos(u2), b * std::sin(u3), b * std::cos(u3))
-            .normalized();
-    }
-
-private:
-    std::mt19937_64 engine_;
-};
-
-Real boundingRadius(const Shape& s) {
-    switch (s.type) {
-        case ShapeType::Sphere:
-            return s.radius;
-        case ShapeType::Box:
-            return s.half_extents.norm();
-        case ShapeType::Capsule:
-            return s.radius + s.half_height;
-        default: {
-            Real r = 0;
-            for (const Vec3& v : s.hull->vertices) r = std::max(r, v.norm());
-            return r;
-        }
-    }
-}
+using Random = cdlab_test::Rng;
+using cdlab_test::boundingRadius;
 
 Shape randomShape(ShapeType type, Random& rng) {
     switch (type) {

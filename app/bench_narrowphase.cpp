@@ -25,6 +25,7 @@
 
 #include "bvh_unit_costs.h"
 #include "collision/bvh/bvh.h"
+#include "collision/test_meshes.h"
 #include "command.h"
 #include "output_files.h"
 
@@ -56,27 +57,7 @@ double secondsSince(Clock::time_point t) {
 
 // A torus around local z, ring radius 1, tube radius 0.4: nu segments around the ring, nv around
 // the tube, 2 nu nv triangles.
-TriangleMesh makeTorus(int nu, int nv) {
-    constexpr Real kRing = 1.0;
-    constexpr Real kTube = 0.4;
-    TriangleMesh m;
-    for (int i = 0; i < nu; ++i) {
-        const Real u = 2 * std::numbers::pi_v<Real> * i / nu;
-        for (int j = 0; j < nv; ++j) {
-            const Real v = 2 * std::numbers::pi_v<Real> * j / nv;
-            const Real w = kRing + kTube * std::cos(v);
-            m.vertices.emplace_back(w * std::cos(u), w * std::sin(u), kTube * std::sin(v));
-        }
-    }
-    auto id = [&](int i, int j) { return static_cast<std::int32_t>((i % nu) * nv + (j % nv)); };
-    for (int i = 0; i < nu; ++i) {
-        for (int j = 0; j < nv; ++j) {
-            m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-            m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-        }
-    }
-    return m;
-}
+TriangleMesh makeTorus(int nu, int nv) { return cdlab_test::makeTorusMesh(1.0, 0.4, nu, nv); }
 
 // One way of answering the two queries.
 class NarrowMethod {

@@ -16,8 +16,11 @@
 #include "collision/narrowphase/contact.h"
 #include "test_random.h"
 #include "test_scale.h"
+#include "test_shapes.h"
 
 namespace {
+
+using cdlab_test::boundingRadius;
 
 using collision::contact;
 using collision::ContactOutput;
@@ -60,22 +63,6 @@ Shape randomHull(cdlab_test::Rng& rng, Real size, int points) {
         p.push_back(size * v.normalized().cwiseProduct(stretch));
     }
     return hullOf(p);
-}
-
-Real boundingRadius(const Shape& s) {
-    switch (s.type) {
-        case ShapeType::Sphere:
-            return s.radius;
-        case ShapeType::Box:
-            return s.half_extents.norm();
-        case ShapeType::Capsule:
-            return s.half_height + s.radius;
-        default: {
-            Real r = 0;
-            for (const Vec3& v : s.hull->vertices) r = std::max(r, v.norm());
-            return r;
-        }
-    }
 }
 
 // Axis-aligned boxes: the overlap is the smallest per-axis interval overlap (exact), and the

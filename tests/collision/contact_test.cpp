@@ -20,8 +20,11 @@
 // Private narrow-phase headers (collision/src is on the test include path) for the caps.
 #include "narrowphase/epa.h"
 #include "test_random.h"
+#include "test_shapes.h"
 
 namespace {
+
+using cdlab_test::boundingRadius;
 
 using collision::collide;
 using collision::contact;
@@ -90,22 +93,6 @@ Real surfaceDistance(const Shape& s, const Pose& pose, const Vec3& world) {
         }
     }
     return 0;
-}
-
-Real boundingRadius(const Shape& s) {
-    switch (s.type) {
-        case ShapeType::Sphere:
-            return s.radius;
-        case ShapeType::Box:
-            return s.half_extents.norm();
-        case ShapeType::Capsule:
-            return s.half_height + s.radius;
-        default: {
-            Real r = 0;
-            for (const Vec3& v : s.hull->vertices) r = std::max(r, v.norm());
-            return r;
-        }
-    }
 }
 
 // Checks every output invariant of contact.h that holds for any pair: finite, unit normal,

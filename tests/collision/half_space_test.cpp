@@ -17,8 +17,11 @@
 #include "collision/geometry/convex_hull.h"
 #include "collision/narrowphase/narrow_phase.h"
 #include "test_random.h"
+#include "test_shapes.h"
 
 namespace {
+
+using cdlab_test::boundingRadius;
 
 using collision::contact;
 using collision::ContactOutput;
@@ -47,22 +50,6 @@ std::vector<Shape> shapesAt(Real s) {
     for (int i = 0; i < 12; ++i) pts.push_back(rng.vec(-1, 1).cwiseProduct(Vec3(1, 0.6, 0.8)) * s);
     return {Shape::sphere(Real(0.7) * s), Shape::box(Vec3(0.5, 0.3, 0.8) * s),
             Shape::capsule(Real(0.3) * s, Real(0.6) * s), Shape::convexHull(hullOf(pts))};
-}
-
-Real boundingRadius(const Shape& b) {
-    switch (b.type) {
-        case ShapeType::Sphere:
-            return b.radius;
-        case ShapeType::Box:
-            return b.half_extents.norm();
-        case ShapeType::Capsule:
-            return b.half_height + b.radius;
-        default: {
-            Real r = 0;
-            for (const Vec3& v : b.hull->vertices) r = std::max(r, v.norm());
-            return r;
-        }
-    }
 }
 
 // The brute-force reference: min over the shape's vertex set (box corners, hull vertices) of

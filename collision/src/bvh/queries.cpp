@@ -225,14 +225,7 @@ std::vector<TrianglePair> intersectSelf(const Bvh<BV>& tree, BvhQueryStats* stat
             }
             continue;
         }
-        const bool descend_a = nb.isLeaf() || (!na.isLeaf() && na.cost >= nb.cost);
-        if (descend_a) {
-            stack.emplace_back(na.right, ib);
-            stack.emplace_back(ia + 1, ib);
-        } else {
-            stack.emplace_back(ia, nb.right);
-            stack.emplace_back(ia, ib + 1);
-        }
+        pushChildrenOfLarger(stack, na, ia, nb, ib);
     }
     if (stats) {
         stats->bv_tests += bv_tests;

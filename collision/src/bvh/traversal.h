@@ -19,6 +19,21 @@
 
 namespace collision {
 
+/// The tandem descent rule (Gottschalk 1996 §5) for a node pair that is not two leaves: the node
+/// of larger cost is split, or the only internal one; both (child, other node) pairs are pushed,
+/// the right child's first, so the left child's pair is visited first.
+template <class Node, class Stack>
+void pushChildrenOfLarger(Stack& stack, const Node& na, std::int32_t ia, const Node& nb,
+                          std::int32_t ib) {
+    if (nb.isLeaf() || (!na.isLeaf() && na.cost >= nb.cost)) {
+        stack.emplace_back(na.right, ib);
+        stack.emplace_back(ia + 1, ib);
+    } else {
+        stack.emplace_back(ia, nb.right);
+        stack.emplace_back(ia, ib + 1);
+    }
+}
+
 // A traversal stack that lives on the call stack when the bound on its size fits (the usual
 // case: the bound is the sum of the tree depths), so a query allocates nothing; larger bounds
 // (very deep trees) fall back to the heap once per query.

@@ -9,6 +9,7 @@
 #include <memory>
 #include <vector>
 
+#include "bvh/traversal.h"
 #include "collision/bvh/bvh.h"
 #include "collision/ccd/ccd.h"
 #include "collision/geometry/shape.h"
@@ -128,14 +129,7 @@ MeshToiOutput timeOfImpactMeshes(const MeshToiInput& input) {
                 continue;
             }
             // Descend the larger volume (or the only internal node), as the discrete traversal.
-            const bool split_a = !na.isLeaf() && (nb.isLeaf() || na.cost >= nb.cost);
-            if (split_a) {
-                stack.emplace_back(na.right, ib);
-                stack.emplace_back(ia + 1, ib);
-            } else {
-                stack.emplace_back(ia, nb.right);
-                stack.emplace_back(ia, ib + 1);
-            }
+            pushChildrenOfLarger(stack, na, ia, nb, ib);
         }
     }
     return out;
