@@ -40,19 +40,31 @@ void faceOutput(const Polytope& poly, const Face& f, EpaOutput& out) {
     out.point_b = w[0] * p.b + w[1] * q.b + w[2] * r.b;
 }
 
-}  // namespace
+// Coplanar faces (a split face of the obstacle) share the distance of the face nearest the origin
+// (`closest`, up to `tol`); the origin's projection lies in the one whose own closest point to
+// the origin is nearest.
+Face faceHoldingProjection(const Polytope& poly, const Face& closest, Real tol) {
+    Face chosen = closest;
+    Real chosen2 = std::numeric_limits<Real>::infinity();
+    for (int f = 0; f < poly.face_count; ++f) {
+        const Face& face = poly.faces[static_cast<std::size_t>(f)];
+        if (!face.valid || face.normal.isZero() || face.dist > closest.dist + tol) continue;
+        std::array<Real, 3> wt{};
+        const Real d2 = closestOnTriangle(poly.point(face.v[0]), poly.point(face.v[1]),
+                                          poly.point(face.v[2]), wt)
+                            .squaredNorm();
+        if (d2 < chosen2) {
+            chosen2 = d2;
+            chosen = face;
+        }
+    }
+    return chosen;
+}
 
-EpaOutput epaPenetration(const ConvexCore& a, const ConvexCore& b, const RelativePose& b_in_a,
-                         const WitnessSimplex& start, Real scale) {
-    const MinkowskiDifference cso{a, b, b_in_a};
-    EpaOutput out;
-    Polytope poly;
-    poly.eps = std::max(Real(64) * kEpsilon * scale, std::numeric_limits<Real>::min());
-    const Real tol = std::max(kEpaRelativeTolerance * scale, std::numeric_limits<Real>::min());
-    for (int i = 0; i < start.n; ++i)
-        poly.vert[static_cast<std::size_t>(poly.vertex_count++)] =
-            start.v[static_cast<std::size_t>(i)];
-
+// Grows GJK's simplex (in `poly`, 1 to 4 vertices) to a tetrahedron by support points along
+// directions off its span. False when the answer is already in `out`: a flat obstacle (the
+// best probe's plane, Converged) or the cap (Failed).
+bool blowUpToTetrahedron(const MinkowskiDifference& cso, Polytope& poly, EpaOutput& out) {
     // Every probed direction n gives an upper bound h(n) on the depth; the best one answers when
     // the obstacle is flat (zero volume) and the polytope cannot grow to a tetrahedron.
     Real best_h = std::numeric_limits<Real>::infinity();
@@ -70,7 +82,7 @@ EpaOutput epaPenetration(const ConvexCore& a, const ConvexCore& b, const Relativ
     };
 
     while (poly.vertex_count < 4) {
-        if (++out.iterations > kEpaMaxIterations) return out;  // Failed
+        if (++out.iterations > kEpaMaxIterations) return false;  // Failed
         const Vec3 w0 = poly.vert[0].w;
         std::array<Vec3, 6> dirs{};
         int dir_count = 0;
@@ -121,13 +133,29 @@ EpaOutput epaPenetration(const ConvexCore& a, const ConvexCore& b, const Relativ
         if (!grown) {
             // Flat obstacle: the best probe's plane is the answer (depth 0 up to rounding).
             out.state = std::isfinite(best_h) ? EpaState::Converged : EpaState::Failed;
-            return out;
+            return false;
         }
     }
+    return true;
 
+}
+
+}  // namespace
+
+EpaOutput epaPenetration(const ConvexCore& a, const ConvexCore& b, const RelativePose& b_in_a,
+                         const WitnessSimplex& start, Real scale) {
+    const MinkowskiDifference cso{a, b, b_in_a};
+    EpaOutput out;
+    Polytope poly;
+    poly.eps = std::max(Real(64) * kEpsilon * scale, std::numeric_limits<Real>::min());
+    const Real tol = std::max(kEpaRelativeTolerance * scale, std::numeric_limits<Real>::min());
+    for (int i = 0; i < start.n; ++i)
+        poly.vert[static_cast<std::size_t>(poly.vertex_count++)] =
+            start.v[static_cast<std::size_t>(i)];
+
+    if (!blowUpToTetrahedron(cso, poly, out)) return out;
     const bool started_as_tetrahedron = out.iterations == 0;
     poly.closeTetrahedron();
-    std::array<std::array<int, 2>, 3 * kMaxFaces> edges;  // the first edge_count are set
     for (int iter = 0; iter < kEpaMaxIterations; ++iter) {
         ++out.iterations;
         const int best = poly.closestFace();
@@ -151,74 +179,11 @@ EpaOutput epaPenetration(const ConvexCore& a, const ConvexCore& b, const Relativ
             }
         }
         if (converged) {
-            // Coplanar faces (a split face of the obstacle) share the distance; the origin's
-            // projection lies in the one whose closest point to the origin is nearest.
-            Face chosen = closest;
-            Real chosen2 = std::numeric_limits<Real>::infinity();
-            for (int f = 0; f < poly.face_count; ++f) {
-                const Face& face = poly.faces[static_cast<std::size_t>(f)];
-                if (!face.valid || face.normal.isZero() || face.dist > closest.dist + tol) continue;
-                std::array<Real, 3> wt{};
-                const Real d2 =
-                    closestOnTriangle(poly.vert[static_cast<std::size_t>(face.v[0])].w,
-                                      poly.vert[static_cast<std::size_t>(face.v[1])].w,
-                                      poly.vert[static_cast<std::size_t>(face.v[2])].w, wt)
-                        .squaredNorm();
-                if (d2 < chosen2) {
-                    chosen2 = d2;
-                    chosen = face;
-                }
-            }
-            faceOutput(poly, chosen, out);
+            faceOutput(poly, faceHoldingProjection(poly, closest, tol), out);
             out.state = EpaState::Converged;
             return out;
         }
-        if (poly.vertex_count >= kMaxVertices) break;
-        const int new_index = poly.vertex_count;
-        poly.vert[static_cast<std::size_t>(poly.vertex_count++)] = w;
-
-        // Remove the faces that see w; their boundary (edges not shared by two removed faces)
-        // is the horizon, closed by a fan to w.
-        int edge_count = 0;
-        for (int f = 0; f < poly.face_count; ++f) {
-            Face& face = poly.faces[static_cast<std::size_t>(f)];
-            if (!face.valid) continue;
-            const bool visible =
-                face.normal.isZero() ||
-                face.normal.dot(w.w - poly.vert[static_cast<std::size_t>(face.v[0])].w) >
-                    poly.eps * Real(0.5);
-            if (!visible) continue;
-            face.valid = false;
-            for (int e = 0; e < 3; ++e) {
-                const int i = face.v[static_cast<std::size_t>(e)];
-                const int j = face.v[static_cast<std::size_t>((e + 1) % 3)];
-                bool cancelled = false;
-                for (int k = 0; k < edge_count; ++k) {
-                    auto& edge = edges[static_cast<std::size_t>(k)];
-                    if (edge[0] == j && edge[1] == i) {
-                        edge = edges[static_cast<std::size_t>(--edge_count)];
-                        cancelled = true;
-                        break;
-                    }
-                }
-                if (!cancelled) edges[static_cast<std::size_t>(edge_count++)] = {i, j};
-            }
-        }
-        int kept = 0;
-        for (int f = 0; f < poly.face_count; ++f) {
-            if (poly.faces[static_cast<std::size_t>(f)].valid) {
-                poly.faces[static_cast<std::size_t>(kept++)] =
-                    poly.faces[static_cast<std::size_t>(f)];
-            }
-        }
-        poly.face_count = kept;
-        for (int k = 0; k < edge_count; ++k) {
-            const auto& edge = edges[static_cast<std::size_t>(k)];
-            if (!poly.addFace(edge[0], edge[1], new_index)) {
-                out.state = EpaState::Failed;
-                return out;
-            }
-        }
+        if (!poly.expand(w)) break;
     }
     out.state = EpaState::Failed;
     return out;

@@ -66,6 +66,54 @@ struct EpaPolytope {
         addFace(1, 3, 2);
     }
 
+    /// Adds `v`, a support point beyond the face nearest the origin, removes the faces that see
+    /// it (it lies more than eps / 2 above their plane) and closes the hole with a fan of faces
+    /// from the horizon (the removed faces' boundary) to it (van den Bergen 2001 §4). False when
+    /// the polytope is full.
+    bool expand(const Vertex& v) {
+        if (vertex_count >= kMaxVertices) return false;
+        const int new_index = vertex_count;
+        vert[static_cast<std::size_t>(vertex_count++)] = v;
+        const Vec3& w = pointOf(v);
+        std::array<std::array<int, 2>, 3 * kMaxFaces> edges;  // the first edge_count are set
+        int edge_count = 0;
+        for (int f = 0; f < face_count; ++f) {
+            Face& face = faces[static_cast<std::size_t>(f)];
+            if (!face.valid) continue;
+            const bool visible = face.normal.isZero() ||
+                                 face.normal.dot(w - point(face.v[0])) > eps * Real(0.5);
+            if (!visible) continue;
+            face.valid = false;
+            for (int e = 0; e < 3; ++e) {
+                const int i = face.v[static_cast<std::size_t>(e)];
+                const int j = face.v[static_cast<std::size_t>((e + 1) % 3)];
+                // An edge shared by two removed faces appears in both directions: cancel it.
+                bool cancelled = false;
+                for (int k = 0; k < edge_count; ++k) {
+                    auto& edge = edges[static_cast<std::size_t>(k)];
+                    if (edge[0] == j && edge[1] == i) {
+                        edge = edges[static_cast<std::size_t>(--edge_count)];
+                        cancelled = true;
+                        break;
+                    }
+                }
+                if (!cancelled) edges[static_cast<std::size_t>(edge_count++)] = {i, j};
+            }
+        }
+        int kept = 0;
+        for (int f = 0; f < face_count; ++f) {
+            if (faces[static_cast<std::size_t>(f)].valid) {
+                faces[static_cast<std::size_t>(kept++)] = faces[static_cast<std::size_t>(f)];
+            }
+        }
+        face_count = kept;
+        for (int k = 0; k < edge_count; ++k) {
+            const auto& edge = edges[static_cast<std::size_t>(k)];
+            if (!addFace(edge[0], edge[1], new_index)) return false;
+        }
+        return true;
+    }
+
     /// The valid, non-degenerate face nearest the origin (lowest index among equals), or -1.
     int closestFace() const {
         int best = -1;

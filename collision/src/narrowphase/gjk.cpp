@@ -275,44 +275,7 @@ ContactState epaDecide(const MinkowskiDifference& cso, const Simplex<Vec3>& star
         for (int i = 0; i < poly.vertex_count; ++i) {
             if ((poly.vert[i] - w).squaredNorm() <= dup * dup) return ContactState::Touching;
         }
-        if (poly.vertex_count >= DecidePolytope::kMaxVertices) return ContactState::Failed;
-        const int new_index = poly.vertex_count;
-        poly.vert[poly.vertex_count++] = w;
-
-        // Remove the faces w sees; the horizon is their boundary (edges whose twin survives).
-        std::array<std::array<int, 2>, 3 * DecidePolytope::kMaxFaces> edges{};
-        int edge_count = 0;
-        for (int f = 0; f < poly.face_count; ++f) {
-            DecidePolytope::Face& face = poly.faces[f];
-            if (!face.valid) continue;
-            const bool visible =
-                face.normal.isZero() || face.normal.dot(w - poly.vert[face.v[0]]) > poly.eps * 0.5;
-            if (!visible) continue;
-            face.valid = false;
-            for (int e = 0; e < 3; ++e) {
-                const int i = face.v[e];
-                const int j = face.v[(e + 1) % 3];
-                // An edge shared by two removed faces appears in both directions: cancel it.
-                bool cancelled = false;
-                for (int k = 0; k < edge_count; ++k) {
-                    if (edges[k][0] == j && edges[k][1] == i) {
-                        edges[k] = edges[--edge_count];
-                        cancelled = true;
-                        break;
-                    }
-                }
-                if (!cancelled) edges[edge_count++] = {i, j};
-            }
-        }
-        // Compact the face list, then close the hole with a fan to w.
-        int kept = 0;
-        for (int f = 0; f < poly.face_count; ++f) {
-            if (poly.faces[f].valid) poly.faces[kept++] = poly.faces[f];
-        }
-        poly.face_count = kept;
-        for (int k = 0; k < edge_count; ++k) {
-            if (!poly.addFace(edges[k][0], edges[k][1], new_index)) return ContactState::Failed;
-        }
+        if (!poly.expand(w)) return ContactState::Failed;
     }
     return ContactState::Failed;
 }
