@@ -48,11 +48,6 @@ Real effectiveMass(const Body& a, const Body& b, const Mat3& ia, const Mat3& ib,
     return k > 0 ? 1 / k : 0;
 }
 
-struct Velocities {
-    Vec3 v = Vec3::Zero();
-    Vec3 w = Vec3::Zero();
-};
-
 // Box-box face manifold by clipping (RTCD 5.x; Gottschalk's reference/incident faces, as in
 // Box2D's b2CollidePolygons): the incident face of B (most anti-parallel to n) clipped by the
 // side planes of A's reference face (most parallel to n), points kept within `margin` of it,
@@ -152,7 +147,250 @@ int boxFaceManifold(const Body& a, const Pose& pa, const Body& b, const Pose& pb
     return kept;
 }
 
+// Shock propagation order (Guendelman, Bridson, Fedkiw 2003 §5): each body's level by
+// breadth-first search of the contact graph from the static bodies (level 0), and the points
+// between two levels, in order of their lower level (then their own order).
+template <class Point>
+void shockOrder(std::span<const Body> bodies, const std::vector<Point>& points,
+                std::vector<int>& level, std::vector<std::size_t>& shock_order) {
+    constexpr int kUnreached = std::numeric_limits<int>::max();
+    const std::size_t n = bodies.size();
+    level.assign(n, kUnreached);
+    std::vector<BodyId> frontier;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (bodies[i].is_static) {
+            level[i] = 0;
+            frontier.push_back(static_cast<BodyId>(i));
+        }
+    }
+    // Breadth-first search over the contact graph (adjacency in compressed rows, built
+    // once: O(points + bodies)).
+    std::vector<std::uint32_t> first(n + 1, 0);
+    for (const Point& p : points) {
+        ++first[p.a + 1];
+        ++first[p.b + 1];
+    }
+    for (std::size_t i = 0; i < n; ++i) first[i + 1] += first[i];
+    std::vector<BodyId> neighbour(first[n]);
+    {
+        std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
+        for (const Point& p : points) {
+            neighbour[fill[p.a]++] = p.b;
+            neighbour[fill[p.b]++] = p.a;
+        }
+    }
+    for (std::size_t head = 0; head < frontier.size(); ++head) {
+        const BodyId u = frontier[head];
+        for (std::uint32_t k = first[u]; k < first[u + 1]; ++k) {
+            const BodyId v = neighbour[k];
+            if (level[v] == kUnreached) {
+                level[v] = level[u] + 1;
+                frontier.push_back(v);
+            }
+        }
+    }
+    for (std::size_t k = 0; k < points.size(); ++k) {
+        const Point& p = points[k];
+        if (level[p.a] != level[p.b] && std::min(level[p.a], level[p.b]) != kUnreached) {
+            shock_order.push_back(k);
+        }
+    }
+    std::stable_sort(shock_order.begin(), shock_order.end(), [&](std::size_t x, std::size_t y) {
+        return std::min(level[points[x].a], level[points[x].b]) <
+               std::min(level[points[y].a], level[points[y].b]);
+    });
+}
+
+// The upper body's share of a contact: effective mass along d with the lower body held fixed
+// (a_up: the upper body is p.a).
+template <class Point>
+Real upperEffectiveMass(std::span<const Body> bodies, const std::vector<Mat3>& inv_inertia,
+                        const Point& p, bool a_up, const Vec3& d) {
+    const Body& up = bodies[a_up ? p.a : p.b];
+    const Vec3& r = a_up ? p.ra : p.rb;
+    const Real k = up.inv_mass + d.dot((inv_inertia[a_up ? p.a : p.b] * r.cross(d)).cross(r));
+    return k > 0 ? 1 / k : Real(0);
+}
+
+// An impulse along a -> b applied to the upper body's velocities (v, w) alone.
+template <class Point>
+void applyToUpper(std::span<const Body> bodies, const std::vector<Mat3>& inv_inertia,
+                  const Point& p, bool a_up, const Vec3& impulse, Vec3& v, Vec3& w) {
+    const BodyId id = a_up ? p.a : p.b;
+    const Vec3& r = a_up ? p.ra : p.rb;
+    const Real sign = a_up ? -1 : 1;
+    v += sign * impulse * bodies[id].inv_mass;
+    w += sign * (inv_inertia[id] * r.cross(impulse));
+}
+
+// kShockPasses passes over the contacts between levels, in shock order; `solve(p, a_up, up)`
+// updates one with its upper body `up` (a_up: it is p.a). The upper body is never static:
+// static bodies are level 0, below every other.
+template <class Point, class Solve>
+void shockPasses(std::vector<Point>& points, const std::vector<std::size_t>& shock_order,
+                 const std::vector<int>& level, const Solve& solve) {
+    for (int pass = 0; pass < kShockPasses; ++pass) {
+        for (const std::size_t k : shock_order) {
+            Point& p = points[k];
+            const bool a_up = level[p.a] > level[p.b];
+            solve(p, a_up, a_up ? p.a : p.b);
+        }
+    }
+}
+
 }  // namespace
+
+void ContactSolver::addPairPoints(std::span<const Body> bodies, const collision::ProxyPair& pair,
+                                  const std::vector<Mat3>& inv_inertia,
+                                  const std::vector<Velocities>& vel, Real dt,
+                                  const ContactSolverSettings& settings) {
+    const Body& a = bodies[pair.a];
+    const Body& b = bodies[pair.b];
+    if (a.is_static && b.is_static) return;
+    const Real size = std::min(boundingRadius(a), boundingRadius(b));
+    const collision::ContactOutput c0 =
+        collision::contact(a.shape, a.pose(), b.shape, b.pose());
+    const Real margin = settings.margin_fraction * size;
+    if (c0.state == collision::ContactState::Failed) return;
+    if (c0.state == collision::ContactState::Separated && !(c0.signed_distance < margin)) {
+        return;
+    }
+    // Speculative manifold (Catto, GDC 2013 "Continuous collision"): the manifold of the
+    // pair with B pushed `shift` deeper along the normal, its points moved back, so that
+    // corners within the margin of touching are kept (with a negative depth = their gap)
+    // and a resting box keeps all four contacts from step to step. A point with a gap may
+    // approach by at most the gap in this step.
+    const Real shift = std::max(c0.signed_distance, Real(0)) + margin;
+    Pose moved = b.pose();
+    moved.position -= shift * c0.normal;
+    collision::ContactOutput c = collision::contact(a.shape, a.pose(), b.shape, moved);
+    if (!collision::isColliding(c.state) || c.manifold_size == 0) return;
+    if (c.manifold_size < 3 && a.shape.type == collision::ShapeType::Box &&
+        b.shape.type == collision::ShapeType::Box) {
+        std::array<collision::ManifoldPoint, 4> face{};
+        const int found = boxFaceManifold(a, a.pose(), b, moved, c.normal, margin, face);
+        if (found > c.manifold_size) {
+            c.manifold = face;
+            c.manifold_size = found;
+        }
+    }
+    for (int k = 0; k < c.manifold_size; ++k) {
+        collision::ManifoldPoint& m = c.manifold[static_cast<std::size_t>(k)];
+        m.point_b += shift * c.normal;
+        m.depth -= shift;  // < 0: a gap
+    }
+    // Previous points of this pair (previous_ is sorted by (a, b)).
+    Point key;
+    key.a = pair.a;
+    key.b = pair.b;
+    const auto range = std::equal_range(
+        previous_.begin(), previous_.end(), key,
+        [](const Point& x, const Point& y) { return x.a < y.a || (x.a == y.a && x.b < y.b); });
+    const std::span<const Point> previous(range.first, range.second);
+    const Real e = std::max(a.restitution, b.restitution);
+    const Real mu = std::sqrt(a.friction * b.friction);
+    for (int k = 0; k < c.manifold_size; ++k) {
+        const collision::ManifoldPoint& m = c.manifold[static_cast<std::size_t>(k)];
+        Point p;
+        p.a = pair.a;
+        p.b = pair.b;
+        const Vec3 at = (m.point_a + m.point_b) / 2;
+        p.ra = at - a.position;
+        p.rb = at - b.position;
+        p.normal = c.normal;
+        tangents(p.normal, p.t1, p.t2);
+        const Mat3& ia = inv_inertia[pair.a];
+        const Mat3& ib = inv_inertia[pair.b];
+        p.mass_n = effectiveMass(a, b, ia, ib, p.ra, p.rb, p.normal);
+        p.mass_t1 = effectiveMass(a, b, ia, ib, p.ra, p.rb, p.t1);
+        p.mass_t2 = effectiveMass(a, b, ia, ib, p.ra, p.rb, p.t2);
+        p.friction = mu;
+        p.depth = m.depth;
+        p.slop = settings.slop_fraction * size;
+        p.local_a = a.pose().applyInverse(at);
+        p.feature_a = c.feature_a;
+        p.feature_b = c.feature_b;
+        const Vec3 dv = (vel[pair.b].v + vel[pair.b].w.cross(p.rb)) -
+                        (vel[pair.a].v + vel[pair.a].w.cross(p.ra));
+        const Real vn = dv.dot(p.normal);
+        const bool bounce = vn < -settings.restitution_threshold;
+        if (m.depth < 0 && !(bounce && -vn * dt > -m.depth)) {
+            // Speculative, not closing the gap in this step: approach by at most the gap.
+            p.velocity_bias = m.depth / dt;
+        } else {
+            // Touching, or a speculative point that closes its gap within the step: bounce
+            // now (the pair turns back at most the gap early, less than the margin).
+            p.velocity_bias = bounce ? -e * vn : 0;
+        }
+        warmStart(p, size, previous);
+        points_.push_back(p);
+    }
+}
+
+void ContactSolver::warmStart(Point& p, Real size, std::span<const Point> range) {
+    Real best = kMatchFraction * size;
+    for (const Point& q : range) {
+        if (q.feature_a.type != p.feature_a.type || q.feature_a.index != p.feature_a.index ||
+            q.feature_b.type != p.feature_b.type || q.feature_b.index != p.feature_b.index) {
+            continue;
+        }
+        const Real d = (q.local_a - p.local_a).norm();
+        if (d < best) {
+            best = d;
+            p.impulse_n = q.impulse_n;
+            // Tangent impulses carried over as a world vector onto the new basis.
+            const Vec3 ft = q.impulse_t1 * q.t1 + q.impulse_t2 * q.t2;
+            p.impulse_t1 = ft.dot(p.t1);
+            p.impulse_t2 = ft.dot(p.t2);
+        }
+    }
+}
+
+void ContactSolver::solvePositions(std::span<const Body> bodies,
+                                   const std::vector<Mat3>& inv_inertia,
+                                   const std::vector<int>& level,
+                                   const std::vector<std::size_t>& shock_order, Real dt,
+                                   const ContactSolverSettings& settings,
+                                   std::vector<Vec3>& pseudo_linear,
+                                   std::vector<Vec3>& pseudo_angular) {
+    // Split impulse: pseudo velocities that remove baumgarte * (depth - slop) / dt of each
+    // penetration, applied to the positions of this step only (never to the momenta).
+    // One split-impulse update of point p: `mass` the effective mass along the normal,
+    // `push(impulse)` applies a pseudo impulse along a -> b.
+    auto solvePseudo = [&](Point& p, Real mass, const auto& push) {
+        const Vec3 dv = (pseudo_linear[p.b] + pseudo_angular[p.b].cross(p.rb)) -
+                        (pseudo_linear[p.a] + pseudo_angular[p.a].cross(p.ra));
+        const Real target = settings.baumgarte * std::max(p.depth - p.slop, Real(0)) / dt;
+        const Real old = p.pseudo_n;
+        p.pseudo_n = std::max(old - mass * (dv.dot(p.normal) - target), Real(0));
+        push((p.pseudo_n - old) * p.normal);
+    };
+    for (int it = 0; it < settings.position_iterations; ++it) {
+        for (Point& p : points_) {
+            solvePseudo(p, p.mass_n, [&](const Vec3& impulse) {
+                const Body& a = bodies[p.a];
+                const Body& b = bodies[p.b];
+                if (!a.is_static) {
+                    pseudo_linear[p.a] -= impulse * a.inv_mass;
+                    pseudo_angular[p.a] -= inv_inertia[p.a] * p.ra.cross(impulse);
+                }
+                if (!b.is_static) {
+                    pseudo_linear[p.b] += impulse * b.inv_mass;
+                    pseudo_angular[p.b] += inv_inertia[p.b] * p.rb.cross(impulse);
+                }
+            });
+        }
+    }
+
+    // The same shock passes for the split impulse: the lower body's pseudo velocity held fixed.
+    shockPasses(points_, shock_order, level, [&](Point& p, bool a_up, BodyId up) {
+        solvePseudo(p, upperEffectiveMass(bodies, inv_inertia, p, a_up, p.normal),
+                    [&](const Vec3& impulse) {
+                        applyToUpper(bodies, inv_inertia, p, a_up, impulse, pseudo_linear[up],
+                                     pseudo_angular[up]);
+                    });
+    });
+}
 
 void ContactSolver::solve(std::span<Body> bodies, std::span<const collision::ProxyPair> pairs,
                           Real dt, const ContactSolverSettings& settings,
@@ -172,104 +410,7 @@ void ContactSolver::solve(std::span<Body> bodies, std::span<const collision::Pro
     }
 
     for (const collision::ProxyPair& pair : pairs) {
-        const Body& a = bodies[pair.a];
-        const Body& b = bodies[pair.b];
-        if (a.is_static && b.is_static) continue;
-        const Real size = std::min(boundingRadius(a), boundingRadius(b));
-        const collision::ContactOutput c0 =
-            collision::contact(a.shape, a.pose(), b.shape, b.pose());
-        const Real margin = settings.margin_fraction * size;
-        if (c0.state == collision::ContactState::Failed) continue;
-        if (c0.state == collision::ContactState::Separated && !(c0.signed_distance < margin)) {
-            continue;
-        }
-        // Speculative manifold (Catto, GDC 2013 "Continuous collision"): the manifold of the
-        // pair with B pushed `shift` deeper along the normal, its points moved back, so that
-        // corners within the margin of touching are kept (with a negative depth = their gap)
-        // and a resting box keeps all four contacts from step to step. A point with a gap may
-        // approach by at most the gap in this step.
-        const Real shift = std::max(c0.signed_distance, Real(0)) + margin;
-        Pose moved = b.pose();
-        moved.position -= shift * c0.normal;
-        collision::ContactOutput c = collision::contact(a.shape, a.pose(), b.shape, moved);
-        if (!collision::isColliding(c.state) || c.manifold_size == 0) continue;
-        if (c.manifold_size < 3 && a.shape.type == collision::ShapeType::Box &&
-            b.shape.type == collision::ShapeType::Box) {
-            std::array<collision::ManifoldPoint, 4> face{};
-            const int found = boxFaceManifold(a, a.pose(), b, moved, c.normal, margin, face);
-            if (found > c.manifold_size) {
-                c.manifold = face;
-                c.manifold_size = found;
-            }
-        }
-        for (int k = 0; k < c.manifold_size; ++k) {
-            collision::ManifoldPoint& m = c.manifold[static_cast<std::size_t>(k)];
-            m.point_b += shift * c.normal;
-            m.depth -= shift;  // < 0: a gap
-        }
-        // Previous points of this pair (previous_ is sorted by (a, b)).
-        Point key;
-        key.a = pair.a;
-        key.b = pair.b;
-        const auto range = std::equal_range(
-            previous_.begin(), previous_.end(), key,
-            [](const Point& x, const Point& y) { return x.a < y.a || (x.a == y.a && x.b < y.b); });
-        const Real e = std::max(a.restitution, b.restitution);
-        const Real mu = std::sqrt(a.friction * b.friction);
-        for (int k = 0; k < c.manifold_size; ++k) {
-            const collision::ManifoldPoint& m = c.manifold[static_cast<std::size_t>(k)];
-            Point p;
-            p.a = pair.a;
-            p.b = pair.b;
-            const Vec3 at = (m.point_a + m.point_b) / 2;
-            p.ra = at - a.position;
-            p.rb = at - b.position;
-            p.normal = c.normal;
-            tangents(p.normal, p.t1, p.t2);
-            const Mat3& ia = inv_inertia[pair.a];
-            const Mat3& ib = inv_inertia[pair.b];
-            p.mass_n = effectiveMass(a, b, ia, ib, p.ra, p.rb, p.normal);
-            p.mass_t1 = effectiveMass(a, b, ia, ib, p.ra, p.rb, p.t1);
-            p.mass_t2 = effectiveMass(a, b, ia, ib, p.ra, p.rb, p.t2);
-            p.friction = mu;
-            p.depth = m.depth;
-            p.slop = settings.slop_fraction * size;
-            p.local_a = a.pose().applyInverse(at);
-            p.feature_a = c.feature_a;
-            p.feature_b = c.feature_b;
-            const Vec3 dv = (vel[pair.b].v + vel[pair.b].w.cross(p.rb)) -
-                            (vel[pair.a].v + vel[pair.a].w.cross(p.ra));
-            const Real vn = dv.dot(p.normal);
-            const bool bounce = vn < -settings.restitution_threshold;
-            if (m.depth < 0 && !(bounce && -vn * dt > -m.depth)) {
-                // Speculative, not closing the gap in this step: approach by at most the gap.
-                p.velocity_bias = m.depth / dt;
-            } else {
-                // Touching, or a speculative point that closes its gap within the step: bounce
-                // now (the pair turns back at most the gap early, less than the margin).
-                p.velocity_bias = bounce ? -e * vn : 0;
-            }
-            // Warm start: the nearest previous point of the same pair and features.
-            Real best = kMatchFraction * size;
-            for (auto it = range.first; it != range.second; ++it) {
-                if (it->feature_a.type != p.feature_a.type ||
-                    it->feature_a.index != p.feature_a.index ||
-                    it->feature_b.type != p.feature_b.type ||
-                    it->feature_b.index != p.feature_b.index) {
-                    continue;
-                }
-                const Real d = (it->local_a - p.local_a).norm();
-                if (d < best) {
-                    best = d;
-                    p.impulse_n = it->impulse_n;
-                    // Tangent impulses carried over as a world vector onto the new basis.
-                    const Vec3 ft = it->impulse_t1 * it->t1 + it->impulse_t2 * it->t2;
-                    p.impulse_t1 = ft.dot(p.t1);
-                    p.impulse_t2 = ft.dot(p.t2);
-                }
-            }
-            points_.push_back(p);
-        }
+        addPairPoints(bodies, pair, inv_inertia, vel, dt, settings);
     }
 
     auto apply = [&](const Point& p, const Vec3& impulse) {
@@ -330,79 +471,15 @@ void ContactSolver::solve(std::span<Body> bodies, std::span<const collision::Pro
     std::vector<std::size_t> shock_order;
     std::vector<int> level;
     if (settings.shock_propagation && !points_.empty()) {
-        constexpr int kUnreached = std::numeric_limits<int>::max();
-        level.assign(n, kUnreached);
-        std::vector<BodyId> frontier;
-        for (std::size_t i = 0; i < n; ++i) {
-            if (bodies[i].is_static) {
-                level[i] = 0;
-                frontier.push_back(static_cast<BodyId>(i));
-            }
-        }
-        // Breadth-first search over the contact graph (adjacency in compressed rows, built
-        // once: O(points + bodies)).
-        std::vector<std::uint32_t> first(n + 1, 0);
-        for (const Point& p : points_) {
-            ++first[p.a + 1];
-            ++first[p.b + 1];
-        }
-        for (std::size_t i = 0; i < n; ++i) first[i + 1] += first[i];
-        std::vector<BodyId> neighbour(first[n]);
-        {
-            std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
-            for (const Point& p : points_) {
-                neighbour[fill[p.a]++] = p.b;
-                neighbour[fill[p.b]++] = p.a;
-            }
-        }
-        for (std::size_t head = 0; head < frontier.size(); ++head) {
-            const BodyId u = frontier[head];
-            for (std::uint32_t k = first[u]; k < first[u + 1]; ++k) {
-                const BodyId v = neighbour[k];
-                if (level[v] == kUnreached) {
-                    level[v] = level[u] + 1;
-                    frontier.push_back(v);
-                }
-            }
-        }
-        for (std::size_t k = 0; k < points_.size(); ++k) {
-            const Point& p = points_[k];
-            if (level[p.a] != level[p.b] && std::min(level[p.a], level[p.b]) != kUnreached) {
-                shock_order.push_back(k);
-            }
-        }
-        std::stable_sort(shock_order.begin(), shock_order.end(), [&](std::size_t x, std::size_t y) {
-            return std::min(level[points_[x].a], level[points_[x].b]) <
-                   std::min(level[points_[y].a], level[points_[y].b]);
-        });
+        shockOrder(bodies, points_, level, shock_order);
     }
-    // The upper body's share of a contact: effective mass with the lower body held fixed.
     auto upperMass = [&](const Point& p, bool a_up, const Vec3& d) {
-        const Body& up = bodies[a_up ? p.a : p.b];
-        const Vec3& r = a_up ? p.ra : p.rb;
-        const Real k = up.inv_mass + d.dot((inv_inertia[a_up ? p.a : p.b] * r.cross(d)).cross(r));
-        return k > 0 ? 1 / k : Real(0);
+        return upperEffectiveMass(bodies, inv_inertia, p, a_up, d);
     };
     auto applyUpper = [&](const Point& p, bool a_up, const Vec3& impulse, Vec3& v, Vec3& w) {
-        const BodyId id = a_up ? p.a : p.b;
-        const Vec3& r = a_up ? p.ra : p.rb;
-        const Real sign = a_up ? -1 : 1;
-        v += sign * impulse * bodies[id].inv_mass;
-        w += sign * (inv_inertia[id] * r.cross(impulse));
+        applyToUpper(bodies, inv_inertia, p, a_up, impulse, v, w);
     };
-    // kShockPasses passes over the contacts between levels, in shock order; `solve(p, a_up, up)`
-    // updates one with its upper body `up` (a_up: it is p.a). The upper body is never static:
-    // static bodies are level 0, below every other.
-    auto shockPasses = [&](const auto& solve) {
-        for (int pass = 0; pass < kShockPasses; ++pass) {
-            for (const std::size_t k : shock_order) {
-                Point& p = points_[k];
-                const bool a_up = level[p.a] > level[p.b];
-                solve(p, a_up, a_up ? p.a : p.b);
-            }
-        }
-    };
-    shockPasses([&](Point& p, bool a_up, BodyId up) {
+    shockPasses(points_, shock_order, level, [&](Point& p, bool a_up, BodyId up) {
         solvePoint(
             p, [&](const Vec3& d, Real) { return upperMass(p, a_up, d); },
             [&](const Vec3& impulse) { applyUpper(p, a_up, impulse, vel[up].v, vel[up].w); });
@@ -417,41 +494,8 @@ void ContactSolver::solve(std::span<Body> bodies, std::span<const collision::Pro
         b.angular_momentum = r * (b.inertia_body * (r.transpose() * vel[i].w));
     }
 
-    // Split impulse: pseudo velocities that remove baumgarte * (depth - slop) / dt of each
-    // penetration, applied to the positions of this step only (never to the momenta).
-    // One split-impulse update of point p: `mass` the effective mass along the normal,
-    // `push(impulse)` applies a pseudo impulse along a -> b.
-    auto solvePseudo = [&](Point& p, Real mass, const auto& push) {
-        const Vec3 dv = (pseudo_linear[p.b] + pseudo_angular[p.b].cross(p.rb)) -
-                        (pseudo_linear[p.a] + pseudo_angular[p.a].cross(p.ra));
-        const Real target = settings.baumgarte * std::max(p.depth - p.slop, Real(0)) / dt;
-        const Real old = p.pseudo_n;
-        p.pseudo_n = std::max(old - mass * (dv.dot(p.normal) - target), Real(0));
-        push((p.pseudo_n - old) * p.normal);
-    };
-    for (int it = 0; it < settings.position_iterations; ++it) {
-        for (Point& p : points_) {
-            solvePseudo(p, p.mass_n, [&](const Vec3& impulse) {
-                const Body& a = bodies[p.a];
-                const Body& b = bodies[p.b];
-                if (!a.is_static) {
-                    pseudo_linear[p.a] -= impulse * a.inv_mass;
-                    pseudo_angular[p.a] -= inv_inertia[p.a] * p.ra.cross(impulse);
-                }
-                if (!b.is_static) {
-                    pseudo_linear[p.b] += impulse * b.inv_mass;
-                    pseudo_angular[p.b] += inv_inertia[p.b] * p.rb.cross(impulse);
-                }
-            });
-        }
-    }
-
-    // The same shock passes for the split impulse: the lower body's pseudo velocity held fixed.
-    shockPasses([&](Point& p, bool a_up, BodyId up) {
-        solvePseudo(p, upperMass(p, a_up, p.normal), [&](const Vec3& impulse) {
-            applyUpper(p, a_up, impulse, pseudo_linear[up], pseudo_angular[up]);
-        });
-    });
+    solvePositions(bodies, inv_inertia, level, shock_order, dt, settings, pseudo_linear,
+                   pseudo_angular);
 
     previous_ = points_;  // already sorted by (a, b): pairs were sorted
 }

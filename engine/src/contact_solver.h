@@ -76,6 +76,27 @@ private:
         collision::Feature feature_a;
         collision::Feature feature_b;
     };
+    struct Velocities {
+        Vec3 v = Vec3::Zero();
+        Vec3 w = Vec3::Zero();
+    };
+
+    /// Appends the constraint points of one candidate pair (none when it is farther apart than
+    /// the margin), warm-started from previous_.
+    void addPairPoints(std::span<const Body> bodies, const collision::ProxyPair& pair,
+                       const std::vector<Mat3>& inv_inertia, const std::vector<Velocities>& vel,
+                       Real dt, const ContactSolverSettings& settings);
+    /// The accumulated impulses of the nearest previous point of the same pair and features,
+    /// within kMatchFraction * size; `range` the pair's previous points.
+    static void warmStart(Point& p, Real size, std::span<const Point> range);
+
+    /// The split-impulse position iterations, then their shock passes: pseudo velocities that
+    /// remove baumgarte * (depth - slop) / dt of each penetration.
+    void solvePositions(std::span<const Body> bodies, const std::vector<Mat3>& inv_inertia,
+                        const std::vector<int>& level, const std::vector<std::size_t>& shock_order,
+                        Real dt, const ContactSolverSettings& settings,
+                        std::vector<Vec3>& pseudo_linear, std::vector<Vec3>& pseudo_angular);
+
     std::vector<Point> points_;
     std::vector<Point> previous_;  ///< last call's points, sorted by (a, b)
 };
