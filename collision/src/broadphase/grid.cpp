@@ -25,13 +25,8 @@ std::uint64_t GridBroadPhase::bucketOf(const CellCoord& c) const {
     return hashCell(c) & (bucket_count_ - 1);
 }
 
-void GridBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) {
-    countMoves(counters);
-    pairs.clear();
-    entries_.clear();
-    big_.clear();
-    if (table_.count() == 0) return;
-
+// The cell size (and, dense, the grid's origin and dimensions) for this frame's proxies.
+void GridBroadPhase::chooseCells() {
     cell_size_ = medianCellSize(table_);
     if (mode_ == Mode::Dense) {
         Aabb all{Vec3::Constant(std::numeric_limits<Real>::max()),
@@ -83,8 +78,11 @@ void GridBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters
             cell_size_ *= 2;
         }
     }
-    const Real inv = Real(1) / cell_size_;
+}
 
+// Every proxy into the cells its AABB covers (oversized ones into big_ instead), then the entries
+// sorted by bucket.
+void GridBroadPhase::binProxies(Real inv) {
     // Bin every proxy into the cells its AABB covers.
     for (ProxyId id = 0; id < table_.capacity(); ++id) {
         if (!table_.contains(id)) continue;
@@ -117,7 +115,12 @@ void GridBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters
         std::vector<std::uint32_t> fill(bucket_start_.begin(), bucket_start_.end() - 1);
         for (const Entry& e : entries_) sorted_[fill[e.bucket]++] = e;
     }
+}
 
+// Pairs of binned proxies sharing a cell, each reported by the cell that holds the corner of
+// their overlap (the owner cell), so once.
+void GridBroadPhase::pairsInCells(Real inv, std::vector<ProxyPair>& pairs,
+                                  BroadPhaseCounters& counters) const {
     for (std::size_t b = 0; b < bucket_count_; ++b) {
         const std::uint32_t begin = bucket_start_[b];
         const std::uint32_t end = bucket_start_[b + 1];
@@ -138,7 +141,10 @@ void GridBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters
             }
         }
     }
+}
 
+void GridBroadPhase::pairsOfOversized(Real inv, std::vector<ProxyPair>& pairs,
+                                      BroadPhaseCounters& counters) {
     // Oversized proxies (more than kMaxCellsPerProxy cells) are not binned; each one visits
     // the cells it covers and meets the binned proxies there, with the same owner-cell rule
     // (the owner cell is in the binned proxy's cell range, so the pair is met exactly once).
@@ -205,6 +211,21 @@ void GridBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters
             if (bb.overlaps(bo)) pairs.push_back(b < o ? ProxyPair{b, o} : ProxyPair{o, b});
         }
     }
+}
+
+void GridBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) {
+    countMoves(counters);
+    pairs.clear();
+    entries_.clear();
+    big_.clear();
+    if (table_.count() == 0) return;
+
+    chooseCells();
+    const Real inv = Real(1) / cell_size_;
+
+    binProxies(inv);
+    pairsInCells(inv, pairs, counters);
+    pairsOfOversized(inv, pairs, counters);
     std::sort(pairs.begin(), pairs.end());
     counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
 }

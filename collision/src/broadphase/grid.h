@@ -40,6 +40,12 @@ private:
     };
     CellCoord clampToGrid(const CellCoord& c) const;
     std::uint64_t bucketOf(const CellCoord& c) const;
+    // The steps of findPairs, in order (grid.cpp); `inv` is 1 / cell_size_.
+    void chooseCells();
+    void binProxies(Real inv);
+    void pairsInCells(Real inv, std::vector<ProxyPair>& pairs,
+                      BroadPhaseCounters& counters) const;
+    void pairsOfOversized(Real inv, std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters);
 
     Mode mode_;
     // Per-frame state, kept for reuse and for draw().

@@ -266,6 +266,135 @@ double HierarchicalGrid::planLevels(const std::array<std::size_t, kMaxLevels>& m
     return cost;
 }
 
+// Each level's members and extents gathered from the lanes, and the levels planned both ways
+// (a hierarchy, or one level); the cheaper estimate is kept.
+void HierarchicalGrid::chooseLevels(Real top, const Extents& x) {
+    finest_ = 0;
+    for (int t = 0; t < lane_count_; ++t) finest_ = std::max(finest_, lanes_[t].finest);
+    level_count_ = finest_ + 1;
+    std::array<Real, kMaxLevels> extent_sum{};
+    std::array<std::size_t, kMaxLevels> members{};
+    for (int k = 0; k < level_count_; ++k) {
+        for (int t = 0; t < lane_count_; ++t) {
+            members[k] += lanes_[t].members[k];
+            extent_sum[k] += lanes_[t].extent_sum[k];
+        }
+    }
+    for (int t = 0; t < lane_count_; ++t) members[finest_] += lanes_[t].zero_size;
+
+    // The hierarchy pays off when one level's columns, as wide as its largest box, would hold
+    // many much smaller boxes (a few huge boxes among many small ones); with sizes spread
+    // evenly it costs more entries than it saves tests (measured on the bench's 1:100 and
+    // 1:10^4 log-uniform mixes: one level 0.80 and 0.80 ms/frame at 10k, levels 8x apart 1.14
+    // and 1.46). So the levels are planned both ways and the cheaper estimate is kept.
+    const Bounds bounds{x.lo_y, x.hi_y, x.lo_z, x.hi_z, x.hi_c - x.lo_c};
+    Plan levels_plan, flat_plan;
+    const double levels_cost =
+        planLevels(members, extent_sum, level_count_, top, bounds, levels_plan);
+    flat_ = false;
+    if (level_count_ > 1) {
+        std::array<std::size_t, kMaxLevels> one{};
+        std::array<Real, kMaxLevels> one_sum{};
+        for (int k = 0; k < level_count_; ++k) {
+            one[0] += members[k];
+            one_sum[0] += extent_sum[k];
+        }
+        flat_ = planLevels(one, one_sum, 1, top, bounds, flat_plan) <= levels_cost;
+    }
+    if (flat_) level_count_ = 1;
+    const Plan& plan = flat_ ? flat_plan : levels_plan;
+    for (int k = 0; k < level_count_; ++k) static_cast<Grid&>(levels_[k]) = plan[k];
+}
+
+// Columns laid out level after level; returns the number of entries, and the number of columns
+// in `flat_columns`.
+std::size_t HierarchicalGrid::layoutColumns(std::size_t& flat_columns) {
+    // Columns laid out level after level; within a column lane 0's entries come before lane
+    // 1's, which keeps each column in (float(min x), id) order. Each lane's counts become its
+    // cursors.
+    std::size_t total = 0;
+    flat_columns = 0;
+    for (int k = 0; k < level_count_; ++k) {
+        Level& lv = levels_[k];
+        lv.first = total;
+        lv.count = 0;
+        lv.first_column = flat_columns;
+        if (lv.members == 0) continue;
+        const std::size_t columns = std::size_t(lv.ny * lv.nz);
+        flat_columns += columns;
+        lv.start.resize(columns + 1);
+        std::uint32_t running = 0;
+        for (std::size_t c = 0; c < columns; ++c) {
+            lv.start[c] = running;
+            for (int t = 0; t < lane_count_; ++t) {
+                std::uint32_t& slot = lanes_[t].cursor[k][kCursorPad + c];
+                const std::uint32_t here = slot;
+                slot = running;
+                running += here;
+            }
+        }
+        lv.start[columns] = running;
+        lv.count = running;
+        total += lv.count;
+    }
+    return total;
+}
+
+void HierarchicalGrid::planChunks(std::size_t total, std::size_t flat_columns) {
+    id_shift_ = bitsFor(static_cast<std::uint64_t>(table_.capacity()));
+    chunks_.clear();
+    chunks_.push_back(0);
+    const std::size_t target = std::max<std::size_t>(total / 64, 1);
+    std::size_t in_chunk = 0;
+    for (int k = 0; k < level_count_; ++k) {
+        const Level& lv = levels_[k];
+        if (lv.members == 0) continue;
+        for (std::size_t c = 0; c + 1 < lv.start.size(); ++c) {
+            in_chunk += lv.start[c + 1] - lv.start[c];
+            if (in_chunk >= target) {
+                chunks_.push_back(lv.first_column + c + 1);
+                in_chunk = 0;
+            }
+        }
+    }
+    if (chunks_.back() != flat_columns) chunks_.push_back(flat_columns);
+    next_chunk_.store(0);
+}
+
+// The two lanes' sorted, disjoint pair lists merged into `pairs`, in two halves at once.
+void HierarchicalGrid::mergeLanePairs(std::vector<ProxyPair>& pairs) {
+    // Merged in two halves at once: the first half of the output takes the smallest
+    // `half` pairs of the two lists, i of them from a and half - i from b, with i found by
+    // binary search (the lists are disjoint, so the split is unique).
+    const std::vector<ProxyPair>& a = lanes_[0].pairs;
+    const std::vector<ProxyPair>& b = lanes_[1].pairs;
+    const std::size_t total_pairs = a.size() + b.size();
+    const std::size_t half = total_pairs / 2;
+    std::size_t lo = half > b.size() ? half - b.size() : 0;
+    std::size_t hi = std::min(half, a.size());
+    while (lo < hi) {  // smallest i with a[i] > b[half - i - 1] (or i = min(half, |a|))
+        const std::size_t i = (lo + hi) / 2;
+        if (a[i] < b[half - i - 1]) {
+            lo = i + 1;
+        } else {
+            hi = i;
+        }
+    }
+    const std::size_t take_a = lo;
+    pairs.resize(total_pairs);
+    auto work = [&](int t) {
+        if (t == 0) {
+            std::merge(a.begin(), a.begin() + std::ptrdiff_t(take_a), b.begin(),
+                       b.begin() + std::ptrdiff_t(half - take_a), pairs.begin());
+        } else {
+            std::merge(a.begin() + std::ptrdiff_t(take_a), a.end(),
+                       b.begin() + std::ptrdiff_t(half - take_a), b.end(),
+                       pairs.begin() + std::ptrdiff_t(half));
+        }
+    };
+    helper_->runBoth(work);
+}
+
 void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) {
     countMoves(counters);
     pairs.clear();
@@ -302,72 +431,12 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     origin_z_ = x.lo_z;
 
     inLanes([this, top](int t) { levelLane(lanes_[t], top); });
-    finest_ = 0;
-    for (int t = 0; t < lanes; ++t) finest_ = std::max(finest_, lanes_[t].finest);
-    level_count_ = finest_ + 1;
-    std::array<Real, kMaxLevels> extent_sum{};
-    std::array<std::size_t, kMaxLevels> members{};
-    for (int k = 0; k < level_count_; ++k) {
-        for (int t = 0; t < lanes; ++t) {
-            members[k] += lanes_[t].members[k];
-            extent_sum[k] += lanes_[t].extent_sum[k];
-        }
-    }
-    for (int t = 0; t < lanes; ++t) members[finest_] += lanes_[t].zero_size;
-
-    // The hierarchy pays off when one level's columns, as wide as its largest box, would hold
-    // many much smaller boxes (a few huge boxes among many small ones); with sizes spread
-    // evenly it costs more entries than it saves tests (measured on the bench's 1:100 and
-    // 1:10^4 log-uniform mixes: one level 0.80 and 0.80 ms/frame at 10k, levels 8x apart 1.14
-    // and 1.46). So the levels are planned both ways and the cheaper estimate is kept.
-    const Bounds bounds{x.lo_y, x.hi_y, x.lo_z, x.hi_z, x.hi_c - x.lo_c};
-    Plan levels_plan, flat_plan;
-    const double levels_cost =
-        planLevels(members, extent_sum, level_count_, top, bounds, levels_plan);
-    flat_ = false;
-    if (level_count_ > 1) {
-        std::array<std::size_t, kMaxLevels> one{};
-        std::array<Real, kMaxLevels> one_sum{};
-        for (int k = 0; k < level_count_; ++k) {
-            one[0] += members[k];
-            one_sum[0] += extent_sum[k];
-        }
-        flat_ = planLevels(one, one_sum, 1, top, bounds, flat_plan) <= levels_cost;
-    }
-    if (flat_) level_count_ = 1;
-    const Plan& plan = flat_ ? flat_plan : levels_plan;
-    for (int k = 0; k < level_count_; ++k) static_cast<Grid&>(levels_[k]) = plan[k];
+    chooseLevels(top, x);
 
     inLanes([this](int t) { countLane(lanes_[t]); });
 
-    // Columns laid out level after level; within a column lane 0's entries come before lane
-    // 1's, which keeps each column in (float(min x), id) order. Each lane's counts become its
-    // cursors.
-    std::size_t total = 0;
     std::size_t flat_columns = 0;
-    for (int k = 0; k < level_count_; ++k) {
-        Level& lv = levels_[k];
-        lv.first = total;
-        lv.count = 0;
-        lv.first_column = flat_columns;
-        if (lv.members == 0) continue;
-        const std::size_t columns = std::size_t(lv.ny * lv.nz);
-        flat_columns += columns;
-        lv.start.resize(columns + 1);
-        std::uint32_t running = 0;
-        for (std::size_t c = 0; c < columns; ++c) {
-            lv.start[c] = running;
-            for (int t = 0; t < lanes; ++t) {
-                std::uint32_t& slot = lanes_[t].cursor[k][kCursorPad + c];
-                const std::uint32_t here = slot;
-                slot = running;
-                running += here;
-            }
-        }
-        lv.start[columns] = running;
-        lv.count = running;
-        total += lv.count;
-    }
+    const std::size_t total = layoutColumns(flat_columns);
     // Past the end: where each lane's branch-free scatter drops entries, 4 slots (224 bytes)
     // apart so that the two lanes never write one cache line.
     entries_.resize(total + 5);
@@ -378,57 +447,12 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     // more candidates per entry in its coarse columns). Which lane sweeps a chunk varies from
     // run to run; the pairs do not: each lane sorts its own, and the lists (disjoint: a pair is
     // found in one column) are merged.
-    id_shift_ = bitsFor(static_cast<std::uint64_t>(table_.capacity()));
-    chunks_.clear();
-    chunks_.push_back(0);
-    const std::size_t target = std::max<std::size_t>(total / 64, 1);
-    std::size_t in_chunk = 0;
-    for (int k = 0; k < level_count_; ++k) {
-        const Level& lv = levels_[k];
-        if (lv.members == 0) continue;
-        for (std::size_t c = 0; c + 1 < lv.start.size(); ++c) {
-            in_chunk += lv.start[c + 1] - lv.start[c];
-            if (in_chunk >= target) {
-                chunks_.push_back(lv.first_column + c + 1);
-                in_chunk = 0;
-            }
-        }
-    }
-    if (chunks_.back() != flat_columns) chunks_.push_back(flat_columns);
-    next_chunk_.store(0);
+    planChunks(total, flat_columns);
     if (lanes == 1) {
         sweepLane(lanes_[0], pairs);
     } else {
         inLanes([this](int t) { sweepLane(lanes_[t], lanes_[t].pairs); });
-        // Merged in two halves at once: the first half of the output takes the smallest
-        // `half` pairs of the two lists, i of them from a and half - i from b, with i found by
-        // binary search (the lists are disjoint, so the split is unique).
-        const std::vector<ProxyPair>& a = lanes_[0].pairs;
-        const std::vector<ProxyPair>& b = lanes_[1].pairs;
-        const std::size_t total_pairs = a.size() + b.size();
-        const std::size_t half = total_pairs / 2;
-        std::size_t lo = half > b.size() ? half - b.size() : 0;
-        std::size_t hi = std::min(half, a.size());
-        while (lo < hi) {  // smallest i with a[i] > b[half - i - 1] (or i = min(half, |a|))
-            const std::size_t i = (lo + hi) / 2;
-            if (a[i] < b[half - i - 1]) {
-                lo = i + 1;
-            } else {
-                hi = i;
-            }
-        }
-        const std::size_t take_a = lo;
-        pairs.resize(total_pairs);
-        inLanes([&](int t) {
-            if (t == 0) {
-                std::merge(a.begin(), a.begin() + std::ptrdiff_t(take_a), b.begin(),
-                           b.begin() + std::ptrdiff_t(half - take_a), pairs.begin());
-            } else {
-                std::merge(a.begin() + std::ptrdiff_t(take_a), a.end(),
-                           b.begin() + std::ptrdiff_t(half - take_a), b.end(),
-                           pairs.begin() + std::ptrdiff_t(half));
-            }
-        });
+        mergeLanePairs(pairs);
     }
     for (int t = 0; t < lanes; ++t) {
         counters.volume_tests += lanes_[t].tests;

@@ -132,6 +132,11 @@ private:
                              const std::array<Real, kMaxLevels>& extent_sum, int level_count,
                              Real top, const Bounds& bounds, Plan& plan);
     Extents gatherBoxes();
+    // Steps of findPairs, in order (hgrid.cpp).
+    void chooseLevels(Real top, const Extents& x);
+    std::size_t layoutColumns(std::size_t& flat_columns);
+    void planChunks(std::size_t total, std::size_t flat_columns);
+    void mergeLanePairs(std::vector<ProxyPair>& pairs);
     void sortByMinX();
     void levelLane(Lane& lane, Real top);
     void countLane(Lane& lane);
