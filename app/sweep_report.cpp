@@ -125,32 +125,12 @@ const std::vector<Chart>& charts() {
     return kCharts;
 }
 
-std::string markdownReport(const SweepOptions& options, const engine::Scene& base, double duration,
-                           const std::vector<SweepRun>& runs, const SweepRun& reference,
-                           const std::vector<FloatRun>& floats) {
+namespace {
+
+// The table of every run and the reference, one row each.
+std::string resultsTable(const SweepOptions& options, const std::vector<SweepRun>& runs,
+                         const SweepRun& reference) {
     std::ostringstream md;
-    md << "# Sweep of `" << options.scene.filename().string() << "`\n\n";
-    md << "- " << base.bodies.size() << " bodies, " << fmt(duration) << " s simulated per run, "
-       << "broad phase `" << base.world.broad_phase << "` unless varied.\n";
-    md << "- Reference: time step " << fmt(reference.time_step) << " s (" << reference.steps
-       << " steps)" << (options.reference.empty() ? "" : ", " + reference.label)
-       << "; it confirmed " << reference.pairs_confirmed_total << " distinct pairs.\n";
-    md << "- A pair is *missed* when the reference confirms it and the run never does; "
-          "*extra* the other way round; a pair the CCD stage stopped at its time of impact "
-          "(*CCD stops*) counts as a contact at that time, and a pair the contact solver "
-          "pushed apart (response: impulse, speculative contacts included) at the start of "
-          "that step. First-contact error compares each common pair's first contact: the end "
-          "of the first step that confirms it (resolution: the larger time step), its time of "
-          "impact or the start of the step that pushed it. Max depth: the deepest "
-          "overlap of a confirmed pair of convex bodies at the end of a step.\n";
-    md << "- Energy drift: max over steps of |E - E0| / (sum of |kinetic| + |potential| terms at "
-          "t = 0); |L| drift: max over bodies and steps of the relative change of a body's "
-          "angular momentum.\n";
-    if (options.report_timing) {
-        md << "- Times are wall-clock, this machine, this build; they vary from run to run "
-              "(results.csv keeps every stage). Memory: the process's peak resident set during "
-              "the run less its resident set at the start (Linux VmHWM, reset per run).\n";
-    }
     md << "\n| run | dt (s) | steps |";
     if (options.report_timing) md << " ms/step | ms per sim. s | memory (MiB) |";
     md << " flagged/step | confirmed/step | BP false pos./step | Nv/step | mesh Nv/step | Np/step "
@@ -178,16 +158,14 @@ std::string markdownReport(const SweepOptions& options, const engine::Scene& bas
     SweepRun ref_row = reference;
     ref_row.label = "reference";
     row(ref_row);
-    md << '\n';
-    for (const Chart& c : charts()) {
-        if (c.timing && !options.report_timing) continue;
-        md << "![" << c.title << "](" << c.file << ")\n\n";
-    }
+    return md.str();
+}
 
-    if (!floats.empty()) {
-        md << floatSection(floats, (base.world.bounds.max - base.world.bounds.min).norm());
-    }
-    // The reading: which choice buys what, from the numbers above.
+// "Reading": which choice buys what, from the numbers of the table.
+std::string readingSection(const SweepOptions& options, const engine::Scene& base,
+                           const std::vector<SweepRun>& runs, const SweepRun& reference,
+                           const std::vector<FloatRun>& floats) {
+    std::ostringstream md;
     md << "## Reading\n\n";
     const SweepRun* accurate = nullptr;
     for (const SweepRun& r : runs) {
@@ -273,6 +251,48 @@ std::string markdownReport(const SweepOptions& options, const engine::Scene& bas
            << " pairs (never confirmed nor stopped by CCD: tunnelling between steps, or contacts "
               "shorter than a step).\n";
     }
+    return md.str();
+}
+
+}  // namespace
+
+std::string markdownReport(const SweepOptions& options, const engine::Scene& base, double duration,
+                           const std::vector<SweepRun>& runs, const SweepRun& reference,
+                           const std::vector<FloatRun>& floats) {
+    std::ostringstream md;
+    md << "# Sweep of `" << options.scene.filename().string() << "`\n\n";
+    md << "- " << base.bodies.size() << " bodies, " << fmt(duration) << " s simulated per run, "
+       << "broad phase `" << base.world.broad_phase << "` unless varied.\n";
+    md << "- Reference: time step " << fmt(reference.time_step) << " s (" << reference.steps
+       << " steps)" << (options.reference.empty() ? "" : ", " + reference.label)
+       << "; it confirmed " << reference.pairs_confirmed_total << " distinct pairs.\n";
+    md << "- A pair is *missed* when the reference confirms it and the run never does; "
+          "*extra* the other way round; a pair the CCD stage stopped at its time of impact "
+          "(*CCD stops*) counts as a contact at that time, and a pair the contact solver "
+          "pushed apart (response: impulse, speculative contacts included) at the start of "
+          "that step. First-contact error compares each common pair's first contact: the end "
+          "of the first step that confirms it (resolution: the larger time step), its time of "
+          "impact or the start of the step that pushed it. Max depth: the deepest "
+          "overlap of a confirmed pair of convex bodies at the end of a step.\n";
+    md << "- Energy drift: max over steps of |E - E0| / (sum of |kinetic| + |potential| terms at "
+          "t = 0); |L| drift: max over bodies and steps of the relative change of a body's "
+          "angular momentum.\n";
+    if (options.report_timing) {
+        md << "- Times are wall-clock, this machine, this build; they vary from run to run "
+              "(results.csv keeps every stage). Memory: the process's peak resident set during "
+              "the run less its resident set at the start (Linux VmHWM, reset per run).\n";
+    }
+    md << resultsTable(options, runs, reference);
+    md << '\n';
+    for (const Chart& c : charts()) {
+        if (c.timing && !options.report_timing) continue;
+        md << "![" << c.title << "](" << c.file << ")\n\n";
+    }
+
+    if (!floats.empty()) {
+        md << floatSection(floats, (base.world.bounds.max - base.world.bounds.min).norm());
+    }
+    md << readingSection(options, base, runs, reference, floats);
     return md.str();
 }
 

@@ -196,6 +196,96 @@ bool finiteInput(const std::array<Vec3, 4>& t0, const std::array<Vec3, 4>& t1) {
     return true;
 }
 
+// Earliest start of a parameter box proven to be all contact (only with min_separation > 0:
+// contact patches), and its witness; t above 1: none yet.
+struct Certain {
+    double t = 2;
+    double u = 0;
+    double v = 0;
+};
+
+void pushBox(std::vector<ParamBox>& heap, const ParamBox& box) {
+    heap.push_back(box);
+    std::push_heap(heap.begin(), heap.end(), LaterBox{});
+}
+
+// Which variable (0 t, 1 u, 2 v) to split: the one that moves F most on this box (the largest
+// corner difference along it) among those whose interval is still wider than kMinWidth; -1
+// when none is. `can_split` says which are.
+int splitDimension(const ParamBox& box, const double (&vals)[8][3], bool (&can_split)[3]) {
+    double effect[3] = {0, 0, 0};  // t, u, v
+    for (int c = 0; c < 8; ++c) {
+        for (int a = 0; a < 3; ++a) {
+            for (int d = 0; d < 3; ++d) {
+                const int bit = 4 >> d;  // corner-index bit of t, u, v
+                if ((c & bit) != 0) continue;
+                effect[d] = std::max(effect[d], std::abs(vals[c | bit][a] - vals[c][a]));
+            }
+        }
+    }
+    can_split[0] = box.t_hi - box.t_lo > kMinWidth;
+    can_split[1] = box.u_hi - box.u_lo > kMinWidth;
+    can_split[2] = box.v_hi - box.v_lo > kMinWidth;
+    int dim = -1;
+    for (int d = 0; d < 3; ++d) {
+        if (can_split[d] && (dim < 0 || effect[d] > effect[dim])) dim = d;
+    }
+    return dim;
+}
+
+// Look-ahead in t (the variable the answer is about): if one half of the t interval is provably
+// empty, keep only the other half at the current u, v resolution (true: the box is dealt with).
+// This bisects t while u, v stay coarse, instead of refining u, v cells along a curve or patch
+// of contacts (parallel edges, face-parallel motion) where every cell would then need its own
+// proof that the early half is empty. A late half that is all contact moves `certain` earlier.
+bool lookAheadInT(const Query& q, const ParamBox& box, Certain& certain,
+                  std::vector<ParamBox>& heap) {
+    const double mid = 0.5 * (box.t_lo + box.t_hi);
+    ParamBox early = box;
+    ParamBox late = box;
+    early.t_hi = late.t_lo = mid;
+    early.depth = late.depth = box.depth + 1;
+    double child_vals[8][3];
+    double child_width = 0;
+    cornerValues(q, early, child_vals);
+    const bool early_out = excludedBox(q, child_vals, child_width);
+    cornerValues(q, late, child_vals);
+    bool late_out = excludedBox(q, child_vals, child_width);
+    if (!late_out && certainBox(q, child_vals)) {
+        // The late half is all contact: remember its start, drop it.
+        if (mid < certain.t) {
+            certain.t = mid;
+            certain.u = 0.5 * (box.u_lo + box.u_hi);
+            certain.v = 0.5 * (box.v_lo + box.v_hi);
+        }
+        late_out = true;
+    }
+    if (!early_out && !late_out) return false;
+    if (!early_out) pushBox(heap, early);
+    if (!late_out && late.t_lo < certain.t) pushBox(heap, late);
+    return true;
+}
+
+// The box halved along `dim`; the later half is dropped when it starts at or after the certain
+// contact.
+void bisect(const ParamBox& box, int dim, double certain_t, std::vector<ParamBox>& heap) {
+    ParamBox a = box;
+    ParamBox b = box;
+    a.depth = b.depth = box.depth + 1;
+    if (dim == 0) {
+        const double mid = 0.5 * (box.t_lo + box.t_hi);
+        a.t_hi = b.t_lo = mid;
+    } else if (dim == 1) {
+        const double mid = 0.5 * (box.u_lo + box.u_hi);
+        a.u_hi = b.u_lo = mid;
+    } else {
+        const double mid = 0.5 * (box.v_lo + box.v_hi);
+        a.v_hi = b.v_lo = mid;
+    }
+    pushBox(heap, a);
+    if (b.t_lo < certain_t) pushBox(heap, b);
+}
+
 CcdOutput inclusionCcd(PrimitivePair pair, const std::array<Vec3, 4>& t0,
                        const std::array<Vec3, 4>& t1, const CcdSettings& settings) {
     CcdOutput out;
@@ -215,26 +305,24 @@ CcdOutput inclusionCcd(PrimitivePair pair, const std::array<Vec3, 4>& t0,
     const double t_tol = std::max(static_cast<double>(settings.time_tolerance), 0.0);
     // Earliest start of a parameter box proven to be all contact (only with min_separation > 0:
     // contact patches), and its witness. Above 1: none yet.
-    double certain_t = 2;
-    double certain_u = 0;
-    double certain_v = 0;
+    Certain certain;
 
     double vals[8][3];
     while (!heap.empty()) {
         std::pop_heap(heap.begin(), heap.end(), later);
         ParamBox box = heap.back();
         heap.pop_back();
-        // A contact is certain at certain_t and none exists before box.t_lo (every box left
-        // starts later): the first contact is bracketed in [box.t_lo, certain_t].
-        if (certain_t - box.t_lo <= t_tol) {
+        // A contact is certain at certain.t and none exists before box.t_lo (every box left
+        // starts later): the first contact is bracketed in [box.t_lo, certain.t].
+        if (certain.t - box.t_lo <= t_tol) {
             out.state = CcdState::Hit;
             out.t = box.t_lo;
-            out.t_upper = certain_t;
-            out.u = certain_u;
-            out.v = certain_v;
+            out.t_upper = certain.t;
+            out.u = certain.u;
+            out.v = certain.v;
             return out;
         }
-        box.t_hi = std::min(box.t_hi, certain_t);  // nothing later can lower the answer
+        box.t_hi = std::min(box.t_hi, certain.t);  // nothing later can lower the answer
         if (out.iterations >= max_boxes) {
             // Every unresolved box starts at or after box.t_lo: no contact before it.
             out.state = CcdState::Failed;
@@ -259,23 +347,8 @@ CcdOutput inclusionCcd(PrimitivePair pair, const std::array<Vec3, 4>& t0,
             return out;
         }
 
-        // Which variable moves F most on this box: the largest corner difference along it.
-        double effect[3] = {0, 0, 0};  // t, u, v
-        for (int c = 0; c < 8; ++c) {
-            for (int a = 0; a < 3; ++a) {
-                for (int d = 0; d < 3; ++d) {
-                    const int bit = 4 >> d;  // corner-index bit of t, u, v
-                    if ((c & bit) != 0) continue;
-                    effect[d] = std::max(effect[d], std::abs(vals[c | bit][a] - vals[c][a]));
-                }
-            }
-        }
-        const bool can_split[3] = {box.t_hi - box.t_lo > kMinWidth, box.u_hi - box.u_lo > kMinWidth,
-                                   box.v_hi - box.v_lo > kMinWidth};
-        int dim = -1;
-        for (int d = 0; d < 3; ++d) {
-            if (can_split[d] && (dim < 0 || effect[d] > effect[dim])) dim = d;
-        }
+        bool can_split[3];
+        const int dim = splitDimension(box, vals, can_split);
         if (width <= q.accept || dim < 0) {
             // Image within the acceptance width of the origin (or the box cannot shrink):
             // report this box. Its t_lo is <= every queued t_lo, hence <= the first root.
@@ -286,70 +359,15 @@ CcdOutput inclusionCcd(PrimitivePair pair, const std::array<Vec3, 4>& t0,
             out.v = 0.5 * (box.v_lo + box.v_hi);
             return out;
         }
-        // Look-ahead in t (the variable the answer is about): if one half of the t interval is
-        // provably empty, keep only the other half at the current u, v resolution. This
-        // bisects t while u, v stay coarse, instead of refining u, v cells along a curve or
-        // patch of contacts (parallel edges, face-parallel motion) where every cell would then
-        // need its own proof that the early half is empty.
-        if (can_split[0]) {
-            const double mid = 0.5 * (box.t_lo + box.t_hi);
-            ParamBox early = box;
-            ParamBox late = box;
-            early.t_hi = late.t_lo = mid;
-            early.depth = late.depth = box.depth + 1;
-            double child_vals[8][3];
-            double child_width = 0;
-            cornerValues(q, early, child_vals);
-            const bool early_out = excludedBox(q, child_vals, child_width);
-            cornerValues(q, late, child_vals);
-            bool late_out = excludedBox(q, child_vals, child_width);
-            if (!late_out && certainBox(q, child_vals)) {
-                // The late half is all contact: remember its start, drop it.
-                if (mid < certain_t) {
-                    certain_t = mid;
-                    certain_u = 0.5 * (box.u_lo + box.u_hi);
-                    certain_v = 0.5 * (box.v_lo + box.v_hi);
-                }
-                late_out = true;
-            }
-            if (early_out || late_out) {
-                if (!early_out) {
-                    heap.push_back(early);
-                    std::push_heap(heap.begin(), heap.end(), later);
-                }
-                if (!late_out && late.t_lo < certain_t) {
-                    heap.push_back(late);
-                    std::push_heap(heap.begin(), heap.end(), later);
-                }
-                continue;
-            }
-        }
-        ParamBox a = box;
-        ParamBox b = box;
-        a.depth = b.depth = box.depth + 1;
-        if (dim == 0) {
-            const double mid = 0.5 * (box.t_lo + box.t_hi);
-            a.t_hi = b.t_lo = mid;
-        } else if (dim == 1) {
-            const double mid = 0.5 * (box.u_lo + box.u_hi);
-            a.u_hi = b.u_lo = mid;
-        } else {
-            const double mid = 0.5 * (box.v_lo + box.v_hi);
-            a.v_hi = b.v_lo = mid;
-        }
-        heap.push_back(a);
-        std::push_heap(heap.begin(), heap.end(), later);
-        if (b.t_lo < certain_t) {
-            heap.push_back(b);
-            std::push_heap(heap.begin(), heap.end(), later);
-        }
+        if (can_split[0] && lookAheadInT(q, box, certain, heap)) continue;
+        bisect(box, dim, certain.t, heap);
     }
-    if (certain_t <= 1) {
-        // Everything before certain_t is excluded and a contact is certain there.
+    if (certain.t <= 1) {
+        // Everything before certain.t is excluded and a contact is certain there.
         out.state = CcdState::Hit;
-        out.t = out.t_upper = certain_t;
-        out.u = certain_u;
-        out.v = certain_v;
+        out.t = out.t_upper = certain.t;
+        out.u = certain.u;
+        out.v = certain.v;
         return out;
     }
     out.state = CcdState::Separated;
