@@ -83,8 +83,11 @@ std::string declaredCountsError(const std::filesystem::path& file, std::uintmax_
     head.resize(static_cast<std::size_t>(in.gcount()));
     const auto tooMany = [&](long double least_bytes, const std::string& what) -> std::string {
         if (least_bytes <= static_cast<long double>(bytes)) return "";
-        return "'" + file.string() + "' declares " + what + ", more than its " +
-               std::to_string(bytes) + " bytes can hold (a truncated or corrupt file)";
+        std::string why = "'";
+        why += file.string();
+        why += "' declares " + what + ", more than its " + std::to_string(bytes) +
+               " bytes can hold (a truncated or corrupt file)";
+        return why;
     };
     HeaderTokens tokens(head);
     const std::optional<std::string> magic = tokens.next();
@@ -150,6 +153,78 @@ std::string declaredCountsError(const std::filesystem::path& file, std::uintmax_
     return "";
 }
 
+// Why `file` cannot be a model file (missing, not a regular file, over the size limit, or
+// declaring more elements than it can hold), or "".
+std::string fileError(const std::filesystem::path& file) {
+    std::error_code ec;
+    if (!std::filesystem::exists(file, ec)) {
+        return "cannot open '" + file.string() + "': no such file";
+    }
+    if (!std::filesystem::is_regular_file(file, ec)) {
+        return "cannot open '" + file.string() + "': not a regular file";
+    }
+    const std::uintmax_t bytes = std::filesystem::file_size(file, ec);
+    if (!ec && bytes > kMaxMeshFileBytes) {
+        std::string why = "'";
+        why += file.string();
+        why += "' has " + std::to_string(bytes) + " bytes, more than the limit of " +
+               std::to_string(kMaxMeshFileBytes) + " (256 MiB) for a model file";
+        return why;
+    }
+    if (!ec) return declaredCountsError(file, bytes);
+    return "";
+
+}
+
+// Every triangle of every mesh of `scene` into `mesh`, scaled, welding equal positions across
+// meshes too (exact comparison: the file's shared vertices are bit-identical after the same
+// transform and scale) and dropping degenerate triangles. Returns an error, or "".
+std::string mergeMeshes(const aiScene& scene, Real scale, const std::filesystem::path& file,
+                        collision::TriangleMesh& mesh) {
+    std::map<std::array<Real, 3>, std::int32_t> index_of;
+    for (unsigned mi = 0; mi < scene.mNumMeshes; ++mi) {
+        const aiMesh* am = scene.mMeshes[mi];
+        if (am == nullptr || am->mVertices == nullptr) continue;
+        std::vector<std::int32_t> local(am->mNumVertices, -1);
+        for (unsigned fi = 0; fi < am->mNumFaces; ++fi) {
+            const aiFace& face = am->mFaces[fi];
+            if (face.mNumIndices != 3) continue;
+            std::array<std::int32_t, 3> tri{};
+            bool valid = true;
+            for (int k = 0; k < 3; ++k) {
+                const unsigned vi = face.mIndices[k];
+                if (vi >= am->mNumVertices) {
+                    valid = false;
+                    break;
+                }
+                if (local[vi] < 0) {
+                    const aiVector3D& v = am->mVertices[vi];
+                    const Vec3 p = Vec3(Real(v.x), Real(v.y), Real(v.z)) * scale;
+                    if (!p.allFinite()) {
+                        return "non-finite vertex in '" + file.string() + "'";
+                    }
+                    const std::array<Real, 3> key = {p.x(), p.y(), p.z()};
+                    const auto [it, inserted] =
+                        index_of.emplace(key, static_cast<std::int32_t>(mesh.vertices.size()));
+                    if (inserted) mesh.vertices.push_back(p);
+                    local[vi] = it->second;
+                }
+                tri[k] = local[vi];
+            }
+            if (!valid) continue;
+            if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) continue;
+            const Vec3& a = mesh.vertices[tri[0]];
+            const Vec3& b = mesh.vertices[tri[1]];
+            const Vec3& c = mesh.vertices[tri[2]];
+            const Real longest2 =
+                std::max({(b - a).squaredNorm(), (c - a).squaredNorm(), (c - b).squaredNorm()});
+            if (!((b - a).cross(c - a).norm() > kDegenerateArea * longest2)) continue;
+            mesh.triangles.push_back(tri);
+        }
+    }
+    return "";
+}
+
 }  // namespace
 
 MeshImportOutput importMesh(const std::filesystem::path& file, collision::Real scale) {
@@ -158,26 +233,8 @@ MeshImportOutput importMesh(const std::filesystem::path& file, collision::Real s
         out.error = "scale must be finite and > 0";
         return out;
     }
-    std::error_code ec;
-    if (!std::filesystem::exists(file, ec)) {
-        out.error = "cannot open '" + file.string() + "': no such file";
-        return out;
-    }
-    if (!std::filesystem::is_regular_file(file, ec)) {
-        out.error = "cannot open '" + file.string() + "': not a regular file";
-        return out;
-    }
-    const std::uintmax_t bytes = std::filesystem::file_size(file, ec);
-    if (!ec && bytes > kMaxMeshFileBytes) {
-        out.error = "'" + file.string() + "' has " + std::to_string(bytes) +
-                    " bytes, more than the limit of " + std::to_string(kMaxMeshFileBytes) +
-                    " (256 MiB) for a model file";
-        return out;
-    }
-    if (!ec) {
-        out.error = declaredCountsError(file, bytes);
-        if (!out.error.empty()) return out;
-    }
+    out.error = fileError(file);
+    if (!out.error.empty()) return out;
 
     Assimp::Importer importer;
     // Only positions matter: drop normals, UVs and colours before JoinIdenticalVertices so that
@@ -210,50 +267,11 @@ MeshImportOutput importMesh(const std::filesystem::path& file, collision::Real s
         return out;
     }
 
-    // Merge every mesh, welding equal positions across meshes too (exact comparison: the file's
-    // shared vertices are bit-identical after the same transform and scale).
-    std::map<std::array<Real, 3>, std::int32_t> index_of;
     collision::TriangleMesh& mesh = out.mesh;
-    for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi) {
-        const aiMesh* am = scene->mMeshes[mi];
-        if (am == nullptr || am->mVertices == nullptr) continue;
-        std::vector<std::int32_t> local(am->mNumVertices, -1);
-        for (unsigned fi = 0; fi < am->mNumFaces; ++fi) {
-            const aiFace& face = am->mFaces[fi];
-            if (face.mNumIndices != 3) continue;
-            std::array<std::int32_t, 3> tri{};
-            bool valid = true;
-            for (int k = 0; k < 3; ++k) {
-                const unsigned vi = face.mIndices[k];
-                if (vi >= am->mNumVertices) {
-                    valid = false;
-                    break;
-                }
-                if (local[vi] < 0) {
-                    const aiVector3D& v = am->mVertices[vi];
-                    const Vec3 p = Vec3(Real(v.x), Real(v.y), Real(v.z)) * scale;
-                    if (!p.allFinite()) {
-                        out.error = "non-finite vertex in '" + file.string() + "'";
-                        return out;
-                    }
-                    const std::array<Real, 3> key = {p.x(), p.y(), p.z()};
-                    const auto [it, inserted] =
-                        index_of.emplace(key, static_cast<std::int32_t>(mesh.vertices.size()));
-                    if (inserted) mesh.vertices.push_back(p);
-                    local[vi] = it->second;
-                }
-                tri[k] = local[vi];
-            }
-            if (!valid) continue;
-            if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) continue;
-            const Vec3& a = mesh.vertices[tri[0]];
-            const Vec3& b = mesh.vertices[tri[1]];
-            const Vec3& c = mesh.vertices[tri[2]];
-            const Real longest2 =
-                std::max({(b - a).squaredNorm(), (c - a).squaredNorm(), (c - b).squaredNorm()});
-            if (!((b - a).cross(c - a).norm() > kDegenerateArea * longest2)) continue;
-            mesh.triangles.push_back(tri);
-        }
+    out.error = mergeMeshes(*scene, scale, file, mesh);
+    if (!out.error.empty()) {
+        mesh = {};
+        return out;
     }
     if (mesh.triangles.empty()) {
         mesh = {};
