@@ -269,6 +269,141 @@ std::vector<std::string> narrowphaseBenchMethods() {
     return names;
 }
 
+namespace {
+
+// One method on the workload: build time, first-contact and all-pairs queries at every pose
+// (fastest of `reps`), their node and triangle tests, mismatches against the brute force, and
+// for cdlab's trees the unit costs and a refit to the deformed torus.
+Row measureMethod(const std::string& n, const TriangleMesh& mesh, const Workload& w,
+                  const TriangleMesh& deformed,
+                  const std::vector<collision::TrianglePair>& deformed_answer, int reps) {
+    const auto n_poses = static_cast<int>(w.poses.size());
+    std::unique_ptr<NarrowMethod> method = makeMethod(n);
+    Row row;
+    row.method = n;
+    row.counters = method->hasCounters();
+    double best_build = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < std::min(reps, 3); ++r) {
+        const Clock::time_point t = Clock::now();
+        method->build(mesh);
+        best_build = std::min(best_build, secondsSince(t) / 2);  // two trees built
+    }
+    row.build_ms = 1e3 * best_build;
+    std::vector<collision::TrianglePair> pairs;
+    for (int i = 0; i < n_poses; ++i) {
+        const Pose& p = w.poses[static_cast<std::size_t>(i)];
+        const auto& expected = w.answers[static_cast<std::size_t>(i)];
+        double best_first = std::numeric_limits<double>::infinity();
+        double best_all = std::numeric_limits<double>::infinity();
+        collision::BvhQueryStats first_stats;
+        collision::BvhQueryStats all_stats;
+        bool hit = false;
+        std::size_t count = 0;
+        for (int r = 0; r < reps; ++r) {
+            collision::BvhQueryStats s1;
+            Clock::time_point t = Clock::now();
+            hit = method->first(p, &s1);
+            best_first = std::min(best_first, secondsSince(t));
+            collision::BvhQueryStats s2;
+            t = Clock::now();
+            count = method->all(p, &s2, r == 0 ? &pairs : nullptr);
+            best_all = std::min(best_all, secondsSince(t));
+            first_stats = s1;
+            all_stats = s2;
+        }
+        row.first_us += 1e6 * best_first / n_poses;
+        row.all_us += 1e6 * best_all / n_poses;
+        row.first_nv += static_cast<double>(first_stats.bv_tests) / n_poses;
+        row.first_np += static_cast<double>(first_stats.triangle_tests) / n_poses;
+        row.all_nv += static_cast<double>(all_stats.bv_tests) / n_poses;
+        row.all_np += static_cast<double>(all_stats.triangle_tests) / n_poses;
+        row.bool_mismatches += hit != !expected.empty();
+        row.count_mismatches += count != expected.size();
+        if (row.counters && pairs != expected) {
+            ++row.count_mismatches;  // same count but another list: still wrong
+        }
+    }
+    if (row.counters) {
+        // Cv and Cp from the tests the all-pairs queries made at these poses, replayed
+        // outside the timed queries above.
+        row.unit = measureBvhUnitCosts(*method->treeA(), *method->treeB(), w.poses);
+        // Refit A to the deformed torus (fastest of the repetitions; a refit of an already
+        // refitted tree does the same work), then check its answer at the first pose.
+        double best_refit = std::numeric_limits<double>::infinity();
+        for (int r = 0; r < std::min(reps, 3); ++r) {
+            const Clock::time_point t = Clock::now();
+            row.refit_nu = method->treeA()->refit(deformed);
+            best_refit = std::min(best_refit, secondsSince(t));
+        }
+        row.refit_ms = 1e3 * best_refit;
+        row.refit_ok =
+            method->treeA()->intersect(*method->treeB(), w.poses.front()) == deformed_answer;
+    }
+    return row;
+}
+
+void printRows(const std::vector<Row>& rows, std::ostream& out) {
+    out << std::left << std::setw(12) << "method" << std::right << std::setw(10) << "build_ms"
+        << std::setw(11) << "first_us" << std::setw(11) << "all_us" << std::setw(11) << "first_Nv"
+        << std::setw(10) << "first_Np" << std::setw(11) << "all_Nv" << std::setw(10) << "all_Np"
+        << std::setw(8) << "Cv_ns" << std::setw(8) << "Cp_ns" << std::setw(10) << "refit_ms"
+        << std::setw(8) << "Nu" << std::setw(11) << "bool_diff" << std::setw(11) << "pair_diff"
+        << '\n';
+    out << std::fixed;
+    for (const Row& r : rows) {
+        out << std::left << std::setw(12) << r.method << std::right << std::setprecision(2)
+            << std::setw(10) << r.build_ms << std::setprecision(1) << std::setw(11) << r.first_us
+            << std::setw(11) << r.all_us;
+        if (r.counters) {
+            out << std::setprecision(0) << std::setw(11) << r.first_nv << std::setw(10)
+                << r.first_np << std::setw(11) << r.all_nv << std::setw(10) << r.all_np
+                << std::setprecision(1) << std::setw(8) << r.unit.bv_test_ns << std::setw(8)
+                << r.unit.triangle_test_ns << std::setprecision(2) << std::setw(10) << r.refit_ms
+                << std::setw(8) << r.refit_nu;
+        } else {
+            out << std::setw(11) << "-" << std::setw(10) << "-" << std::setw(11) << "-"
+                << std::setw(10) << "-" << std::setw(8) << "-" << std::setw(8) << "-"
+                << std::setw(10) << "-" << std::setw(8) << "-";
+        }
+        out << std::setw(11) << r.bool_mismatches << std::setw(11) << r.count_mismatches << '\n';
+    }
+    out.unsetf(std::ios::fixed);
+    out << "(Cv, Cp: ns per BV test and per triangle test, timed by replaying the tests the "
+           "all-pairs"
+           " queries made; refit: one tree to a deformed torus, Nu nodes updated)\n";
+}
+
+nlohmann::json rowsJson(const std::vector<Row>& rows) {
+    nlohmann::json arr = nlohmann::json::array();
+    for (const Row& r : rows) {
+        nlohmann::json o{{"method", r.method},
+                         {"library", r.counters ? "cdlab" : "fcl"},
+                         {"build_ms", r.build_ms},
+                         {"first_us", r.first_us},
+                         {"all_us", r.all_us},
+                         {"bool_mismatches", r.bool_mismatches},
+                         {"pair_mismatches", r.count_mismatches}};
+        if (r.counters) {
+            o["first_nv"] = r.first_nv;
+            o["first_np"] = r.first_np;
+            o["all_nv"] = r.all_nv;
+            o["all_np"] = r.all_np;
+            o["bv_test_ns"] = r.unit.bv_test_ns;
+            o["triangle_test_ns"] = r.unit.triangle_test_ns;
+            o["bv_tests_timed"] = r.unit.bv_tests_timed;
+            o["triangle_tests_timed"] = r.unit.triangle_tests_timed;
+            o["triangle_tests_from_queries"] = r.unit.triangles_from_queries;
+            o["refit_ms"] = r.refit_ms;
+            o["refit_nu"] = r.refit_nu;
+            o["refit_ok"] = r.refit_ok;
+        }
+        arr.push_back(o);
+    }
+    return arr;
+}
+
+}  // namespace
+
 int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& out,
                         std::ostream& err) {
     if (options.poses < 2 || options.poses % 2 != 0) {
@@ -314,67 +449,7 @@ int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& ou
     std::vector<Row> rows;
     bool cdlab_wrong = false;
     for (const std::string& n : names) {
-        std::unique_ptr<NarrowMethod> method = makeMethod(n);
-        Row row;
-        row.method = n;
-        row.counters = method->hasCounters();
-        double best_build = std::numeric_limits<double>::infinity();
-        for (int r = 0; r < std::min(options.reps, 3); ++r) {
-            const Clock::time_point t = Clock::now();
-            method->build(mesh);
-            best_build = std::min(best_build, secondsSince(t) / 2);  // two trees built
-        }
-        row.build_ms = 1e3 * best_build;
-        std::vector<collision::TrianglePair> pairs;
-        for (int i = 0; i < n_poses; ++i) {
-            const Pose& p = w.poses[static_cast<std::size_t>(i)];
-            const auto& expected = w.answers[static_cast<std::size_t>(i)];
-            double best_first = std::numeric_limits<double>::infinity();
-            double best_all = std::numeric_limits<double>::infinity();
-            collision::BvhQueryStats first_stats;
-            collision::BvhQueryStats all_stats;
-            bool hit = false;
-            std::size_t count = 0;
-            for (int r = 0; r < options.reps; ++r) {
-                collision::BvhQueryStats s1;
-                Clock::time_point t = Clock::now();
-                hit = method->first(p, &s1);
-                best_first = std::min(best_first, secondsSince(t));
-                collision::BvhQueryStats s2;
-                t = Clock::now();
-                count = method->all(p, &s2, r == 0 ? &pairs : nullptr);
-                best_all = std::min(best_all, secondsSince(t));
-                first_stats = s1;
-                all_stats = s2;
-            }
-            row.first_us += 1e6 * best_first / n_poses;
-            row.all_us += 1e6 * best_all / n_poses;
-            row.first_nv += static_cast<double>(first_stats.bv_tests) / n_poses;
-            row.first_np += static_cast<double>(first_stats.triangle_tests) / n_poses;
-            row.all_nv += static_cast<double>(all_stats.bv_tests) / n_poses;
-            row.all_np += static_cast<double>(all_stats.triangle_tests) / n_poses;
-            row.bool_mismatches += hit != !expected.empty();
-            row.count_mismatches += count != expected.size();
-            if (row.counters && pairs != expected) {
-                ++row.count_mismatches;  // same count but another list: still wrong
-            }
-        }
-        if (row.counters) {
-            // Cv and Cp from the tests the all-pairs queries made at these poses, replayed
-            // outside the timed queries above.
-            row.unit = measureBvhUnitCosts(*method->treeA(), *method->treeB(), w.poses);
-            // Refit A to the deformed torus (fastest of the repetitions; a refit of an already
-            // refitted tree does the same work), then check its answer at the first pose.
-            double best_refit = std::numeric_limits<double>::infinity();
-            for (int r = 0; r < std::min(options.reps, 3); ++r) {
-                const Clock::time_point t = Clock::now();
-                row.refit_nu = method->treeA()->refit(deformed);
-                best_refit = std::min(best_refit, secondsSince(t));
-            }
-            row.refit_ms = 1e3 * best_refit;
-            row.refit_ok =
-                method->treeA()->intersect(*method->treeB(), w.poses.front()) == deformed_answer;
-        }
+        const Row row = measureMethod(n, mesh, w, deformed, deformed_answer, options.reps);
         if (row.counters &&
             (row.bool_mismatches > 0 || row.count_mismatches > 0 || !row.refit_ok)) {
             cdlab_wrong = true;
@@ -382,34 +457,7 @@ int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& ou
         rows.push_back(row);
     }
 
-    out << std::left << std::setw(12) << "method" << std::right << std::setw(10) << "build_ms"
-        << std::setw(11) << "first_us" << std::setw(11) << "all_us" << std::setw(11) << "first_Nv"
-        << std::setw(10) << "first_Np" << std::setw(11) << "all_Nv" << std::setw(10) << "all_Np"
-        << std::setw(8) << "Cv_ns" << std::setw(8) << "Cp_ns" << std::setw(10) << "refit_ms"
-        << std::setw(8) << "Nu" << std::setw(11) << "bool_diff" << std::setw(11) << "pair_diff"
-        << '\n';
-    out << std::fixed;
-    for (const Row& r : rows) {
-        out << std::left << std::setw(12) << r.method << std::right << std::setprecision(2)
-            << std::setw(10) << r.build_ms << std::setprecision(1) << std::setw(11) << r.first_us
-            << std::setw(11) << r.all_us;
-        if (r.counters) {
-            out << std::setprecision(0) << std::setw(11) << r.first_nv << std::setw(10)
-                << r.first_np << std::setw(11) << r.all_nv << std::setw(10) << r.all_np
-                << std::setprecision(1) << std::setw(8) << r.unit.bv_test_ns << std::setw(8)
-                << r.unit.triangle_test_ns << std::setprecision(2) << std::setw(10) << r.refit_ms
-                << std::setw(8) << r.refit_nu;
-        } else {
-            out << std::setw(11) << "-" << std::setw(10) << "-" << std::setw(11) << "-"
-                << std::setw(10) << "-" << std::setw(8) << "-" << std::setw(8) << "-"
-                << std::setw(10) << "-" << std::setw(8) << "-";
-        }
-        out << std::setw(11) << r.bool_mismatches << std::setw(11) << r.count_mismatches << '\n';
-    }
-    out.unsetf(std::ios::fixed);
-    out << "(Cv, Cp: ns per BV test and per triangle test, timed by replaying the tests the "
-           "all-pairs"
-           " queries made; refit: one tree to a deformed torus, Nu nodes updated)\n";
+    printRows(rows, out);
 
     if (options.json) {
         nlohmann::json j;
@@ -418,32 +466,7 @@ int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& ou
         j["colliding_poses"] = colliding;
         j["reps"] = options.reps;
         j["seed"] = options.seed;
-        nlohmann::json arr = nlohmann::json::array();
-        for (const Row& r : rows) {
-            nlohmann::json o{{"method", r.method},
-                             {"library", r.counters ? "cdlab" : "fcl"},
-                             {"build_ms", r.build_ms},
-                             {"first_us", r.first_us},
-                             {"all_us", r.all_us},
-                             {"bool_mismatches", r.bool_mismatches},
-                             {"pair_mismatches", r.count_mismatches}};
-            if (r.counters) {
-                o["first_nv"] = r.first_nv;
-                o["first_np"] = r.first_np;
-                o["all_nv"] = r.all_nv;
-                o["all_np"] = r.all_np;
-                o["bv_test_ns"] = r.unit.bv_test_ns;
-                o["triangle_test_ns"] = r.unit.triangle_test_ns;
-                o["bv_tests_timed"] = r.unit.bv_tests_timed;
-                o["triangle_tests_timed"] = r.unit.triangle_tests_timed;
-                o["triangle_tests_from_queries"] = r.unit.triangles_from_queries;
-                o["refit_ms"] = r.refit_ms;
-                o["refit_nu"] = r.refit_nu;
-                o["refit_ok"] = r.refit_ok;
-            }
-            arr.push_back(o);
-        }
-        j["rows"] = arr;
+        j["rows"] = rowsJson(rows);
         if (!writeTextReporting(*options.json, j.dump(2) + "\n", err)) return 1;
     }
     if (cdlab_wrong) {
