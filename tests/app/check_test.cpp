@@ -16,7 +16,7 @@
 #include <sstream>
 #include <string>
 
-#include "check_command.h"
+#include "check.h"
 #include "cli_run.h"
 
 namespace app {

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "render/image.h"
-#include "sweep_command.h"
+#include "sweep.h"
 #include "cli_run.h"
 
 namespace {

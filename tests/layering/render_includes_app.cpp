@@ -1,3 +1,3 @@
 // Must NOT compile: render/ sits below app/.
-#include "run_command.h"
+#include "run_scene.h"
 int main() { return 0; }

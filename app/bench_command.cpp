@@ -1,0 +1,128 @@
+// app/bench_command.cpp -- the `cdlab bench` subcommands' flags: broadphase, ccd, convex,
+// narrowphase (lab/bench_*.h).
+#include <CLI/CLI.hpp>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bench_broadphase.h"
+#include "bench_ccd.h"
+#include "bench_convex.h"
+#include "bench_narrowphase.h"
+#include "command.h"
+
+namespace app {
+
+Command addBenchBroadphaseCommand(CLI::App& bench) {
+    struct Flags {
+        BenchOptions options;
+        std::string json;
+        bool in_process = false;
+    };
+    auto f = std::make_shared<Flags>();
+    BenchOptions& o = f->options;
+    CLI::App* cmd = bench.add_subcommand(
+        "broadphase", "cdlab's broad phases beside Bullet and FCL on moving boxes");
+    cmd->add_option("--sizes", o.sizes, "box counts, comma-separated")
+        ->delimiter(',')
+        ->capture_default_str();
+    cmd->add_option("--frames", o.frames, "measured frames per method")->capture_default_str();
+    cmd->add_option("--methods", o.methods,
+                    "comma-separated (default: every AABB broad phase and the default peers)")
+        ->delimiter(',');
+    cmd->add_option("--workload", o.workload,
+                    "uniform, mixed (sizes 1:100), both (those two) or wide (sizes 1:10^4)")
+        ->check(CLI::IsMember({"uniform", "mixed", "both", "wide"}))
+        ->capture_default_str();
+    cmd->add_option("--json", f->json, "also write the rows as JSON to FILE");
+    cmd->add_option("--seed", o.seed, "workload seed")->capture_default_str();
+    cmd->add_option("--budget", o.budget_seconds,
+                    "stop a method after this many seconds of frame time (0: no limit)")
+        ->capture_default_str();
+    cmd->add_option("--clock", o.clock,
+                    "thread: thread CPU time per frame (methods on several threads left out); "
+                    "wall: elapsed time, every method")
+        ->check(CLI::IsMember({"thread", "wall"}))
+        ->capture_default_str();
+    cmd->add_flag("--in-process", f->in_process,
+                  "do not fork per method (no per-method peak memory)");
+    return {cmd, [f]() {
+                if (!f->json.empty()) f->options.json = f->json;
+                f->options.isolate = !f->in_process;
+                return runBenchBroadphase(f->options, std::cout, std::cerr);
+            }};
+}
+
+Command addBenchCcdCommand(CLI::App& bench) {
+    struct Flags {
+        BenchCcdOptions options;
+        std::vector<std::string> dirs;
+        std::string json;
+        std::string scenes;
+        bool no_scenes = false;
+    };
+    auto f = std::make_shared<Flags>();
+    CLI::App* cmd = bench.add_subcommand(
+        "ccd", "vertex-face and edge-edge CCD methods on the sample queries: FN, FP, us/query");
+    cmd->add_option("dirs", f->dirs, "query directories (default tests/data/ccd-sample-queries)");
+    cmd->add_option("--json", f->json, "also write the table as JSON to FILE");
+    cmd->add_option("--method", f->options.method, "conservative, naive or all")
+        ->check(CLI::IsMember({"conservative", "naive", "all"}))
+        ->capture_default_str();
+    cmd->add_option("--scenes", f->scenes,
+                    "folder with tunnel_sphere.yaml and tunnel_bar.yaml (default scenes): "
+                    "CCD cost per frame, off vs on");
+    cmd->add_flag("--no-scenes", f->no_scenes, "skip the tunnelling scenes");
+    return {cmd, [f]() {
+                BenchCcdOptions& o = f->options;
+                for (const std::string& d : f->dirs) o.dirs.emplace_back(d);
+                if (!f->json.empty()) o.json = f->json;
+                if (!f->scenes.empty()) {
+                    o.scenes_dir = f->scenes;
+                    o.scenes_explicit = true;
+                }
+                o.scenes = !f->no_scenes;
+                return runBenchCcd(o, std::cout, std::cerr);
+            }};
+}
+
+Command addBenchConvexCommand(CLI::App& bench) {
+    auto f = std::make_shared<OptionsWithJson<BenchConvexOptions>>();
+    BenchConvexOptions& o = f->options;
+    CLI::App* cmd = bench.add_subcommand(
+        "convex",
+        "convex contact queries (GJK, EPA, SAT, closed forms) beside Bullet's GJK/EPA: "
+        "us/query, answers compared");
+    cmd->add_option("--queries", o.queries, "random pairs per workload")->capture_default_str();
+    cmd->add_option("--passes", o.passes, "timed passes (fastest kept)")->capture_default_str();
+    cmd->add_option("--seed", o.seed, "pose seed")->capture_default_str();
+    cmd->add_option("--tolerance", o.tolerance,
+                    "relative answer tolerance for counting disagreements")
+        ->capture_default_str();
+    cmd->add_option("--json", f->json, "also write the rows as JSON to FILE");
+    return {cmd, [f]() { return runBenchConvex(f->resolved(), std::cout, std::cerr); }};
+}
+
+Command addBenchNarrowphaseCommand(CLI::App& bench) {
+    auto f = std::make_shared<OptionsWithJson<BenchNarrowphaseOptions>>();
+    BenchNarrowphaseOptions& o = f->options;
+    CLI::App* cmd = bench.add_subcommand(
+        "narrowphase",
+        "mesh-mesh queries on two tori: every BVH volume type beside FCL's "
+        "BVHModel types (build, first contact, all pairs, Nv, Np)");
+    cmd->add_option("--triangles", o.triangles, "triangles per torus")->capture_default_str();
+    cmd->add_flag("--large", o.large, "100k-triangle tori");
+    cmd->add_option("--poses", o.poses, "poses, even: half collide")->capture_default_str();
+    cmd->add_option("--reps", o.reps, "repetitions per pose (fastest counts)")
+        ->capture_default_str();
+    cmd->add_option("--seed", o.seed, "pose seed")->capture_default_str();
+    cmd->add_option("--methods", o.methods,
+                    "comma-separated (default all): volume names (NAME-bu: bottom-up build) "
+                    "and fcl-obbrss, fcl-obb, fcl-rss, fcl-kios, fcl-aabb, fcl-kdop18")
+        ->delimiter(',');
+    cmd->add_option("--json", f->json, "also write the table as JSON to FILE");
+    return {cmd, [f]() { return runBenchNarrowphase(f->resolved(), std::cout, std::cerr); }};
+}
+
+}  // namespace app

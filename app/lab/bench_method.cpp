@@ -1,0 +1,68 @@
+// app/lab/bench_method.cpp -- cdlab's AABB broad phases behind the benchmark interface, and the
+// list of every benchmark method by name.
+#include "bench_method.h"
+
+namespace app {
+
+namespace {
+
+/// A cdlab registry broad phase: move() per proxy, findPairs() into a reused vector.
+class CdlabMethod : public BenchMethod {
+public:
+    explicit CdlabMethod(const collision::BroadPhaseEntry& entry) : broad_phase_(entry.create()) {}
+
+    void insertAll(const MovingBoxes& /*boxes*/,
+                   std::span<const collision::ProxyVolumes> volumes) override {
+        for (std::size_t i = 0; i < volumes.size(); ++i) {
+            broad_phase_->insert(static_cast<collision::ProxyId>(i), volumes[i]);
+        }
+    }
+    void moveAll(const MovingBoxes& /*boxes*/,
+                 std::span<const collision::ProxyVolumes> volumes) override {
+        for (std::size_t i = 0; i < volumes.size(); ++i) {
+            broad_phase_->move(static_cast<collision::ProxyId>(i), volumes[i]);
+        }
+    }
+    void findPairs() override { broad_phase_->findPairs(pairs_, counters_); }
+    PairSummary summary(const MovingBoxes& /*boxes*/) override { return summarizePairs(pairs_); }
+
+private:
+    std::unique_ptr<collision::BroadPhase> broad_phase_;
+    std::vector<collision::ProxyPair> pairs_;
+    collision::BroadPhaseCounters counters_;
+};
+
+std::vector<BenchMethodEntry> makeMethods() {
+    std::vector<BenchMethodEntry> methods;
+    for (const collision::BroadPhaseEntry& entry : collision::broadPhaseRegistry()) {
+        if (entry.volume != "aabb") continue;
+        BenchMethodEntry m;
+        m.name = std::string(entry.name);
+        m.description = std::string(entry.description);
+        m.default_set = true;
+        m.threads = entry.threads;
+        const collision::BroadPhaseEntry* e = &entry;
+        m.create = [e]() -> std::unique_ptr<BenchMethod> {
+            return std::make_unique<CdlabMethod>(*e);
+        };
+        methods.push_back(std::move(m));
+    }
+    appendPeerMethods(methods);
+    return methods;
+}
+
+}  // namespace
+
+const std::vector<BenchMethodEntry>& benchMethods() {
+    static const std::vector<BenchMethodEntry> methods = makeMethods();
+    return methods;
+}
+
+const BenchMethodEntry* findBenchMethod(std::string_view name) {
+    for (const BenchMethodEntry& m : benchMethods()) {
+        if (m.name == name) return &m;
+    }
+    return nullptr;
+}
+
+}  // namespace app

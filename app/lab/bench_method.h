@@ -1,0 +1,61 @@
+// app/lab/bench_method.h -- one broad phase as the benchmarks drive it: cdlab's registry entries and
+// the peer libraries (Bullet, FCL) behind one small interface, listed by name.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "bench_workload.h"
+#include "collision/broadphase/broad_phase.h"
+
+namespace app {
+
+/// A broad phase under benchmark. Proxy i is box i of the workload. A frame is moveAll() then
+/// findPairs(); both are timed. summary() is not timed: a peer whose pair cache is a superset of
+/// the exact pairs (fattened or quantised boxes) filters it there, so peers are never charged for
+/// reproducing cdlab's exact answer.
+class BenchMethod {
+public:
+    virtual ~BenchMethod() = default;
+    /// Adds every box of `boxes` (volumes[i] is box i's). Called once.
+    virtual void insertAll(const MovingBoxes& boxes,
+                           std::span<const collision::ProxyVolumes> volumes) = 0;
+    /// Gives every proxy its box at the workload's current frame.
+    virtual void moveAll(const MovingBoxes& boxes,
+                         std::span<const collision::ProxyVolumes> volumes) = 0;
+    /// Finds the overlapping pairs of the current boxes.
+    virtual void findPairs() = 0;
+    /// The exact overlapping pairs found by the last findPairs().
+    virtual PairSummary summary(const MovingBoxes& boxes) = 0;
+    /// Pairs the method itself holds before exact filtering (its pair cache), or -1 when it
+    /// reports exact pairs.
+    virtual std::int64_t rawPairs() const { return -1; }
+};
+
+struct BenchMethodEntry {
+    std::string name;
+    std::string description;
+    bool peer = false;         ///< a Bullet or FCL configuration (the "best peer" is among these)
+    bool default_set = false;  ///< run when no --methods is given
+    /// Skipped in the default set from this many boxes on (0: never), with `skip_reason`.
+    int default_max_n = 0;
+    std::string skip_reason;
+    /// Threads the method runs on. Thread CPU time (the default clock) would count only the
+    /// calling thread's share of a method on more than one, so those run with --clock wall only.
+    int threads = 1;
+    std::function<std::unique_ptr<BenchMethod>()> create;
+};
+
+/// Every method the benchmarks know: the AABB-based cdlab registry entries, then the peer
+/// configurations compiled in (none when Bullet and FCL were not found at configure time).
+const std::vector<BenchMethodEntry>& benchMethods();
+/// nullptr when there is no method of that name.
+const BenchMethodEntry* findBenchMethod(std::string_view name);
+
+/// Peer configurations, appended to benchMethods(); defined in bench_peers.cpp.
+void appendPeerMethods(std::vector<BenchMethodEntry>& methods);
+
+}  // namespace app

@@ -1,0 +1,30 @@
+// app/lab/output_files.h -- output directories and files that are either complete or absent.
+#pragma once
+
+#include <filesystem>
+#include <ostream>
+#include <string>
+
+namespace app {
+
+/// Writes `text` to FILE.partial and renames it to `file`, so a file that exists is complete; an
+/// existing `file` that is not a regular file (a device, a FIFO, a link) is refused, never
+/// replaced (render/output_file.h). Throws render::RenderError naming the file on failure.
+void writeTextAtomically(const std::filesystem::path& file, const std::string& text);
+
+/// writeTextAtomically() for the commands that report instead of throwing: on failure prints the
+/// reason to `err` and returns false.
+bool writeTextReporting(const std::filesystem::path& file, const std::string& text,
+                        std::ostream& err);
+
+/// Creates `dir` (and parents) and proves it writable before any work is done.
+/// Throws render::RenderError naming the directory on failure.
+void prepareOutputDir(const std::filesystem::path& dir);
+
+/// Removes what an earlier run left in `dir`, so a rerun with fewer frames never shows the old
+/// ones beside the new summary: cdlab's own outputs only (frame_NNNNN.png, pause_N.png and .json,
+/// summary.json, and *.partial files of a killed run), and only regular files. Other files stay.
+/// Throws render::RenderError when one cannot be removed.
+void clearPreviousRun(const std::filesystem::path& dir);
+
+}  // namespace app

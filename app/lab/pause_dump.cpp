@@ -1,0 +1,56 @@
+// app/lab/pause_dump.cpp -- pause dumps as JSON (nlohmann::ordered_json, numbers round-trip exactly).
+#include "pause_dump.h"
+
+#include <nlohmann/json.hpp>
+
+namespace app {
+
+namespace {
+
+nlohmann::ordered_json vec(const collision::Vec3& v) { return {v.x(), v.y(), v.z()}; }
+
+nlohmann::ordered_json pairs(std::span<const collision::ProxyPair> list) {
+    nlohmann::ordered_json out = nlohmann::ordered_json::array();
+    for (const collision::ProxyPair& p : list) out.push_back({p.a, p.b});
+    return out;
+}
+
+}  // namespace
+
+std::string pauseDumpJson(const engine::World& world, int frame) {
+    nlohmann::ordered_json doc;
+    doc["frame"] = frame;
+    doc["time"] = world.time();
+    doc["broadphase"] = std::string(world.broadPhase().name());
+    nlohmann::ordered_json bodies = nlohmann::ordered_json::array();
+    const auto all = world.bodies();
+    for (std::size_t i = 0; i < all.size(); ++i) {
+        const engine::Body& b = all[i];
+        const collision::ProxyVolumes& v = world.volumes()[i];
+        const collision::Quat& q = b.orientation;
+        nlohmann::ordered_json axes = nlohmann::ordered_json::array();
+        for (int k = 0; k < 3; ++k) axes.push_back(vec(v.obb.axes.col(k)));
+        bodies.push_back({
+            {"id", i},
+            {"name", b.name},
+            {"shape", std::string(collision::shapeTypeName(b.shape.type))},
+            {"position", vec(b.position)},
+            {"orientation_wxyz", {q.w(), q.x(), q.y(), q.z()}},
+            {"velocity", vec(b.velocity())},
+            {"angular_velocity", vec(b.angularVelocity())},
+            {"sphere", {{"center", vec(v.sphere.center)}, {"radius", v.sphere.radius}}},
+            {"aabb", {{"min", vec(v.aabb.min)}, {"max", vec(v.aabb.max)}}},
+            {"obb",
+             {{"center", vec(v.obb.center)},
+              {"axes", axes},
+              {"half_extents", vec(v.obb.half_extents)}}},
+            {"state", std::string(engine::bodyStateName(world.states()[i]))},
+        });
+    }
+    doc["bodies"] = std::move(bodies);
+    doc["flagged_pairs"] = pairs(world.flaggedPairs());
+    doc["colliding_pairs"] = pairs(world.collidingPairs());
+    return doc.dump(1) + "\n";
+}
+
+}  // namespace app

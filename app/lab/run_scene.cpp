@@ -1,0 +1,333 @@
+// app/lab/run_scene.cpp -- the run loop: load, simulate, render, write; every failure reported.
+// Outputs appear complete or not at all: PNGs and the video are written under temporary names
+// and renamed, and summary.json, written last, marks a finished run.
+#include "run_scene.h"
+
+#include <memory>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <new>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "broadphase_check.h"
+#include "collision/broadphase/broad_phase.h"
+#include "engine/scene.h"
+#include "exit_codes.h"
+#include "output_files.h"
+#include "pause_dump.h"
+#include "render/image.h"
+#include "render/output_file.h"
+#include "render/renderer.h"
+
+namespace app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+class ProgressBar {
+public:
+    ProgressBar(bool enabled, int total) : enabled_(enabled), total_(total) {}
+    void update(int done) {
+        if (!enabled_) return;
+        const int width = 40;
+        const int filled = total_ > 0 ? done * width / total_ : width;
+        std::fprintf(stderr, "\r[%.*s%*s] %d/%d frames", filled,
+                     "########################################", width - filled, "", done, total_);
+        std::fflush(stderr);
+    }
+    ~ProgressBar() {
+        if (enabled_) std::fputc('\n', stderr);
+    }
+
+private:
+    bool enabled_;
+    int total_;
+};
+
+// Per-frame sums of the step counters, for --stats.
+struct FrameStats {
+    collision::BroadPhaseCounters broad;
+    std::int64_t narrow_tests = 0;
+    std::int64_t triangle_tests = 0;
+    std::int64_t bv_tests = 0;
+    double integrate_s = 0, volumes_s = 0, broad_s = 0, narrow_s = 0, ccd_s = 0, response_s = 0,
+           total_s = 0;
+
+    void add(const engine::StepStats& s) {
+        broad.volume_tests += s.broad.volume_tests;
+        broad.pairs_flagged += s.broad.pairs_flagged;
+        broad.volumes_updated += s.broad.volumes_updated;
+        broad.swaps += s.broad.swaps;
+        narrow_tests += s.narrow_tests;
+        triangle_tests += s.triangle_tests;
+        bv_tests += s.bv_tests;
+        integrate_s += s.integrate_s;
+        volumes_s += s.volumes_s;
+        broad_s += s.broad_phase_s;
+        narrow_s += s.narrow_phase_s;
+        ccd_s += s.ccd_s;
+        response_s += s.response_s;
+        total_s += s.total_s;
+    }
+};
+
+constexpr const char* kStatsHeader =
+    "frame,time,broadphase,bodies,flagged,colliding,volume_tests,volumes_updated,swaps,"
+    "narrow_tests,triangle_tests,bv_tests,integrate_ms,volumes_ms,broadphase_ms,narrowphase_ms,"
+    "ccd_ms,response_ms,step_ms\n";
+
+std::string statsRow(int frame, const engine::World& world, const FrameStats& f) {
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "%d,%.9g,%s,%zu,%zu,%zu,%lld,%lld,%lld,%lld,%lld,%lld,%.6f,%.6f,%.6f,%.6f,%.6f,"
+                  "%.6f,%.6f\n",
+                  frame, double(world.time()), std::string(world.broadPhase().name()).c_str(),
+                  world.bodies().size(), world.flaggedPairs().size(), world.collidingPairs().size(),
+                  (long long)f.broad.volume_tests, (long long)f.broad.volumes_updated,
+                  (long long)f.broad.swaps, (long long)f.narrow_tests, (long long)f.triangle_tests,
+                  (long long)f.bv_tests, 1e3 * f.integrate_s, 1e3 * f.volumes_s, 1e3 * f.broad_s,
+                  1e3 * f.narrow_s, 1e3 * f.ccd_s, 1e3 * f.response_s, 1e3 * f.total_s);
+    return line;
+}
+
+// One frame of a trace (see RunOptions::trace), numbers with every digit of a double so
+// builds can be compared to the last bit of the narrower one.
+std::string traceLine(int frame, const engine::World& world) {
+    nlohmann::json line;
+    line["frame"] = frame;
+    line["time"] = double(world.time());
+    nlohmann::json positions = nlohmann::json::array();
+    nlohmann::json orientations = nlohmann::json::array();
+    for (const engine::Body& b : world.bodies()) {
+        positions.push_back(
+            {double(b.position.x()), double(b.position.y()), double(b.position.z())});
+        const engine::Quat& q = b.orientation;
+        orientations.push_back({double(q.w()), double(q.x()), double(q.y()), double(q.z())});
+    }
+    line["positions"] = std::move(positions);
+    line["orientations_wxyz"] = std::move(orientations);
+    nlohmann::json pairs = nlohmann::json::array();
+    for (const collision::ProxyPair& p : world.collidingPairs()) pairs.push_back({p.a, p.b});
+    line["colliding_pairs"] = std::move(pairs);
+    return line.dump() + "\n";
+}
+
+std::string frameName(int frame) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%05d.png", frame);
+    return name;
+}
+
+}  // namespace
+
+namespace {
+
+// The scene with the command line's overrides applied, and the pause frames; an error message
+// and kExitBadInput when anything is wrong with the input (before any output is written).
+int loadRunScene(const RunOptions& options, std::ostream& err, engine::Scene& scene,
+                 std::set<int>& pauses) {
+    try {
+        scene = engine::loadScene(options.scene, options.overrides);
+    } catch (const engine::SceneError& e) {
+        err << e.what() << "\n";
+        return kExitBadInput;
+    }
+    if (options.frames) {
+        if (*options.frames < 1) {
+            err << "--frames: must be >= 1\n";
+            return kExitBadInput;
+        }
+        scene.frames = *options.frames;
+    }
+    if (options.broad_phase) {
+        if (collision::findBroadPhase(*options.broad_phase) == nullptr) {
+            err << "--broadphase: unknown broad phase '" << *options.broad_phase
+                << "' (expected one of: " << collision::broadPhaseNames() << ")\n";
+            return kExitBadInput;
+        }
+        scene.world.broad_phase = *options.broad_phase;
+    }
+    pauses = std::set<int>(options.pause_at.begin(), options.pause_at.end());
+    for (int f : pauses) {
+        if (f < 0 || f >= scene.frames) {
+            err << "--pause-at " << f << ": frame out of range (the run has frames 0.."
+                << scene.frames - 1 << ")\n";
+            return kExitBadInput;
+        }
+    }
+    return kExitOk;
+}
+
+// Every output folder made and every output path proven writable (and not a device, FIFO, link
+// or directory) before the first step, not after the whole simulation; an earlier run's outputs
+// in `out_dir` cleared. Throws render::RenderError.
+void prepareOutputs(const RunOptions& options, const fs::path& out_dir, bool want_video,
+                    const fs::path& video_path) {
+    prepareOutputDir(out_dir);
+    if (want_video && video_path.has_parent_path()) prepareOutputDir(video_path.parent_path());
+    if (options.stats_csv && options.stats_csv->has_parent_path()) {
+        prepareOutputDir(options.stats_csv->parent_path());
+    }
+    if (options.trace && options.trace->has_parent_path()) {
+        prepareOutputDir(options.trace->parent_path());
+    }
+    if (options.stats_csv) render::checkOutputWritable(*options.stats_csv);
+    if (options.trace) render::checkOutputWritable(*options.trace);
+    if (want_video) render::checkOutputWritable(video_path);
+    clearPreviousRun(out_dir);
+}
+
+// What summary.json records of a run that completed.
+struct RunTotals {
+    std::int64_t flagged = 0;    ///< flagged pairs summed over frames
+    std::int64_t colliding = 0;  ///< colliding pairs summed over frames
+    double step_seconds = 0;
+};
+
+std::string summaryJson(const RunOptions& options, const engine::Scene& scene,
+                        const engine::World& world, const RunTotals& totals, bool want_video,
+                        const fs::path& video_path) {
+    nlohmann::ordered_json summary;
+    summary["scene"] = options.scene.string();
+    summary["broadphase"] = scene.world.broad_phase;
+    summary["frames"] = scene.frames;
+    summary["steps"] = world.stepCount();
+    summary["time"] = world.time();
+    summary["bodies"] = world.bodies().size();
+    summary["state_hash"] = world.stateHash();
+    summary["flagged_pair_frames"] = totals.flagged;
+    summary["colliding_pair_frames"] = totals.colliding;
+    summary["mean_step_ms"] =
+        world.stepCount() > 0 ? 1e3 * totals.step_seconds / double(world.stepCount()) : 0.0;
+    summary["video"] = want_video ? video_path.string() : "";
+    summary["checked_broadphase"] = options.check_broad_phase;
+    return summary.dump(1) + "\n";
+}
+
+}  // namespace
+
+int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
+    // 1. Everything that can be wrong with the input is found before any output is written.
+    engine::Scene scene;
+    std::set<int> pauses;
+    if (const int code = loadRunScene(options, err, scene, pauses); code != kExitOk) return code;
+    const fs::path out_dir =
+        options.out_dir.empty() ? fs::path("out") / scene.name : options.out_dir;
+    const bool want_video = !options.no_video;
+    const fs::path video_path = options.video ? *options.video : out_dir / (scene.name + ".mp4");
+    if (want_video && !render::ffmpegAvailable()) {
+        err << "ffmpeg not found on PATH: install it (apt-get install ffmpeg) or pass --no-video\n";
+        return kExitFailure;
+    }
+
+    try {
+        prepareOutputs(options, out_dir, want_video, video_path);
+        engine::World world = engine::makeWorld(scene);
+        render::Renderer renderer(scene.output.width, scene.output.height);
+        std::unique_ptr<render::VideoWriter> video;
+        if (want_video) {
+            video = std::make_unique<render::VideoWriter>(video_path, scene.output.width,
+                                                          scene.output.height, scene.output.fps);
+        }
+        render::FrameOptions frame_options;
+        frame_options.draw = scene.draw;
+        frame_options.draw_structure = scene.draw.structure || options.draw_structure;
+        render::FrameOptions pause_options = frame_options;
+        pause_options.draw.sphere = pause_options.draw.aabb = pause_options.draw.obb = true;
+
+        std::unique_ptr<BroadPhaseChecker> checker;
+        if (options.check_broad_phase) {
+            checker = std::make_unique<BroadPhaseChecker>(scene.world.broad_phase);
+        }
+        std::string stats_text;
+        if (options.stats_csv) stats_text = kStatsHeader;
+        std::string trace_text;
+        ProgressBar progress(options.progress && ::isatty(STDERR_FILENO), scene.frames);
+        RunTotals totals;
+        for (int frame = 0; frame < scene.frames; ++frame) {
+            FrameStats frame_stats;
+            auto checkStep = [&](int step) -> bool {
+                if (!checker) return true;
+                const std::string report = checker->check(world);
+                if (report.empty()) return true;
+                err << "check-broadphase: MISMATCH at frame " << frame << ", step " << step
+                    << ", t=" << world.time() << " s\n"
+                    << report;
+                return false;
+            };
+            if (frame == 0) {
+                frame_stats.add(world.lastStats());
+                if (!checkStep(0)) return kExitCheckFailed;
+            } else {
+                for (int s = 0; s < scene.steps_per_frame; ++s) {
+                    try {
+                        world.step();
+                    } catch (const engine::SimulationError& e) {
+                        // No summary.json: the run is incomplete, and says so.
+                        err << "error: " << options.scene.string() << ": frame " << frame << ": "
+                            << e.what() << "\n";
+                        return kExitFailure;
+                    }
+                    frame_stats.add(world.lastStats());
+                    totals.step_seconds += world.lastStats().total_s;
+                    if (!checkStep(static_cast<int>(world.stepCount()))) return kExitCheckFailed;
+                }
+            }
+            if (options.stats_csv) stats_text += statsRow(frame, world, frame_stats);
+            if (options.trace) trace_text += traceLine(frame, world);
+            totals.flagged += static_cast<std::int64_t>(world.flaggedPairs().size());
+            totals.colliding += static_cast<std::int64_t>(world.collidingPairs().size());
+            frame_options.hud_text =
+                scene.draw.hud ? render::hudLine(world, frame, options.hud_timing) : "";
+            if (!options.no_frames || video) {
+                const render::Image image = renderer.render(world, scene.camera, frame_options);
+                if (!options.no_frames) render::writePng(out_dir / frameName(frame), image);
+                if (video) video->addFrame(image);
+            }
+            if (pauses.count(frame)) {
+                pause_options.hud_text = "PAUSED  " + render::hudLine(world, frame, false);
+                const std::string stem = "pause_" + std::to_string(frame);
+                render::writePng(out_dir / (stem + ".png"),
+                                 renderer.render(world, scene.camera, pause_options));
+                writeTextAtomically(out_dir / (stem + ".json"), pauseDumpJson(world, frame));
+            }
+            progress.update(frame + 1);
+        }
+        if (video) video->finish();
+        if (options.stats_csv) writeTextAtomically(*options.stats_csv, stats_text);
+        if (options.trace) writeTextAtomically(*options.trace, trace_text);
+
+        writeTextAtomically(out_dir / "summary.json",
+                            summaryJson(options, scene, world, totals, want_video, video_path));
+
+        out << "wrote " << (options.no_frames ? 0 : scene.frames) << " frames to "
+            << out_dir.string();
+        if (want_video) out << " and " << video_path.string();
+        out << " (" << world.bodies().size() << " bodies, " << world.stepCount() << " steps, "
+            << scene.world.broad_phase << (options.check_broad_phase ? ", every step checked" : "")
+            << ")\n";
+    } catch (const render::RenderError& e) {
+        err << "error: " << e.what() << "\n";
+        return kExitFailure;
+    } catch (const std::bad_alloc&) {
+        err << "error: out of memory: this scene needs more memory than the machine can allocate "
+               "(fewer bodies, fewer volumes drawn, or --no-frames --no-video)\n";
+        return kExitFailure;
+    } catch (const std::exception& e) {
+        err << "error: " << e.what() << "\n";
+        return kExitFailure;
+    }
+    return kExitOk;
+}
+
+}  // namespace app

@@ -1,0 +1,39 @@
+// app/lab/run_scene.h -- `cdlab run`: scene -> simulation -> PNG frames, video, pause dumps.
+#pragma once
+
+#include <filesystem>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "engine/scene.h"
+
+namespace app {
+
+struct RunOptions {
+    std::filesystem::path scene;
+    std::filesystem::path out_dir;               ///< default: out/<scene stem>
+    std::optional<int> frames;                   ///< overrides the scene's frame count
+    std::optional<std::filesystem::path> video;  ///< default: <out_dir>/<scene stem>.mp4
+    bool no_video = false;
+    bool no_frames = false;                  ///< skip the per-frame PNGs
+    std::optional<std::string> broad_phase;  ///< overrides the scene's broad phase
+    std::vector<int> pause_at;               ///< frames to dump
+    bool hud_timing = true;                  ///< step time in the HUD (off: bit-identical frames)
+    bool progress = true;                    ///< progress bar when stderr is a terminal
+    bool draw_structure = false;             ///< draw the broad phase's own structure
+    bool check_broad_phase = false;          ///< compare every step with the brute reference
+    std::optional<std::filesystem::path> stats_csv;  ///< one row of counters per frame
+    /// Scene values replaced before validation (`--set world.time_step=0.01`).
+    std::vector<engine::SceneOverride> overrides;
+    /// One JSON line per frame: time, every body's position and orientation, confirmed pairs
+    /// (`cdlab sweep --float-binary` compares a float build's trace with the double one's).
+    std::optional<std::filesystem::path> trace;
+};
+
+/// Exit codes: 0 success, 1 output or runtime failure, 2 bad input (scene, flags),
+/// 3 --check-broadphase found a step where the broad phase differs from its reference.
+int runScene(const RunOptions& options, std::ostream& out, std::ostream& err);
+
+}  // namespace app

@@ -1,0 +1,372 @@
+// app/lab/sweep.cpp -- `cdlab sweep` (see sweep.h): the combinations of --vary, the
+// reference run, every run measured (sweep_measure.h) and written (sweep_report.h), and the
+// float build's comparison.
+// Every run simulates the same interval; accuracy is judged against one reference run of the
+// same scene with a finer time step. Contacts are compared pair by pair through their first
+// contact time: a pair the reference confirms and a run never does is missed; a pair both
+// confirm contributes |t_run - t_ref| to the first-contact error (resolution: the larger of the
+// two time steps). Everything but the wall-clock times is deterministic.
+#include "sweep.h"
+
+#include <iostream>
+#include <malloc.h>
+#include <memory>
+#include <string>
+#include <sys/wait.h>
+#include <vector>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <ostream>
+#include <sstream>
+#include <utility>
+
+#include "exit_codes.h"
+#include "output_files.h"
+#include "render/chart.h"
+#include "render/image.h"
+#include "run_scene.h"
+#include "sweep_measure.h"
+#include "sweep_report.h"
+
+namespace app {
+
+namespace fs = std::filesystem;
+
+using sweep::Chart;
+using sweep::charts;
+using sweep::compareWithReference;
+using sweep::csvField;
+using sweep::csvTable;
+using sweep::FirstContacts;
+using sweep::fmt;
+using sweep::labelOf;
+using sweep::markdownReport;
+using sweep::measure;
+
+namespace {
+
+std::string trim(const std::string& s) {
+    const std::size_t a = s.find_first_not_of(" \t");
+    if (a == std::string::npos) return "";
+    const std::size_t b = s.find_last_not_of(" \t");
+    return s.substr(a, b - a + 1);
+}
+
+// Single-quoted for /bin/sh: every character literal, ' written as '\''.
+std::string shellQuote(const std::string& s) {
+    std::string q = "'";
+    for (char c : s) {
+        if (c == '\'') {
+            q += "'\\''";
+        } else {
+            q += c;
+        }
+    }
+    return q + "'";
+}
+
+// Runs one combination through this (double) build in-process and through the float build as a
+// child process, both writing traces, and compares them.
+FloatRun compareFloat(const SweepOptions& options, const std::vector<engine::SceneOverride>& c,
+                      const fs::path& dir, std::size_t index) {
+    const std::string stem = "run" + std::to_string(index);
+    RunOptions run;
+    run.scene = options.scene;
+    run.overrides = c;
+    run.no_video = true;
+    run.no_frames = true;
+    run.progress = false;
+    run.out_dir = dir / (stem + "_double");
+    run.trace = dir / (stem + "_double.jsonl");
+    std::ostringstream run_out, run_err;
+    FloatRun result;
+    result.label = labelOf(c);
+    if (runScene(run, run_out, run_err) != 0) {
+        result.comparison.error = "double run failed: " + run_err.str();
+        return result;
+    }
+    const fs::path float_trace = dir / (stem + "_float.jsonl");
+    std::string cmd = shellQuote(options.float_binary->string()) + " run " +
+                      shellQuote(options.scene.string()) + " --no-frames --no-video --quiet" +
+                      " --out " + shellQuote((dir / (stem + "_float")).string()) + " --trace " +
+                      shellQuote(float_trace.string());
+    for (const engine::SceneOverride& o : c) cmd += " --set " + shellQuote(o.key + "=" + o.value);
+    cmd += " > " + shellQuote((dir / (stem + "_float.log")).string()) + " 2>&1";
+    const int status = std::system(cmd.c_str());
+    if (!(WIFEXITED(status) && WEXITSTATUS(status) == 0)) {
+        result.comparison.error =
+            "the float build failed (see " + (dir / (stem + "_float.log")).string() + ")";
+        return result;
+    }
+    result.comparison = compareTraces(*run.trace, float_trace);
+    return result;
+}
+
+}  // namespace
+
+bool parseVary(const std::string& text, std::string& key, std::vector<std::string>& values,
+               std::string& error) {
+    const std::size_t eq = text.find('=');
+    if (eq == std::string::npos || eq == 0) {
+        error = "'" + text + "': expected KEY=V1,V2,...";
+        return false;
+    }
+    key = trim(text.substr(0, eq));
+    values.clear();
+    int depth = 0;
+    std::string current;
+    for (std::size_t i = eq + 1; i <= text.size(); ++i) {
+        const char c = i < text.size() ? text[i] : ',';
+        if (c == '[' || c == '{') ++depth;
+        if (c == ']' || c == '}') --depth;
+        if (c == ',' && depth <= 0) {
+            current = trim(current);
+            if (current.empty()) {
+                error = "'" + text + "': empty value";
+                return false;
+            }
+            values.push_back(current);
+            current.clear();
+        } else {
+            current += c;
+        }
+    }
+    if (depth != 0) {
+        error = "'" + text + "': unbalanced brackets";
+        return false;
+    }
+    if (key.empty() || key.find_first_of(" \t") != std::string::npos) {
+        error = "'" + text + "': bad key '" + key + "'";
+        return false;
+    }
+    return true;
+}
+
+namespace {
+
+using Axes = std::vector<std::pair<std::string, std::vector<std::string>>>;
+
+// The axes of --vary and the overrides of --reference; an error message and false when one is
+// malformed or a key is given twice.
+bool parseSweepOptions(const SweepOptions& options, std::ostream& err, Axes& axes,
+                       std::vector<engine::SceneOverride>& reference_overrides) {
+    for (const std::string& v : options.vary) {
+        std::string key, error;
+        std::vector<std::string> values;
+        if (!parseVary(v, key, values, error)) {
+            err << "--vary " << error << "\n";
+            return false;
+        }
+        for (const auto& axis : axes) {
+            if (axis.first == key) {
+                err << "--vary " << key << ": given twice; list every value in one --vary (" << key
+                    << "=A,B,...)\n";
+                return false;
+            }
+        }
+        axes.emplace_back(key, values);
+    }
+    for (const std::string& v : options.reference) {
+        std::string key, error;
+        std::vector<std::string> values;
+        if (!parseVary(v, key, values, error) || values.size() != 1) {
+            err << "--reference " << (error.empty() ? "'" + v + "': expected KEY=VALUE" : error)
+                << "\n";
+            return false;
+        }
+        reference_overrides.push_back({key, values[0], "--reference"});
+    }
+    if (!(options.reference_refine >= 1) || !std::isfinite(options.reference_refine)) {
+        err << "--reference-refine: must be a finite number >= 1\n";
+        return false;
+    }
+    if (options.duration && !(*options.duration > 0 && std::isfinite(*options.duration))) {
+        err << "--duration: must be a finite number > 0\n";
+        return false;
+    }
+
+    return true;
+}
+
+// Every combination of the axes' values, in axis order (one empty combination without axes).
+std::vector<std::vector<engine::SceneOverride>> combinations(const Axes& axes) {
+    std::vector<std::vector<engine::SceneOverride>> combos{{}};
+    for (const auto& [key, values] : axes) {
+        std::vector<std::vector<engine::SceneOverride>> next;
+        for (const auto& c : combos) {
+            for (const std::string& v : values) {
+                next.push_back(c);
+                next.back().push_back({key, v, "--vary"});
+            }
+        }
+        combos = std::move(next);
+    }
+    return combos;
+}
+
+// One bar chart per column of charts() (timings only with report_timing), reference last.
+void writeCharts(const SweepOptions& options, const fs::path& out_dir,
+                 const std::vector<SweepRun>& runs, const SweepRun& reference) {
+    for (const Chart& c : charts()) {
+        if (c.timing && !options.report_timing) continue;
+        render::BarChart chart;
+        chart.title = c.title;
+        chart.log_scale = c.log_scale;
+        for (const SweepRun& r : runs) chart.bars.push_back({r.label, r.*(c.field), false});
+        chart.bars.push_back({"reference", reference.*(c.field), true});
+        render::writePng(out_dir / c.file, render::drawBarChart(chart));
+    }
+}
+
+// Every combination run again through the float build (--float-binary): float_vs_double.csv
+// and its chart, and the comparisons for the report.
+std::vector<FloatRun> compareFloatBuild(
+    const SweepOptions& options, const std::vector<std::vector<engine::SceneOverride>>& combos,
+    const fs::path& out_dir, std::ostream& out) {
+    std::vector<FloatRun> floats;
+    const fs::path traces = out_dir / "traces";
+    prepareOutputDir(traces);
+    std::string csv =
+        "run,frames,first_pair_difference,pair_frames_differing,max_position_deviation,"
+        "final_position_deviation,max_orientation_deviation,error\n";
+    render::BarChart chart;
+    chart.title = "float vs double: max position deviation (m, log scale)";
+    chart.log_scale = true;
+    for (std::size_t i = 0; i < combos.size(); ++i) {
+        floats.push_back(compareFloat(options, combos[i], traces, i));
+        const TraceComparison& c = floats.back().comparison;
+        out << "[float " << i + 1 << "/" << combos.size() << "] " << floats.back().label
+            << ": "
+            << (c.error.empty() ? "max deviation " + fmt(c.max_position_deviation) +
+                                      " m, pairs differ in " +
+                                      std::to_string(c.pair_frames_differing) + " frames"
+                                : c.error)
+            << "\n";
+        csv += csvField(floats.back().label) + "," + std::to_string(c.frames) + "," +
+               std::to_string(c.first_pair_difference) + "," +
+               std::to_string(c.pair_frames_differing) + "," +
+               fmt(c.max_position_deviation, "%.6g") + "," +
+               fmt(c.final_position_deviation, "%.6g") + "," +
+               fmt(c.max_orientation_deviation, "%.6g") + "," + csvField(c.error) + "\n";
+        chart.bars.push_back({floats.back().label, c.max_position_deviation, false});
+    }
+    writeTextAtomically(out_dir / "float_vs_double.csv", csv);
+    if (!options.keep_traces) fs::remove_all(traces);
+    render::writePng(out_dir / "float_deviation.png", render::drawBarChart(chart));
+    return floats;
+}
+
+}  // namespace
+
+int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) {
+    // The axes of the sweep.
+    Axes axes;
+    std::vector<engine::SceneOverride> reference_overrides;
+    if (!parseSweepOptions(options, err, axes, reference_overrides)) return kExitBadInput;
+    if (options.float_binary) {
+        std::error_code ec;
+        if (!fs::is_regular_file(*options.float_binary, ec)) {
+            err << "--float-binary " << options.float_binary->string()
+                << ": no such file (build one with cmake -DCDLAB_USE_FLOAT=ON)\n";
+            return kExitBadInput;
+        }
+    }
+    // Every combination is loaded (and so validated) before anything runs.
+    // Every combination is loaded (and so validated) before anything runs.
+    const std::vector<std::vector<engine::SceneOverride>> combos = combinations(axes);
+    engine::Scene base;
+    std::vector<engine::Scene> scenes;
+    try {
+        base = engine::loadScene(options.scene);
+    } catch (const engine::SceneError& e) {
+        err << e.what() << "\n";
+        return kExitBadInput;
+    }
+    for (const auto& c : combos) {
+        try {
+            scenes.push_back(engine::loadScene(options.scene, c));
+        } catch (const engine::SceneError& e) {
+            err << "sweep run '" << labelOf(c) << "': " << e.what() << "\n";
+            return kExitBadInput;
+        }
+    }
+    const double duration = options.duration ? *options.duration
+                                             : double(std::max(base.frames - 1, 1)) *
+                                                   base.steps_per_frame * base.world.time_step;
+    engine::Scene reference_scene;
+    try {
+        std::vector<engine::SceneOverride> ref = {
+            {"world.time_step", fmt(base.world.time_step / options.reference_refine, "%.17g")}};
+        ref.insert(ref.end(), reference_overrides.begin(), reference_overrides.end());
+        reference_scene = engine::loadScene(options.scene, ref);
+    } catch (const engine::SceneError& e) {
+        err << "sweep reference: " << e.what() << "\n";
+        return kExitBadInput;
+    }
+
+    // Steps per run, checked before anything runs: llround of a huge quotient is undefined, and
+    // a run of 1e20 s would never end.
+    constexpr double kMaxSweepSteps = 1e9;
+    std::vector<const engine::Scene*> all_runs{&reference_scene};
+    for (const engine::Scene& s : scenes) all_runs.push_back(&s);
+    for (const engine::Scene* s : all_runs) {
+        const double steps = duration / s->world.time_step;
+        if (!(steps <= kMaxSweepSteps)) {
+            err << "--duration " << fmt(duration) << ": " << fmt(steps) << " steps at time step "
+                << fmt(s->world.time_step) << " s, more than the limit of " << fmt(kMaxSweepSteps)
+                << "\n";
+            return kExitBadInput;
+        }
+    }
+
+    const fs::path out_dir =
+        options.out_dir.empty() ? fs::path("out") / ("sweep_" + base.name) : options.out_dir;
+    try {
+        prepareOutputDir(out_dir);
+        for (const char* f :
+             {"results.csv", "report.md", "float_vs_double.csv", "float_deviation.png"}) {
+            fs::remove(out_dir / f);
+        }
+        for (const Chart& c : charts()) fs::remove(out_dir / c.file);
+
+        FirstContacts reference_contacts;
+        SweepRun reference = measure(reference_scene, duration, reference_contacts);
+        reference.label = labelOf(reference_overrides);
+        out << "reference: dt " << fmt(reference.time_step) << " s, " << reference.steps
+            << " steps, " << reference.pairs_confirmed_total << " pairs confirmed\n";
+        std::vector<SweepRun> runs;
+        for (std::size_t i = 0; i < scenes.size(); ++i) {
+            FirstContacts contacts;
+            SweepRun run = measure(scenes[i], duration, contacts);
+            run.overrides = combos[i];
+            run.label = labelOf(combos[i]);
+            compareWithReference(run, contacts, reference_contacts);
+            out << "[" << i + 1 << "/" << scenes.size() << "] " << run.label << ": " << run.steps
+                << " steps, " << fmt(run.ms_step, "%.3f") << " ms/step, "
+                << fmt(run.broad_false_positives, "%.2f") << " broad false positives/step, "
+                << run.missed_pairs << " missed, " << run.extra_pairs << " extra\n";
+            runs.push_back(std::move(run));
+        }
+
+        writeCharts(options, out_dir, runs, reference);
+        const std::vector<FloatRun> floats =
+            options.float_binary ? compareFloatBuild(options, combos, out_dir, out)
+                                 : std::vector<FloatRun>{};
+        writeTextAtomically(out_dir / "results.csv", csvTable(runs));
+        writeTextAtomically(out_dir / "report.md",
+                            markdownReport(options, base, duration, runs, reference, floats));
+        out << "wrote " << (out_dir / "report.md").string() << ", "
+            << (out_dir / "results.csv").string() << " and charts\n";
+    } catch (const std::exception& e) {
+        err << "error: " << e.what() << "\n";
+        return kExitFailure;
+    }
+    return kExitOk;
+}
+
+}  // namespace app

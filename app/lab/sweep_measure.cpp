@@ -1,0 +1,181 @@
+// app/lab/sweep_measure.cpp -- see sweep_measure.h.
+#include "sweep_measure.h"
+
+#include <iostream>
+#include <malloc.h>
+#include <memory>
+#include <string>
+#include <sys/wait.h>
+#include <vector>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <ostream>
+#include <sstream>
+#include <utility>
+
+#include "exit_codes.h"
+#include "output_files.h"
+#include "render/chart.h"
+#include "render/image.h"
+#include "run_scene.h"
+
+namespace app::sweep {
+
+namespace {
+
+// Total mechanical energy: kinetic (translation + rotation) and gravity's potential.
+double totalEnergy(const engine::World& world, double& scale) {
+    const engine::Vec3 g = world.settings().gravity;
+    double e = 0;
+    scale = 0;
+    for (const engine::Body& b : world.bodies()) {
+        const double kinetic = b.kineticEnergy();
+        const double potential = -b.mass * g.dot(b.position);
+        e += kinetic + potential;
+        scale += std::abs(kinetic) + std::abs(potential);
+    }
+    return e;
+}
+
+// Linux /proc/self/status fields in kB (VmRSS: resident now; VmHWM: peak since the last reset),
+// -1 when not available.
+double procStatusKb(const char* field) {
+    std::ifstream f("/proc/self/status");
+    std::string line;
+    const std::string key = std::string(field) + ":";
+    while (std::getline(f, line)) {
+        if (line.rfind(key, 0) == 0) return std::strtod(line.c_str() + key.size(), nullptr);
+    }
+    return -1;
+}
+
+// Resets VmHWM to the present resident set (Linux >= 4.0: "5" to clear_refs), after handing the
+// heap's free pages back (glibc malloc_trim), so that a run does not grow into pages an earlier
+// run left resident.
+bool resetPeakResident() {
+    malloc_trim(0);
+    std::ofstream f("/proc/self/clear_refs");
+    f << "5";
+    f.flush();
+    return bool(f);
+}
+
+}  // namespace
+
+std::string labelOf(const std::vector<engine::SceneOverride>& overrides) {
+    std::string label;
+    for (const engine::SceneOverride& o : overrides) {
+        if (!label.empty()) label += ' ';
+        label += o.key + "=" + o.value;
+    }
+    return label.empty() ? "scene as written" : label;
+}
+
+SweepRun measure(const engine::Scene& scene, double duration, FirstContacts& first) {
+    SweepRun run;
+    const bool peak_reset = resetPeakResident();
+    const double resident_kb = procStatusKb("VmRSS");
+    engine::World world = engine::makeWorld(scene);
+    run.time_step = scene.world.time_step;
+    run.steps = std::max<std::int64_t>(1, std::llround(duration / run.time_step));
+
+    // Contacts the run saw: pairs confirmed at the end of a step, pairs the CCD stage stopped at
+    // their time of impact within it (they never overlap at a step's end), and pairs the contact
+    // solver pushed apart at its start.
+    auto record = [&first, &world, &run](double step_start) {
+        const double dt = double(world.settings().time_step);
+        for (const engine::ToiEvent& e : world.toiEvents()) {
+            first.try_emplace(PairKey{std::min(e.a, e.b), std::max(e.a, e.b)},
+                              step_start + double(e.t) * dt);
+        }
+        // The contact solver acts at the step's start, on pairs touching or about to touch
+        // within the step (speculative contacts): a push counts as a contact then.
+        for (const collision::ProxyPair& p : world.pushedPairs()) {
+            first.try_emplace(PairKey{p.a, p.b}, step_start);
+        }
+        for (const collision::ProxyPair& p : world.collidingPairs()) {
+            first.try_emplace(PairKey{p.a, p.b}, double(world.time()));
+        }
+        // Depth of convex pairs (a mesh would answer as its hull, an overestimate).
+        run.max_penetration = std::max(run.max_penetration, double(world.deepestPenetration()));
+    };
+    record(double(world.time()));
+    double energy_scale = 0;
+    const double e0 = totalEnergy(world, energy_scale);
+    std::vector<double> l0;
+    for (const engine::Body& b : world.bodies()) l0.push_back(b.angular_momentum.norm());
+
+    for (std::int64_t s = 0; s < run.steps; ++s) {
+        const double step_start = double(world.time());
+        world.step();
+        const engine::StepStats& st = world.lastStats();
+        run.ms_integrate += 1e3 * st.integrate_s;
+        run.ms_volumes += 1e3 * st.volumes_s;
+        run.ms_broad += 1e3 * st.broad_phase_s;
+        run.ms_narrow += 1e3 * st.narrow_phase_s;
+        run.ms_ccd += 1e3 * st.ccd_s;
+        run.ms_response += 1e3 * st.response_s;
+        run.toi_events += st.toi_events;
+        run.ms_step += 1e3 * st.total_s;
+        run.flagged += double(world.flaggedPairs().size());
+        run.confirmed += double(world.collidingPairs().size());
+        run.bv_tests += double(st.broad.volume_tests);
+        run.narrow_tests += double(st.narrow_tests);
+        run.triangle_tests += double(st.triangle_tests);
+        run.mesh_bv_tests += double(st.bv_tests);
+        record(step_start);
+        double scale_now = 0;
+        const double e = totalEnergy(world, scale_now);
+        if (energy_scale > 0) {
+            run.max_energy_drift = std::max(run.max_energy_drift, std::abs(e - e0) / energy_scale);
+        }
+        const auto bodies = world.bodies();
+        for (std::size_t i = 0; i < bodies.size(); ++i) {
+            if (l0[i] <= 0) continue;
+            const double drift = std::abs(bodies[i].angular_momentum.norm() - l0[i]) / l0[i];
+            run.max_angular_momentum_drift = std::max(run.max_angular_momentum_drift, drift);
+        }
+    }
+    const double n = double(run.steps);
+    for (double* v : {&run.ms_integrate, &run.ms_volumes, &run.ms_broad, &run.ms_narrow,
+                      &run.ms_ccd, &run.ms_response, &run.ms_step, &run.flagged, &run.confirmed,
+                      &run.bv_tests, &run.narrow_tests, &run.triangle_tests, &run.mesh_bv_tests}) {
+        *v /= n;
+    }
+    run.broad_false_positives = run.flagged - run.confirmed;
+    run.ms_per_simulated_s = run.ms_step / run.time_step;
+    run.pairs_confirmed_total = static_cast<std::int64_t>(first.size());
+    run.state_hash = world.stateHash();
+    const double peak_kb = procStatusKb("VmHWM");
+    if (peak_reset && resident_kb >= 0 && peak_kb >= 0) {
+        run.memory_mib = std::max(0.0, peak_kb - resident_kb) / 1024;
+    }
+    return run;
+}
+
+void compareWithReference(SweepRun& run, const FirstContacts& mine, const FirstContacts& ref) {
+    double sum = 0;
+    std::int64_t common = 0;
+    for (const auto& [pair, t_ref] : ref) {
+        const auto it = mine.find(pair);
+        if (it == mine.end()) {
+            ++run.missed_pairs;
+            continue;
+        }
+        const double err = std::abs(it->second - t_ref);
+        run.max_first_contact_error = std::max(run.max_first_contact_error, err);
+        sum += err;
+        ++common;
+    }
+    for (const auto& entry : mine) {
+        if (ref.count(entry.first) == 0) ++run.extra_pairs;
+    }
+    run.mean_first_contact_error = common > 0 ? sum / double(common) : 0;
+}
+
+}  // namespace app::sweep
