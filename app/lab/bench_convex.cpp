@@ -157,18 +157,7 @@ struct Variant {
 constexpr std::array<Variant, 3> kVariants{
     {{"far", 1, kFarOffset}, {"small", 1e-4, 0}, {"large", 1e4, 0}}};
 
-Shape scaledShape(const Shape& s, Real f) {
-    Shape out = s;
-    out.radius *= f;
-    out.half_height *= f;
-    out.half_extents *= f;
-    if (s.hull) {
-        auto hull = std::make_shared<collision::ConvexPolytope>(*s.hull);
-        for (Vec3& v : hull->vertices) v *= f;
-        out.hull = hull;
-    }
-    return out;
-}
+using cdlab_test::scaledShape;
 
 std::vector<Pair> transformed(const std::vector<Pair>& pairs, const Variant& v) {
     std::vector<Pair> out;

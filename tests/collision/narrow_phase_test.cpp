@@ -16,6 +16,7 @@
 #include "geometry/triangle_triangle.h"
 #include "narrowphase/gjk.h"
 #include "test_random.h"
+#include "test_shapes.h"
 
 namespace {
 
@@ -308,26 +309,6 @@ TEST(NarrowPhase, SwapAndTranslationGiveIdenticalOutputs) {
     EXPECT_LT(colliding, 3 * total / 4);
 }
 
-Shape scaled(const Shape& s, Real k) {
-    Shape out = s;
-    out.radius *= k;
-    out.half_height *= k;
-    out.half_extents *= k;
-    if (s.hull) {
-        auto hull = std::make_shared<ConvexPolytope>(*s.hull);
-        for (Vec3& v : hull->vertices) v *= k;
-        out.hull = hull;
-    }
-    if (s.mesh) {
-        auto mesh = std::make_shared<TriangleMesh>(*s.mesh);
-        for (Vec3& v : mesh->vertices) v *= k;
-        out.mesh = mesh;
-        // The hierarchy belongs to the mesh it was built from: rebuild it for the scaled copy.
-        if (s.bvh) out.bvh = collision::buildMeshBvh(s.bvh->volumeName(), *mesh);
-    }
-    return out;
-}
-
 TEST(NarrowPhase, ScalingKeepsTheState) {
     cdlab_test::Rng rng(314);
     int checked = 0;
@@ -339,8 +320,8 @@ TEST(NarrowPhase, ScalingKeepsTheState) {
                 // Powers of two scale every rounding exactly: identical state, scaled distance.
                 for (const Real k : {std::ldexp(Real(1), -13), std::ldexp(Real(1), 13)}) {
                     const CollideOutput s =
-                        collide(scaled(p.a, k), at(p.pa.position * k, p.pa.orientation),
-                                scaled(p.b, k), at(p.pb.position * k, p.pb.orientation));
+                        collide(cdlab_test::scaledShape(p.a, k), at(p.pa.position * k, p.pa.orientation),
+                                cdlab_test::scaledShape(p.b, k), at(p.pb.position * k, p.pb.orientation));
                     EXPECT_EQ(s.state, base.state);
                     EXPECT_NEAR(s.distance, base.distance * k, 1e-12 * k);
                 }
@@ -351,8 +332,8 @@ TEST(NarrowPhase, ScalingKeepsTheState) {
                 }
                 for (const Real k : {Real(1e-4), Real(1e4)}) {
                     const CollideOutput s =
-                        collide(scaled(p.a, k), at(p.pa.position * k, p.pa.orientation),
-                                scaled(p.b, k), at(p.pb.position * k, p.pb.orientation));
+                        collide(cdlab_test::scaledShape(p.a, k), at(p.pa.position * k, p.pa.orientation),
+                                cdlab_test::scaledShape(p.b, k), at(p.pb.position * k, p.pb.orientation));
                     EXPECT_EQ(s.state, base.state) << ta << " " << tb << " " << n;
                     EXPECT_NEAR(s.distance, base.distance * k, 1e-9 * k);
                 }
@@ -383,11 +364,11 @@ TEST(NarrowPhase, TouchingSurvivesTranslationAndScaling) {
         {
             const Vec3 o(shift, shift, -shift);
             EXPECT_EQ(
-                collide(scaled(unit, k), at(o), scaled(unit, k), at(o + Vec3(2 * k, 0, 0))).state,
+                collide(cdlab_test::scaledShape(unit, k), at(o), cdlab_test::scaledShape(unit, k), at(o + Vec3(2 * k, 0, 0))).state,
                 ContactState::Touching)
                 << k << " " << shift;
             EXPECT_EQ(
-                collide(scaled(mesh, k), at(o), scaled(mesh, k), at(o + Vec3(0, 2 * k, 0))).state,
+                collide(cdlab_test::scaledShape(mesh, k), at(o), cdlab_test::scaledShape(mesh, k), at(o + Vec3(0, 2 * k, 0))).state,
                 ContactState::Touching)
                 << k << " " << shift;
             EXPECT_EQ(

@@ -3,7 +3,9 @@
 #pragma once
 
 #include <algorithm>
+#include <memory>
 
+#include "collision/bvh/bvh.h"
 #include "collision/geometry/shape.h"
 
 namespace cdlab_test {
@@ -25,6 +27,27 @@ inline collision::Real boundingRadius(const collision::Shape& s) {
             return r;
         }
     }
+}
+
+/// The shape scaled by `k` about its local origin: dimensions, hull and mesh vertices; a mesh's
+/// hierarchy is rebuilt (with the same volume type) for the scaled copy.
+inline collision::Shape scaledShape(const collision::Shape& s, collision::Real k) {
+    collision::Shape out = s;
+    out.radius *= k;
+    out.half_height *= k;
+    out.half_extents *= k;
+    if (s.hull) {
+        auto hull = std::make_shared<collision::ConvexPolytope>(*s.hull);
+        for (collision::Vec3& v : hull->vertices) v *= k;
+        out.hull = hull;
+    }
+    if (s.mesh) {
+        auto mesh = std::make_shared<collision::TriangleMesh>(*s.mesh);
+        for (collision::Vec3& v : mesh->vertices) v *= k;
+        out.mesh = mesh;
+        if (s.bvh) out.bvh = collision::buildMeshBvh(s.bvh->volumeName(), *mesh);
+    }
+    return out;
 }
 
 }  // namespace cdlab_test
