@@ -1,5 +1,7 @@
 // collision/src/narrowphase/epa.cpp -- the expanding polytope algorithm (van den Bergen 2001 §4;
-// RTCD 9.5 for the simplex sub-steps), from GJK's final simplex (gjk.h).
+// RTCD 9.5 for the simplex sub-steps), from GJK's final simplex (gjk.h), with two stopping rules
+// on one polytope (epa_polytope.h): the full depth with witnesses (epaPenetration, contact()) and
+// the bounded decision "deeper than a threshold?" (epaDecide, collide()).
 // Invariants: the loop is capped (kEpaMaxIterations) and reports Failed; every division is
 // guarded by a scale-relative epsilon, so finite input never yields NaN; faces and horizon edges
 // are visited in index order, so the output is deterministic.
@@ -188,5 +190,100 @@ EpaOutput epaPenetration(const ConvexCore& a, const ConvexCore& b, const Relativ
     out.state = EpaState::Failed;
     return out;
 }
+
+// ---- The bounded decision: does the penetration depth exceed `threshold`? ----
+
+namespace {
+
+using DecidePolytope = EpaPolytope<Vec3, kGjkMaxIterations + 4>;
+
+}  // namespace
+
+ContactState epaDecide(const MinkowskiDifference& cso, const GjkSimplex<Vec3>& start,
+                       Real threshold, Real scale, std::int32_t& iterations) {
+    DecidePolytope poly;
+    poly.eps = std::max(Real(64) * kEpsilon * scale, std::numeric_limits<Real>::min());
+    for (int i = 0; i < start.n; ++i) poly.vert[poly.vertex_count++] = start.v[i];
+
+    // Direction probes: any direction n with support h(n) <= threshold proves depth <= threshold.
+    auto probe = [&](const Vec3& dir, Vec3& w_out) {
+        w_out = cso.support(dir);
+        return dir.dot(w_out) <= threshold;
+    };
+
+    // Blow a lower-dimensional simplex up to a tetrahedron (the CSO is 3-D unless it is flat, and
+    // a flat CSO has penetration depth zero).
+    while (poly.vertex_count < 4) {
+        const Vec3 w0 = poly.vert[0];
+        std::array<Vec3, 6> dirs{};
+        int dir_count = 0;
+        if (poly.vertex_count == 1) {
+            dirs = {Vec3::UnitX(),  -Vec3::UnitX(), Vec3::UnitY(),
+                    -Vec3::UnitY(), Vec3::UnitZ(),  -Vec3::UnitZ()};
+            dir_count = 6;
+        } else if (poly.vertex_count == 2) {
+            const Vec3 e = poly.vert[1] - w0;
+            int axis = 0;
+            e.cwiseAbs().minCoeff(&axis);
+            const Vec3 d1 = e.cross(Vec3::Unit(axis)).normalized();
+            const Vec3 d2 = e.cross(d1).normalized();
+            dirs = {d1, -d1, d2, -d2, Vec3::Zero(), Vec3::Zero()};
+            dir_count = 4;
+        } else {
+            const Vec3 n = (poly.vert[1] - w0).cross(poly.vert[2] - w0);
+            const Real len = n.norm();
+            if (!(len > poly.eps * poly.eps)) return ContactState::Touching;
+            dirs = {n / len, -n / len, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+            dir_count = 2;
+        }
+        bool grown = false;
+        for (int k = 0; k < dir_count && !grown; ++k) {
+            Vec3 w;
+            if (probe(dirs[k], w)) return ContactState::Touching;
+            Real off = 0;
+            if (poly.vertex_count == 1) {
+                off = (w - w0).norm();
+            } else if (poly.vertex_count == 2) {
+                const Vec3 e = poly.vert[1] - w0;
+                off = e.cross(w - w0).norm() / e.norm();
+            } else {
+                off = std::abs(dirs[k].dot(w - w0));
+            }
+            if (off > poly.eps) {
+                poly.vert[poly.vertex_count++] = w;
+                grown = true;
+            }
+        }
+        if (!grown) return ContactState::Touching;  // flat CSO: zero depth
+    }
+
+    poly.closeTetrahedron();
+    for (int iter = 0; iter < kGjkMaxIterations; ++iter) {
+        ++iterations;
+        const int best = poly.closestFace();
+        if (best < 0) return ContactState::Failed;
+        const DecidePolytope::Face closest = poly.faces[best];
+        // The origin lies inside the polytope (inside the CSO), so depth >= closest plane
+        // distance; and depth <= h(n) for every probed n (van den Bergen 2001 §4).
+        if (closest.dist > threshold) return ContactState::Penetrating;
+        Vec3 w;
+        if (probe(closest.normal, w)) return ContactState::Touching;
+        const Real h = closest.normal.dot(w);
+        if (h - closest.dist <= poly.eps) {
+            // Converged at depth ~ threshold: the bounds no longer separate; call it touching.
+            return ContactState::Touching;
+        }
+        // A support point already in the polytope cannot grow it: the depth is closest.dist up
+        // to rounding (<= threshold here). Without this check exactly touching boxes re-added
+        // the same vertex until the cap and came out Failed.
+        const Real dup = kDuplicateRelative * std::max(w.norm(), scale);
+        for (int i = 0; i < poly.vertex_count; ++i) {
+            if ((poly.vert[i] - w).squaredNorm() <= dup * dup) return ContactState::Touching;
+        }
+        if (!poly.expand(w)) return ContactState::Failed;
+    }
+    return ContactState::Failed;
+}
+
 
 }  // namespace collision

@@ -1,6 +1,7 @@
-// collision/src/narrowphase/epa.h -- EPA penetration depth with normal and witness points (van den
-// Bergen 2001; RTCD 9.5) on the ConvexCore support mappings of gjk.h, started from gjkWitness's
-// final simplex. Used by contact() (contact.cpp); private to collision.
+// collision/src/narrowphase/epa.h -- the one EPA (van den Bergen 2001; RTCD 9.5) on the ConvexCore
+// support mappings of gjk.h, started from GJK's final simplex: the penetration depth with normal
+// and witness points (contact()), or the bounded decision whether the depth exceeds a threshold
+// (collide(), through decideConvexCores). Private to collision.
 #pragma once
 
 #include <algorithm>
@@ -45,5 +46,14 @@ inline constexpr Real kEpaRelativeTolerance = std::max(Real(1e-11), Real(64) * k
 /// polytope degenerates; never NaN for finite input.
 EpaOutput epaPenetration(const ConvexCore& a, const ConvexCore& b, const RelativePose& b_in_a,
                          const WitnessSimplex& start, Real scale);
+
+/// The bounded EPA: whether the penetration depth of two overlapping cores exceeds `threshold`
+/// (Penetrating) or not (Touching), from GJK's final simplex `start` (points of A - B). It stops
+/// as soon as the bounds decide: the nearest face's distance is a lower bound on the depth, the
+/// support along any direction an upper bound (van den Bergen 2001 §4); converged or degenerate
+/// at depth ~ threshold is Touching. Failed at kGjkMaxIterations or when the polytope is full.
+/// `iterations` is increased by the iterations run.
+ContactState epaDecide(const MinkowskiDifference& cso, const GjkSimplex<Vec3>& start,
+                       Real threshold, Real scale, std::int32_t& iterations);
 
 }  // namespace collision

@@ -1,11 +1,10 @@
 // collision/src/narrowphase/gjk.cpp -- GJK distance (van den Bergen 1999, "A Fast and Robust GJK
 // Implementation for Collision Detection of Convex Objects"; RTCD 9.5), one loop for both vertex
 // types: w = a - b alone, or with a and b kept so the closest point's barycentric weights give
-// witness points (§3). And the bounded EPA
-// decision (van den Bergen 2001 "Proximity Queries and Penetration Depth Computation on 3D Game
-// Objects") used when the cores overlap.
-// Invariants: |v| decreases strictly every GJK iteration or GJK stops; both loops run at most
-// kGjkMaxIterations times and report Failed rather than loop; no division by a quantity that
+// witness points (§3); and the state decision of a convex pair from a GJK run (decideConvexCores),
+// with the bounded EPA (epa.h) when the cores overlap.
+// Invariants: |v| decreases strictly every GJK iteration or GJK stops; it runs at most
+// kGjkMaxIterations times and reports Failed rather than loop; no division by a quantity that
 // was not checked against a scale-relative epsilon, so finite input never produces NaN.
 #include "narrowphase/gjk.h"
 
@@ -17,7 +16,7 @@
 
 #include "collision/assert.h"
 #include "geometry/closest_points.h"
-#include "narrowphase/epa_polytope.h"
+#include "narrowphase/epa.h"
 
 namespace collision {
 
@@ -190,96 +189,6 @@ GjkRun<Vertex> runGjk(const ConvexCore& a, const ConvexCore& b, const RelativePo
     return finish(GjkState::Failed, v.norm());
 }
 
-// ---- Bounded EPA: decides whether the penetration depth of the cores exceeds `threshold`. ----
-
-using DecidePolytope = EpaPolytope<Vec3, kGjkMaxIterations + 4>;
-
-ContactState epaDecide(const MinkowskiDifference& cso, const Simplex<Vec3>& start, Real threshold,
-                       Real scale, std::int32_t& iterations) {
-    DecidePolytope poly;
-    poly.eps = std::max(Real(64) * kEpsilon * scale, std::numeric_limits<Real>::min());
-    for (int i = 0; i < start.n; ++i) poly.vert[poly.vertex_count++] = start.v[i];
-
-    // Direction probes: any direction n with support h(n) <= threshold proves depth <= threshold.
-    auto probe = [&](const Vec3& dir, Vec3& w_out) {
-        w_out = cso.support(dir);
-        return dir.dot(w_out) <= threshold;
-    };
-
-    // Blow a lower-dimensional simplex up to a tetrahedron (the CSO is 3-D unless it is flat, and
-    // a flat CSO has penetration depth zero).
-    while (poly.vertex_count < 4) {
-        const Vec3 w0 = poly.vert[0];
-        std::array<Vec3, 6> dirs{};
-        int dir_count = 0;
-        if (poly.vertex_count == 1) {
-            dirs = {Vec3::UnitX(),  -Vec3::UnitX(), Vec3::UnitY(),
-                    -Vec3::UnitY(), Vec3::UnitZ(),  -Vec3::UnitZ()};
-            dir_count = 6;
-        } else if (poly.vertex_count == 2) {
-            const Vec3 e = poly.vert[1] - w0;
-            int axis = 0;
-            e.cwiseAbs().minCoeff(&axis);
-            const Vec3 d1 = e.cross(Vec3::Unit(axis)).normalized();
-            const Vec3 d2 = e.cross(d1).normalized();
-            dirs = {d1, -d1, d2, -d2, Vec3::Zero(), Vec3::Zero()};
-            dir_count = 4;
-        } else {
-            const Vec3 n = (poly.vert[1] - w0).cross(poly.vert[2] - w0);
-            const Real len = n.norm();
-            if (!(len > poly.eps * poly.eps)) return ContactState::Touching;
-            dirs = {n / len, -n / len, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
-            dir_count = 2;
-        }
-        bool grown = false;
-        for (int k = 0; k < dir_count && !grown; ++k) {
-            Vec3 w;
-            if (probe(dirs[k], w)) return ContactState::Touching;
-            Real off = 0;
-            if (poly.vertex_count == 1) {
-                off = (w - w0).norm();
-            } else if (poly.vertex_count == 2) {
-                const Vec3 e = poly.vert[1] - w0;
-                off = e.cross(w - w0).norm() / e.norm();
-            } else {
-                off = std::abs(dirs[k].dot(w - w0));
-            }
-            if (off > poly.eps) {
-                poly.vert[poly.vertex_count++] = w;
-                grown = true;
-            }
-        }
-        if (!grown) return ContactState::Touching;  // flat CSO: zero depth
-    }
-
-    poly.closeTetrahedron();
-    for (int iter = 0; iter < kGjkMaxIterations; ++iter) {
-        ++iterations;
-        const int best = poly.closestFace();
-        if (best < 0) return ContactState::Failed;
-        const DecidePolytope::Face closest = poly.faces[best];
-        // The origin lies inside the polytope (inside the CSO), so depth >= closest plane
-        // distance; and depth <= h(n) for every probed n (van den Bergen 2001 §4).
-        if (closest.dist > threshold) return ContactState::Penetrating;
-        Vec3 w;
-        if (probe(closest.normal, w)) return ContactState::Touching;
-        const Real h = closest.normal.dot(w);
-        if (h - closest.dist <= poly.eps) {
-            // Converged at depth ~ threshold: the bounds no longer separate; call it touching.
-            return ContactState::Touching;
-        }
-        // A support point already in the polytope cannot grow it: the depth is closest.dist up
-        // to rounding (<= threshold here). Without this check exactly touching boxes re-added
-        // the same vertex until the cap and came out Failed.
-        const Real dup = kDuplicateRelative * std::max(w.norm(), scale);
-        for (int i = 0; i < poly.vertex_count; ++i) {
-            if ((poly.vert[i] - w).squaredNorm() <= dup * dup) return ContactState::Touching;
-        }
-        if (!poly.expand(w)) return ContactState::Failed;
-    }
-    return ContactState::Failed;
-}
-
 }  // namespace
 
 ConvexCore ConvexCore::fromShape(const Shape& shape) {
@@ -425,7 +334,7 @@ CollideOutput decideConvexCores(const GjkSummary& g, const Vec3* simplex, int si
                 out.state = ContactState::Penetrating;
                 out.iterations += 1;
             } else {
-                Simplex<Vec3> start;
+                GjkSimplex<Vec3> start;
                 start.n = simplex_count;
                 for (int i = 0; i < simplex_count; ++i) start.v[i] = simplex[i];
                 std::int32_t epa_iterations = 0;

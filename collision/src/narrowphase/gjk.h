@@ -1,8 +1,7 @@
 // collision/src/narrowphase/gjk.h -- the one GJK (van den Bergen 1999; RTCD 9.5) between convex
 // cores, as a distance (gjkDistance: collide() and conservative advancement) or with witness
-// points (gjkWitness: contact()), and a bounded EPA that only decides "touching or penetrating"
-// (narrow phase, private). Every convex pair without a closed form goes through
-// collideConvexCores.
+// points (gjkWitness: contact()), and the state decision both queries take from a GJK run
+// (decideConvexCores; the bounded EPA of epa.h when the cores overlap). Private to collision.
 #pragma once
 
 #include <array>
