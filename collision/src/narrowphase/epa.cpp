@@ -25,8 +25,6 @@ constexpr Real kDuplicateRelative = Real(8) * kEpsilon;
 
 using Polytope = EpaPolytope<SupportVertex, kEpaMaxIterations + 4>;
 using Face = Polytope::Face;
-constexpr int kMaxVertices = Polytope::kMaxVertices;
-constexpr int kMaxFaces = Polytope::kMaxFaces;
 
 // Writes the output for face f: the origin's projection n * dist expressed in the face's
 // vertices, and the same weights applied to their support points.
