@@ -34,6 +34,17 @@ using collision::Vec3;
 
 const char* const kDefaultDir = "tests/data/ccd-sample-queries";
 
+// A default data path (the query sets, the tunnelling scenes): relative to the working directory
+// when it is there, else in the source tree this program was built from, else as given (the
+// caller then says what is missing and what to pass).
+fs::path defaultDataPath(const fs::path& relative) {
+    std::error_code ec;
+    if (fs::exists(relative, ec)) return relative;
+    const fs::path in_source = fs::path(CDLAB_SOURCE_DIR) / relative;
+    if (fs::exists(in_source, ec)) return in_source;
+    return relative;
+}
+
 struct Query {
     std::array<Vec3, 4> t0{Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
     std::array<Vec3, 4> t1{Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
@@ -313,7 +324,16 @@ int runBenchCcd(const BenchCcdOptions& options, std::ostream& out, std::ostream&
         return 2;
     }
     std::vector<fs::path> dirs = options.dirs;
-    if (dirs.empty()) dirs.emplace_back(kDefaultDir);
+    if (dirs.empty()) {
+        dirs.push_back(defaultDataPath(kDefaultDir));
+        std::error_code ec;
+        if (!fs::is_directory(dirs.back(), ec)) {
+            err << "cdlab bench ccd: no query directory given, and " << kDefaultDir
+                << " is neither in the working directory nor in the source tree "
+                << CDLAB_SOURCE_DIR << "; pass the query directories (cdlab bench ccd DIR...)\n";
+            return 2;
+        }
+    }
     std::map<std::pair<std::string, std::string>, Group> groups;
     for (const fs::path& dir : dirs) {
         std::string error;
@@ -363,12 +383,18 @@ int runBenchCcd(const BenchCcdOptions& options, std::ostream& out, std::ostream&
     // The engine's CCD stage per frame in the tunnelling scenes, off vs on.
     std::vector<SceneRow> scene_rows;
     if (options.scenes) {
-        const fs::path dir = options.scenes_dir;
+        const fs::path dir =
+            options.scenes_explicit ? options.scenes_dir : defaultDataPath(options.scenes_dir);
         const bool found = fs::is_regular_file(dir / "tunnel_sphere.yaml") &&
                            fs::is_regular_file(dir / "tunnel_bar.yaml");
         if (!found && options.scenes_explicit) {
             err << dir.string() << ":1:1: no tunnel_sphere.yaml and tunnel_bar.yaml here\n";
             return 2;
+        }
+        if (!found) {
+            err << "cdlab bench ccd: tunnelling table skipped: no " << options.scenes_dir.string()
+                << "/tunnel_sphere.yaml and tunnel_bar.yaml in the working directory nor in the "
+                   "source tree (pass --scenes DIR, or --no-scenes)\n";
         }
         if (found) {
             for (const char* name : {"tunnel_sphere.yaml", "tunnel_bar.yaml"}) {

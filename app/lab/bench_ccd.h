@@ -14,13 +14,15 @@ namespace app {
 
 struct BenchCcdOptions {
     /// Query directories: a root of `<set>/<vertex-face|edge-edge>/*.csv`, one set, or one
-    /// kind directory. Empty: tests/data/ccd-sample-queries relative to the working directory.
+    /// kind directory. Empty: tests/data/ccd-sample-queries, in the working directory or else in
+    /// the source tree the program was built from.
     std::vector<std::filesystem::path> dirs;
     std::optional<std::filesystem::path> json;  ///< also write the table as JSON
     std::string method = "all";                 ///< conservative | naive | all
     /// Folder holding tunnel_sphere.yaml and tunnel_bar.yaml: each is run with ccd off and with
     /// ccd conservative_advancement, reporting the step time and the CCD stage's time per frame.
-    /// Default "scenes" (skipped when absent); an explicitly given folder must hold them.
+    /// Default "scenes", in the working directory or else in the source tree (skipped, with a
+    /// note on stderr, when in neither); an explicitly given folder must hold them.
     std::filesystem::path scenes_dir = "scenes";
     bool scenes_explicit = false;
     bool scenes = true;  ///< false: --no-scenes

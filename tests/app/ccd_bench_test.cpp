@@ -23,6 +23,19 @@ using cdlab_test::slurp;
 
 fs::path tempDir(const std::string& name) { return cdlab_test::tempDir("cdlab_ccd_bench_", name); }
 
+// From a working directory other than the repository's root, the defaults still find the query
+// sets and the tunnelling scenes (in the source tree the program was built from): the full
+// table, the tunnelling table, nothing silently dropped.
+TEST(CcdBench, DefaultsWorkOutsideTheRepositoryRoot) {
+    const fs::path work = tempDir("elsewhere");
+    const Result r = runCdlab("bench ccd --method conservative", work, "", work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("conservative all"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("erleben-spikes"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("tunnel_bar"), std::string::npos) << r.out;
+    EXPECT_EQ(r.err.find("skipped"), std::string::npos) << r.err;
+}
+
 TEST(CcdBench, UnitTestSetTableAndJsonWithNoFalseNegatives) {
     const fs::path work = tempDir("unit");
     const fs::path json = work / "ccd.json";
