@@ -225,6 +225,12 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         options.out_dir.empty() ? fs::path("out") / scene.name : options.out_dir;
     const bool want_video = !options.no_video;
     const fs::path video_path = options.video ? *options.video : out_dir / (scene.name + ".mp4");
+    if (want_video && !render::isSupportedVideoFile(video_path)) {
+        err << video_path.string() << ": unsupported video container '"
+            << video_path.extension().string()
+            << "' (supported: " << render::supportedVideoExtensions() << ")\n";
+        return kExitBadInput;
+    }
     if (want_video && !render::ffmpegAvailable()) {
         err << "ffmpeg not found on PATH: install it (apt-get install ffmpeg) or pass --no-video\n";
         return kExitFailure;

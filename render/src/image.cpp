@@ -17,8 +17,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <string>
 #include <string_view>
 #include <system_error>
+#include <vector>
 
 #include "render/output_file.h"
 
@@ -147,12 +149,69 @@ bool ffmpegAvailable() {
     }
 }
 
+namespace {
+
+// What ffmpeg is asked to encode into each container Debian's ffmpeg writes: H.264 (mp4, mov,
+// mkv; +faststart so browsers start playing before the end), VP9 at constant quality (webm;
+// realtime speed, so a 300-frame run does not wait minutes), GIF with one palette made for the
+// whole video (gif).
+struct VideoContainer {
+    std::string_view extension;
+    std::vector<const char*> codec_args;
+    bool needs_even_size;  ///< yuv420p halves the chroma resolution
+};
+
+const std::vector<VideoContainer>& videoContainers() {
+    static const std::vector<VideoContainer> containers{
+        {".mp4", {"-c:v", "libx264", "-pix_fmt", "yuv420p", "-movflags", "+faststart"}, true},
+        {".mov", {"-c:v", "libx264", "-pix_fmt", "yuv420p", "-movflags", "+faststart"}, true},
+        {".mkv", {"-c:v", "libx264", "-pix_fmt", "yuv420p"}, true},
+        {".webm",
+         {"-c:v", "libvpx-vp9", "-pix_fmt", "yuv420p", "-b:v", "0", "-crf", "32", "-deadline",
+          "realtime", "-cpu-used", "8"},
+         true},
+        {".gif",
+         {"-filter_complex", "[0:v]split[a][b];[a]palettegen[p];[b][p]paletteuse", "-c:v", "gif"},
+         false},
+    };
+    return containers;
+}
+
+const VideoContainer* findVideoContainer(const fs::path& file) {
+    const std::string ext = file.has_extension() ? file.extension().string() : ".mp4";
+    for (const VideoContainer& c : videoContainers()) {
+        if (c.extension == ext) return &c;
+    }
+    return nullptr;
+}
+
+}  // namespace
+
+std::string supportedVideoExtensions() {
+    std::string list;
+    for (const VideoContainer& c : videoContainers()) {
+        if (!list.empty()) list += ", ";
+        list += c.extension;
+    }
+    return list;
+}
+
+bool isSupportedVideoFile(const fs::path& file) { return findVideoContainer(file) != nullptr; }
+
 VideoWriter::VideoWriter(const fs::path& file, int width, int height, int fps,
                          std::chrono::milliseconds stall_timeout)
     : file_(file), width_(width), height_(height), stall_timeout_(stall_timeout) {
-    if (width <= 0 || height <= 0 || width % 2 != 0 || height % 2 != 0) {
+    const VideoContainer* container = findVideoContainer(file);
+    if (container == nullptr) {
+        throw RenderError(file.string() + ": unsupported video container '" +
+                          file.extension().string() + "' (supported: " +
+                          supportedVideoExtensions() + ")");
+    }
+    if (width <= 0 || height <= 0 ||
+        (container->needs_even_size && (width % 2 != 0 || height % 2 != 0))) {
         throw RenderError(file.string() + ": video size " + std::to_string(width) + "x" +
-                          std::to_string(height) + " must be positive and even (H.264 yuv420p)");
+                          std::to_string(height) + " must be positive" +
+                          (container->needs_even_size ? " and even (yuv420p)" : ""));
     }
     if (fps <= 0) {
         throw RenderError(file.string() + ": video fps " + std::to_string(fps) + " must be > 0");
@@ -172,11 +231,13 @@ VideoWriter::VideoWriter(const fs::path& file, int width, int height, int fps,
     const std::string size = std::to_string(width) + "x" + std::to_string(height);
     const std::string rate = std::to_string(fps);
     const std::string out = partial_.string();
-    const char* argv[] = {"ffmpeg",    "-y",         "-loglevel", "error",     "-f",
-                          "rawvideo",  "-pix_fmt",   "rgb24",     "-s",        size.c_str(),
-                          "-r",        rate.c_str(), "-i",        "-",         "-c:v",
-                          "libx264",   "-pix_fmt",   "yuv420p",   "-movflags", "+faststart",
-                          out.c_str(), nullptr};
+    std::vector<const char*> argv = {"ffmpeg", "-y",         "-loglevel", "error",
+                                     "-f",     "rawvideo",   "-pix_fmt",  "rgb24",
+                                     "-s",     size.c_str(), "-r",        rate.c_str(),
+                                     "-i",     "-"};
+    argv.insert(argv.end(), container->codec_args.begin(), container->codec_args.end());
+    argv.push_back(out.c_str());
+    argv.push_back(nullptr);
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
     // dup2 clears close-on-exec on fd 0 only; the child never holds our write end, so closing
@@ -184,7 +245,8 @@ VideoWriter::VideoWriter(const fs::path& file, int width, int height, int fps,
     posix_spawn_file_actions_adddup2(&actions, fds[0], STDIN_FILENO);
     pid_t pid = -1;
     const int spawn_error =
-        ::posix_spawnp(&pid, "ffmpeg", &actions, nullptr, const_cast<char* const*>(argv), environ);
+        ::posix_spawnp(&pid, "ffmpeg", &actions, nullptr, const_cast<char* const*>(argv.data()),
+                       environ);
     posix_spawn_file_actions_destroy(&actions);
     ::close(fds[0]);
     if (spawn_error != 0) {

@@ -154,6 +154,37 @@ TEST(Cli, RunWritesAnH264Yuv420pVideoWithEveryFrame) {
     fs::remove_all(work);
 }
 
+// --video picks the container by its extension: a WebM holds VP9 (not the H.264 that made ffmpeg
+// fail with "Resource temporarily unavailable"), a GIF its own codec; an unsupported extension is
+// bad input found before any output, with the list of supported containers.
+TEST(Cli, RunWritesWebmAndGifAndRefusesUnsupportedContainers) {
+    if (!haveFfprobe()) GTEST_SKIP() << "ffprobe not on PATH (Debian package ffmpeg)";
+    const fs::path work = tempDir("containers");
+    const fs::path out = work / "out";
+    for (const auto& [name, codec] : {std::pair<std::string, std::string>{"tiny.webm", "vp9"},
+                                      {"tiny.gif", "gif"}}) {
+        const fs::path video = work / name;
+        const Result r = runCdlab("run " + kTiny + " --out " + out.string() + " --video " +
+                                      video.string(),
+                                  work);
+        ASSERT_EQ(r.exit_code, 0) << name << ": " << r.err;
+        const std::map<std::string, std::string> probe = probeVideo(video, work);
+        ASSERT_EQ(probe.count("error"), 0u) << probe.at("error");
+        EXPECT_EQ(probe.count("codec_name") ? probe.at("codec_name") : "?", codec) << name;
+        EXPECT_EQ(probe.count("nb_read_frames") ? probe.at("nb_read_frames") : "?", "6") << name;
+    }
+    const fs::path bad_out = work / "bad_out";
+    const Result r = runCdlab("run " + kTiny + " --out " + bad_out.string() + " --video " +
+                                  (work / "tiny.avi").string(),
+                              work);
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find("unsupported video container '.avi' (supported: .mp4"),
+              std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(bad_out)) << "output written before the check";
+    fs::remove_all(work);
+}
+
 // ffmpeg missing: found before any output is written, a message that says what to do, exit 1.
 // cdlab looks for ffmpeg on PATH, so an empty directory as PATH hides it; the same run with
 // --no-video succeeds, so it is the missing encoder and nothing else that stops the first run.

@@ -711,6 +711,54 @@ TEST(Video, TenFramesMakeANonEmptyMp4) {
     EXPECT_EQ(std::string(head + 4, 4), "ftyp");
 }
 
+// Every container of supportedVideoExtensions() is written with a codec it holds (the raw H.264
+// stream into a .webm or .gif used to fail inside ffmpeg): WebM starts with the EBML magic, GIF
+// with its signature; an odd size is fine for GIF (no chroma subsampling).
+TEST(Video, WebmAndGifAreWritten) {
+    if (!render::ffmpegAvailable()) GTEST_SKIP() << "ffmpeg not on PATH";
+    TempDir dir;
+    render::Renderer renderer(kWidth, kHeight);
+    const render::Image frame = renderThreeSpheres(renderer);
+    for (const char* name : {"clip.webm", "clip.gif", "clip.mkv", "clip.mov"}) {
+        const fs::path file = dir.path() / name;
+        {
+            render::VideoWriter video(file, kWidth, kHeight, 30);
+            for (int i = 0; i < 5; ++i) video.addFrame(frame);
+            video.finish();
+        }
+        ASSERT_TRUE(fs::exists(file)) << name;
+        EXPECT_GT(fs::file_size(file), 100u) << name;
+    }
+    std::ifstream webm(dir.path() / "clip.webm", std::ios::binary);
+    unsigned char ebml[4] = {};
+    webm.read(reinterpret_cast<char*>(ebml), 4);
+    EXPECT_EQ(ebml[0], 0x1A);
+    EXPECT_EQ(ebml[1], 0x45);
+    EXPECT_EQ(ebml[2], 0xDF);
+    EXPECT_EQ(ebml[3], 0xA3);
+    std::ifstream gif(dir.path() / "clip.gif", std::ios::binary);
+    char sig[6] = {};
+    gif.read(sig, 6);
+    EXPECT_EQ(std::string(sig, 3), "GIF");
+    EXPECT_NO_THROW(render::VideoWriter(dir.path() / "odd.gif", 161, 121, 30));
+}
+
+TEST(Video, UnsupportedContainerIsRefusedWithTheList) {
+    TempDir dir;
+    try {
+        render::VideoWriter video(dir.path() / "clip.avi", kWidth, kHeight, 30);
+        FAIL() << "no error for .avi";
+    } catch (const render::RenderError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("unsupported video container '.avi'"), std::string::npos) << what;
+        EXPECT_NE(what.find(".webm"), std::string::npos) << what;
+    }
+    EXPECT_FALSE(render::isSupportedVideoFile("x.avi"));
+    EXPECT_TRUE(render::isSupportedVideoFile("x.gif"));
+    EXPECT_TRUE(render::isSupportedVideoFile("x"));  // no extension: mp4
+    EXPECT_TRUE(fs::is_empty(dir.path()));
+}
+
 TEST(Video, AnUnfinishedVideoLeavesNoFile) {
     if (!render::ffmpegAvailable()) GTEST_SKIP() << "ffmpeg not on PATH";
     TempDir dir;

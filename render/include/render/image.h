@@ -35,7 +35,14 @@ Image readPng(const std::filesystem::path& file);
 /// True when `ffmpeg` can be run from PATH.
 bool ffmpegAvailable();
 
-/// Pipes raw frames to ffmpeg: H.264, yuv420p, +faststart, so browsers play the file.
+/// The video containers VideoWriter writes, by file extension: ".mp4, .mov, .mkv, .webm, .gif".
+std::string supportedVideoExtensions();
+/// True when VideoWriter can write `file` (its extension is supported; none means .mp4).
+bool isSupportedVideoFile(const std::filesystem::path& file);
+
+/// Pipes raw frames to ffmpeg, the codec chosen by the file's extension: H.264 yuv420p for .mp4,
+/// .mov (+faststart, so browsers play the file) and .mkv; VP9 for .webm; GIF with one palette
+/// for .gif. Any other extension is a RenderError before ffmpeg starts.
 /// The output appears under its final name only after finish() succeeded. An ffmpeg that stops
 /// reading (or never exits) is an error after `stall_timeout` without progress, not a hang.
 class VideoWriter {
