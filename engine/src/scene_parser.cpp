@@ -366,6 +366,11 @@ Scene SceneParser::parse(const std::string& text) {
             }
         }
     }
+    if (scene.bodies.empty()) {
+        const Entry* bodies = find(es, "bodies");
+        fail(bodies != nullptr ? bodies->key_node : root, "bodies",
+             "a scene needs at least one body (a list under 'bodies:')");
+    }
     if (const Entry* bodies = find(es, "bodies")) {
         const double pairs = estimateStartPairs(scene.bodies);
         if (pairs > double(kMaxCandidatePairs)) {

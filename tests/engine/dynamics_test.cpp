@@ -295,11 +295,14 @@ TEST(Integrators, TorqueFreeSymmetricTopPrecessesAtTheClosedFormRate) {
 
 TEST(Integrators, SceneKeySelectsTheIntegrator) {
     const std::string head = "world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n";
-    EXPECT_EQ(parseScene(head, "t.yaml", ".").world.integrator, Integrator::SemiImplicitEuler);
-    EXPECT_EQ(parseScene(head + "  integrator: rk4\n", "t.yaml", ".").world.integrator,
+    const std::string body = "bodies:\n  - {shape: sphere, radius: 0.25, position: [0.5, 0.5, 0.5]}\n";
+    EXPECT_EQ(parseScene(head + body, "t.yaml", ".").world.integrator,
+              Integrator::SemiImplicitEuler);
+    EXPECT_EQ(parseScene(head + "  integrator: rk4\n" + body, "t.yaml", ".").world.integrator,
               Integrator::Rk4);
-    EXPECT_EQ(parseScene(head + "  integrator: explicit_euler\n", "t.yaml", ".").world.integrator,
-              Integrator::ExplicitEuler);
+    EXPECT_EQ(
+        parseScene(head + "  integrator: explicit_euler\n" + body, "t.yaml", ".").world.integrator,
+        Integrator::ExplicitEuler);
     try {
         parseScene(head + "  integrator: verlet\n", "t.yaml", ".");
         FAIL() << "accepted an unknown integrator";

@@ -39,7 +39,8 @@ const std::string kScene =
     "expect:\n";                                                          // 7
 
 TEST(SceneExpect, AbsentMeansNotPresent) {
-    const Scene s = parseScene("world: {bounds: {min: [-1, -1, -1], max: [1, 1, 1]}}\nbodies:\n",
+    const Scene s = parseScene("world: {bounds: {min: [-1, -1, -1], max: [1, 1, 1]}}\nbodies:\n"
+                               "  - {shape: sphere, radius: 0.25, position: [0.5, 0.5, 0.5]}\n",
                                "x.yaml", ".");
     EXPECT_FALSE(s.expect.present);
     const Scene one = parseScene(kScene + "  min_bodies: 1\n", "x.yaml", ".");

@@ -51,6 +51,9 @@ const std::string kHeader =
 
 std::string withBody(const std::string& body_lines) { return kHeader + body_lines; }
 
+// kHeader with one body: the smallest scene that loads.
+const std::string kValid = kHeader + "  - {shape: sphere, radius: 0.25, position: [0.5, 0.5, 0.5]}\n";
+
 const char* const kFullScene = R"(world:
   bounds: {min: [-10, -6, -10], max: [10, 6, 10]}
   gravity: [0, -9.81, 0]
@@ -198,18 +201,21 @@ TEST(Scene, Defaults) {
     EXPECT_EQ(b.linear_momentum, Vec3::Zero());
     EXPECT_EQ(b.angular_momentum, Vec3::Zero());
     // Bodies are optional.
-    EXPECT_TRUE(parse(kHeader).bodies.empty());
+    // No bodies, or an empty list: an error, not a run that shows nothing.
+    EXPECT_SCENE_ERROR(kHeader, "3:1: bodies: ", "a scene needs at least one body");
+    EXPECT_SCENE_ERROR("world:\n  bounds: {min: [-1, -1, -1], max: [1, 1, 1]}\nbodies: []\n",
+                       "3:1: bodies: ", "a scene needs at least one body");
 }
 
 // draw.bvh_depth: the hierarchy level to draw (-1: off, as when absent); draw.contacts.
 TEST(Scene, DrawBvhDepthAndContacts) {
-    const Scene on = parse(kHeader + "draw: {bvh_depth: 4, contacts: true}\n");
+    const Scene on = parse(kValid + "draw: {bvh_depth: 4, contacts: true}\n");
     EXPECT_EQ(on.draw.bvh_depth, 4);
     EXPECT_TRUE(on.draw.contacts);
-    const Scene root = parse(kHeader + "draw: {bvh_depth: 0, contacts: false}\n");
+    const Scene root = parse(kValid + "draw: {bvh_depth: 0, contacts: false}\n");
     EXPECT_EQ(root.draw.bvh_depth, 0);
     EXPECT_FALSE(root.draw.contacts);
-    EXPECT_EQ(parse(kHeader + "draw: {bvh_depth: -1}\n").draw.bvh_depth, -1);
+    EXPECT_EQ(parse(kValid + "draw: {bvh_depth: -1}\n").draw.bvh_depth, -1);
     // The other draw keys keep their defaults.
     EXPECT_TRUE(on.draw.sphere);
     EXPECT_FALSE(on.draw.structure);
@@ -377,13 +383,13 @@ TEST(Scene, MeshBvhIsChosenByTheWorld) {
 TEST(Scene, CcdToleranceAndTargetGapReachTheWorld) {
     // Defaults: the constants the continuous stage had before the keys existed, so scenes that
     // do not set them keep their results.
-    const Scene d = parse(kHeader);
+    const Scene d = parse(kValid);
     EXPECT_EQ(d.world.ccd_tolerance, collision::kToiRelativeTolerance);
     EXPECT_EQ(d.world.ccd_target_gap, Real(1e-3));
     const Scene s = parse(
         "world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n"
         "  ccd: conservative_advancement\n  ccd_tolerance: 0.05\n"
-        "  ccd_target_gap: 0\nbodies:\n");
+        "  ccd_target_gap: 0\nbodies:\n  - {shape: sphere, radius: 0.25, position: [0.5, 0.5, 0.5]}\n");
     EXPECT_EQ(s.world.ccd_tolerance, Real(0.05));
     EXPECT_EQ(s.world.ccd_target_gap, Real(0));
     const World w = makeWorld(s);
@@ -391,7 +397,8 @@ TEST(Scene, CcdToleranceAndTargetGapReachTheWorld) {
     EXPECT_EQ(w.settings().ccd_target_gap, Real(0));
     // The upper ends of the ranges are accepted.
     EXPECT_EQ(errorOf("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  ccd_tolerance: 1\n"
-                      "  ccd_target_gap: 1\n"),
+                      "  ccd_target_gap: 1\nbodies:\n  - {shape: sphere, radius: 0.25, position: "
+                      "[0.5, 0.5, 0.5]}\n"),
               "");
 }
 
@@ -897,7 +904,8 @@ TEST(SceneErrors, OctalAndQuotedNumbersAreRefused) {
     EXPECT_SCENE_ERROR(world + "  time_step: \"0.5\"\nbodies:\n", "3:14: world.time_step: ",
                        "expected a number, got the string \"0.5\"");
     // What stays valid: plain decimals, a sign, zero itself, and one leading "---".
-    EXPECT_EQ(errorOf("---\n" + world + "  frames: 300\n  steps_per_frame: +2\nbodies:\n"), "");
+    EXPECT_EQ(errorOf("---\n" + world + "  frames: 300\n  steps_per_frame: +2\nbodies:\n  - {shape: sphere, radius: 0.25, position: [0.5, 0.5, 0.5]}\n"),
+              "");
 }
 
 // Regression: 20,000 coincident spheres were accepted and spent 130 s and 11 GB on frame 0 (10^6
@@ -928,8 +936,9 @@ TEST(SceneErrors, ASecondDocumentIsRefusedWhereItStarts) {
     // An empty second document is still a second document.
     EXPECT_SCENE_ERROR(world + "---\n", "4:1: scene: ", "a second YAML document");
     // One document with its own end marker, a leading "---" and trailing comments stay valid.
-    EXPECT_EQ(errorOf("---\n" + world + "...\n"), "");
-    EXPECT_EQ(errorOf(world + "# the end\n"), "");
+    const std::string one_body = world + "  - {shape: sphere, radius: 0.25, position: [0.5, 0.5, 0.5]}\n";
+    EXPECT_EQ(errorOf("---\n" + one_body + "...\n"), "");
+    EXPECT_EQ(errorOf(one_body + "# the end\n"), "");
 }
 
 // Regression: a one-triangle mesh was refused with "cannot build the convex hull ... needs at
