@@ -13,6 +13,7 @@
 #include "collision/geometry/shape.h"
 #include "collision/narrowphase/narrow_phase.h"
 #include "test_random.h"
+#include "test_shapes.h"
 
 namespace collision {
 namespace {
@@ -199,14 +200,7 @@ TEST(ConservativeAdvancement, InvariantUnderOffsetScaleAndSwap) {
 }
 
 // Largest distance of the shape from its origin (what timeOfImpact calls the bounding radius).
-Real boundingRadius(const Shape& s) {
-    switch (s.type) {
-        case ShapeType::Sphere: return s.radius;
-        case ShapeType::Box: return s.half_extents.norm();
-        case ShapeType::Capsule: return s.radius + s.half_height;
-        default: return 0;
-    }
-}
+using cdlab_test::boundingRadius;
 
 Shape randomShape(cdlab_test::Rng& rng) {
     switch (rng.integer(0, 2)) {

@@ -18,9 +18,6 @@ namespace collision {
 
 namespace {
 
-// Lengths below this multiple of kEpsilon * (size of the polytope) are rounding noise.
-constexpr Real kDuplicateRelative = Real(8) * kEpsilon;
-
 // ---- EPA polytope ----
 
 using Polytope = EpaPolytope<SupportVertex, kEpaMaxIterations + 4>;
@@ -170,15 +167,7 @@ EpaOutput epaPenetration(const ConvexCore& a, const ConvexCore& b, const Relativ
         const SupportVertex w = cso.supportVertex<SupportVertex>(closest.normal);
         const Real h = closest.normal.dot(w.w);
         // Lower bound closest.dist <= depth <= h (van den Bergen 2001 §4).
-        bool converged = h - closest.dist <= tol;
-        if (!converged) {
-            const Real dup = kDuplicateRelative * std::max(w.w.norm(), scale);
-            for (int i = 0; i < poly.vertex_count && !converged; ++i) {
-                converged =
-                    (poly.vert[static_cast<std::size_t>(i)].w - w.w).squaredNorm() <= dup * dup;
-            }
-        }
-        if (converged) {
+        if (h - closest.dist <= tol || poly.holdsPoint(w.w, scale)) {
             faceOutput(poly, faceHoldingProjection(poly, closest, tol), out);
             out.state = EpaState::Converged;
             return out;
@@ -274,10 +263,7 @@ ContactState epaDecide(const MinkowskiDifference& cso, const GjkSimplex<Vec3>& s
         // A support point already in the polytope cannot grow it: the depth is closest.dist up
         // to rounding (<= threshold here). Without this check exactly touching boxes re-added
         // the same vertex until the cap and came out Failed.
-        const Real dup = kDuplicateRelative * std::max(w.norm(), scale);
-        for (int i = 0; i < poly.vertex_count; ++i) {
-            if ((poly.vert[i] - w).squaredNorm() <= dup * dup) return ContactState::Touching;
-        }
+        if (poly.holdsPoint(w, scale)) return ContactState::Touching;
         if (!poly.expand(w)) return ContactState::Failed;
     }
     return ContactState::Failed;

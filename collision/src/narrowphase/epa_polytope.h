@@ -3,6 +3,7 @@
 // full depth with witnesses in epa.cpp (SupportVertex). Private to collision.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <utility>
 #include <cstddef>
@@ -112,6 +113,16 @@ struct EpaPolytope {
             if (!addFace(edge[0], edge[1], new_index)) return false;
         }
         return true;
+    }
+
+    /// True when `w` is one of the vertices again, up to kDuplicateRelative * max(|w|, scale)
+    /// (gjk.h): such a support point cannot grow the polytope.
+    bool holdsPoint(const Vec3& w, Real scale) const {
+        const Real dup = kDuplicateRelative * std::max(w.norm(), scale);
+        for (int i = 0; i < vertex_count; ++i) {
+            if ((point(i) - w).squaredNorm() <= dup * dup) return true;
+        }
+        return false;
     }
 
     /// The valid, non-degenerate face nearest the origin (lowest index among equals), or -1.

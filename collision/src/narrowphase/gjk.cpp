@@ -22,9 +22,8 @@ namespace collision {
 
 namespace {
 
-// Below these multiples of kEpsilon * (size of the simplex) a length is rounding noise.
+// Below this multiple of kEpsilon * (size of the simplex) |v| is rounding noise.
 constexpr Real kOverlapRelative = Real(32) * kEpsilon;
-constexpr Real kDuplicateRelative = Real(8) * kEpsilon;
 
 Real signOrPlus(Real x) { return x < 0 ? Real(-1) : Real(1); }
 

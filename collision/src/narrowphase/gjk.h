@@ -76,6 +76,11 @@ struct GjkOutput : GjkSummary {
     std::array<Vec3, 4> simplex{};   ///< vertices of A - B, in A's frame
 };
 
+/// A support point closer than kDuplicateRelative times its size to a vertex already held (by
+/// GJK's simplex or an EPA polytope) is that vertex again: it cannot make progress, and rounding
+/// decides the rest.
+inline constexpr Real kDuplicateRelative = Real(8) * kEpsilon;
+
 /// Iteration cap of GJK and of the EPA decision.
 inline constexpr int kGjkMaxIterations = 64;
 /// GJK stops when |v|^2 - v.w <= kGjkRelativeTolerance * |v|^2, which bounds the relative error of
