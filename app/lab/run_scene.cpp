@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -322,6 +323,12 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         out << " (" << world.bodies().size() << " bodies, " << world.stepCount() << " steps, "
             << scene.world.broad_phase << (options.check_broad_phase ? ", every step checked" : "")
             << ")\n";
+        const double scale = double(engine::videoTimeScale(scene));
+        if (want_video && std::abs(scale - 1.0) > 1e-9) {
+            // A scene may ask for slow motion; say so, so that nobody reads it as real time.
+            out << "note: one second of video shows " << scale
+                << " s of simulated time (time_step x steps_per_frame x fps)\n";
+        }
     } catch (const render::RenderError& e) {
         err << "error: " << e.what() << "\n";
         return kExitFailure;

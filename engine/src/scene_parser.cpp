@@ -337,6 +337,8 @@ Scene SceneParser::parse(const std::string& text) {
     }
     const std::vector<Entry> es =
         entries(root, "", {"world", "broadphase", "output", "camera", "draw", "bodies", "expect"});
+    // The output's frame rate first: the world's default time step is derived from it.
+    if (const Entry* output = find(es, "output")) parseOutput(output->value, scene);
     parseWorld(require(es, "world", root, "").value, scene);
     for (const Entry& e : es) {
         if (e.key == "broadphase") {
@@ -347,8 +349,6 @@ Scene SceneParser::parse(const std::string& text) {
                          "' (expected one of: " + collision::broadPhaseNames() + ")");
             }
             scene.world.broad_phase = name;
-        } else if (e.key == "output") {
-            parseOutput(e.value, scene);
         } else if (e.key == "camera") {
             parseCamera(e.value, scene);
         } else if (e.key == "draw") {

@@ -78,6 +78,9 @@ inline constexpr int kMaxStepsPerFrame = 100000;
 
 inline constexpr int kMaxFrames = 1000000;
 
+// Steps per second of simulated time when a scene gives neither time_step nor steps_per_frame.
+inline constexpr int kDefaultMaxStepRate = 60;
+
 struct Entry {
     std::string key;
     YAML::Node key_node;
@@ -147,6 +150,9 @@ private:
 
     void parseWorld(const YAML::Node& n, Scene& scene) const;
     void parseOutput(const YAML::Node& n, Scene& scene) const;
+    /// Fills in whichever of time_step and steps_per_frame the scene left out so that a frame
+    /// spans 1/fps s of simulated time (output.fps must be parsed already).
+    static void defaultTiming(bool has_time_step, bool has_steps_per_frame, Scene& scene);
     void parseCamera(const YAML::Node& n, Scene& scene) const;
     void parseDraw(const YAML::Node& n, Scene& scene) const;
     /// One body, or the `repeat.count` bodies a `repeat` entry generates.

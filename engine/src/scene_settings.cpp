@@ -127,6 +127,7 @@ void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
             }
         }
     }
+    defaultTiming(find(es, "time_step") != nullptr, find(es, "steps_per_frame") != nullptr, scene);
     // Gravity against the time step, once both are known: |g| dt is a speed gained per step.
     if (const Entry* g = find(es, "gravity")) {
         const std::string problem =
@@ -135,6 +136,22 @@ void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
             fail(g->value, childPath(path, "gravity"),
                  "too strong for the time step: the " + problem + " (gained in one step)");
         }
+    }
+}
+
+void SceneParser::defaultTiming(bool has_time_step, bool has_steps_per_frame, Scene& scene) {
+    // A frame shows 1/fps s of simulated time unless the scene says otherwise, so a video plays
+    // at the speed things happen. With neither key the step is at most 1/60 s:
+    // ceil(60 / fps) steps per frame of 1 / (fps * steps) s each (30 fps: two steps of 1/60 s).
+    const int fps = scene.output.fps;
+    if (!has_time_step && !has_steps_per_frame) {
+        scene.steps_per_frame = (kDefaultMaxStepRate + fps - 1) / fps;
+        scene.world.time_step = Real(1) / (Real(fps) * Real(scene.steps_per_frame));
+    } else if (!has_time_step) {
+        scene.world.time_step = Real(1) / (Real(fps) * Real(scene.steps_per_frame));
+    } else if (!has_steps_per_frame) {
+        const double steps = std::round(1.0 / (double(fps) * double(scene.world.time_step)));
+        scene.steps_per_frame = static_cast<int>(std::clamp(steps, 1.0, double(kMaxStepsPerFrame)));
     }
 }
 

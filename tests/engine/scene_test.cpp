@@ -173,9 +173,12 @@ TEST(Scene, Defaults) {
     const Scene s =
         parse(withBody("  - shape: sphere\n    radius: 0.5\n    position: [0, 0, 0]\n"));
     EXPECT_EQ(s.world.gravity, Vec3::Zero());
+    // No time_step or steps_per_frame: two steps of 1/60 s per frame at 30 fps, so the video
+    // plays at the speed of the simulation.
     EXPECT_EQ(s.world.time_step, Real(1) / 60);
     EXPECT_EQ(s.world.broad_phase, "sap");
-    EXPECT_EQ(s.steps_per_frame, 1);
+    EXPECT_EQ(s.steps_per_frame, 2);
+    EXPECT_EQ(videoTimeScale(s), 1);
     EXPECT_EQ(s.frames, 120);
     EXPECT_EQ(s.output.width, 960);
     EXPECT_EQ(s.output.height, 540);
@@ -200,11 +203,43 @@ TEST(Scene, Defaults) {
     EXPECT_EQ(b.orientation.coeffs(), Quat::Identity().coeffs());
     EXPECT_EQ(b.linear_momentum, Vec3::Zero());
     EXPECT_EQ(b.angular_momentum, Vec3::Zero());
-    // Bodies are optional.
     // No bodies, or an empty list: an error, not a run that shows nothing.
     EXPECT_SCENE_ERROR(kHeader, "3:1: bodies: ", "a scene needs at least one body");
     EXPECT_SCENE_ERROR("world:\n  bounds: {min: [-1, -1, -1], max: [1, 1, 1]}\nbodies: []\n",
                        "3:1: bodies: ", "a scene needs at least one body");
+}
+
+// Whichever of time_step and steps_per_frame a scene leaves out is chosen so that one frame
+// spans 1/fps s of simulated time; a scene that gives both keeps them (slow motion is allowed).
+TEST(Scene, DefaultTimingMakesVideoTimeSimulatedTime) {
+    const std::string body = "bodies:\n  - {shape: sphere, radius: 0.5, position: [0, 0, 0]}\n";
+    const auto scene = [&](const std::string& world_lines, const std::string& output) {
+        return parse("world:\n  bounds: {min: [-9, -9, -9], max: [9, 9, 9]}\n" + world_lines +
+                     output + body);
+    };
+    const Scene fps24 = scene("", "output: {fps: 24}\n");
+    EXPECT_EQ(fps24.steps_per_frame, 3);  // ceil(60 / 24): steps no longer than 1/60 s
+    EXPECT_EQ(fps24.world.time_step, Real(1) / 72);
+    const Scene fps120 = scene("", "output: {fps: 120}\n");
+    EXPECT_EQ(fps120.steps_per_frame, 1);
+    EXPECT_EQ(fps120.world.time_step, Real(1) / 120);
+    const Scene steps_only = scene("  steps_per_frame: 4\n", "");
+    EXPECT_EQ(steps_only.world.time_step, Real(1) / 120);
+    const Scene dt_only = scene("  time_step: 0.005\n", "");
+    EXPECT_EQ(dt_only.steps_per_frame, 7);  // round(6.67): the nearest whole number of steps
+    const Scene coarse = scene("  time_step: 0.5\n", "");
+    EXPECT_EQ(coarse.steps_per_frame, 1);
+    const Scene both = scene("  time_step: 0.001\n  steps_per_frame: 2\n", "");
+    EXPECT_EQ(both.world.time_step, 0.001);
+    EXPECT_EQ(both.steps_per_frame, 2);
+    EXPECT_NEAR(videoTimeScale(both), 0.06, 1e-15);
+    for (const Scene* s : {&fps24, &fps120, &steps_only}) {
+        EXPECT_NEAR(videoTimeScale(*s), 1, 1e-15);
+    }
+    // The key order in the file does not matter: output may come after world or before it.
+    const Scene output_first = parse("output: {fps: 24}\nworld:\n  bounds: {min: [-9, -9, -9], "
+                                     "max: [9, 9, 9]}\n" + body);
+    EXPECT_EQ(output_first.steps_per_frame, 3);
 }
 
 // draw.bvh_depth: the hierarchy level to draw (-1: off, as when absent); draw.contacts.

@@ -130,13 +130,22 @@ struct Scene {
     std::string name;  ///< file stem
     WorldSettings world;
     int frames = 120;         ///< frames to write (frame 0 is the initial state)
-    int steps_per_frame = 1;  ///< integrator steps between two frames
+    /// Integrator steps between two frames. A loaded scene that leaves out time_step or
+    /// steps_per_frame (or both) gets values for which one frame is 1/fps s of simulated time:
+    /// neither key, ceil(60 / fps) steps of 1 / (fps * steps) s; one key, the other from it.
+    int steps_per_frame = 1;
     OutputSettings output;
     CameraSettings camera;
     DrawSettings draw;
     std::vector<Body> bodies;
     Expectations expect;  ///< `expect:` (self-grading), empty when absent
 };
+
+/// Simulated seconds per second of the scene's video: time_step * steps_per_frame * fps
+/// (1 = real time; below 1, slow motion).
+inline Real videoTimeScale(const Scene& scene) {
+    return scene.world.time_step * Real(scene.steps_per_frame) * Real(scene.output.fps);
+}
 
 /// A bad scene file. what() is "FILE:LINE:COL: key.path: what is wrong" (1-based line and column).
 class SceneError : public std::runtime_error {
