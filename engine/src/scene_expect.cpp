@@ -30,9 +30,9 @@ class ExpectReader {
 public:
     ExpectReader(const SceneParser& parser, const Scene& scene, int run_frames)
         : p_(parser), run_frames_(run_frames) {
-        // Body names -> index; a name given to several bodies cannot be referred to.
+        // Body names -> index (the loader has made them unique).
         for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
-            by_name_[scene.bodies[i].name].push_back(static_cast<BodyId>(i));
+            by_name_.emplace(scene.bodies[i].name, static_cast<BodyId>(i));
         }
     }
 
@@ -76,12 +76,7 @@ public:
         const std::string name = p_.readString(v, p);
         const auto it = by_name_.find(name);
         if (it == by_name_.end()) p_.fail(v, p, "no body is named '" + name + "'");
-        if (it->second.size() > 1) {
-            p_.fail(v, p,
-                    "the name '" + name + "' is given to " + std::to_string(it->second.size()) +
-                        " bodies");
-        }
-        return it->second.front();
+        return it->second;
     }
     BodyState readState(const YAML::Node& v, const std::string& p) const {
         const std::string c = p_.readString(v, p);
@@ -102,7 +97,7 @@ public:
 private:
     const SceneParser& p_;
     int run_frames_;
-    std::map<std::string, std::vector<BodyId>> by_name_;
+    std::map<std::string, BodyId> by_name_;
 };
 
 void ExpectReader::tunnellingOrToi(const Entry& e, const std::string& p, Expectations& ex) const {

@@ -356,13 +356,17 @@ Scene SceneParser::parse(const std::string& text) {
         } else if (e.key == "bodies") {
             if (e.value.IsNull()) continue;  // "bodies:" with nothing after it: no bodies
             if (!e.value.IsSequence()) fail(e.value, "bodies", "expected a list of bodies");
+            std::unordered_map<std::string, std::size_t> first_entry_of_name;
             for (std::size_t i = 0; i < e.value.size(); ++i) {
                 if (scene.bodies.size() >= kMaxBodies) {
                     fail(e.value[i], indexPath("bodies", i),
                          "more than " + std::to_string(kMaxBodies) + " bodies in a scene");
                 }
                 std::vector<Body> made = parseBody(e.value[i], i, scene);
-                for (Body& b : made) scene.bodies.push_back(std::move(b));
+                for (Body& b : made) {
+                    requireUniqueName(b.name, e.value[i], i, first_entry_of_name);
+                    scene.bodies.push_back(std::move(b));
+                }
             }
         }
     }
@@ -382,6 +386,28 @@ Scene SceneParser::parse(const std::string& text) {
     }
     if (const Entry* e = find(es, "expect")) parseExpect(*e, scene);
     return scene;
+}
+
+void SceneParser::requireUniqueName(
+    const std::string& name, const YAML::Node& entry, std::size_t index,
+    std::unordered_map<std::string, std::size_t>& first_entry_of_name) const {
+    // Expectations, traces, pause dumps and --set refer to bodies by name, so a name that two
+    // bodies share would refer to neither.
+    const auto [it, inserted] = first_entry_of_name.emplace(name, index);
+    if (inserted) return;
+    const YAML::Node name_node = entry.IsMap() ? entry["name"] : YAML::Node();
+    const bool generated = entry.IsMap() && entry["repeat"];
+    std::string what = "the body name '" + name + "' is already taken by bodies[" +
+                       std::to_string(it->second) + "]";
+    if (it->second == index) what = "repeat generates the name '" + name + "' twice";
+    if (generated) {
+        what += " (repeat names its bodies <name>_0, <name>_1, ...)";
+    } else if (!name_node) {
+        what += " (a body without a name is called <shape><index>)";
+    }
+    fail(name_node ? name_node : entry, name_node ? childPath(indexPath("bodies", index), "name")
+                                                  : indexPath("bodies", index),
+         what + "; body names must be unique");
 }
 
 void SceneParser::collectOverrideNodes(const YAML::Node& node, const SceneOverride& o) {

@@ -14,6 +14,7 @@
 #include <string>
 #include <string_view>
 #include <tuple>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -150,6 +151,10 @@ private:
 
     void parseWorld(const YAML::Node& n, Scene& scene) const;
     void parseOutput(const YAML::Node& n, Scene& scene) const;
+    /// Fails at the `bodies` entry (its `name` key when written) whose body `name` an earlier
+    /// body already has; records the name otherwise.
+    void requireUniqueName(const std::string& name, const YAML::Node& entry, std::size_t index,
+                           std::unordered_map<std::string, std::size_t>& first_entry_of_name) const;
     /// Fills in whichever of time_step and steps_per_frame the scene left out so that a frame
     /// spans 1/fps s of simulated time (output.fps must be parsed already).
     static void defaultTiming(bool has_time_step, bool has_steps_per_frame, Scene& scene);
