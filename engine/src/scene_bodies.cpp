@@ -23,6 +23,7 @@
 #include "collision/geometry/convex_hull.h"
 #include "engine/mass_properties.h"
 #include "engine/mesh_import.h"
+#include "repeat_placement.h"
 #include "scene_parser.h"
 
 namespace engine::scene_parsing {
@@ -395,68 +396,94 @@ std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
 }
 
 
-template <typename Place>
-std::vector<Body> SceneParser::repeatBody(const Body& base, const Entry& entry,
-                                          const std::string& path, const Scene& scene,
-                                          Place&& place) const {
+RepeatSpec SceneParser::readRepeat(const Entry& entry, const std::string& path,
+                                   const Scene& scene) const {
     const YAML::Node& n = entry.value;
     if (!n.IsMap())
         fail(n, path,
              "expected a mapping with keys: " +
-                 join({"count", "seed", "region", "speed", "spin", "random_orientation"}));
+                 join({"count", "seed", "region", "speed", "spin", "random_orientation",
+                       "separated"}));
     const std::vector<Entry> es = entries(
         n, path, std::vector<std::string_view>(std::begin(kRepeatKeys), std::end(kRepeatKeys)));
+    RepeatSpec r;
+    r.region = scene.world.bounds;
+    r.node = n;
     const Entry& count_entry = require(es, "count", n, path);
-    const int count = readInt(count_entry.value, childPath(path, "count"));
-    if (count < 1 || count > kMaxRepeat) {
+    r.count = readInt(count_entry.value, childPath(path, "count"));
+    if (r.count < 1 || r.count > kMaxRepeat) {
         fail(count_entry.value, childPath(path, "count"),
              "must be in 1.." + std::to_string(kMaxRepeat));
     }
-    if (scene.bodies.size() + static_cast<std::size_t>(count) > kMaxBodies) {
+    if (scene.bodies.size() + static_cast<std::size_t>(r.count) > kMaxBodies) {
         fail(count_entry.value, childPath(path, "count"),
-             std::to_string(count) + " more bodies after " + std::to_string(scene.bodies.size()) +
-                 " would pass the limit of " + std::to_string(kMaxBodies) + " bodies in a scene");
+             std::to_string(r.count) + " more bodies after " +
+                 std::to_string(scene.bodies.size()) + " would pass the limit of " +
+                 std::to_string(kMaxBodies) + " bodies in a scene");
     }
-    std::uint64_t seed = 1;
-    collision::Aabb region = scene.world.bounds;
-    Real speed = 0;
-    Real spin = 0;
-    bool random_orientation = true;
     for (const Entry& e : es) {
         const std::string p = childPath(path, e.key);
         if (e.key == "seed") {
-            const int s = readInt(e.value, p);
-            if (s < 0) fail(e.value, p, "must be >= 0");
-            seed = static_cast<std::uint64_t>(s);
+            const int seed = readInt(e.value, p);
+            if (seed < 0) fail(e.value, p, "must be >= 0");
+            r.seed = static_cast<std::uint64_t>(seed);
         } else if (e.key == "region") {
-            const std::vector<Entry> r = entries(e.value, p, {"min", "max"});
-            region.min = readVec3(require(r, "min", e.value, p).value, childPath(p, "min"));
-            region.max = readVec3(require(r, "max", e.value, p).value, childPath(p, "max"));
+            const std::vector<Entry> re = entries(e.value, p, {"min", "max"});
+            r.region.min = readVec3(require(re, "min", e.value, p).value, childPath(p, "min"));
+            r.region.max = readVec3(require(re, "max", e.value, p).value, childPath(p, "max"));
             for (int a = 0; a < 3; ++a) {
-                if (!(region.min[a] <= region.max[a])) {
+                if (!(r.region.min[a] <= r.region.max[a])) {
                     fail(e.value, p, "min must be <= max on every axis");
                 }
             }
-            if (!scene.world.bounds.contains(region.min) ||
-                !scene.world.bounds.contains(region.max)) {
+            if (!scene.world.bounds.contains(r.region.min) ||
+                !scene.world.bounds.contains(r.region.max)) {
                 fail(e.value, p, "must lie inside the world bounds");
             }
         } else if (e.key == "speed") {
-            speed = readReal(e.value, p);
-            if (!(speed >= 0)) fail(e.value, p, "must be >= 0 (m/s)");
-            const std::string problem = speedProblem(speed, scene.world);
+            r.speed = readReal(e.value, p);
+            if (!(r.speed >= 0)) fail(e.value, p, "must be >= 0 (m/s)");
+            const std::string problem = speedProblem(r.speed, scene.world);
             if (!problem.empty()) fail(e.value, p, problem);
         } else if (e.key == "spin") {
-            spin = readReal(e.value, p);
-            if (!(spin >= 0)) fail(e.value, p, "must be >= 0 (rad/s)");
-            const std::string problem = spinProblem(spin, scene.world);
+            r.spin = readReal(e.value, p);
+            if (!(r.spin >= 0)) fail(e.value, p, "must be >= 0 (rad/s)");
+            const std::string problem = spinProblem(r.spin, scene.world);
             if (!problem.empty()) fail(e.value, p, problem);
         } else if (e.key == "random_orientation") {
-            random_orientation = readBool(e.value, p);
+            r.random_orientation = readBool(e.value, p);
+        } else if (e.key == "separated") {
+            r.separated = readBool(e.value, p);
         }
     }
+    return r;
+}
+
+void SceneParser::requireRoomToSeparate(const RepeatSpec& r, Real radius,
+                                        const std::string& path) const {
+    // Random sequential addition of equal spheres jams at a volume fraction of about 0.38 in
+    // three dimensions (0.55 of the area in two, 0.75 of the length in one, each below 0.4 as a
+    // fraction of the region grown by the radius): asking for more than kMaxRepeatPacking of the
+    // grown region cannot succeed, so it is refused before any try.
+    const Vec3 grown = r.region.max - r.region.min + Vec3::Constant(2 * radius);
+    const double room = double(grown.x()) * double(grown.y()) * double(grown.z());
+    const double need = double(r.count) * 4.0 / 3.0 * std::numbers::pi * std::pow(double(radius), 3);
+    if (need > kMaxRepeatPacking * room) {
+        fail(r.node, path,
+             std::to_string(r.count) + " bounding spheres of radius " + formatLimit(radius) +
+                 " fill " + formatLimit(Real(100 * need / room)) +
+                 "% of the region (grown by the radius); randomly placed spheres stay apart "
+                 "only below about 38%: enlarge region, lower count, or set separated: false");
+    }
+}
+
+template <typename Place>
+std::vector<Body> SceneParser::repeatBody(const Body& base, const Entry& entry,
+                                          const std::string& path, const Scene& scene,
+                                          Place&& place) const {
+    const RepeatSpec r = readRepeat(entry, path, scene);
     // splitmix64: the same bodies from the same seed on every platform.
-    std::uint64_t state = seed * 0x9E3779B97F4A7C15ull + 0x632BE59BD9B4E019ull;
+    std::uint64_t state = r.seed * 0x9E3779B97F4A7C15ull + 0x632BE59BD9B4E019ull;
     auto uniform = [&state]() {
         std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
         z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
@@ -468,18 +495,41 @@ std::vector<Body> SceneParser::repeatBody(const Body& base, const Entry& entry,
         // Uniform on the sphere: z uniform in [-1, 1], azimuth uniform (Archimedes).
         const Real z = 2 * uniform() - 1;
         const Real phi = 2 * std::numbers::pi_v<Real> * uniform();
-        const Real r = std::sqrt(std::max(Real(0), 1 - z * z));
-        return Vec3(r * std::cos(phi), r * std::sin(phi), z);
+        const Real rad = std::sqrt(std::max(Real(0), 1 - z * z));
+        return Vec3(rad * std::cos(phi), rad * std::sin(phi), z);
     };
+    // Bounding radius about the centre of mass, whatever the orientation drawn later.
+    const Real radius = base.local_bounds.sphere.center.norm() + base.local_bounds.sphere.radius;
+    std::optional<SeparatedPlacement> placement;
+    if (r.separated) {
+        requireRoomToSeparate(r, radius, path);
+        placement.emplace(scene.bodies, radius, r.region);
+    }
+    const std::int64_t max_attempts =
+        kRepeatAttemptsPerBody * std::int64_t(r.count) + kRepeatAttemptsReserve;
+    std::int64_t attempts_left = max_attempts;
     std::vector<Body> out;
-    out.reserve(static_cast<std::size_t>(count));
-    for (int k = 0; k < count; ++k) {
+    out.reserve(static_cast<std::size_t>(r.count));
+    for (int k = 0; k < r.count; ++k) {
         Body b = base;
         b.name = base.name + "_" + std::to_string(k);
-        const Vec3 t(uniform(), uniform(), uniform());
-        const Vec3 p = region.min + (region.max - region.min).cwiseProduct(t);
+        Vec3 p;
+        do {
+            if (placement && --attempts_left < 0) {
+                fail(r.node, path,
+                     "placed " + std::to_string(k) + " of " + std::to_string(r.count) +
+                         " bodies apart from each other and from the bodies listed before, "
+                         "then found no free place in " +
+                         std::to_string(max_attempts) +
+                         " random tries (bounding spheres of radius " + formatLimit(radius) +
+                         "): enlarge region, lower count, or set separated: false");
+            }
+            const Vec3 t(uniform(), uniform(), uniform());
+            p = r.region.min + (r.region.max - r.region.min).cwiseProduct(t);
+        } while (placement && !placement->fits(p));
+        if (placement) placement->add(p);
         Quat q = Quat::Identity();
-        if (random_orientation) {
+        if (r.random_orientation) {
             // Shoemake's uniform random rotation.
             const Real u1 = uniform(), u2 = uniform(), u3 = uniform();
             const Real a = std::sqrt(1 - u1), c = std::sqrt(u1);
@@ -488,8 +538,8 @@ std::vector<Body> SceneParser::repeatBody(const Body& base, const Entry& entry,
                      c * std::cos(tau * u3))
                     .normalized();
         }
-        const Vec3 v = direction() * (speed * uniform());
-        const Vec3 w = direction() * (spin * uniform());
+        const Vec3 v = direction() * (r.speed * uniform());
+        const Vec3 w = direction() * (r.spin * uniform());
         place(b, p, q, v, w);
         out.push_back(std::move(b));
     }

@@ -44,8 +44,16 @@ inline constexpr std::string_view kBodyKeys[] = {
     "scale", "position", "orientation_wxyz", "euler_deg",   "velocity",     "angular_velocity",
     "mass",  "density",  "repeat",           "static",      "restitution",  "friction"};
 
-inline constexpr std::string_view kRepeatKeys[] = {"count", "seed", "region",
-                                            "speed", "spin", "random_orientation"};
+inline constexpr std::string_view kRepeatKeys[] = {
+    "count", "seed", "region", "speed", "spin", "random_orientation", "separated"};
+
+// `repeat` with separated: true (the default) draws at most this many random centres for an
+// entry of n bodies before it gives up: 100 n on average plus a reserve for the last, hardest
+// places (random sequential addition slows down sharply near its jamming limit).
+inline constexpr std::int64_t kRepeatAttemptsPerBody = 100;
+inline constexpr std::int64_t kRepeatAttemptsReserve = 1000000;
+// The volume fraction beyond which separated `repeat` placement is refused without trying.
+inline constexpr double kMaxRepeatPacking = 0.5;
 
 // Keys that `repeat` generates itself.
 inline constexpr std::string_view kGeneratedKeys[] = {"position", "velocity", "angular_velocity",
@@ -110,6 +118,20 @@ struct BodyValues {
 };
 
 // Geometry imported for hull and mesh bodies: re-centred shape and its properties at density 1.
+/// A body entry's `repeat:` as read: how many copies, where and how fast.
+struct RepeatSpec {
+    int count = 0;
+    std::uint64_t seed = 1;
+    collision::Aabb region;       ///< where the centres are drawn (default: the world bounds)
+    Real speed = 0;               ///< m/s, upper bound of each body's speed
+    Real spin = 0;                ///< rad/s, upper bound of each body's angular speed
+    bool random_orientation = true;
+    /// Redraw a centre until the body's bounding sphere is apart from every body placed before
+    /// it (this entry's and earlier entries'), so that nothing overlaps at frame 0.
+    bool separated = true;
+    YAML::Node node;              ///< the `repeat:` mapping, for errors
+};
+
 struct PreparedShape {
     Shape shape;
     MassProperties unit;  // mass = volume
@@ -178,6 +200,8 @@ private:
                                           const std::string& bvh_name);
     /// `expect:` (after the bodies, whose names it refers to).
     void parseExpect(const Entry& entry, Scene& scene) const;
+    RepeatSpec readRepeat(const Entry& entry, const std::string& path, const Scene& scene) const;
+    void requireRoomToSeparate(const RepeatSpec& r, Real radius, const std::string& path) const;
     template <typename Place>
     std::vector<Body> repeatBody(const Body& base, const Entry& entry, const std::string& path,
                                  const Scene& scene, Place&& place) const;

@@ -886,6 +886,64 @@ TEST(SceneRepeat, GeneratesDeterministicBodiesInsideTheRegion) {
     EXPECT_NE(parse(withBody(other)).bodies[0].position, a.bodies[0].position);
 }
 
+// Regression: repeat placed 40 crates in a small box with 5 pairs already colliding at frame 0
+// (crowd.yaml started with 98). By default each body is placed apart from every body before it,
+// its own entry's and earlier entries' (a static floor here); separated: false keeps the plain
+// draw, overlaps and all.
+TEST(SceneRepeat, BodiesStartApartUnlessAskedOtherwise) {
+    const std::string body =
+        "  - {name: floor, shape: box, half_extents: [4, 0.5, 4], position: [0, -1.5, 0], "
+        "static: true}\n"
+        "  - name: crate\n"
+        "    shape: box\n"
+        "    half_extents: [0.4, 0.3, 0.2]\n"
+        "    repeat: {count: 40, seed: 3, region: {min: [-3, -2, -3], max: [3, 2, 3]}SEP}\n";
+    const auto sceneWith = [&](const std::string& sep) {
+        std::string text = body;
+        text.replace(text.find("SEP"), 3, sep);
+        return parse(withBody(text));
+    };
+    // Crates by their bounding spheres, each crate and the floor by their OBBs.
+    const auto overlaps = [](const Scene& s) {
+        int n = 0;
+        for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+            for (std::size_t j = i + 1; j < s.bodies.size(); ++j) {
+                const Body& a = s.bodies[i];
+                const Body& b = s.bodies[j];
+                const collision::Pose pa{a.position, a.orientation};
+                const collision::Pose pb{b.position, b.orientation};
+                if (i == 0) {
+                    n += collision::transformObb(a.local_bounds.obb, pa)
+                             .overlaps(collision::transformObb(b.local_bounds.obb, pb));
+                    continue;
+                }
+                const auto sa = collision::transformSphere(a.local_bounds.sphere, pa);
+                const auto sb = collision::transformSphere(b.local_bounds.sphere, pb);
+                n += (sa.center - sb.center).norm() <= sa.radius + sb.radius;
+            }
+        }
+        return n;
+    };
+    const Scene apart = sceneWith("");
+    const Scene drawn = sceneWith(", separated: false");
+    ASSERT_EQ(apart.bodies.size(), 41u);
+    EXPECT_EQ(overlaps(apart), 0);
+    EXPECT_GT(overlaps(drawn), 0);
+    EXPECT_EQ(makeWorld(apart).collidingPairs().size(), 0u);
+    // The same seed without separation: the draw this scene is a test of really overlaps.
+    EXPECT_GT(makeWorld(drawn).collidingPairs().size(), 0u);
+    EXPECT_EQ(sceneWith(", separated: true").bodies[7].position, apart.bodies[7].position);
+    EXPECT_EQ(sceneWith("").bodies[20].position, apart.bodies[20].position);  // deterministic
+    // Asking for more than random placement can keep apart fails at the repeat key at once, and
+    // a crowded region that runs out of tries says what to change.
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 0.5\n"
+                                "    repeat: {count: 900, region: {min: [-2, -2, -2], max: [2, 2, 2]}}\n"),
+                       "6:13: bodies[0].repeat: ", "randomly placed spheres stay apart only below");
+    EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 0.5\n"
+                                "    repeat: {count: 10, region: {min: [0, 0, 0], max: [0, 0, 0]}}\n"),
+                       "6:13: bodies[0].repeat: ", "or set separated: false");
+}
+
 TEST(SceneRepeat, ErrorsNameTheKey) {
     EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radius: 0.5\n    position: [0, 0, 0]\n"
                                 "    repeat: {count: 3}\n"),
@@ -971,7 +1029,7 @@ TEST(SceneErrors, BodiesOverlappingEnMasseAreRefusedUpFront) {
         "bodies:\n  - shape: sphere\n    radius: 1\n";
     EXPECT_SCENE_ERROR(head +
                            "    repeat: {count: 5000, seed: 1, region: {min: [-1, -1, -1], "
-                           "max: [1, 1, 1]}}\n",
+                           "max: [1, 1, 1]}, separated: false}\n",
                        "3:1: bodies: ",
                        "overlap in about 1.24975e+07 pairs at the start, more "
                        "than the 10000000 a step may flag");
