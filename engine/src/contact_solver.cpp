@@ -151,7 +151,7 @@ int boxFaceManifold(const Body& a, const Pose& pa, const Body& b, const Pose& pb
 // breadth-first search of the contact graph from the static bodies (level 0), and the points
 // between two levels, in order of their lower level (then their own order).
 template <class Point>
-void shockOrder(std::span<const Body> bodies, const std::vector<Point>& points,
+void shockOrder(const SolverBodies& bodies, const std::vector<Point>& points,
                 std::vector<int>& level, std::vector<std::size_t>& shock_order) {
     constexpr int kUnreached = std::numeric_limits<int>::max();
     const std::size_t n = bodies.size();
@@ -204,7 +204,7 @@ void shockOrder(std::span<const Body> bodies, const std::vector<Point>& points,
 // The upper body's share of a contact: effective mass along d with the lower body held fixed
 // (a_up: the upper body is p.a).
 template <class Point>
-Real upperEffectiveMass(std::span<const Body> bodies, const std::vector<Mat3>& inv_inertia,
+Real upperEffectiveMass(const SolverBodies& bodies, const std::vector<Mat3>& inv_inertia,
                         const Point& p, bool a_up, const Vec3& d) {
     const Body& up = bodies[a_up ? p.a : p.b];
     const Vec3& r = a_up ? p.ra : p.rb;
@@ -214,7 +214,7 @@ Real upperEffectiveMass(std::span<const Body> bodies, const std::vector<Mat3>& i
 
 // An impulse along a -> b applied to the upper body's velocities (v, w) alone.
 template <class Point>
-void applyToUpper(std::span<const Body> bodies, const std::vector<Mat3>& inv_inertia,
+void applyToUpper(const SolverBodies& bodies, const std::vector<Mat3>& inv_inertia,
                   const Point& p, bool a_up, const Vec3& impulse, Vec3& v, Vec3& w) {
     const BodyId id = a_up ? p.a : p.b;
     const Vec3& r = a_up ? p.ra : p.rb;
@@ -240,7 +240,13 @@ void shockPasses(std::vector<Point>& points, const std::vector<std::size_t>& sho
 
 }  // namespace
 
-void ContactSolver::addPairPoints(std::span<const Body> bodies, const collision::ProxyPair& pair,
+Body ContactSolver::makeWallBody() {
+    Body wall;
+    setStatic(wall);
+    return wall;
+}
+
+void ContactSolver::addPairPoints(const SolverBodies& bodies, const collision::ProxyPair& pair,
                                   const std::vector<Mat3>& inv_inertia,
                                   const std::vector<Velocities>& vel, Real dt,
                                   const ContactSolverSettings& settings) {
@@ -274,6 +280,43 @@ void ContactSolver::addPairPoints(std::span<const Body> bodies, const collision:
             c.manifold_size = found;
         }
     }
+    addManifoldPoints(bodies, pair.a, pair.b, c, shift, size, std::max(a.restitution, b.restitution),
+                      std::sqrt(a.friction * b.friction), inv_inertia, vel, dt, settings);
+}
+
+void ContactSolver::addWallPoints(const SolverBodies& bodies, const Wall& wall, BodyId wall_id,
+                                  BodyId body, const std::vector<Mat3>& inv_inertia,
+                                  const std::vector<Velocities>& vel, Real dt,
+                                  const ContactSolverSettings& settings) {
+    // The body against the wall's half-space (collision/narrowphase/half_space.h), with the
+    // speculative margin of a body pair whose other body is as large as this one.
+    const Body& b = bodies[body];
+    if (b.is_static) return;
+    const Real size = boundingRadius(b);
+    const collision::ContactOutput c0 = collision::contact(wall.plane, b.shape, b.pose());
+    const Real margin = settings.margin_fraction * size;
+    if (c0.state == collision::ContactState::Failed) return;
+    if (c0.state == collision::ContactState::Separated && !(c0.signed_distance < margin)) {
+        return;
+    }
+    const Real shift = std::max(c0.signed_distance, Real(0)) + margin;
+    Pose moved = b.pose();
+    moved.position -= shift * c0.normal;
+    collision::ContactOutput c = collision::contact(wall.plane, b.shape, moved);
+    if (!collision::isColliding(c.state) || c.manifold_size == 0) return;
+    addManifoldPoints(bodies, wall_id, body, c, shift, size,
+                      std::max(wall.restitution, b.restitution),
+                      std::sqrt(wall.friction * b.friction), inv_inertia, vel, dt, settings);
+}
+
+void ContactSolver::addManifoldPoints(const SolverBodies& bodies, BodyId a_id, BodyId b_id,
+                                      collision::ContactOutput& c, Real shift, Real size,
+                                      Real restitution, Real friction,
+                                      const std::vector<Mat3>& inv_inertia,
+                                      const std::vector<Velocities>& vel, Real dt,
+                                      const ContactSolverSettings& settings) {
+    const Body& a = bodies[a_id];
+    const Body& b = bodies[b_id];
     for (int k = 0; k < c.manifold_size; ++k) {
         collision::ManifoldPoint& m = c.manifold[static_cast<std::size_t>(k)];
         m.point_b += shift * c.normal;
@@ -281,37 +324,35 @@ void ContactSolver::addPairPoints(std::span<const Body> bodies, const collision:
     }
     // Previous points of this pair (previous_ is sorted by (a, b)).
     Point key;
-    key.a = pair.a;
-    key.b = pair.b;
+    key.a = a_id;
+    key.b = b_id;
     const auto range = std::equal_range(
         previous_.begin(), previous_.end(), key,
         [](const Point& x, const Point& y) { return x.a < y.a || (x.a == y.a && x.b < y.b); });
     const std::span<const Point> previous(range.first, range.second);
-    const Real e = std::max(a.restitution, b.restitution);
-    const Real mu = std::sqrt(a.friction * b.friction);
     for (int k = 0; k < c.manifold_size; ++k) {
         const collision::ManifoldPoint& m = c.manifold[static_cast<std::size_t>(k)];
         Point p;
-        p.a = pair.a;
-        p.b = pair.b;
+        p.a = a_id;
+        p.b = b_id;
         const Vec3 at = (m.point_a + m.point_b) / 2;
         p.ra = at - a.position;
         p.rb = at - b.position;
         p.normal = c.normal;
         tangents(p.normal, p.t1, p.t2);
-        const Mat3& ia = inv_inertia[pair.a];
-        const Mat3& ib = inv_inertia[pair.b];
+        const Mat3& ia = inv_inertia[a_id];
+        const Mat3& ib = inv_inertia[b_id];
         p.mass_n = effectiveMass(a, b, ia, ib, p.ra, p.rb, p.normal);
         p.mass_t1 = effectiveMass(a, b, ia, ib, p.ra, p.rb, p.t1);
         p.mass_t2 = effectiveMass(a, b, ia, ib, p.ra, p.rb, p.t2);
-        p.friction = mu;
+        p.friction = friction;
         p.depth = m.depth;
         p.slop = settings.slop_fraction * size;
         p.local_a = a.pose().applyInverse(at);
         p.feature_a = c.feature_a;
         p.feature_b = c.feature_b;
-        const Vec3 dv = (vel[pair.b].v + vel[pair.b].w.cross(p.rb)) -
-                        (vel[pair.a].v + vel[pair.a].w.cross(p.ra));
+        const Vec3 dv = (vel[b_id].v + vel[b_id].w.cross(p.rb)) -
+                        (vel[a_id].v + vel[a_id].w.cross(p.ra));
         const Real vn = dv.dot(p.normal);
         const bool bounce = vn < -settings.restitution_threshold;
         if (m.depth < 0 && !(bounce && -vn * dt > -m.depth)) {
@@ -320,7 +361,7 @@ void ContactSolver::addPairPoints(std::span<const Body> bodies, const collision:
         } else {
             // Touching, or a speculative point that closes its gap within the step: bounce
             // now (the pair turns back at most the gap early, less than the margin).
-            p.velocity_bias = bounce ? -e * vn : 0;
+            p.velocity_bias = bounce ? -restitution * vn : 0;
         }
         warmStart(p, size, previous);
         points_.push_back(p);
@@ -346,7 +387,7 @@ void ContactSolver::warmStart(Point& p, Real size, std::span<const Point> range)
     }
 }
 
-void ContactSolver::solvePositions(std::span<const Body> bodies,
+void ContactSolver::solvePositions(const SolverBodies& bodies,
                                    const std::vector<Mat3>& inv_inertia,
                                    const std::vector<int>& level,
                                    const std::vector<std::size_t>& shock_order, Real dt,
@@ -393,16 +434,22 @@ void ContactSolver::solvePositions(std::span<const Body> bodies,
 }
 
 void ContactSolver::solve(std::span<Body> bodies, std::span<const collision::ProxyPair> pairs,
-                          Real dt, const ContactSolverSettings& settings,
+                          std::span<const Wall> walls,
+                          std::span<const WallCandidate> wall_candidates, Real dt,
+                          const ContactSolverSettings& settings,
                           std::vector<Vec3>& pseudo_linear, std::vector<Vec3>& pseudo_angular) {
     const std::size_t n = bodies.size();
-    pseudo_linear.assign(n, Vec3::Zero());
-    pseudo_angular.assign(n, Vec3::Zero());
+    const SolverBodies table{bodies, &wall_body_, walls.size()};
+    const std::size_t total = table.size();
+    pseudo_linear.assign(total, Vec3::Zero());
+    pseudo_angular.assign(total, Vec3::Zero());
     points_.clear();
+    if (n != body_count_) previous_.clear();  // wall indices moved: nothing to warm-start
+    body_count_ = n;
 
-    // World inverse inertias at the present poses, once per body.
-    std::vector<Mat3> inv_inertia(n);
-    std::vector<Velocities> vel(n);
+    // World inverse inertias at the present poses, once per body (zero for the walls).
+    std::vector<Mat3> inv_inertia(total, Mat3::Zero());
+    std::vector<Velocities> vel(total);
     for (std::size_t i = 0; i < n; ++i) {
         inv_inertia[i] = bodies[i].invInertiaWorld();
         vel[i].v = bodies[i].velocity();
@@ -410,12 +457,17 @@ void ContactSolver::solve(std::span<Body> bodies, std::span<const collision::Pro
     }
 
     for (const collision::ProxyPair& pair : pairs) {
-        addPairPoints(bodies, pair, inv_inertia, vel, dt, settings);
+        addPairPoints(table, pair, inv_inertia, vel, dt, settings);
+    }
+    // After every body pair, walls in order: points_ stays sorted by (a, b).
+    for (const WallCandidate& w : wall_candidates) {
+        addWallPoints(table, walls[w.wall], static_cast<BodyId>(n + w.wall), w.body, inv_inertia,
+                      vel, dt, settings);
     }
 
     auto apply = [&](const Point& p, const Vec3& impulse) {
-        Body& a = bodies[p.a];
-        Body& b = bodies[p.b];
+        const Body& a = table[p.a];
+        const Body& b = table[p.b];
         if (!a.is_static) {
             vel[p.a].v -= impulse * a.inv_mass;
             vel[p.a].w -= inv_inertia[p.a] * p.ra.cross(impulse);
@@ -471,13 +523,13 @@ void ContactSolver::solve(std::span<Body> bodies, std::span<const collision::Pro
     std::vector<std::size_t> shock_order;
     std::vector<int> level;
     if (settings.shock_propagation && !points_.empty()) {
-        shockOrder(bodies, points_, level, shock_order);
+        shockOrder(table, points_, level, shock_order);
     }
     auto upperMass = [&](const Point& p, bool a_up, const Vec3& d) {
-        return upperEffectiveMass(bodies, inv_inertia, p, a_up, d);
+        return upperEffectiveMass(table, inv_inertia, p, a_up, d);
     };
     auto applyUpper = [&](const Point& p, bool a_up, const Vec3& impulse, Vec3& v, Vec3& w) {
-        applyToUpper(bodies, inv_inertia, p, a_up, impulse, v, w);
+        applyToUpper(table, inv_inertia, p, a_up, impulse, v, w);
     };
     shockPasses(points_, shock_order, level, [&](Point& p, bool a_up, BodyId up) {
         solvePoint(
@@ -494,7 +546,7 @@ void ContactSolver::solve(std::span<Body> bodies, std::span<const collision::Pro
         b.angular_momentum = r * (b.inertia_body * (r.transpose() * vel[i].w));
     }
 
-    solvePositions(bodies, inv_inertia, level, shock_order, dt, settings, pseudo_linear,
+    solvePositions(table, inv_inertia, level, shock_order, dt, settings, pseudo_linear,
                    pseudo_angular);
 
     previous_ = points_;  // already sorted by (a, b): pairs were sorted
@@ -503,7 +555,9 @@ void ContactSolver::solve(std::span<Body> bodies, std::span<const collision::Pro
 void ContactSolver::pushedPairs(std::vector<collision::ProxyPair>& out) const {
     out.clear();
     for (const Point& p : points_) {
-        if (p.impulse_n > 0) out.push_back({std::min(p.a, p.b), std::max(p.a, p.b)});
+        if (p.impulse_n > 0 && std::size_t(p.a) < body_count_ && std::size_t(p.b) < body_count_) {
+            out.push_back({std::min(p.a, p.b), std::max(p.a, p.b)});
+        }
     }
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());

@@ -2,14 +2,39 @@
 // sequential-impulse solver over the manifolds of collision::contact() for the colliding pairs.
 #pragma once
 
+#include <cstdint>
 #include <span>
 #include <vector>
 
 #include "collision/broadphase/broad_phase.h"
 #include "collision/narrowphase/contact.h"
+#include "collision/narrowphase/half_space.h"
 #include "engine/body.h"
 
 namespace engine {
+
+/// A static wall (a face of the world's bounds): a half-space with a material of its own.
+struct Wall {
+    collision::HalfSpace plane;  ///< the solid side is dot(normal, x) <= offset
+    Real restitution = 0;
+    Real friction = 0;
+};
+
+/// A body that may touch a wall this step (its grown AABB reaches the wall's plane).
+struct WallCandidate {
+    std::uint32_t wall = 0;  ///< index into the walls
+    BodyId body = 0;
+};
+
+/// The bodies as the solver indexes them: the world's bodies 0..n-1, then one static stand-in
+/// per wall (n + w), so that every constraint is a pair of indices.
+struct SolverBodies {
+    std::span<const Body> bodies;
+    const Body* wall = nullptr;  ///< a static body at the origin: infinite mass, no velocity
+    std::size_t walls = 0;
+    std::size_t size() const { return bodies.size() + walls; }
+    const Body& operator[](std::size_t id) const { return id < bodies.size() ? bodies[id] : *wall; }
+};
 
 /// Solver parameters (the world's settings pass them through).
 struct ContactSolverSettings {
@@ -36,20 +61,26 @@ struct ContactSolverSettings {
 class ContactSolver {
 public:
     /// Builds the constraints of the candidate `pairs` (sorted; touching, penetrating, or closer
-    /// than the margin: speculative) at the bodies' present poses,
+    /// than the margin: speculative) and of the bodies near `walls` (`wall_candidates` sorted
+    /// by wall, then body; each wall a static body of restitution and friction of its own) at
+    /// the bodies' present poses,
     /// warm-starts them from the previous call's accumulated impulses (same body pair, same
     /// witness features, nearest point within 10 % of the smaller body's radius), runs the
     /// velocity iterations (changing the momenta), then the split-impulse position iterations,
     /// whose pseudo velocities go to `pseudo_linear` / `pseudo_angular` (m/s, rad/s, world): the
     /// caller moves the bodies by them for one step only, so position correction adds no energy.
-    void solve(std::span<Body> bodies, std::span<const collision::ProxyPair> pairs, Real dt,
-               const ContactSolverSettings& settings, std::vector<Vec3>& pseudo_linear,
+    /// `pseudo_linear` and `pseudo_angular` get one entry per body and wall (those of the walls
+    /// stay zero).
+    void solve(std::span<Body> bodies, std::span<const collision::ProxyPair> pairs,
+               std::span<const Wall> walls, std::span<const WallCandidate> wall_candidates,
+               Real dt, const ContactSolverSettings& settings, std::vector<Vec3>& pseudo_linear,
                std::vector<Vec3>& pseudo_angular);
 
     /// Contact points solved in the last call.
     int pointCount() const { return static_cast<int>(points_.size()); }
-    /// The pairs of the last solve with a positive normal impulse at some point (pushed apart,
-    /// including speculative contacts not yet touching), sorted, each once.
+    /// The body pairs of the last solve with a positive normal impulse at some point (pushed
+    /// apart, including speculative contacts not yet touching), sorted, each once; walls are
+    /// not bodies and are left out.
     void pushedPairs(std::vector<collision::ProxyPair>& out) const;
 
 private:
@@ -83,22 +114,36 @@ private:
 
     /// Appends the constraint points of one candidate pair (none when it is farther apart than
     /// the margin), warm-started from previous_.
-    void addPairPoints(std::span<const Body> bodies, const collision::ProxyPair& pair,
+    void addPairPoints(const SolverBodies& bodies, const collision::ProxyPair& pair,
                        const std::vector<Mat3>& inv_inertia, const std::vector<Velocities>& vel,
                        Real dt, const ContactSolverSettings& settings);
+    /// The same for a body and a wall (the wall is a, index n + wall).
+    void addWallPoints(const SolverBodies& bodies, const Wall& wall, BodyId wall_id, BodyId body,
+                       const std::vector<Mat3>& inv_inertia, const std::vector<Velocities>& vel,
+                       Real dt, const ContactSolverSettings& settings);
+    /// The points of manifold `c` of a and b, found with b moved `shift` along the normal
+    /// (speculative contacts: the shift is taken back here), with the pair's material.
+    void addManifoldPoints(const SolverBodies& bodies, BodyId a_id, BodyId b_id,
+                           collision::ContactOutput& c, Real shift, Real size, Real restitution,
+                           Real friction, const std::vector<Mat3>& inv_inertia,
+                           const std::vector<Velocities>& vel, Real dt,
+                           const ContactSolverSettings& settings);
     /// The accumulated impulses of the nearest previous point of the same pair and features,
     /// within kMatchFraction * size; `range` the pair's previous points.
     static void warmStart(Point& p, Real size, std::span<const Point> range);
 
     /// The split-impulse position iterations, then their shock passes: pseudo velocities that
     /// remove baumgarte * (depth - slop) / dt of each penetration.
-    void solvePositions(std::span<const Body> bodies, const std::vector<Mat3>& inv_inertia,
+    void solvePositions(const SolverBodies& bodies, const std::vector<Mat3>& inv_inertia,
                         const std::vector<int>& level, const std::vector<std::size_t>& shock_order,
                         Real dt, const ContactSolverSettings& settings,
                         std::vector<Vec3>& pseudo_linear, std::vector<Vec3>& pseudo_angular);
 
     std::vector<Point> points_;
     std::vector<Point> previous_;  ///< last call's points, sorted by (a, b)
+    std::size_t body_count_ = 0;   ///< bodies of the last call (walls come after them)
+    Body wall_body_ = makeWallBody();
+    static Body makeWallBody();
 };
 
 }  // namespace engine

@@ -154,7 +154,21 @@ std::string_view bodyStateName(BodyState state) {
 
 World::World(WorldSettings settings)
     : settings_(std::move(settings)), broad_phase_(makeBroadPhase(settings_.broad_phase)) {
-    if (settings_.response == Response::Impulse) solver_ = std::make_unique<ContactSolver>();
+    if (settings_.response == Response::Impulse) {
+        solver_ = std::make_unique<ContactSolver>();
+        // The six faces of the bounds, solid outside: -x, +x, -y, +y, -z, +z.
+        for (int k = 0; k < 3; ++k) {
+            for (const Real side : {Real(-1), Real(1)}) {
+                Wall w;
+                w.plane.normal = Vec3::Zero();
+                w.plane.normal[k] = -side;  // out of the solid, into the world
+                w.plane.offset = side < 0 ? settings_.bounds.min[k] : -settings_.bounds.max[k];
+                w.restitution = settings_.restitution;
+                w.friction = settings_.friction;
+                walls_.push_back(w);
+            }
+        }
+    }
 }
 
 World::~World() = default;
@@ -333,12 +347,27 @@ void World::findResponsePairs(Real margin_fraction) {
         }
     }
     std::sort(response_pairs_.begin(), response_pairs_.end());
+    // Bodies whose grown AABB reaches a face of the bounds, by wall then body.
+    wall_candidates_.clear();
+    for (std::uint32_t w = 0; w < walls_.size(); ++w) {
+        const int k = static_cast<int>(w / 2);
+        const bool low = w % 2 == 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            if (bodies_[i].is_static) continue;
+            if (low ? grown_[i].min[k] <= settings_.bounds.min[k]
+                    : grown_[i].max[k] >= settings_.bounds.max[k]) {
+                wall_candidates_.push_back({w, static_cast<BodyId>(i)});
+            }
+        }
+    }
 }
 
 void World::reflectOffBounds() {
-    // The coursework's "reflect objects off the edge of the scene": a body whose exact world AABB
-    // crosses a face of the bounds while moving outward has that velocity component negated.
-    // Kinetic energy is unchanged by the flip.
+    // The coursework's "reflect objects off the edge of the scene" (response: none): a body
+    // whose exact world AABB crosses a face of the bounds while moving outward has that velocity
+    // component negated. Kinetic energy is unchanged by the flip. With response: impulse the
+    // faces are walls of the contact solver instead (restitution, friction, resting contact),
+    // and only the fold below remains, as the last resort for a body that went through one.
     // Runs after updateVolumes: the flip changes momenta only, so the AABBs stay valid.
     // A body fast enough to carry its centre of mass past a face within one step (a 20 m world
     // crossed at 1e4 m/s) would leave for good, flipping back and forth outside. Its centre is
@@ -366,6 +395,7 @@ void World::reflectOffBounds() {
             folded = true;
         }
         if (folded) updateVolume(i);
+        if (solver_) continue;
         const collision::Aabb& box = volumes_[i].aabb;
         for (int k = 0; k < 3; ++k) {
             const Real p = b.linear_momentum[k];
@@ -468,8 +498,8 @@ void World::step() {
         t = Clock::now();
         const ContactSolverSettings solver_settings;
         findResponsePairs(solver_settings.margin_fraction);
-        solver_->solve(bodies_, response_pairs_, dt, solver_settings, pseudo_linear_,
-                       pseudo_angular_);
+        solver_->solve(bodies_, response_pairs_, walls_, wall_candidates_, dt, solver_settings,
+                       pseudo_linear_, pseudo_angular_);
         stats_.response_s = secondsSince(t);
         stats_.contact_points = solver_->pointCount();
         solver_->pushedPairs(pushed_);

@@ -3,7 +3,8 @@
 // for restitution <= 1 in a long random box pile; the shipped 5-box stack rests without drift
 // or jitter; a 1:1000 mass-ratio stack holds; runs are bit-identical; response none costs
 // nothing (no solver); a dropped ball rebounds at e times its impact speed and a sliding box
-// stops at the Coulomb distance v0^2 / (2 mu g) (closed forms).
+// stops at the Coulomb distance v0^2 / (2 mu g) (closed forms), on a floor body and on the
+// bounds' bottom face alike.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -269,6 +270,26 @@ TEST(Response, RunsAreBitIdenticalAndNoneMeansNoSolver) {
 }
 
 // A static floor slab whose top face is y = 0 (the shape scenes/bounce.yaml and stack.yaml use).
+// The floor of the closed-form tests: a static box body, or the bottom face of the world's
+// bounds (a wall of the contact solver, with the world's material).
+enum class Floor { Body, Bounds };
+
+const char* floorName(Floor f) { return f == Floor::Body ? "floor body" : "bounds as floor"; }
+
+// A world of half-size 50 whose floor is at y = 0; the floor body, if any, is body 0 and the
+// returned index is the first free one.
+std::size_t addFloor(World& world, Floor floor, Real restitution, Real friction);
+
+WorldSettings floorWorld(Floor floor, Real restitution, Real friction) {
+    WorldSettings s = impulseWorld(50);
+    if (floor == Floor::Bounds) {
+        s.bounds.min.y() = 0;
+        s.restitution = restitution;
+        s.friction = friction;
+    }
+    return s;
+}
+
 Body staticFloor(Real restitution, Real friction) {
     const Vec3 h(20, 0.25, 20);
     Body floor = makeBody("floor", Shape::box(h), boxMass(h, 1));
@@ -277,6 +298,12 @@ Body staticFloor(Real restitution, Real friction) {
     floor.friction = friction;
     setStatic(floor);
     return floor;
+}
+
+std::size_t addFloor(World& world, Floor floor, Real restitution, Real friction) {
+    if (floor == Floor::Bounds) return 0;
+    world.addBody(staticFloor(restitution, friction));
+    return 1;
 }
 
 // Restitution, closed form: a ball dropped from rest with its bottom h above the floor meets it
@@ -298,14 +325,15 @@ TEST(Response, DroppedBallReboundsAtRestitutionTimesImpactSpeed) {
     const Real g = 9.81;
     const Real h = 1;
     const Real r = 0.2;
+    for (const Floor floor : {Floor::Body, Floor::Bounds})
     for (const Real e : {Real(0), Real(0.5), Real(0.8)}) {
-        SCOPED_TRACE("e = " + std::to_string(e));
-        WorldSettings s = impulseWorld(50);
+        SCOPED_TRACE(std::string(floorName(floor)) + ", e = " + std::to_string(e));
+        WorldSettings s = floorWorld(floor, 0, 0.5);
         s.gravity = Vec3(0, -g, 0);
         s.time_step = Real(1) / 240;
         const Real dt = s.time_step;
         World world(s);
-        world.addBody(staticFloor(0, 0.5));
+        const std::size_t id = addFloor(world, floor, 0, 0.5);
         Body ball = makeBody("ball", Shape::sphere(r), sphereMass(r, 1));
         ball.position = Vec3(0, r + h, 0);
         ball.restitution = e;
@@ -319,9 +347,9 @@ TEST(Response, DroppedBallReboundsAtRestitutionTimesImpactSpeed) {
         Real apex = 0;    // highest bottom after the first bounce, before the second
         Real lowest = h;  // lowest bottom over the whole run
         for (int i = 0; i < 600; ++i) {
-            const Real v_prev = world.bodies()[1].velocity().y();
+            const Real v_prev = world.bodies()[id].velocity().y();
             world.step();
-            const Body& b = world.bodies()[1];
+            const Body& b = world.bodies()[id];
             if (bounce_step < 0 && b.velocity().y() > v_prev) {
                 bounce_step = i;
                 v_before = v_prev;
@@ -338,14 +366,16 @@ TEST(Response, DroppedBallReboundsAtRestitutionTimesImpactSpeed) {
         std::snprintf(text, sizeof text,
                       "impact %.6f exact %.6f rebound %.9f apex %.5f lowest %.5f", v_impact,
                       v_exact, v_after, apex, lowest);
-        RecordProperty("e_" + std::to_string(e), text);
+        RecordProperty(std::string(floor == Floor::Body ? "body_" : "bounds_") + "e_" +
+                           std::to_string(e),
+                       text);
         EXPECT_NEAR(v_impact, v_exact, 2 * g * dt);
         EXPECT_NEAR(v_after, e * v_impact, 1e-12 * v_impact);
         EXPECT_NEAR(apex, e * e * h, 2 * e * e * h * (2 * g * dt / v_exact) + e * v_exact * dt);
         EXPECT_GT(lowest, -v_exact * dt);
         if (e == 0) {
             // Perfectly inelastic: it stays on the floor.
-            EXPECT_LT(world.bodies()[1].velocity().norm(), 1e-3);
+            EXPECT_LT(world.bodies()[id].velocity().norm(), 1e-3);
             EXPECT_LT(apex, 0.005 * r);  // at most the solver's slop above the face
         }
     }
@@ -363,14 +393,15 @@ TEST(Response, SlidingBoxStopsAtTheCoulombDistance) {
     const Real v0 = 3;
     const Vec3 hb(0.3, 0.1, 0.3);
     const Real t_end = 3;
+    for (const Floor floor : {Floor::Body, Floor::Bounds})
     for (const Real mu : {Real(0), Real(0.2), Real(0.5), Real(1)}) {
-        SCOPED_TRACE("mu = " + std::to_string(mu));
-        WorldSettings s = impulseWorld(50);
+        SCOPED_TRACE(std::string(floorName(floor)) + ", mu = " + std::to_string(mu));
+        WorldSettings s = floorWorld(floor, 0, mu);
         s.gravity = Vec3(0, -g, 0);
         s.time_step = Real(1) / 240;
         const Real dt = s.time_step;
         World world(s);
-        world.addBody(staticFloor(0, mu));
+        const std::size_t id = addFloor(world, floor, 0, mu);
         Body box = makeBody("box", Shape::box(hb), boxMass(hb, 2));
         box.position = Vec3(-10, hb.y(), 0);
         box.linear_momentum = box.mass * Vec3(v0, 0, 0);
@@ -383,16 +414,18 @@ TEST(Response, SlidingBoxStopsAtTheCoulombDistance) {
         Real max_tilt = 0;
         for (int i = 0; i < n; ++i) {
             world.step();
-            const Body& b = world.bodies()[1];
+            const Body& b = world.bodies()[id];
             max_tilt = std::max(max_tilt, b.orientation.angularDistance(Quat::Identity()));
             if (stop_step < 0 && b.velocity().x() < 1e-6) stop_step = i;
         }
-        const Body& b = world.bodies()[1];
+        const Body& b = world.bodies()[id];
         const Real d = b.position.x() + 10;
         char text[128];
         std::snprintf(text, sizeof text, "d %.6f stop step %d v %.3e tilt %.2e y %.6f", d,
                       stop_step, b.velocity().norm(), max_tilt, b.position.y());
-        RecordProperty("mu_" + std::to_string(mu), text);
+        RecordProperty(std::string(floor == Floor::Body ? "body_" : "bounds_") + "mu_" +
+                           std::to_string(mu),
+                       text);
         EXPECT_LT(max_tilt, 1e-9);                               // it slides, it does not tip
         EXPECT_NEAR(b.position.y(), hb.y(), 0.005 * hb.norm());  // on the floor (slop)
         if (mu == 0) {
@@ -408,6 +441,37 @@ TEST(Response, SlidingBoxStopsAtTheCoulombDistance) {
         EXPECT_NEAR(d, d_exact - v0 * dt / 2, a * dt * dt);
         EXPECT_NEAR(stop_step + 1, v0 / a / dt, 1.0);
         EXPECT_LT(b.velocity().norm(), 1e-9);  // and stays stopped (static friction)
+    }
+}
+
+// Every face of the bounds is a wall of the solver with the world's material: a ball sent into a
+// corner at 45 degrees in zero gravity leaves both walls at e times its normal speeds, its
+// tangential speed untouched without friction. With response: none the bounds still reflect
+// elastically (the coursework's behaviour).
+TEST(Response, EveryFaceOfTheBoundsIsAWall) {
+    for (const Response response : {Response::Impulse, Response::None}) {
+        SCOPED_TRACE(response == Response::Impulse ? "impulse" : "none");
+        WorldSettings s = impulseWorld(2);
+        s.response = response;
+        s.restitution = 0.5;
+        s.friction = 0;
+        s.time_step = Real(1) / 240;
+        World world(s);
+        Body ball = makeBody("ball", Shape::sphere(0.25), sphereMass(0.25, 1));
+        ball.position = Vec3(0, 0, 0);
+        ball.linear_momentum = Vec3(2, 0, -2);
+        ball.restitution = 0;
+        ball.friction = 0;
+        world.addBody(ball);
+        world.detect();
+        for (int i = 0; i < 480; ++i) world.step();  // 2 s: both walls met once
+        const Vec3 v = world.bodies()[0].velocity();
+        const Real e = response == Response::Impulse ? Real(0.5) : Real(1);
+        EXPECT_NEAR(v.x(), -2 * e, 1e-9);
+        EXPECT_NEAR(v.z(), 2 * e, 1e-9);
+        EXPECT_EQ(v.y(), 0);
+        const Vec3 p = world.bodies()[0].position;
+        EXPECT_TRUE((p.cwiseAbs().array() <= 2).all()) << p.transpose();
     }
 }
 

@@ -85,7 +85,9 @@ std::string_view bodyStateName(BodyState state);  ///< "apart", "flagged", "coll
 inline constexpr std::size_t kMaxCandidatePairs = 10'000'000;
 
 struct WorldSettings {
-    collision::Aabb bounds{Vec3::Constant(-10), Vec3::Constant(10)};  ///< m; bodies reflect off it
+    /// m. With response: none bodies reflect off it (velocity flipped, elastic); with response:
+    /// impulse its faces are static walls for the contact solver (restitution, friction).
+    collision::Aabb bounds{Vec3::Constant(-10), Vec3::Constant(10)};
     Vec3 gravity = Vec3::Zero();                                      ///< m/s^2
     Real time_step = Real(1) / 60;                                    ///< s, > 0
     std::string broad_phase = "sap";                                  ///< registry name
@@ -104,8 +106,11 @@ struct WorldSettings {
     /// step starts separated. Scene key `world.ccd_target_gap`, in [0, 1].
     Real ccd_target_gap = Real(1e-3);
     Response response = Response::None;
-    Real restitution = Real(0.5);  ///< default of bodies that do not set theirs (scene files)
-    Real friction = Real(0.5);     ///< default of bodies that do not set theirs (scene files)
+    /// Default of bodies that do not set theirs (scene files), and with response: impulse the
+    /// material of the bounds' faces, which then act as static walls.
+    Real restitution = Real(0.5);
+    Real friction = Real(0.5);  ///< as restitution
+
     /// A step that flags more candidate pairs stops the run (SimulationError). Not a scene key:
     /// scenes get kMaxCandidatePairs; tests lower it.
     std::size_t max_candidate_pairs = kMaxCandidatePairs;
@@ -130,6 +135,8 @@ struct StepStats {
 };
 
 class ContactSolver;
+struct Wall;
+struct WallCandidate;
 
 /// Colours and sizes of World::drawHierarchyLevels and World::drawContacts: the caller's palette.
 struct ContactDrawStyle {
@@ -258,6 +265,8 @@ private:
     std::unique_ptr<ContactSolver> solver_;  ///< only with response: impulse
     std::vector<collision::Aabb> grown_;
     std::vector<collision::ProxyPair> response_pairs_;
+    std::vector<Wall> walls_;  ///< the faces of the bounds, for the solver (response: impulse)
+    std::vector<WallCandidate> wall_candidates_;
     std::vector<collision::ProxyPair> pushed_;
     std::vector<Vec3> pseudo_linear_;
     std::vector<Vec3> pseudo_angular_;
