@@ -13,6 +13,8 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "camera.h"
@@ -21,6 +23,7 @@
 #include "font.h"
 #include "gl_debug_draw.h"
 #include "osmesa_context.h"
+#include "render/volume_states.h"
 #include "tessellation.h"
 
 namespace render {
@@ -44,6 +47,61 @@ font::Rgb toRgb8(const Color& c) {
         return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
     };
     return {channel(c.r), channel(c.g), channel(c.b)};
+}
+
+/// One row of a legend: items side by side, each a swatch (when `swatch`) and a label.
+struct LegendItem {
+    std::optional<Color> swatch;
+    std::string label;
+};
+using LegendRow = std::vector<LegendItem>;
+
+/// Width and height in pixels of a legend block's rows (without the plate's padding).
+struct BlockSize {
+    int width = 0;
+    int height = 0;
+};
+
+BlockSize legendBlockSize(const std::vector<LegendRow>& rows, int scale) {
+    const int swatch = font::kCapHeight * scale;
+    const int gap = 4 * scale;
+    BlockSize size;
+    for (const LegendRow& row : rows) {
+        int w = 0;
+        for (const LegendItem& item : row) {
+            w += (item.swatch ? swatch + gap : 0) + font::textWidth(item.label, scale) + 3 * gap;
+        }
+        size.width = std::max(size.width, w - 3 * gap);
+    }
+    const int row_height = font::kLineHeight * scale;
+    size.height = rows.empty() ? 0 : int(rows.size()) * row_height - (row_height - swatch);
+    return size;
+}
+
+/// Draws `rows` top to bottom from (left, top) on one translucent plate.
+void drawLegendBlock(Image& image, int left, int top, const std::vector<LegendRow>& rows,
+                     int scale) {
+    const font::Rgb text_color{236, 238, 242};
+    const int swatch = font::kCapHeight * scale;
+    const int gap = 4 * scale;
+    const int pad = 3 * scale;
+    const BlockSize size = legendBlockSize(rows, scale);
+    font::blendRect(image, left - pad, top - pad, size.width + 2 * pad + scale,
+                    size.height + 2 * pad + scale, {0, 0, 0}, 0.45f);
+    int y = top;
+    for (const LegendRow& row : rows) {
+        int x = left;
+        for (const LegendItem& item : row) {
+            if (item.swatch) {
+                font::fillRect(image, x + scale, y + scale, swatch, swatch, {12, 12, 16});
+                font::fillRect(image, x, y, swatch, swatch, toRgb8(*item.swatch));
+                x += swatch + gap;
+            }
+            font::drawText(image, x, y, item.label, scale, text_color);
+            x += font::textWidth(item.label, scale) + 3 * gap;
+        }
+        y += font::kLineHeight * scale;
+    }
 }
 
 /// "Nice" grid spacing (1, 2 or 5 times a power of ten) giving about `target` cells over `extent`.
@@ -99,6 +157,11 @@ struct Renderer::Impl {
     LineBuffer outline_lines;    ///< bounding spheres' silhouettes
     LineBuffer bvh_lines;        ///< mesh hierarchy levels (draw.bvh_depth)
     LineBuffer contact_lines;    ///< contact witnesses and normals (draw.contacts)
+    std::vector<LegendEntry> structure_legend;  ///< what the broad phase's colours show
+    /// Some volume drawn is not the kind the broad phase tests: the legend says that each
+    /// volume is coloured by its own test.
+    bool own_tests = false;
+    std::optional<VolumeKind> tested_volume;  ///< the kind the broad phase tests
     std::vector<GLubyte> readback;
     FrameStats stats;
 
@@ -110,7 +173,8 @@ struct Renderer::Impl {
         return it->second;
     }
 
-    CameraFrame setUpCamera(const engine::World& world, const engine::CameraSettings& camera);
+    CameraFrame setUpCamera(const engine::World& world, const engine::CameraSettings& camera,
+                            const FrameOptions& options);
     void setUpGl(const CameraFrame& cam);
     /// Tessellates and draws every body that may show, in batches.
     void drawBodies(const engine::World& world, const CameraFrame& cam,
@@ -125,13 +189,17 @@ struct Renderer::Impl {
 };
 
 CameraFrame Renderer::Impl::setUpCamera(const engine::World& world,
-                                        const engine::CameraSettings& camera) {
+                                        const engine::CameraSettings& camera,
+                                        const FrameOptions& options) {
     CameraFrame cam = makeCameraFrame(camera, width * ss, height * ss);
     // Clip planes hug everything that may be drawn: the bounds and every body's volumes (the
     // AABB's and OBB's circumspheres enclose the body and its wireframes).
     DepthRange range;
     const collision::Aabb& bounds = world.settings().bounds;
-    range.add(cam, bounds.center(), Real(0.5) * bounds.extents().norm());
+    // Structure diagrams laid out along the bounds' edges reach 17 % of its size beyond them.
+    const Real structure_margin =
+        options.draw_structure ? Real(0.17) * bounds.extents().maxCoeff() : Real(0);
+    range.add(cam, bounds.center(), Real(0.5) * bounds.extents().norm() + structure_margin);
     const auto bodies = world.bodies();
     const auto volumes = world.volumes();
     for (std::size_t i = 0; i < bodies.size(); ++i) {
@@ -283,16 +351,32 @@ void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& c
         debug.drawAabb(b, kBoundsColor);
     }
 
+    structure_legend.clear();
     if (options.draw_structure) {
         debug.setTarget(structure_lines);
-        world.broadPhase().draw(debug);
+        debug.setLegend(&structure_legend);
+        world.broadPhase().draw(debug, world.settings().bounds);
+        debug.setLegend(nullptr);
     }
 
+    // Each kind of volume in the colours of its own overlap test: the broad phase's flags for
+    // the kind it tests, that kind's own pairs for the others (volume_states.h).
+    tested_volume = broadPhaseVolume(world);
+    own_tests = false;
+    const bool drawn[3] = {options.draw.sphere, options.draw.aabb, options.draw.obb};
+    std::vector<engine::BodyState> kind_states[3];
+    for (const VolumeKind kind : kVolumeKinds) {
+        if (!drawn[int(kind)]) continue;
+        kind_states[int(kind)] = volumeOverlaps(world, kind).states;
+        own_tests = own_tests || tested_volume != kind;
+    }
     const auto volumes = world.volumes();
-    const auto states = world.states();
     debug.setTarget(volume_lines, &outline_lines);
     for (std::size_t i = 0; i < volumes.size() && i < world.bodies().size(); ++i) {
-        const Color color = stateColor(i < states.size() ? states[i] : engine::BodyState::Apart);
+        auto colorOf = [&](VolumeKind kind) {
+            const std::vector<engine::BodyState>& states = kind_states[int(kind)];
+            return stateColor(i < states.size() ? states[i] : engine::BodyState::Apart);
+        };
         const collision::ProxyVolumes& v = volumes[i];
         auto shows = [&](const Vec3& center, Real radius) {
             if (!options.cull || cam.mayShow(center, radius)) return true;
@@ -300,13 +384,13 @@ void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& c
             return false;
         };
         if (options.draw.sphere && shows(v.sphere.center, v.sphere.radius)) {
-            debug.drawSphere(v.sphere, color);
+            debug.drawSphere(v.sphere, colorOf(VolumeKind::Sphere));
         }
         if (options.draw.aabb && shows(v.aabb.center(), Real(0.5) * v.aabb.extents().norm())) {
-            debug.drawAabb(v.aabb, color);
+            debug.drawAabb(v.aabb, colorOf(VolumeKind::Aabb));
         }
         if (options.draw.obb && shows(v.obb.center, v.obb.half_extents.norm())) {
-            debug.drawObb(v.obb, color);
+            debug.drawObb(v.obb, colorOf(VolumeKind::Obb));
         }
     }
 
@@ -460,34 +544,35 @@ void Renderer::Impl::drawOverlays(Image& image, const FrameOptions& options) con
                         plate, 0.45f);
         font::drawText(image, margin, margin, options.hud_text, scale, text_color);
     }
-    const bool any_volume =
-        options.draw.sphere || options.draw.aabb || options.draw.obb || options.draw.bvh_depth >= 0;
-    if (options.draw.hud && any_volume) {
-        struct Entry {
-            engine::BodyState state;
-            const char* label;
-        };
-        const Entry entries[] = {{engine::BodyState::Apart, "apart"},
-                                 {engine::BodyState::Flagged, "flagged"},
-                                 {engine::BodyState::Colliding, "colliding"}};
-        const int swatch = font::kCapHeight * scale;
-        const int gap = 4 * scale;
-        int total = 0;
-        for (const Entry& e : entries) {
-            total += swatch + gap + font::textWidth(e.label, scale) + 3 * gap;
+    if (!options.draw.hud) return;
+    // Legends: the state colours bottom-left, what the structure's colours show top-right.
+    const bool any_volume = options.draw.sphere || options.draw.aabb || options.draw.obb;
+    if (any_volume || options.draw.bvh_depth >= 0) {
+        const Color apart = stateColor(engine::BodyState::Apart);
+        const Color flagged = stateColor(engine::BodyState::Flagged);
+        const Color colliding = stateColor(engine::BodyState::Colliding);
+        std::vector<LegendRow> rows;
+        if (any_volume && own_tests) {
+            rows.push_back({{std::nullopt, "each volume coloured by its own overlap test"}});
+            rows.push_back({{apart, "apart"},
+                            {flagged, "overlaps a volume of its kind"},
+                            {colliding, "colliding"}});
+        } else {
+            std::string flagged_label = "flagged";
+            if (any_volume && tested_volume) {
+                const char* const names[3] = {"sphere", "AABB", "OBB"};
+                flagged_label += " (" + std::string(names[int(*tested_volume)]) + " test)";
+            }
+            rows.push_back({{apart, "apart"}, {flagged, flagged_label}, {colliding, "colliding"}});
         }
-        total -= 3 * gap;
-        const int y = height - margin - swatch;
-        font::blendRect(image, margin - pad, y - pad, total + 2 * pad + scale,
-                        swatch + 2 * pad + scale, plate, 0.45f);
-        int x = margin;
-        for (const Entry& e : entries) {
-            font::fillRect(image, x + scale, y + scale, swatch, swatch, {12, 12, 16});
-            font::fillRect(image, x, y, swatch, swatch, toRgb8(stateColor(e.state)));
-            x += swatch + gap;
-            font::drawText(image, x, y, e.label, scale, text_color);
-            x += font::textWidth(e.label, scale) + 3 * gap;
-        }
+        drawLegendBlock(image, margin, height - margin - legendBlockSize(rows, scale).height, rows,
+                        scale);
+    }
+    if (!structure_legend.empty()) {
+        std::vector<LegendRow> rows;
+        for (const LegendEntry& e : structure_legend) rows.push_back({{e.color, e.label}});
+        drawLegendBlock(image, width - margin - legendBlockSize(rows, scale).width, margin, rows,
+                        scale);
     }
 }
 
@@ -504,7 +589,7 @@ Image Renderer::render(const engine::World& world, const engine::CameraSettings&
                        const FrameOptions& options) {
     Impl& im = *impl_;
     im.context.makeCurrent();
-    const CameraFrame cam = im.setUpCamera(world, camera);
+    const CameraFrame cam = im.setUpCamera(world, camera, options);
     im.setUpGl(cam);
     im.stats = FrameStats{};
     if (options.draw.bodies) im.drawBodies(world, cam, options);

@@ -524,7 +524,7 @@ TEST(Renderer, DrawStructureShowsEachBroadPhasesStructure) {
         world.detect();  // inserts the proxies into the new broad phase
         ASSERT_EQ(world.broadPhase().name(), name);
         RecordingDraw recorded;
-        world.broadPhase().draw(recorded);
+        world.broadPhase().draw(recorded, world.settings().bounds);
         ASSERT_GT(recorded.lines, 0) << "draws nothing";
 
         render::FrameOptions options = plainOptions();
