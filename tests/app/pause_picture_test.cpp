@@ -117,8 +117,10 @@ TEST(PausePicture, FramesDrawTheVolumeTheBroadPhaseTests) {
     const fs::path work = tempDir("default");
     const fs::path scene = writeScene(work, "rods.yaml", sceneText(0, 0, kRodBodies));
     const engine::CameraSettings cam = cameraAt(0, 0);
-    // The middle of rod1's long upper front edge: on its OBB, inside its bounding sphere.
-    const Vec3 edge_mid = Vec3(-0.3, 0.3, 0.15) + Vec3(-0.15, 0.15, 0) * std::sqrt(Real(0.5));
+    // A point of rod1's long upper front edge, 0.7 from its middle: on its OBB, clear of its and
+    // rod2's bounding spheres' circles.
+    const Real c = std::sqrt(Real(0.5));
+    const Vec3 edge_point = Vec3(-0.3, 0.3, 0.15) + Vec3(0.7 * c - 0.15 * c, 0.7 * c + 0.15 * c, 0);
     for (const std::string bp : {"obb", "sphere", "sap"}) {
         SCOPED_TRACE(bp);
         const fs::path out = work / bp;
@@ -132,7 +134,7 @@ TEST(PausePicture, FramesDrawTheVolumeTheBroadPhaseTests) {
         ASSERT_EQ(dump["overlapping_pairs"]["aabb"], nlohmann::json::array({{0, 1}}));
         ASSERT_EQ(dump["overlapping_pairs"]["obb"], nlohmann::json::array());
         const render::Image frame = render::readPng(out / "frame_00000.png");
-        const PixelPos px = project(cam, frame.width, frame.height, edge_mid);
+        const PixelPos px = project(cam, frame.width, frame.height, edge_point);
         if (bp == "obb") {
             EXPECT_EQ(countColor(frame, kYellow), 0);
             EXPECT_TRUE(colorNear(frame, px, kGreen, 1)) << "no green OBB edge";

@@ -130,7 +130,9 @@ TEST(VolumeColors, SphereStaysGreenWhenOnlyTheAabbsOverlap) {
 // AABBs, yellow. A scene that chose AABBs keeps them, yellow by their own test even under the
 // OBB broad phase (they were green: coloured by the OBB test).
 TEST(VolumeColors, ObbBroadPhaseDrawsObbsAndNoYellowWhenOnlyTheAabbsOverlap) {
-    render::Renderer renderer(kWidth, kHeight);
+    constexpr int kW = 320;
+    constexpr int kH = 240;
+    render::Renderer renderer(kW, kH);
     const engine::CameraSettings cam = headOnCamera();
     engine::DrawSettings scene_default = plainOptions().draw;  // draw.volumes not given
     scene_default.bodies = false;
@@ -145,9 +147,11 @@ TEST(VolumeColors, ObbBroadPhaseDrawsObbsAndNoYellowWhenOnlyTheAabbsOverlap) {
     EXPECT_FALSE(options.draw.sphere);
     const render::Image obb_image = renderer.render(obb_world, cam, options);
     EXPECT_EQ(countColor(obb_image, kYellow), 0);
-    // The middle of rod1's long upper edge on its front face: an OBB line, not a sphere's.
-    const Vec3 edge_mid = Vec3(-0.3, 0.3, 0.15) + Vec3(-0.15, 0.15, 0) * std::sqrt(Real(0.5));
-    EXPECT_TRUE(colorNear(obb_image, project(cam, kWidth, kHeight, edge_mid), kGreen, 1));
+    // A point of rod1's long upper front edge, 0.7 from its middle: on its OBB, clear of its and
+    // rod2's bounding spheres' circles, so green there is an OBB line.
+    const Real c = std::sqrt(Real(0.5));
+    const Vec3 edge_point = Vec3(-0.3, 0.3, 0.15) + Vec3(0.7 * c - 0.15 * c, 0.7 * c + 0.15 * c, 0);
+    EXPECT_TRUE(colorNear(obb_image, project(cam, kW, kH, edge_point), kGreen, 1));
 
     const engine::World sap_world = makeParallelRodsWorld("sap");
     ASSERT_EQ(sap_world.flaggedPairs().size(), 1u);
