@@ -22,6 +22,7 @@
 #include "collision/volumes/bounding_volumes.h"
 #include "font.h"
 #include "gl_debug_draw.h"
+#include "legend.h"
 #include "osmesa_context.h"
 #include "render/volume_states.h"
 #include "tessellation.h"
@@ -41,68 +42,6 @@ constexpr Color kGridColor{0.22f, 0.24f, 0.29f, 1.0f};
 /// witness cross and the length of the normal segment.
 constexpr Real kContactCrossFraction = Real(0.06);
 constexpr Real kContactNormalFraction = Real(0.5);
-
-font::Rgb toRgb8(const Color& c) {
-    auto channel = [](float v) {
-        return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
-    };
-    return {channel(c.r), channel(c.g), channel(c.b)};
-}
-
-/// One row of a legend: items side by side, each a swatch (when `swatch`) and a label.
-struct LegendItem {
-    std::optional<Color> swatch;
-    std::string label;
-};
-using LegendRow = std::vector<LegendItem>;
-
-/// Width and height in pixels of a legend block's rows (without the plate's padding).
-struct BlockSize {
-    int width = 0;
-    int height = 0;
-};
-
-BlockSize legendBlockSize(const std::vector<LegendRow>& rows, int scale) {
-    const int swatch = font::kCapHeight * scale;
-    const int gap = 4 * scale;
-    BlockSize size;
-    for (const LegendRow& row : rows) {
-        int w = 0;
-        for (const LegendItem& item : row) {
-            w += (item.swatch ? swatch + gap : 0) + font::textWidth(item.label, scale) + 3 * gap;
-        }
-        size.width = std::max(size.width, w - 3 * gap);
-    }
-    const int row_height = font::kLineHeight * scale;
-    size.height = rows.empty() ? 0 : int(rows.size()) * row_height - (row_height - swatch);
-    return size;
-}
-
-/// Draws `rows` top to bottom from (left, top) on one translucent plate.
-void drawLegendBlock(Image& image, int left, int top, const std::vector<LegendRow>& rows,
-                     int scale) {
-    const font::Rgb text_color{236, 238, 242};
-    const int swatch = font::kCapHeight * scale;
-    const int gap = 4 * scale;
-    const int pad = 3 * scale;
-    const BlockSize size = legendBlockSize(rows, scale);
-    font::blendRect(image, left - pad, top - pad, size.width + 2 * pad + scale,
-                    size.height + 2 * pad + scale, {0, 0, 0}, 0.45f);
-    int y = top;
-    for (const LegendRow& row : rows) {
-        int x = left;
-        for (const LegendItem& item : row) {
-            if (item.swatch) {
-                font::fillRect(image, x + scale, y + scale, swatch, swatch, {12, 12, 16});
-                font::fillRect(image, x, y, swatch, swatch, toRgb8(*item.swatch));
-                x += swatch + gap;
-            }
-            font::drawText(image, x, y, item.label, scale, text_color);
-            x += font::textWidth(item.label, scale) + 3 * gap;
-        }
-        y += font::kLineHeight * scale;
-    }
-}
 
 /// "Nice" grid spacing (1, 2 or 5 times a power of ten) giving about `target` cells over `extent`.
 Real gridStep(Real extent, Real target) {
@@ -151,12 +90,12 @@ struct Renderer::Impl {
     OsMesaContext context;
     std::map<int, UnitSphereGrid> sphere_grids;  ///< by slice count
     TriangleBuffer triangles;
-    LineBuffer frame_lines;      ///< world bounds and floor grid
-    LineBuffer structure_lines;  ///< the broad phase's own drawing
-    LineBuffer volume_lines;     ///< bounding volumes
-    LineBuffer outline_lines;    ///< bounding spheres' silhouettes
-    LineBuffer bvh_lines;        ///< mesh hierarchy levels (draw.bvh_depth)
-    LineBuffer contact_lines;    ///< contact witnesses and normals (draw.contacts)
+    LineBuffer frame_lines;                     ///< world bounds and floor grid
+    LineBuffer structure_lines;                 ///< the broad phase's own drawing
+    LineBuffer volume_lines;                    ///< bounding volumes
+    LineBuffer outline_lines;                   ///< bounding spheres' silhouettes
+    LineBuffer bvh_lines;                       ///< mesh hierarchy levels (draw.bvh_depth)
+    LineBuffer contact_lines;                   ///< contact witnesses and normals (draw.contacts)
     std::vector<LegendEntry> structure_legend;  ///< what the broad phase's colours show
     /// Some volume drawn is not the kind the broad phase tests: the legend says that each
     /// volume is coloured by its own test.
@@ -181,6 +120,9 @@ struct Renderer::Impl {
                     const FrameOptions& options);
     void buildLines(const engine::World& world, const CameraFrame& cam,
                     const FrameOptions& options);
+    /// The bounding-volume wireframes, each kind in the colours of its own overlap test.
+    void drawVolumes(const engine::World& world, const CameraFrame& cam,
+                     const FrameOptions& options, GlDebugDraw& debug);
     /// Draws the triangle buffer and empties it.
     void drawTriangles();
     void drawLines(const LineBuffer& lines, float width_px);
@@ -359,40 +301,7 @@ void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& c
         debug.setLegend(nullptr);
     }
 
-    // Each kind of volume in the colours of its own overlap test: the broad phase's flags for
-    // the kind it tests, that kind's own pairs for the others (volume_states.h).
-    tested_volume = broadPhaseVolume(world);
-    own_tests = false;
-    const bool drawn[3] = {options.draw.sphere, options.draw.aabb, options.draw.obb};
-    std::vector<engine::BodyState> kind_states[3];
-    for (const VolumeKind kind : kVolumeKinds) {
-        if (!drawn[int(kind)]) continue;
-        kind_states[int(kind)] = volumeOverlaps(world, kind).states;
-        own_tests = own_tests || tested_volume != kind;
-    }
-    const auto volumes = world.volumes();
-    debug.setTarget(volume_lines, &outline_lines);
-    for (std::size_t i = 0; i < volumes.size() && i < world.bodies().size(); ++i) {
-        auto colorOf = [&](VolumeKind kind) {
-            const std::vector<engine::BodyState>& states = kind_states[int(kind)];
-            return stateColor(i < states.size() ? states[i] : engine::BodyState::Apart);
-        };
-        const collision::ProxyVolumes& v = volumes[i];
-        auto shows = [&](const Vec3& center, Real radius) {
-            if (!options.cull || cam.mayShow(center, radius)) return true;
-            ++stats.volumes_culled;
-            return false;
-        };
-        if (options.draw.sphere && shows(v.sphere.center, v.sphere.radius)) {
-            debug.drawSphere(v.sphere, colorOf(VolumeKind::Sphere));
-        }
-        if (options.draw.aabb && shows(v.aabb.center(), Real(0.5) * v.aabb.extents().norm())) {
-            debug.drawAabb(v.aabb, colorOf(VolumeKind::Aabb));
-        }
-        if (options.draw.obb && shows(v.obb.center, v.obb.half_extents.norm())) {
-            debug.drawObb(v.obb, colorOf(VolumeKind::Obb));
-        }
-    }
+    drawVolumes(world, cam, options, debug);
 
     // CCD: each moving body of a time-of-impact event at its pose there (spheres as spheres,
     // other shapes as their OBB), and the contact normal, in blue. Read-only use of the events.
@@ -434,6 +343,44 @@ void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& c
     if (options.draw.contacts) {
         debug.setTarget(contact_lines);
         world.drawContacts(debug, style);
+    }
+}
+
+void Renderer::Impl::drawVolumes(const engine::World& world, const CameraFrame& cam,
+                                 const FrameOptions& options, GlDebugDraw& debug) {
+    // Each kind of volume in the colours of its own overlap test: the broad phase's flags for
+    // the kind it tests, that kind's own pairs for the others (volume_states.h).
+    tested_volume = broadPhaseVolume(world);
+    own_tests = false;
+    const bool drawn[3] = {options.draw.sphere, options.draw.aabb, options.draw.obb};
+    std::vector<engine::BodyState> kind_states[3];
+    for (const VolumeKind kind : kVolumeKinds) {
+        if (!drawn[int(kind)]) continue;
+        kind_states[int(kind)] = volumeOverlaps(world, kind).states;
+        own_tests = own_tests || tested_volume != kind;
+    }
+    const auto volumes = world.volumes();
+    debug.setTarget(volume_lines, &outline_lines);
+    for (std::size_t i = 0; i < volumes.size() && i < world.bodies().size(); ++i) {
+        auto colorOf = [&](VolumeKind kind) {
+            const std::vector<engine::BodyState>& states = kind_states[int(kind)];
+            return stateColor(i < states.size() ? states[i] : engine::BodyState::Apart);
+        };
+        const collision::ProxyVolumes& v = volumes[i];
+        auto shows = [&](const Vec3& center, Real radius) {
+            if (!options.cull || cam.mayShow(center, radius)) return true;
+            ++stats.volumes_culled;
+            return false;
+        };
+        if (options.draw.sphere && shows(v.sphere.center, v.sphere.radius)) {
+            debug.drawSphere(v.sphere, colorOf(VolumeKind::Sphere));
+        }
+        if (options.draw.aabb && shows(v.aabb.center(), Real(0.5) * v.aabb.extents().norm())) {
+            debug.drawAabb(v.aabb, colorOf(VolumeKind::Aabb));
+        }
+        if (options.draw.obb && shows(v.obb.center, v.obb.half_extents.norm())) {
+            debug.drawObb(v.obb, colorOf(VolumeKind::Obb));
+        }
     }
 }
 

@@ -20,9 +20,12 @@ constexpr std::string_view kFinder[] = {"sphere", "sap", "obb"};
 
 std::string_view volumeKindName(VolumeKind kind) {
     switch (kind) {
-        case VolumeKind::Sphere: return "sphere";
-        case VolumeKind::Aabb: return "aabb";
-        case VolumeKind::Obb: return "obb";
+        case VolumeKind::Sphere:
+            return "sphere";
+        case VolumeKind::Aabb:
+            return "aabb";
+        case VolumeKind::Obb:
+            return "obb";
     }
     return "aabb";
 }
@@ -36,8 +39,7 @@ std::optional<VolumeKind> broadPhaseVolume(const engine::World& world) {
     return std::nullopt;
 }
 
-engine::DrawSettings drawSettingsFor(const engine::DrawSettings& draw,
-                                     const engine::World& world) {
+engine::DrawSettings drawSettingsFor(const engine::DrawSettings& draw, const engine::World& world) {
     engine::DrawSettings out = draw;
     if (draw.volumes_given) return out;
     const VolumeKind kind = broadPhaseVolume(world).value_or(VolumeKind::Aabb);

@@ -639,8 +639,9 @@ void HierarchicalGrid::draw(DebugDraw& draw, const Aabb& /*bounds*/) const {
             }
         }
         char label[96];
-        std::snprintf(label, sizeof label, "hgrid level %d: home cells of its %zu proxies, %.3g wide",
-                      k, lv.members, double(lv.cell));
+        std::snprintf(label, sizeof label,
+                      "hgrid level %d: home cells of its %zu proxies, %.3g wide", k, lv.members,
+                      double(lv.cell));
         draw.legend(label, color);
     }
 }

@@ -19,9 +19,12 @@ struct Edge {
 
 Edge edgeFor(const Aabb& b, int axis) {
     switch (axis) {
-        case 0: return {Vec3(0, b.min.y(), b.max.z()), -Vec3::UnitY()};
-        case 1: return {Vec3(b.min.x(), 0, b.max.z()), -Vec3::UnitX()};
-        default: return {Vec3(b.max.x(), b.min.y(), 0), Vec3::UnitX()};
+        case 0:
+            return {Vec3(0, b.min.y(), b.max.z()), -Vec3::UnitY()};
+        case 1:
+            return {Vec3(b.min.x(), 0, b.max.z()), -Vec3::UnitX()};
+        default:
+            return {Vec3(b.max.x(), b.min.y(), 0), Vec3::UnitX()};
     }
 }
 
@@ -45,9 +48,12 @@ std::vector<int> assignRows(std::span<const DiagramInterval> intervals, int& row
 
 std::string intervalDiagramPlace(int axis) {
     switch (axis) {
-        case 0: return "below the front bottom edge";
-        case 1: return "left of the front left edge";
-        default: return "right of the bottom right edge";
+        case 0:
+            return "below the front bottom edge";
+        case 1:
+            return "left of the front left edge";
+        default:
+            return "right of the bottom right edge";
     }
 }
 

@@ -28,8 +28,7 @@ std::optional<VolumeKind> broadPhaseVolume(const engine::World& world);
 /// The scene's draw settings with, unless the scene chose its volumes (`draw.volumes` given),
 /// exactly the volume the world's broad phase tests drawn: bounding spheres for `sphere`, OBBs
 /// for `obb`, AABBs for every AABB-based broad phase.
-engine::DrawSettings drawSettingsFor(const engine::DrawSettings& draw,
-                                     const engine::World& world);
+engine::DrawSettings drawSettingsFor(const engine::DrawSettings& draw, const engine::World& world);
 
 /// One kind of volume over all bodies, each judged by that kind's own overlap test.
 struct VolumeOverlaps {
