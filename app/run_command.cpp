@@ -38,15 +38,20 @@ Command addRunCommand(CLI::App& cli) {
     cmd->add_option("--broadphase", f->broad_phase,
                     "broad phase (overrides the scene): " + collision::broadPhaseNames());
     cmd->add_option("--pause-at", f->run.pause_at,
-                    "pause at FRAME: write pause_FRAME.png (every bounding volume) and "
-                    "pause_FRAME.json (repeatable)")
+                    "pause at FRAME: write pause_FRAME.png (every bounding volume, each "
+                    "coloured by its own overlap test) and pause_FRAME.json (repeatable); the "
+                    "video holds the picture for --pause-hold seconds")
         ->expected(1)
         ->take_all();
+    cmd->add_option("--pause-hold", f->run.pause_hold_s,
+                    "seconds each pause picture stays on screen in the video, as in a live "
+                    "demo (default 2; 0: no hold); the PNG frames are not repeated");
     cmd->add_flag("--no-hud-timing", f->no_timing,
                   "leave the step time out of the HUD so frames are bit-identical");
     cmd->add_flag("--draw-structure", f->run.draw_structure,
-                  "draw the broad phase's own structure: grid/hash cells, hierarchical-grid "
-                  "cells by level, SAP intervals, tree and octree nodes by depth");
+                  "draw the broad phase's own structure, with a legend: grid/hash cells, "
+                  "hierarchical-grid cells by level, SAP/sap1 sorted intervals along the edges "
+                  "of the world bounds, tree and octree nodes by depth");
     cmd->add_flag("--check-broadphase", f->run.check_broad_phase,
                   "verify every step's pairs against the brute-force reference; stop with a "
                   "report (exit 3) at the first mismatch");

@@ -1,7 +1,11 @@
 // app/lab/pause_dump.cpp -- pause dumps as JSON (nlohmann::ordered_json, numbers round-trip exactly).
 #include "pause_dump.h"
 
+#include <array>
 #include <nlohmann/json.hpp>
+#include <string_view>
+
+#include "render/volume_states.h"
 
 namespace app {
 
@@ -15,6 +19,17 @@ nlohmann::ordered_json pairs(std::span<const collision::ProxyPair> list) {
     return out;
 }
 
+/// A volume's state in the dump: "apart", "overlapping" (its volume overlaps another body's
+/// volume of the same kind) or "colliding" (a pair the narrow phase confirmed).
+std::string_view volumeStateName(engine::BodyState state) {
+    switch (state) {
+        case engine::BodyState::Apart: return "apart";
+        case engine::BodyState::Flagged: return "overlapping";
+        case engine::BodyState::Colliding: return "colliding";
+    }
+    return "apart";
+}
+
 }  // namespace
 
 std::string pauseDumpJson(const engine::World& world, int frame) {
@@ -22,6 +37,13 @@ std::string pauseDumpJson(const engine::World& world, int frame) {
     doc["frame"] = frame;
     doc["time"] = world.time();
     doc["broadphase"] = std::string(world.broadPhase().name());
+    doc["broadphase_volume"] = std::string(
+        render::volumeKindName(render::broadPhaseVolume(world).value_or(render::VolumeKind::Aabb)));
+    // Each kind of volume by its own overlap test, as the pause picture colours them.
+    std::array<render::VolumeOverlaps, 3> overlaps;
+    for (const render::VolumeKind kind : render::kVolumeKinds) {
+        overlaps[int(kind)] = render::volumeOverlaps(world, kind);
+    }
     nlohmann::ordered_json bodies = nlohmann::ordered_json::array();
     const auto all = world.bodies();
     for (std::size_t i = 0; i < all.size(); ++i) {
@@ -46,10 +68,22 @@ std::string pauseDumpJson(const engine::World& world, int frame) {
               {"half_extents", vec(v.obb.half_extents)}}},
             {"state", std::string(engine::bodyStateName(world.states()[i]))},
         });
+        nlohmann::ordered_json volume_states;
+        for (const render::VolumeKind kind : render::kVolumeKinds) {
+            const auto& states = overlaps[int(kind)].states;
+            volume_states[std::string(render::volumeKindName(kind))] = std::string(
+                volumeStateName(i < states.size() ? states[i] : engine::BodyState::Apart));
+        }
+        bodies.back()["volume_states"] = std::move(volume_states);
     }
     doc["bodies"] = std::move(bodies);
     doc["flagged_pairs"] = pairs(world.flaggedPairs());
     doc["colliding_pairs"] = pairs(world.collidingPairs());
+    nlohmann::ordered_json overlapping = nlohmann::ordered_json::object();
+    for (const render::VolumeKind kind : render::kVolumeKinds) {
+        overlapping[std::string(render::volumeKindName(kind))] = pairs(overlaps[int(kind)].pairs);
+    }
+    doc["overlapping_pairs"] = std::move(overlapping);
     return doc.dump(1) + "\n";
 }
 

@@ -7,8 +7,11 @@
 
 namespace app {
 
-/// The pause dump as JSON text: frame, time, broad phase, bodies (pose, sphere, AABB, OBB,
-/// state), flagged and colliding pairs (sorted, i < j). Numbers are printed to round-trip.
+/// The pause dump as JSON text: frame, time, broad phase and the volume it tests
+/// ("broadphase_volume"), bodies (pose, sphere, AABB, OBB, state, and "volume_states": each
+/// volume's state by its own overlap test, "apart" / "overlapping" / "colliding", as the pause
+/// picture colours it), flagged and colliding pairs, and "overlapping_pairs" per volume kind
+/// (all pair lists sorted, i < j). Numbers are printed to round-trip.
 std::string pauseDumpJson(const engine::World& world, int frame);
 
 }  // namespace app

@@ -28,6 +28,7 @@
 #include "render/image.h"
 #include "render/output_file.h"
 #include "render/renderer.h"
+#include "render/volume_states.h"
 
 namespace app {
 
@@ -158,6 +159,12 @@ int loadRunScene(const RunOptions& options, std::ostream& err, engine::Scene& sc
         }
         scene.world.broad_phase = *options.broad_phase;
     }
+    if (!std::isfinite(options.pause_hold_s) || options.pause_hold_s < 0 ||
+        options.pause_hold_s > kMaxPauseHoldSeconds) {
+        err << "--pause-hold " << options.pause_hold_s << ": must be a number of seconds from 0 "
+            << "(no hold) to " << kMaxPauseHoldSeconds << "\n";
+        return kExitBadInput;
+    }
     pauses = std::set<int>(options.pause_at.begin(), options.pause_at.end());
     for (int f : pauses) {
         if (f < 0 || f >= scene.frames) {
@@ -247,10 +254,12 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
                                                           scene.output.height, scene.output.fps);
         }
         render::FrameOptions frame_options;
-        frame_options.draw = scene.draw;
+        frame_options.draw = render::drawSettingsFor(scene.draw, world);
         frame_options.draw_structure = scene.draw.structure || options.draw_structure;
         render::FrameOptions pause_options = frame_options;
         pause_options.draw.sphere = pause_options.draw.aabb = pause_options.draw.obb = true;
+        // Each pause picture is held this many video frames after its frame.
+        const long hold_frames = std::lround(options.pause_hold_s * scene.output.fps);
 
         std::unique_ptr<BroadPhaseChecker> checker;
         if (options.check_broad_phase) {
@@ -304,9 +313,11 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
             if (pauses.count(frame)) {
                 pause_options.hud_text = "PAUSED  " + render::hudLine(world, frame, false);
                 const std::string stem = "pause_" + std::to_string(frame);
-                render::writePng(out_dir / (stem + ".png"),
-                                 renderer.render(world, scene.camera, pause_options));
+                const render::Image pause_image =
+                    renderer.render(world, scene.camera, pause_options);
+                render::writePng(out_dir / (stem + ".png"), pause_image);
                 writeTextAtomically(out_dir / (stem + ".json"), pauseDumpJson(world, frame));
+                for (long k = 0; video && k < hold_frames; ++k) video->addFrame(pause_image);
             }
             progress.update(frame + 1);
         }

@@ -11,6 +11,9 @@
 
 namespace app {
 
+/// The longest --pause-hold: an hour of one picture is a mistake, not a demo.
+inline constexpr double kMaxPauseHoldSeconds = 3600;
+
 struct RunOptions {
     std::filesystem::path scene;
     std::filesystem::path out_dir;               ///< default: out/<scene stem>
@@ -20,6 +23,9 @@ struct RunOptions {
     bool no_frames = false;                  ///< skip the per-frame PNGs
     std::optional<std::string> broad_phase;  ///< overrides the scene's broad phase
     std::vector<int> pause_at;               ///< frames to dump
+    /// Seconds each pause picture stays on screen in the video (repeated at the video's fps),
+    /// as a live demo holds its pause; 0 = not held. Finite, 0..kMaxPauseHoldSeconds.
+    double pause_hold_s = 2.0;
     bool hud_timing = true;                  ///< step time in the HUD (off: bit-identical frames)
     bool progress = true;                    ///< progress bar when stderr is a terminal
     bool draw_structure = false;             ///< draw the broad phase's own structure

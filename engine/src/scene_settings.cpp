@@ -231,6 +231,7 @@ void SceneParser::parseDraw(const YAML::Node& n, Scene& scene) const {
         if (e.key == "volumes") {
             if (!e.value.IsSequence()) fail(e.value, p, "expected a list of: sphere, aabb, obb");
             d.sphere = d.aabb = d.obb = false;
+            d.volumes_given = true;
             for (std::size_t i = 0; i < e.value.size(); ++i) {
                 const std::string ip = indexPath(p, i);
                 const std::string v = readString(e.value[i], ip);

@@ -47,6 +47,14 @@ void GlDebugDraw::drawSphere(const collision::BoundingSphere& sphere, const Colo
     target_ = great_circles;
 }
 
+void GlDebugDraw::legend(std::string_view label, const Color& color) {
+    if (legend_ == nullptr) return;
+    for (const LegendEntry& e : *legend_) {
+        if (e.label == label && e.color == color) return;
+    }
+    legend_->push_back(LegendEntry{std::string(label), color});
+}
+
 /// center + cos(t) u + sin(t) v over a full turn in n segments.
 void GlDebugDraw::circle(const Vec3& center, const Vec3& u, const Vec3& v, int n,
                      const Color& color) {

@@ -5,6 +5,8 @@
 
 #include <GL/gl.h>
 
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "camera.h"
@@ -52,6 +54,12 @@ struct LineBuffer {
     GLsizei count() const { return GLsizei(positions.size() / 3); }
 };
 
+/// One line of a legend: a colour swatch and what lines of that colour show.
+struct LegendEntry {
+    std::string label;
+    Color color;
+};
+
 /// Segments around a circle of `radius` centred at `center` so that each spans about
 /// `px_per_segment` framebuffer pixels, a multiple of 4 in [lo, hi].
 int segmentsFor(const CameraFrame& cam, const Vec3& center, Real radius, Real px_per_segment,
@@ -75,6 +83,11 @@ public:
     /// Three great circles and the silhouette (gl_debug_draw.cpp).
     void drawSphere(const collision::BoundingSphere& sphere, const Color& color) override;
 
+    /// Where legend entries go from now on (nullptr: dropped).
+    void setLegend(std::vector<LegendEntry>* legend) { legend_ = legend; }
+    /// Appends the entry unless the same (label, colour) is already listed.
+    void legend(std::string_view label, const Color& color) override;
+
 private:
     /// center + cos(t) u + sin(t) v over a full turn in n segments.
     void circle(const Vec3& center, const Vec3& u, const Vec3& v, int n, const Color& color);
@@ -82,6 +95,7 @@ private:
     const CameraFrame& cam_;
     LineBuffer* target_;
     LineBuffer* outlines_ = nullptr;
+    std::vector<LegendEntry>* legend_ = nullptr;
 };
 
 }  // namespace render

@@ -13,6 +13,8 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "camera.h"
@@ -20,7 +22,9 @@
 #include "collision/volumes/bounding_volumes.h"
 #include "font.h"
 #include "gl_debug_draw.h"
+#include "legend.h"
 #include "osmesa_context.h"
+#include "render/volume_states.h"
 #include "tessellation.h"
 
 namespace render {
@@ -38,13 +42,6 @@ constexpr Color kGridColor{0.22f, 0.24f, 0.29f, 1.0f};
 /// witness cross and the length of the normal segment.
 constexpr Real kContactCrossFraction = Real(0.06);
 constexpr Real kContactNormalFraction = Real(0.5);
-
-font::Rgb toRgb8(const Color& c) {
-    auto channel = [](float v) {
-        return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
-    };
-    return {channel(c.r), channel(c.g), channel(c.b)};
-}
 
 /// "Nice" grid spacing (1, 2 or 5 times a power of ten) giving about `target` cells over `extent`.
 Real gridStep(Real extent, Real target) {
@@ -93,12 +90,17 @@ struct Renderer::Impl {
     OsMesaContext context;
     std::map<int, UnitSphereGrid> sphere_grids;  ///< by slice count
     TriangleBuffer triangles;
-    LineBuffer frame_lines;      ///< world bounds and floor grid
-    LineBuffer structure_lines;  ///< the broad phase's own drawing
-    LineBuffer volume_lines;     ///< bounding volumes
-    LineBuffer outline_lines;    ///< bounding spheres' silhouettes
-    LineBuffer bvh_lines;        ///< mesh hierarchy levels (draw.bvh_depth)
-    LineBuffer contact_lines;    ///< contact witnesses and normals (draw.contacts)
+    LineBuffer frame_lines;                     ///< world bounds and floor grid
+    LineBuffer structure_lines;                 ///< the broad phase's own drawing
+    LineBuffer volume_lines;                    ///< bounding volumes
+    LineBuffer outline_lines;                   ///< bounding spheres' silhouettes
+    LineBuffer bvh_lines;                       ///< mesh hierarchy levels (draw.bvh_depth)
+    LineBuffer contact_lines;                   ///< contact witnesses and normals (draw.contacts)
+    std::vector<LegendEntry> structure_legend;  ///< what the broad phase's colours show
+    /// Some volume drawn is not the kind the broad phase tests: the legend says that each
+    /// volume is coloured by its own test.
+    bool own_tests = false;
+    std::optional<VolumeKind> tested_volume;  ///< the kind the broad phase tests
     std::vector<GLubyte> readback;
     FrameStats stats;
 
@@ -110,13 +112,17 @@ struct Renderer::Impl {
         return it->second;
     }
 
-    CameraFrame setUpCamera(const engine::World& world, const engine::CameraSettings& camera);
+    CameraFrame setUpCamera(const engine::World& world, const engine::CameraSettings& camera,
+                            const FrameOptions& options);
     void setUpGl(const CameraFrame& cam);
     /// Tessellates and draws every body that may show, in batches.
     void drawBodies(const engine::World& world, const CameraFrame& cam,
                     const FrameOptions& options);
     void buildLines(const engine::World& world, const CameraFrame& cam,
                     const FrameOptions& options);
+    /// The bounding-volume wireframes, each kind in the colours of its own overlap test.
+    void drawVolumes(const engine::World& world, const CameraFrame& cam,
+                     const FrameOptions& options, GlDebugDraw& debug);
     /// Draws the triangle buffer and empties it.
     void drawTriangles();
     void drawLines(const LineBuffer& lines, float width_px);
@@ -125,13 +131,17 @@ struct Renderer::Impl {
 };
 
 CameraFrame Renderer::Impl::setUpCamera(const engine::World& world,
-                                        const engine::CameraSettings& camera) {
+                                        const engine::CameraSettings& camera,
+                                        const FrameOptions& options) {
     CameraFrame cam = makeCameraFrame(camera, width * ss, height * ss);
     // Clip planes hug everything that may be drawn: the bounds and every body's volumes (the
     // AABB's and OBB's circumspheres enclose the body and its wireframes).
     DepthRange range;
     const collision::Aabb& bounds = world.settings().bounds;
-    range.add(cam, bounds.center(), Real(0.5) * bounds.extents().norm());
+    // Structure diagrams laid out along the bounds' edges reach 17 % of its size beyond them.
+    const Real structure_margin =
+        options.draw_structure ? Real(0.17) * bounds.extents().maxCoeff() : Real(0);
+    range.add(cam, bounds.center(), Real(0.5) * bounds.extents().norm() + structure_margin);
     const auto bodies = world.bodies();
     const auto volumes = world.volumes();
     for (std::size_t i = 0; i < bodies.size(); ++i) {
@@ -283,32 +293,15 @@ void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& c
         debug.drawAabb(b, kBoundsColor);
     }
 
+    structure_legend.clear();
     if (options.draw_structure) {
         debug.setTarget(structure_lines);
-        world.broadPhase().draw(debug);
+        debug.setLegend(&structure_legend);
+        world.broadPhase().draw(debug, world.settings().bounds);
+        debug.setLegend(nullptr);
     }
 
-    const auto volumes = world.volumes();
-    const auto states = world.states();
-    debug.setTarget(volume_lines, &outline_lines);
-    for (std::size_t i = 0; i < volumes.size() && i < world.bodies().size(); ++i) {
-        const Color color = stateColor(i < states.size() ? states[i] : engine::BodyState::Apart);
-        const collision::ProxyVolumes& v = volumes[i];
-        auto shows = [&](const Vec3& center, Real radius) {
-            if (!options.cull || cam.mayShow(center, radius)) return true;
-            ++stats.volumes_culled;
-            return false;
-        };
-        if (options.draw.sphere && shows(v.sphere.center, v.sphere.radius)) {
-            debug.drawSphere(v.sphere, color);
-        }
-        if (options.draw.aabb && shows(v.aabb.center(), Real(0.5) * v.aabb.extents().norm())) {
-            debug.drawAabb(v.aabb, color);
-        }
-        if (options.draw.obb && shows(v.obb.center, v.obb.half_extents.norm())) {
-            debug.drawObb(v.obb, color);
-        }
-    }
+    drawVolumes(world, cam, options, debug);
 
     // CCD: each moving body of a time-of-impact event at its pose there (spheres as spheres,
     // other shapes as their OBB), and the contact normal, in blue. Read-only use of the events.
@@ -350,6 +343,44 @@ void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& c
     if (options.draw.contacts) {
         debug.setTarget(contact_lines);
         world.drawContacts(debug, style);
+    }
+}
+
+void Renderer::Impl::drawVolumes(const engine::World& world, const CameraFrame& cam,
+                                 const FrameOptions& options, GlDebugDraw& debug) {
+    // Each kind of volume in the colours of its own overlap test: the broad phase's flags for
+    // the kind it tests, that kind's own pairs for the others (volume_states.h).
+    tested_volume = broadPhaseVolume(world);
+    own_tests = false;
+    const bool drawn[3] = {options.draw.sphere, options.draw.aabb, options.draw.obb};
+    std::vector<engine::BodyState> kind_states[3];
+    for (const VolumeKind kind : kVolumeKinds) {
+        if (!drawn[int(kind)]) continue;
+        kind_states[int(kind)] = volumeOverlaps(world, kind).states;
+        own_tests = own_tests || tested_volume != kind;
+    }
+    const auto volumes = world.volumes();
+    debug.setTarget(volume_lines, &outline_lines);
+    for (std::size_t i = 0; i < volumes.size() && i < world.bodies().size(); ++i) {
+        auto colorOf = [&](VolumeKind kind) {
+            const std::vector<engine::BodyState>& states = kind_states[int(kind)];
+            return stateColor(i < states.size() ? states[i] : engine::BodyState::Apart);
+        };
+        const collision::ProxyVolumes& v = volumes[i];
+        auto shows = [&](const Vec3& center, Real radius) {
+            if (!options.cull || cam.mayShow(center, radius)) return true;
+            ++stats.volumes_culled;
+            return false;
+        };
+        if (options.draw.sphere && shows(v.sphere.center, v.sphere.radius)) {
+            debug.drawSphere(v.sphere, colorOf(VolumeKind::Sphere));
+        }
+        if (options.draw.aabb && shows(v.aabb.center(), Real(0.5) * v.aabb.extents().norm())) {
+            debug.drawAabb(v.aabb, colorOf(VolumeKind::Aabb));
+        }
+        if (options.draw.obb && shows(v.obb.center, v.obb.half_extents.norm())) {
+            debug.drawObb(v.obb, colorOf(VolumeKind::Obb));
+        }
     }
 }
 
@@ -460,34 +491,35 @@ void Renderer::Impl::drawOverlays(Image& image, const FrameOptions& options) con
                         plate, 0.45f);
         font::drawText(image, margin, margin, options.hud_text, scale, text_color);
     }
-    const bool any_volume =
-        options.draw.sphere || options.draw.aabb || options.draw.obb || options.draw.bvh_depth >= 0;
-    if (options.draw.hud && any_volume) {
-        struct Entry {
-            engine::BodyState state;
-            const char* label;
-        };
-        const Entry entries[] = {{engine::BodyState::Apart, "apart"},
-                                 {engine::BodyState::Flagged, "flagged"},
-                                 {engine::BodyState::Colliding, "colliding"}};
-        const int swatch = font::kCapHeight * scale;
-        const int gap = 4 * scale;
-        int total = 0;
-        for (const Entry& e : entries) {
-            total += swatch + gap + font::textWidth(e.label, scale) + 3 * gap;
+    if (!options.draw.hud) return;
+    // Legends: the state colours bottom-left, what the structure's colours show top-right.
+    const bool any_volume = options.draw.sphere || options.draw.aabb || options.draw.obb;
+    if (any_volume || options.draw.bvh_depth >= 0) {
+        const Color apart = stateColor(engine::BodyState::Apart);
+        const Color flagged = stateColor(engine::BodyState::Flagged);
+        const Color colliding = stateColor(engine::BodyState::Colliding);
+        std::vector<LegendRow> rows;
+        if (any_volume && own_tests) {
+            rows.push_back({{std::nullopt, "each volume coloured by its own overlap test"}});
+            rows.push_back({{apart, "apart"},
+                            {flagged, "overlaps a volume of its kind"},
+                            {colliding, "colliding"}});
+        } else {
+            std::string flagged_label = "flagged";
+            if (any_volume && tested_volume) {
+                const char* const names[3] = {"sphere", "AABB", "OBB"};
+                flagged_label += " (" + std::string(names[int(*tested_volume)]) + " test)";
+            }
+            rows.push_back({{apart, "apart"}, {flagged, flagged_label}, {colliding, "colliding"}});
         }
-        total -= 3 * gap;
-        const int y = height - margin - swatch;
-        font::blendRect(image, margin - pad, y - pad, total + 2 * pad + scale,
-                        swatch + 2 * pad + scale, plate, 0.45f);
-        int x = margin;
-        for (const Entry& e : entries) {
-            font::fillRect(image, x + scale, y + scale, swatch, swatch, {12, 12, 16});
-            font::fillRect(image, x, y, swatch, swatch, toRgb8(stateColor(e.state)));
-            x += swatch + gap;
-            font::drawText(image, x, y, e.label, scale, text_color);
-            x += font::textWidth(e.label, scale) + 3 * gap;
-        }
+        drawLegendBlock(image, margin, height - margin - legendBlockSize(rows, scale).height, rows,
+                        scale);
+    }
+    if (!structure_legend.empty()) {
+        std::vector<LegendRow> rows;
+        for (const LegendEntry& e : structure_legend) rows.push_back({{e.color, e.label}});
+        drawLegendBlock(image, width - margin - legendBlockSize(rows, scale).width, margin, rows,
+                        scale);
     }
 }
 
@@ -504,7 +536,7 @@ Image Renderer::render(const engine::World& world, const engine::CameraSettings&
                        const FrameOptions& options) {
     Impl& im = *impl_;
     im.context.makeCurrent();
-    const CameraFrame cam = im.setUpCamera(world, camera);
+    const CameraFrame cam = im.setUpCamera(world, camera, options);
     im.setUpGl(cam);
     im.stats = FrameStats{};
     if (options.draw.bodies) im.drawBodies(world, cam, options);

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 
@@ -53,6 +54,31 @@ inline CliResult runCdlab(const std::string& args, const std::filesystem::path& 
     r.out = slurp(out);
     r.err = slurp(err);
     return r;
+}
+
+/// True when ffprobe (Debian package ffmpeg) can be run.
+inline bool haveFfprobe() { return std::system("ffprobe -version > /dev/null 2>&1") == 0; }
+
+/// ffprobe's key=value lines for the first video stream, frames decoded and counted.
+inline std::map<std::string, std::string> probeVideo(const std::filesystem::path& video,
+                                                     const std::filesystem::path& work) {
+    const std::filesystem::path out = work / "ffprobe.txt";
+    const std::string cmd =
+        "ffprobe -v error -select_streams v:0 -count_frames -show_entries "
+        "stream=codec_name,pix_fmt,width,height,nb_read_frames "
+        "-of default=noprint_wrappers=1 " +
+        video.string() + " > " + out.string() + " 2>&1";
+    std::map<std::string, std::string> fields;
+    if (std::system(cmd.c_str()) != 0) {
+        fields["error"] = slurp(out);
+        return fields;
+    }
+    std::istringstream lines(slurp(out));
+    for (std::string line; std::getline(lines, line);) {
+        const std::size_t eq = line.find('=');
+        if (eq != std::string::npos) fields[line.substr(0, eq)] = line.substr(eq + 1);
+    }
+    return fields;
 }
 
 }  // namespace cdlab_test

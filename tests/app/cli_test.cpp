@@ -28,28 +28,8 @@ using cdlab_test::slurp;
 
 fs::path tempDir(const std::string& name) { return cdlab_test::tempDir("cdlab_cli_", name); }
 
-bool haveFfprobe() { return std::system("ffprobe -version > /dev/null 2>&1") == 0; }
-
-// ffprobe's key=value lines for the first video stream, frames decoded and counted.
-std::map<std::string, std::string> probeVideo(const fs::path& video, const fs::path& work) {
-    const fs::path out = work / "ffprobe.txt";
-    const std::string cmd =
-        "ffprobe -v error -select_streams v:0 -count_frames -show_entries "
-        "stream=codec_name,pix_fmt,width,height,nb_read_frames "
-        "-of default=noprint_wrappers=1 " +
-        video.string() + " > " + out.string() + " 2>&1";
-    std::map<std::string, std::string> fields;
-    if (std::system(cmd.c_str()) != 0) {
-        fields["error"] = slurp(out);
-        return fields;
-    }
-    std::istringstream lines(slurp(out));
-    for (std::string line; std::getline(lines, line);) {
-        const std::size_t eq = line.find('=');
-        if (eq != std::string::npos) fields[line.substr(0, eq)] = line.substr(eq + 1);
-    }
-    return fields;
-}
+using cdlab_test::haveFfprobe;
+using cdlab_test::probeVideo;
 
 // Pixels that differ between two images of the same size, counting rows from `first_row` on.
 int differingPixels(const render::Image& a, const render::Image& b, int first_row) {

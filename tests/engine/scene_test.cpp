@@ -122,6 +122,7 @@ TEST(Scene, FullSceneRoundTrip) {
     EXPECT_FALSE(s.draw.sphere);
     EXPECT_TRUE(s.draw.aabb);
     EXPECT_TRUE(s.draw.obb);
+    EXPECT_TRUE(s.draw.volumes_given);  // the scene chose: no broad-phase default
     EXPECT_FALSE(s.draw.bounds);
     EXPECT_FALSE(s.draw.hud);
     EXPECT_TRUE(s.draw.structure);
@@ -191,6 +192,7 @@ TEST(Scene, Defaults) {
     EXPECT_TRUE(s.draw.sphere);
     EXPECT_FALSE(s.draw.aabb);
     EXPECT_FALSE(s.draw.obb);
+    EXPECT_FALSE(s.draw.volumes_given);  // a run draws its broad phase's volume
     EXPECT_TRUE(s.draw.bounds);
     EXPECT_TRUE(s.draw.hud);
     EXPECT_FALSE(s.draw.structure);

@@ -25,6 +25,7 @@
 #include "engine/world.h"
 #include "render/image.h"
 #include "render/renderer.h"
+#include "pixel_checks.h"
 
 namespace {
 
@@ -33,115 +34,7 @@ using engine::Mat3;
 using engine::Quat;
 using engine::Real;
 using engine::Vec3;
-using Rgb = std::array<int, 3>;
-
-constexpr int kWidth = 160;
-constexpr int kHeight = 120;
-constexpr double kPi = 3.14159265358979323846;
-
-engine::Body makeShapeBody(const std::string& name, collision::Shape shape, const Vec3& position,
-                           const Quat& orientation = Quat::Identity()) {
-    engine::MassProperties mass;
-    mass.mass = 1;
-    mass.inertia = Mat3::Identity() * Real(0.4);
-    engine::Body body = engine::makeBody(name, std::move(shape), mass);
-    body.position = position;
-    body.orientation = orientation;
-    return body;
-}
-
-engine::Body sphereBody(const std::string& name, Real radius, const Vec3& position) {
-    return makeShapeBody(name, collision::Shape::sphere(radius), position);
-}
-
-// Two overlapping spheres on the left (colliding: red) and one alone on the right (apart: green),
-// seen head-on from +z:
-//
-//        y
-//        |   ( A )( B )        ( C )
-//   -----+--------------------------- x      camera at (0, 0, 9) looking at the origin
-//            x=-3  x=-1.6      x=2.6
-//
-// The bounds are far outside the view, so every pixel that is not a body or a line is background.
-engine::World makeThreeSphereWorld() {
-    engine::WorldSettings settings;
-    settings.bounds = collision::Aabb{Vec3::Constant(-20), Vec3::Constant(20)};
-    engine::World world(settings);
-    world.addBody(sphereBody("a", 1, Vec3(-3, 0, 0)));
-    world.addBody(sphereBody("b", 1, Vec3(-1.6, 0.2, 0)));
-    world.addBody(sphereBody("c", 1, Vec3(2.6, 0, 0)));
-    world.detect();
-    return world;
-}
-
-engine::CameraSettings headOnCamera() {
-    engine::CameraSettings camera;
-    camera.position = Vec3(0, 0, 9);
-    camera.look_at = Vec3::Zero();
-    camera.up = Vec3::UnitY();
-    camera.fov_deg = 45;
-    return camera;
-}
-
-render::FrameOptions plainOptions() {
-    render::FrameOptions options;
-    options.draw.bodies = true;
-    options.draw.sphere = true;
-    options.draw.aabb = false;
-    options.draw.obb = false;
-    options.draw.bounds = false;
-    options.draw.hud = false;
-    return options;
-}
-
-// Pinhole projection written out independently of the renderer (gluLookAt + gluPerspective):
-// pixel x to the right, y down, (0, 0) the top-left corner of the image.
-struct PixelPos {
-    double x;
-    double y;
-};
-
-PixelPos project(const engine::CameraSettings& camera, int width, int height, const Vec3& p) {
-    const Vec3 f = (camera.look_at - camera.position).normalized();
-    const Vec3 r = f.cross(camera.up).normalized();
-    const Vec3 u = r.cross(f);
-    const Vec3 d = p - camera.position;
-    const double t = std::tan(double(camera.fov_deg) * kPi / 360.0);
-    const double aspect = double(width) / double(height);
-    const double ndc_x = double(d.dot(r)) / (double(d.dot(f)) * t * aspect);
-    const double ndc_y = double(d.dot(u)) / (double(d.dot(f)) * t);
-    return {(ndc_x + 1) * 0.5 * width, (1 - ndc_y) * 0.5 * height};
-}
-
-Rgb pixelAt(const render::Image& image, int x, int y) {
-    const std::uint8_t* p = image.pixel(x, y);
-    return {p[0], p[1], p[2]};
-}
-
-Rgb toRgb(const collision::Color& c) {
-    return {int(std::lround(c.r * 255)), int(std::lround(c.g * 255)), int(std::lround(c.b * 255))};
-}
-
-bool close(const Rgb& a, const Rgb& b, int tolerance) {
-    for (int k = 0; k < 3; ++k) {
-        if (std::abs(a[k] - b[k]) > tolerance) return false;
-    }
-    return true;
-}
-
-// True when some pixel within `radius` of `at` is within `tolerance` of `color` per channel.
-bool colorNear(const render::Image& image, PixelPos at, const Rgb& color, int radius = 2,
-               int tolerance = 40) {
-    const int cx = int(std::floor(at.x));
-    const int cy = int(std::floor(at.y));
-    for (int y = cy - radius; y <= cy + radius; ++y) {
-        for (int x = cx - radius; x <= cx + radius; ++x) {
-            if (x < 0 || y < 0 || x >= image.width || y >= image.height) continue;
-            if (close(pixelAt(image, x, y), color, tolerance)) return true;
-        }
-    }
-    return false;
-}
+using namespace cdlab_test;
 
 class TempDir {
 public:
@@ -216,42 +109,6 @@ TEST(Renderer, SphereOutlinesTakeTheirStateColour) {
 //        y
 //        |        ( E )               E (0, 0.6), D (-1.2, -0.6), r = 0.8
 //   -----+----( D )---------( F )---- x      F (2.8, 0) alone: green
-TEST(Renderer, FlaggedButNotTouchingPairIsYellow) {
-    engine::WorldSettings settings;
-    settings.bounds = collision::Aabb{Vec3::Constant(-20), Vec3::Constant(20)};
-    settings.broad_phase = "sap";
-    engine::World world(settings);
-    world.addBody(sphereBody("d", 0.8, Vec3(-1.2, -0.6, 0)));
-    world.addBody(sphereBody("e", 0.8, Vec3(0, 0.6, 0)));
-    world.addBody(sphereBody("f", 0.8, Vec3(2.8, 0, 0)));
-    world.detect();
-    ASSERT_EQ(world.states().size(), 3u);
-    ASSERT_EQ(world.states()[0], engine::BodyState::Flagged);
-    ASSERT_EQ(world.states()[1], engine::BodyState::Flagged);
-    ASSERT_EQ(world.states()[2], engine::BodyState::Apart);
-
-    render::Renderer renderer(kWidth, kHeight);
-    const engine::CameraSettings cam = headOnCamera();
-    const render::Image image = renderer.render(world, cam, plainOptions());
-    const Rgb yellow = toRgb(render::stateColor(engine::BodyState::Flagged));
-    const Rgb red = toRgb(render::stateColor(engine::BodyState::Colliding));
-    const Rgb green = toRgb(render::stateColor(engine::BodyState::Apart));
-    // Outline points of D and E seen from +z, away from where the two outlines come close.
-    const std::vector<Vec3> yellow_points = {{-2.0, -0.6, 0}, {-1.2, -1.4, 0}, {-1.2, 0.2, 0},
-                                             {0.8, 0.6, 0},   {0, 1.4, 0},     {-0.8, 0.6, 0}};
-    for (const Vec3& p : yellow_points) {
-        const PixelPos px = project(cam, kWidth, kHeight, p);
-        EXPECT_TRUE(colorNear(image, px, yellow)) << "no yellow near " << px.x << "," << px.y;
-        EXPECT_FALSE(colorNear(image, px, red)) << "red near " << px.x << "," << px.y;
-        EXPECT_FALSE(colorNear(image, px, green)) << "green near " << px.x << "," << px.y;
-    }
-    for (const Vec3& p : {Vec3(2.0, 0, 0), Vec3(3.6, 0, 0), Vec3(2.8, 0.8, 0)}) {
-        const PixelPos px = project(cam, kWidth, kHeight, p);
-        EXPECT_TRUE(colorNear(image, px, green)) << "no green near " << px.x << "," << px.y;
-        EXPECT_FALSE(colorNear(image, px, yellow)) << "yellow near " << px.x << "," << px.y;
-    }
-}
-
 TEST(Renderer, BackgroundIsTheBackgroundColour) {
     render::Renderer renderer(kWidth, kHeight);
     const render::Image image = renderThreeSpheres(renderer);
@@ -475,83 +332,6 @@ TEST(Renderer, VolumeSelectionControlsWhichWireframesAppear) {
     EXPECT_FALSE(colorNear(renderThreeSpheres(renderer, options), corner, green, 1));
     options.draw.aabb = true;
     EXPECT_TRUE(colorNear(renderThreeSpheres(renderer, options), corner, green, 1));
-}
-
-// Records what a broad phase draws, to know which colours its structure uses.
-class RecordingDraw final : public collision::DebugDraw {
-public:
-    void drawLine(const Vec3& /*a*/, const Vec3& /*b*/, const collision::Color& color) override {
-        ++lines;
-        const Rgb c = toRgb(color);
-        if (std::find(colors.begin(), colors.end(), c) == colors.end()) colors.push_back(c);
-    }
-    int lines = 0;
-    std::vector<Rgb> colors;
-};
-
-// True when `seen` is `line` laid over `under` with a coverage of at least 30 %, within 10 per
-// channel: a 1-pixel line falls across two pixels after the supersampling box filter, each then
-// a partial blend, so comparing with the line's colour alone would miss it.
-bool blendedOver(const Rgb& seen, const Rgb& under, const Rgb& line) {
-    double de = 0;
-    double ee = 0;
-    for (int k = 0; k < 3; ++k) {
-        de += double(seen[k] - under[k]) * double(line[k] - under[k]);
-        ee += double(line[k] - under[k]) * double(line[k] - under[k]);
-    }
-    if (ee < 30 * 30) return false;   // the line's colour is (nearly) what was there already
-    const double coverage = de / ee;  // least squares: seen - under = coverage (line - under)
-    if (coverage < 0.3 || coverage > 1.05) return false;
-    for (int k = 0; k < 3; ++k) {
-        const double residual = double(seen[k] - under[k]) - coverage * double(line[k] - under[k]);
-        if (std::abs(residual) > 10) return false;
-    }
-    return true;
-}
-
-// --draw-structure: every broad phase that has a structure to show draws it, so the picture
-// changes, and the change is in the structure's own colours (not, say, a state colour). The
-// three-sphere scene leaves room where nothing else is drawn: the gap between B and C, where
-// SAP's intervals on y and z and the grid cells cross, and the space around the spheres.
-TEST(Renderer, DrawStructureShowsEachBroadPhasesStructure) {
-    const std::vector<std::string> drawing = {"grid", "hash", "hgrid", "sap",
-                                              "sap1", "tree", "octree"};
-    render::Renderer renderer(kWidth, kHeight);
-    for (const std::string& name : drawing) {
-        SCOPED_TRACE(name);
-        engine::World world = makeThreeSphereWorld();
-        world.setBroadPhase(name);
-        world.detect();  // inserts the proxies into the new broad phase
-        ASSERT_EQ(world.broadPhase().name(), name);
-        RecordingDraw recorded;
-        world.broadPhase().draw(recorded);
-        ASSERT_GT(recorded.lines, 0) << "draws nothing";
-
-        render::FrameOptions options = plainOptions();
-        const render::Image without = renderer.render(world, headOnCamera(), options);
-        options.draw_structure = true;
-        const render::Image with = renderer.render(world, headOnCamera(), options);
-        int differing = 0;
-        int structure_coloured = 0;  // pixels that show a blend of one of the structure's colours
-        for (int y = 0; y < kHeight; ++y) {
-            for (int x = 0; x < kWidth; ++x) {
-                const Rgb a = pixelAt(without, x, y);
-                const Rgb b = pixelAt(with, x, y);
-                if (a == b) continue;
-                ++differing;
-                for (const Rgb& c : recorded.colors) {
-                    if (blendedOver(b, a, c)) {
-                        ++structure_coloured;
-                        break;
-                    }
-                }
-            }
-        }
-        EXPECT_GE(differing, 20) << "structure barely visible";
-        EXPECT_GE(structure_coloured, 10)
-            << "of " << differing << " changed pixels, too few in the structure's "
-            << recorded.colors.size() << " colours";
-    }
 }
 
 TEST(Renderer, HudTextChangesTopLeftPixelsOnly) {
@@ -899,13 +679,6 @@ engine::CameraSettings torusCamera() {
     return camera;
 }
 
-int countColor(const render::Image& image, const Rgb& color, int tolerance = 40) {
-    int n = 0;
-    for (int y = 0; y < image.height; ++y) {
-        for (int x = 0; x < image.width; ++x) n += close(pixelAt(image, x, y), color, tolerance);
-    }
-    return n;
-}
 
 }  // namespace
 

@@ -6,6 +6,7 @@
 #include "broadphase/grid.h"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "collision/debug_draw.h"
 
@@ -230,14 +231,19 @@ void GridBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters
     counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
 }
 
-void GridBroadPhase::draw(DebugDraw& draw) const {
-    const Color color{0.5f, 0.5f, 1.0f, 1};
+void GridBroadPhase::draw(DebugDraw& draw, const Aabb& /*bounds*/) const {
+    const Color& color = kStructurePalette[0];
     for (std::size_t i = 0; i < sorted_.size(); ++i) {
         if (i > 0 && sorted_[i].cell == sorted_[i - 1].cell) continue;
         const CellCoord& c = sorted_[i].cell;
         const Vec3 lo = origin_ + Vec3(Real(c.x), Real(c.y), Real(c.z)) * cell_size_;
         draw.drawAabb(Aabb{lo, lo + Vec3::Constant(cell_size_)}, color);
     }
+    if (sorted_.empty()) return;
+    char label[96];
+    std::snprintf(label, sizeof label, "%s cells holding proxies, %.3g wide",
+                  mode_ == Mode::Dense ? "grid" : "hash", double(cell_size_));
+    draw.legend(label, color);
 }
 
 }  // namespace collision

@@ -28,7 +28,7 @@ public:
 
     std::string_view name() const override { return mode_ == Mode::Dense ? "grid" : "hash"; }
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
-    void draw(DebugDraw& draw) const override;
+    void draw(DebugDraw& draw, const Aabb& bounds) const override;
 
     static constexpr std::int64_t kMaxCellsPerProxy = 64;
 

@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <sstream>
 #include <type_traits>
@@ -621,14 +622,12 @@ void HierarchicalGrid::sweepLane(Lane& lane, std::vector<ProxyPair>& pairs) {
                              /*order_ids=*/true);
 }
 
-void HierarchicalGrid::draw(DebugDraw& draw) const {
-    // Each proxy's home cell at its own level (one cell tall at its min x), coloured by level:
-    // coarse levels orange, fine levels blue.
+void HierarchicalGrid::draw(DebugDraw& draw, const Aabb& /*bounds*/) const {
+    // Each proxy's home cell at its own level (one cell tall at its min x), one colour per level.
     for (int k = 0; k < level_count_; ++k) {
         const Level& lv = levels_[k];
         if (lv.members == 0) continue;
-        const float t = level_count_ > 1 ? float(k) / float(level_count_ - 1) : 0.0f;
-        const Color color{1.0f - 0.7f * t, 0.55f, 0.3f + 0.7f * t, 1};
+        const Color color = structureColor(k);
         const Entry* const e = entries_.data() + lv.first;
         for (std::size_t c = 0; c + 1 < lv.start.size(); ++c) {
             const Real y = origin_y_ + Real(std::int64_t(c) % lv.ny) * lv.cell;
@@ -639,6 +638,11 @@ void HierarchicalGrid::draw(DebugDraw& draw) const {
                 draw.drawAabb(Aabb{lo, lo + Vec3::Constant(lv.cell)}, color);
             }
         }
+        char label[96];
+        std::snprintf(label, sizeof label,
+                      "hgrid level %d: home cells of its %zu proxies, %.3g wide", k, lv.members,
+                      double(lv.cell));
+        draw.legend(label, color);
     }
 }
 

@@ -53,7 +53,7 @@ public:
     ~HierarchicalGrid() override;
     std::string_view name() const override { return helper_ ? "hgrid2" : "hgrid"; }
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
-    void draw(DebugDraw& draw) const override;
+    void draw(DebugDraw& draw, const Aabb& bounds) const override;
     std::string validate() const override;
 
     static constexpr int kMaxLevels = 40;

@@ -88,13 +88,17 @@ void LooseOctree::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& c
     counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
 }
 
-void LooseOctree::draw(DebugDraw& draw) const {
+void LooseOctree::draw(DebugDraw& draw, const Aabb& /*bounds*/) const {
+    // The cells of the nodes that hold proxies (their loose boxes are twice as wide), one colour
+    // per depth.
+    int depths = 0;
     for (const Node& n : nodes_) {
         if (n.proxies.empty()) continue;
-        const float t = std::min(1.0f, float(n.depth) / 6.0f);
         draw.drawAabb(Aabb{n.center - Vec3::Constant(n.half), n.center + Vec3::Constant(n.half)},
-                      Color{1.0f - 0.6f * t, 0.5f + 0.3f * t, 0.3f + 0.7f * t, 1});
+                      structureColor(n.depth));
+        depths = std::max(depths, n.depth + 1);
     }
+    legendByNumber(draw, "octree cells holding proxies, depth", depths);
 }
 
 }  // namespace collision

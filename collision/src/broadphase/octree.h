@@ -19,7 +19,7 @@ class LooseOctree : public RebuildingBroadPhase {
 public:
     std::string_view name() const override { return "octree"; }
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
-    void draw(DebugDraw& draw) const override;
+    void draw(DebugDraw& draw, const Aabb& bounds) const override;
 
     static constexpr int kMaxDepth = 16;
 

@@ -10,7 +10,10 @@
 
 #include <algorithm>
 #include <sstream>
+#include <string>
+#include <vector>
 
+#include "broadphase/interval_diagram.h"
 #include "broadphase/radix_sort.h"
 #include "collision/debug_draw.h"
 
@@ -122,23 +125,38 @@ void SweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters&
     counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
 }
 
-void SweepAndPrune::draw(DebugDraw& draw) const {
-    // Each proxy's interval on each axis, drawn as a segment on that axis through the origin of
-    // the scene, offset slightly per proxy so overlapping intervals stay distinguishable.
-    const Color colors[3] = {{1.0f, 0.4f, 0.4f, 1}, {0.4f, 1.0f, 0.4f, 1}, {0.4f, 0.6f, 1.0f, 1}};
+void SweepAndPrune::draw(DebugDraw& draw, const Aabb& bounds) const {
+    // Each axis's sorted list as a 1-D interval diagram along an edge of the bounds; the
+    // intervals of the proxies in an active pair (overlapping on all three axes) marked.
+    std::vector<char> active(static_cast<std::size_t>(std::max<ProxyId>(table_.capacity(), 0)), 0);
+    pairs_.forEach([&](std::uint64_t k) {
+        active[static_cast<std::size_t>(k >> 32)] = 1;
+        active[static_cast<std::size_t>(k & 0xFFFFFFFFu)] = 1;
+    });
+    const Color& marked = kStructurePalette[1];
+    const char* const axis_names[3] = {"x", "y", "z"};
+    const int axis_colors[3] = {0, 2, 3};  // cyan, violet, pink
+    std::vector<DiagramInterval> intervals;
+    std::vector<std::size_t> slot(active.size(), 0);
     for (int axis = 0; axis < 3; ++axis) {
-        for (ProxyId id = 0; id < table_.capacity(); ++id) {
-            if (!table_.contains(id)) continue;
-            const Aabb& box = table_.aabb(id);
-            Vec3 a = Vec3::Zero();
-            Vec3 b = Vec3::Zero();
-            a[axis] = box.min[axis];
-            b[axis] = box.max[axis];
-            const int up = (axis + 1) % 3;
-            a[up] = b[up] = Real(-0.05) * Real(1 + id % 16);
-            draw.drawLine(a, b, colors[axis]);
+        // The list is in `before` order, so intervals come out sorted by their min.
+        intervals.clear();
+        for (const Endpoint& e : axes_[axis]) {
+            const auto id = static_cast<std::size_t>(e.id);
+            if (!e.is_max) {
+                slot[id] = intervals.size();
+                intervals.push_back(DiagramInterval{e.value, e.value, active[id] != 0});
+            } else {
+                intervals[slot[id]].hi = e.value;
+            }
         }
+        const Color& color = kStructurePalette[axis_colors[axis]];
+        drawIntervalDiagram(draw, bounds, axis, intervals, color, marked);
+        draw.legend(std::string("SAP ") + axis_names[axis] + " intervals, sorted, " +
+                        intervalDiagramPlace(axis),
+                    color);
     }
+    draw.legend("interval of a proxy in an active pair (overlap on x, y and z)", marked);
 }
 
 std::string SweepAndPrune::validate() const {

@@ -3,7 +3,10 @@
 #include "broadphase/sap1.h"
 
 #include <algorithm>
+#include <string>
+#include <vector>
 
+#include "broadphase/interval_diagram.h"
 #include "collision/debug_draw.h"
 
 namespace collision {
@@ -102,18 +105,29 @@ void SortAndSweep1::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters&
     counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
 }
 
-void SortAndSweep1::draw(DebugDraw& draw) const {
+void SortAndSweep1::draw(DebugDraw& draw, const Aabb& bounds) const {
+    // The one sorted list as a 1-D interval diagram along an edge of the bounds; the intervals
+    // of proxies whose AABBs overlap another's marked (the sweep of findPairs, repeated).
     if (axis_ < 0) return;
-    const Color color{0.4f, 0.8f, 1.0f, 1};
+    std::vector<DiagramInterval> intervals;
+    intervals.reserve(items_.size());
+    for (const Item& it : items_) intervals.push_back(DiagramInterval{it.lo, it.hi, false});
     for (std::size_t i = 0; i < items_.size(); ++i) {
-        Vec3 a = Vec3::Zero();
-        Vec3 b = Vec3::Zero();
-        a[axis_] = items_[i].lo;
-        b[axis_] = items_[i].hi;
-        const int up = (axis_ + 1) % 3;
-        a[up] = b[up] = Real(-0.05) * Real(1 + i % 16);
-        draw.drawLine(a, b, color);
+        const Aabb& box = table_.aabb(items_[i].id);
+        for (std::size_t j = i + 1; j < items_.size() && items_[j].lo <= items_[i].hi; ++j) {
+            if (box.overlaps(table_.aabb(items_[j].id))) {
+                intervals[i].marked = intervals[j].marked = true;
+            }
+        }
     }
+    const Color& color = kStructurePalette[0];
+    const Color& marked = kStructurePalette[1];
+    drawIntervalDiagram(draw, bounds, axis_, intervals, color, marked);
+    const char* const axis_names[3] = {"x", "y", "z"};
+    draw.legend(std::string("sap1 intervals on ") + axis_names[axis_] +
+                    " (the sort axis), sorted, " + intervalDiagramPlace(axis_),
+                color);
+    draw.legend("interval of a proxy in an overlapping pair", marked);
 }
 
 std::string SortAndSweep1::validate() const {

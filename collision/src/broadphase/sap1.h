@@ -20,7 +20,7 @@ public:
     void remove(ProxyId id) override;
     void move(ProxyId id, const ProxyVolumes& v) override;
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
-    void draw(DebugDraw& draw) const override;
+    void draw(DebugDraw& draw, const Aabb& bounds) const override;
     std::string validate() const override;
 
 private:

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "broadphase/radix_sort.h"
 #include "collision/debug_draw.h"
@@ -269,21 +271,23 @@ void DynamicAabbTree::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounter
     counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
 }
 
-void DynamicAabbTree::draw(DebugDraw& draw) const {
+void DynamicAabbTree::draw(DebugDraw& draw, const Aabb& /*bounds*/) const {
+    // Every node's fat box, one colour per depth (root 0).
     if (root_ == kNull) return;
-    const int root_height = std::max(1, nodes_[root_].height);
-    std::vector<int> stack{root_};
+    int depths = 0;
+    std::vector<std::pair<int, int>> stack{{root_, 0}};  // (node, depth)
     while (!stack.empty()) {
-        const int index = stack.back();
+        const auto [index, depth] = stack.back();
         stack.pop_back();
         const Node& n = nodes_[index];
-        const float t = float(n.height) / float(root_height);
-        draw.drawAabb(n.box, Color{0.2f + 0.8f * t, 0.6f, 1.0f - 0.8f * t, 1});
+        draw.drawAabb(n.box, structureColor(depth));
+        depths = std::max(depths, depth + 1);
         if (!n.isLeaf()) {
-            stack.push_back(n.child1);
-            stack.push_back(n.child2);
+            stack.push_back({n.child1, depth + 1});
+            stack.push_back({n.child2, depth + 1});
         }
     }
+    legendByNumber(draw, "tree nodes (fat boxes), depth", depths, " (root 0)");
 }
 
 std::string DynamicAabbTree::validateNode(int node, int parent) const {

@@ -1,8 +1,10 @@
 // collision/src/geometry/debug_draw.cpp -- default DebugDraw shapes, built from drawLine.
 #include "collision/debug_draw.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <string>
 
 namespace collision {
 
@@ -39,6 +41,18 @@ void DebugDraw::drawSphere(const BoundingSphere& sphere, const Color& color) {
             drawLine(prev, p, color);
             prev = p;
         }
+    }
+}
+
+void legendByNumber(DebugDraw& draw, std::string_view prefix, int count, std::string_view suffix) {
+    for (int first = 0; first < std::min(count, kStructurePaletteSize); ++first) {
+        std::string label(prefix);
+        for (int k = first; k < count; k += kStructurePaletteSize) {
+            label += k == first ? " " : ", ";
+            label += std::to_string(k);
+        }
+        label += suffix;
+        draw.legend(label, structureColor(first));
     }
 }
 

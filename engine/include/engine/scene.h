@@ -32,6 +32,9 @@ struct DrawSettings {
     bool sphere = true;
     bool aabb = false;
     bool obb = false;
+    /// The scene chose sphere/aabb/obb with `draw.volumes`. Otherwise `cdlab run` draws the
+    /// volume its broad phase tests (render::drawSettingsFor) instead of the defaults above.
+    bool volumes_given = false;
     bool bounds = true;
     bool hud = true;
     bool structure = false;  ///< the broad phase's own structure (cells, intervals, nodes)

@@ -56,8 +56,11 @@ public:
     virtual void move(ProxyId id, const ProxyVolumes& volumes) = 0;
     /// Writes every overlapping pair into `pairs` (cleared first), sorted, unique.
     virtual void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) = 0;
-    /// Draws the broad phase's own structure (cells, intervals, nodes). Default: nothing.
-    virtual void draw(DebugDraw& /*draw*/) const {}
+    /// Draws the broad phase's own structure (cells, intervals, nodes) as it was at the last
+    /// findPairs, in kStructurePalette colours, and names each colour with DebugDraw::legend.
+    /// `bounds` is the box the picture frames (the world bounds): what has no place in space of
+    /// its own (SAP's intervals on each axis) is laid out along its edges. Default: nothing.
+    virtual void draw(DebugDraw& /*draw*/, const Aabb& /*bounds*/) const {}
     /// Checks internal invariants; returns an empty string when they hold, else what is broken.
     virtual std::string validate() const { return {}; }
 };

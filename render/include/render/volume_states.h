@@ -1,0 +1,50 @@
+// render/volume_states.h -- each kind of bounding volume judged by its own overlap test: which
+// volumes a picture draws by default, and the state colour of every volume it draws.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include "collision/broadphase/broad_phase.h"
+#include "engine/scene.h"
+#include "engine/world.h"
+
+namespace render {
+
+/// The bounding volumes a body has (collision::ProxyVolumes).
+enum class VolumeKind : std::uint8_t { Sphere, Aabb, Obb };
+inline constexpr VolumeKind kVolumeKinds[] = {VolumeKind::Sphere, VolumeKind::Aabb,
+                                              VolumeKind::Obb};
+
+/// "sphere", "aabb", "obb": the names of the registry's volume column and of `draw.volumes`.
+std::string_view volumeKindName(VolumeKind kind);
+
+/// The volume the world's broad phase decides on (BroadPhaseEntry::volume); nullopt for a
+/// broad phase that is not in the registry.
+std::optional<VolumeKind> broadPhaseVolume(const engine::World& world);
+
+/// The scene's draw settings with, unless the scene chose its volumes (`draw.volumes` given),
+/// exactly the volume the world's broad phase tests drawn: bounding spheres for `sphere`, OBBs
+/// for `obb`, AABBs for every AABB-based broad phase.
+engine::DrawSettings drawSettingsFor(const engine::DrawSettings& draw, const engine::World& world);
+
+/// One kind of volume over all bodies, each judged by that kind's own overlap test.
+struct VolumeOverlaps {
+    /// Pairs whose volumes of this kind overlap (touching counts): sorted, a < b, unique.
+    std::vector<collision::ProxyPair> pairs;
+    /// Per body: Colliding when in a pair the narrow phase confirmed (World::collidingPairs) and
+    /// whose volumes of this kind overlap; else Flagged when its volume overlaps another body's
+    /// volume of this kind; else Apart.
+    std::vector<engine::BodyState> states;
+};
+
+/// The overlaps of the world's volumes of `kind` at its last detect() or step(). For the kind
+/// the broad phase tests these are the world's own flagged pairs and states (the broad phases
+/// report exactly their volume's overlaps); any other kind is found afresh by the registry's
+/// sorting broad phase for that volume (sap, sphere, obb: exact tests, each checked against its
+/// brute-force reference), O(n log n + pairs).
+VolumeOverlaps volumeOverlaps(const engine::World& world, VolumeKind kind);
+
+}  // namespace render

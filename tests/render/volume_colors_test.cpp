@@ -1,0 +1,241 @@
+// tests/render/volume_colors_test.cpp -- every drawn volume takes the colour of its own overlap
+// test, and a run draws the volume its broad phase tests unless the scene chose.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "collision/broadphase/broad_phase.h"
+#include "engine/scene.h"
+#include "engine/world.h"
+#include "pixel_checks.h"
+#include "render/renderer.h"
+#include "render/volume_states.h"
+
+namespace {
+
+using namespace cdlab_test;
+namespace fs = std::filesystem;
+
+// D and E sit diagonally: their AABBs overlap (x in [-0.8, -0.4], y in [-0.2, 0.2]) but their
+// spheres do not (centres 1.70 apart, radii 0.8 + 0.8). F is alone.
+//
+//        y
+//        |     [ ( E ) ]
+//   [ ( D ) ]                 ( F )
+//   -----+------------------------- x      camera at (0, 0, 9) looking at the origin
+engine::World makeDiagonalPairWorld(const std::string& broad_phase) {
+    engine::WorldSettings settings;
+    settings.bounds = collision::Aabb{Vec3::Constant(-20), Vec3::Constant(20)};
+    settings.broad_phase = broad_phase;
+    engine::World world(settings);
+    world.addBody(sphereBody("d", 0.8, Vec3(-1.2, -0.6, 0)));
+    world.addBody(sphereBody("e", 0.8, Vec3(0, 0.6, 0)));
+    world.addBody(sphereBody("f", 0.8, Vec3(2.8, 0, 0)));
+    world.detect();
+    return world;
+}
+
+// Two parallel rods turned 45 degrees about z, side by side: their AABBs overlap, their OBBs
+// (the rods themselves) are 0.85 apart across, more than the 0.3 of their two half widths.
+//
+//        y        /  /
+//        |       /  /        rods along (1, 1), the second shifted by (0.6, -0.6)
+//   -----+------/--/------ x
+engine::World makeParallelRodsWorld(const std::string& broad_phase) {
+    engine::WorldSettings settings;
+    settings.bounds = collision::Aabb{Vec3::Constant(-20), Vec3::Constant(20)};
+    settings.broad_phase = broad_phase;
+    engine::World world(settings);
+    const Quat turn(Eigen::AngleAxis<Real>(kPi / 4, Vec3::UnitZ()));
+    const collision::Shape rod = collision::Shape::box(Vec3(1, 0.15, 0.15));
+    world.addBody(makeShapeBody("rod1", rod, Vec3(-0.3, 0.3, 0), turn));
+    world.addBody(makeShapeBody("rod2", rod, Vec3(0.3, -0.3, 0), turn));
+    world.detect();
+    return world;
+}
+
+render::FrameOptions volumesOnly(bool sphere, bool aabb, bool obb) {
+    render::FrameOptions options = plainOptions();
+    options.draw.bodies = false;
+    options.draw.sphere = sphere;
+    options.draw.aabb = aabb;
+    options.draw.obb = obb;
+    return options;
+}
+
+const Rgb kGreen = toRgb(render::stateColor(engine::BodyState::Apart));
+const Rgb kYellow = toRgb(render::stateColor(engine::BodyState::Flagged));
+const Rgb kRed = toRgb(render::stateColor(engine::BodyState::Colliding));
+
+}  // namespace
+
+// The broad phase (sap) flags D and E by their AABBs: the AABBs, the volume it tests, are
+// yellow; F's is green. Outline points on the boxes' front faces, away from where they cross.
+TEST(VolumeColors, FlaggedButNotTouchingAabbsAreYellow) {
+    const engine::World world = makeDiagonalPairWorld("sap");
+    ASSERT_EQ(world.states()[0], engine::BodyState::Flagged);
+    ASSERT_EQ(world.states()[1], engine::BodyState::Flagged);
+    ASSERT_EQ(world.states()[2], engine::BodyState::Apart);
+    render::Renderer renderer(kWidth, kHeight);
+    const engine::CameraSettings cam = headOnCamera();
+    const render::Image image = renderer.render(world, cam, volumesOnly(false, true, false));
+    for (const Vec3& p :
+         {Vec3(-2.0, -0.9, 0.8), Vec3(-1.5, -1.4, 0.8), Vec3(0.8, 0.9, 0.8), Vec3(0.3, 1.4, 0.8)}) {
+        const PixelPos px = project(cam, kWidth, kHeight, p);
+        EXPECT_TRUE(colorNear(image, px, kYellow)) << "no yellow near " << px.x << "," << px.y;
+        EXPECT_FALSE(colorNear(image, px, kGreen)) << "green near " << px.x << "," << px.y;
+        EXPECT_FALSE(colorNear(image, px, kRed)) << "red near " << px.x << "," << px.y;
+    }
+    const PixelPos f_edge = project(cam, kWidth, kHeight, Vec3(3.6, 0.3, 0.8));
+    EXPECT_TRUE(colorNear(image, f_edge, kGreen));
+    EXPECT_FALSE(colorNear(image, f_edge, kYellow));
+}
+
+// Issue "pictures that tell the truth": the pause picture drew D's and E's spheres yellow
+// because their AABBs were flagged. Drawn together, each volume takes its own test's colour:
+// the spheres (apart as spheres) green, the AABBs and OBBs (overlapping) yellow.
+TEST(VolumeColors, SphereStaysGreenWhenOnlyTheAabbsOverlap) {
+    const engine::World world = makeDiagonalPairWorld("sap");
+    constexpr int kW = 320;
+    constexpr int kH = 240;
+    render::Renderer renderer(kW, kH);
+    // Looking straight at D, so its box's front and back faces frame its sphere concentrically
+    // and the sphere's outline at 45 degrees lies 5 or more pixels from every box edge.
+    engine::CameraSettings cam = headOnCamera();
+    cam.position = Vec3(-1.2, -0.6, 9);
+    cam.look_at = Vec3(-1.2, -0.6, 0);
+    for (const bool with_boxes : {false, true}) {
+        SCOPED_TRACE(with_boxes ? "spheres, AABBs and OBBs" : "spheres only");
+        const render::Image image =
+            renderer.render(world, cam, volumesOnly(true, with_boxes, with_boxes));
+        // D's outline at 45 degrees, except towards E.
+        const Real r = Real(0.8) * std::sqrt(Real(0.5));
+        for (const Vec3& p : {Vec3(-1.2 - r, -0.6 - r, 0), Vec3(-1.2 - r, -0.6 + r, 0),
+                              Vec3(-1.2 + r, -0.6 - r, 0)}) {
+            const PixelPos px = project(cam, kW, kH, p);
+            EXPECT_TRUE(colorNear(image, px, kGreen, 1)) << "no green near " << px.x << "," << px.y;
+            EXPECT_FALSE(colorNear(image, px, kYellow, 1)) << "yellow near " << px.x << "," << px.y;
+        }
+        if (with_boxes) {
+            const PixelPos corner = project(cam, kW, kH, Vec3(-2.0, -1.4, 0.8));
+            EXPECT_TRUE(colorNear(image, corner, kYellow)) << "the AABBs overlap: yellow";
+        }
+    }
+}
+
+// --broadphase obb on a scene without draw.volumes: the OBBs are drawn, green, since they do not
+// overlap, and nothing is yellow, though the AABBs overlap. An AABB-based broad phase draws the
+// AABBs, yellow. A scene that chose AABBs keeps them, yellow by their own test even under the
+// OBB broad phase (they were green: coloured by the OBB test).
+TEST(VolumeColors, ObbBroadPhaseDrawsObbsAndNoYellowWhenOnlyTheAabbsOverlap) {
+    constexpr int kW = 320;
+    constexpr int kH = 240;
+    render::Renderer renderer(kW, kH);
+    const engine::CameraSettings cam = headOnCamera();
+    engine::DrawSettings scene_default = plainOptions().draw;  // draw.volumes not given
+    scene_default.bodies = false;
+    ASSERT_FALSE(scene_default.volumes_given);
+
+    const engine::World obb_world = makeParallelRodsWorld("obb");
+    ASSERT_EQ(obb_world.flaggedPairs().size(), 0u);
+    render::FrameOptions options;
+    options.draw = render::drawSettingsFor(scene_default, obb_world);
+    EXPECT_TRUE(options.draw.obb);
+    EXPECT_FALSE(options.draw.aabb);
+    EXPECT_FALSE(options.draw.sphere);
+    const render::Image obb_image = renderer.render(obb_world, cam, options);
+    EXPECT_EQ(countColor(obb_image, kYellow), 0);
+    // A point of rod1's long upper front edge, 0.7 from its middle: on its OBB, clear of its and
+    // rod2's bounding spheres' circles, so green there is an OBB line.
+    const Real c = std::sqrt(Real(0.5));
+    const Vec3 edge_point = Vec3(-0.3, 0.3, 0.15) + Vec3(0.7 * c - 0.15 * c, 0.7 * c + 0.15 * c, 0);
+    EXPECT_TRUE(colorNear(obb_image, project(cam, kW, kH, edge_point), kGreen, 1));
+
+    const engine::World sap_world = makeParallelRodsWorld("sap");
+    ASSERT_EQ(sap_world.flaggedPairs().size(), 1u);
+    options.draw = render::drawSettingsFor(scene_default, sap_world);
+    EXPECT_TRUE(options.draw.aabb);
+    EXPECT_FALSE(options.draw.obb);
+    EXPECT_GT(countColor(renderer.render(sap_world, cam, options), kYellow), 20);
+
+    engine::DrawSettings chose_aabb = scene_default;
+    chose_aabb.sphere = false;
+    chose_aabb.aabb = true;
+    chose_aabb.volumes_given = true;
+    options.draw = render::drawSettingsFor(chose_aabb, obb_world);
+    EXPECT_TRUE(options.draw.aabb);
+    EXPECT_FALSE(options.draw.obb);
+    EXPECT_GT(countColor(renderer.render(obb_world, cam, options), kYellow), 20);
+}
+
+// The default volume follows the registry's volume column for every broad phase; a scene's
+// draw.volumes is kept as it is.
+TEST(VolumeColors, DefaultVolumeIsTheOneEachBroadPhaseTests) {
+    engine::World world = makeDiagonalPairWorld("sap");
+    for (const collision::BroadPhaseEntry& e : collision::broadPhaseRegistry()) {
+        SCOPED_TRACE(std::string(e.name));
+        world.setBroadPhase(std::string(e.name));
+        const engine::DrawSettings d = render::drawSettingsFor(engine::DrawSettings{}, world);
+        EXPECT_EQ(d.sphere, e.volume == "sphere");
+        EXPECT_EQ(d.aabb, e.volume == "aabb");
+        EXPECT_EQ(d.obb, e.volume == "obb");
+        engine::DrawSettings chosen;
+        chosen.sphere = chosen.aabb = chosen.obb = true;
+        chosen.volumes_given = true;
+        const engine::DrawSettings kept = render::drawSettingsFor(chosen, world);
+        EXPECT_TRUE(kept.sphere && kept.aabb && kept.obb);
+    }
+    EXPECT_FALSE(engine::loadScene(fs::path(CDLAB_SOURCE_DIR) / "scenes" / "bounce.yaml")
+                     .draw.sphere);  // volumes: [] is a choice too
+}
+
+// The per-kind overlaps equal brute force over the volumes with the collision library's own
+// tests, whichever broad phase the world runs (its own pairs serve the kind it tests), and the
+// states follow from the pairs and the confirmed pairs. The coursework scene after 2 s has pairs
+// of every kind and kinds that disagree.
+TEST(VolumeOverlaps, EqualBruteForceForEveryKindUnderEveryBroadPhase) {
+    const engine::Scene scene =
+        engine::loadScene(fs::path(CDLAB_SOURCE_DIR) / "scenes" / "coursework.yaml");
+    engine::World world = engine::makeWorld(scene);
+    for (int s = 0; s < 240; ++s) world.step();
+    const auto volumes = world.volumes();
+    std::vector<collision::ProxyPair> brute[3];
+    for (std::size_t i = 0; i < volumes.size(); ++i) {
+        for (std::size_t j = i + 1; j < volumes.size(); ++j) {
+            const collision::ProxyPair p{collision::ProxyId(i), collision::ProxyId(j)};
+            if (volumes[i].sphere.overlaps(volumes[j].sphere)) brute[0].push_back(p);
+            if (volumes[i].aabb.overlaps(volumes[j].aabb)) brute[1].push_back(p);
+            if (volumes[i].obb.overlaps(volumes[j].obb)) brute[2].push_back(p);
+        }
+    }
+    for (const auto& pairs : brute) ASSERT_FALSE(pairs.empty());
+    EXPECT_NE(brute[0], brute[1]);
+    EXPECT_NE(brute[1], brute[2]);
+    ASSERT_FALSE(world.collidingPairs().empty());
+
+    for (const std::string bp : {"sap", "sphere", "obb", "hgrid", "brute"}) {
+        SCOPED_TRACE(bp);
+        world.setBroadPhase(bp);
+        world.detect();
+        for (const render::VolumeKind kind : render::kVolumeKinds) {
+            SCOPED_TRACE(std::string(render::volumeKindName(kind)));
+            const render::VolumeOverlaps o = render::volumeOverlaps(world, kind);
+            EXPECT_EQ(o.pairs, brute[int(kind)]);
+            ASSERT_EQ(o.states.size(), volumes.size());
+            std::vector<engine::BodyState> expected(volumes.size(), engine::BodyState::Apart);
+            for (const collision::ProxyPair& p : brute[int(kind)]) {
+                expected[p.a] = expected[p.b] = engine::BodyState::Flagged;
+            }
+            for (const collision::ProxyPair& p : world.collidingPairs()) {
+                expected[p.a] = expected[p.b] = engine::BodyState::Colliding;
+            }
+            EXPECT_EQ(o.states, expected);
+            if (render::broadPhaseVolume(world) == kind) {
+                EXPECT_EQ(o.states, std::vector<engine::BodyState>(world.states().begin(),
+                                                                   world.states().end()));
+            }
+        }
+    }
+}
