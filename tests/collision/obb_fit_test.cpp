@@ -25,10 +25,12 @@ namespace {
 using cdlab_test::Rng;
 
 // The fitted box may exceed the best box the brute-force search finds by at most this factor.
-// Measured (see the table the VolumeRatio tests print): cube, cylinder and torus 1.000 (the
-// best box has a face on a hull face, which the fit solves exactly), random hulls at most 1.04;
-// the covariance fit alone gives 3.47 on the cube, 1.25 on the torus and up to 1.4 on random hulls.
-constexpr Real kBruteRatioBound = 1.06;
+// Measured (the table the VolumeRatio tests print): cube, cylinder and torus 1.0000 (the best box
+// has a face on a hull face, which the fit solves exactly); random hulls at most 1.014 (thin
+// ellipsoid hulls, whose best box has no face on a hull face). The bound leaves twice that
+// margin; the covariance fit alone gives 1.34 and 4.13 on the cube and up to 1.72 on the random
+// hulls, so a fit that falls back to it fails here.
+constexpr Real kBruteRatioBound = 1.03;
 
 Real volumeOf(const Obb& o) { return 8 * o.half_extents.prod(); }
 

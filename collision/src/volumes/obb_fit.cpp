@@ -29,6 +29,8 @@ namespace {
 // costs O(F + V + s log s) per direction (s: silhouette vertices), so the cap bounds a hull with
 // thousands of faces at about kMaxFaceAxes * O(F + V).
 constexpr std::size_t kMaxFaceAxes = 128;
+// At most this many hull-edge directions are tried as axes (longest edges first).
+constexpr std::size_t kMaxEdgeAxes = 64;
 // Alternating refinement rounds on the best box's own axes (each round: its three axes).
 constexpr int kMaxRefineRounds = 4;
 // Two unit axes are the same candidate when |cos| is within this of 1 (about 1.4e-6 rad).
@@ -138,6 +140,30 @@ std::vector<Vec3> patchNormals(const ConvexPolytope& hull, const std::vector<Vec
     normals.reserve(roots.size());
     for (std::int32_t r : roots) normals.push_back(sum[r].normalized());
     return normals;
+}
+
+// Unit directions of the hull's edges, longest first (ties by the edge's first appearance in the
+// face list). A box axis along a hull edge holds, e.g., the prism-like hulls whose lateral faces
+// are thin slivers. O(F log F).
+std::vector<Vec3> edgeDirections(const ConvexPolytope& hull) {
+    const std::vector<Vec3>& v = hull.vertices;
+    std::vector<std::pair<Real, Vec3>> edges;
+    for (const auto& t : hull.faces) {
+        for (int e = 0; e < 3; ++e) {
+            const std::int32_t a = t[e];
+            const std::int32_t b = t[(e + 1) % 3];
+            const Vec3 d = v[b] - v[a];
+            const Real len = d.norm();
+            // Each edge of a closed triangulation appears twice, once in each direction.
+            if (a < b && len > 0) edges.emplace_back(len, d / len);
+        }
+    }
+    std::stable_sort(edges.begin(), edges.end(),
+                     [](const auto& x, const auto& y) { return x.first > y.first; });
+    std::vector<Vec3> dirs;
+    dirs.reserve(edges.size());
+    for (const auto& e : edges) dirs.push_back(e.second);
+    return dirs;
 }
 
 // Candidate axes after DiTO (Larsson & Källberg 2011, "Fast computation of tight-fitting oriented
@@ -306,6 +332,11 @@ Obb fitObbTight(const ConvexPolytope& hull) {
         if (search.tryAxis(n)) ++face_axes;
     }
     for (const Vec3& n : ditoAxes(hull.vertices)) search.tryAxis(n);
+    std::size_t edge_axes = 0;
+    for (const Vec3& d : edgeDirections(hull)) {
+        if (edge_axes == kMaxEdgeAxes) break;
+        if (search.tryAxis(d)) ++edge_axes;
+    }
     // Coordinate descent on the best box: re-solve the 2-D problem about each of its own axes
     // (an axis tried before is skipped), until a round finds nothing new or smaller.
     for (int round = 0; round < kMaxRefineRounds; ++round) {

@@ -91,13 +91,15 @@ Obb fitObbPrincipal(const ConvexPolytope& hull);
 /// after rounding). Candidates: the principal frame above (so never larger than it), then for
 /// each candidate axis the minimum-area rectangle of the hull projected along it (exact for that
 /// axis: Freeman & Shapira 1975) -- axes: the principal and coordinate axes, the normals of the
-/// hull's planar faces (largest 128 by area), DiTO's triangle normals (Larsson & Källberg 2011),
-/// and finally each axis of the best box so far (a few rounds of coordinate descent).
+/// hull's planar faces (the 128 largest), DiTO's triangle normals (Larsson & Källberg 2011), the
+/// hull's edge directions (the 64 longest), and finally each axis of the best box so far (a few
+/// rounds of coordinate descent).
 /// Exact when some minimum-volume box has a face flush with a hull face (boxes, prisms, the
 /// cube whatever its triangulation and vertex order); otherwise a heuristic: O'Rourke 1985 only
 /// guarantees two adjacent box faces each flush with a hull edge, which is not searched.
-/// Deterministic. Cost O(k (F + V + s log s)) for k <= 128 + 19 axes, F faces, V vertices and
-/// s silhouette vertices per axis.
+/// Deterministic. Cost O(k (F + V + s log s)) for k <= 128 + 64 + 25 axes, F faces, V vertices
+/// and s silhouette vertices per axis (measured: 2 ms for a 2,000-triangle torus, 30 ms for a
+/// hull of 10,000 vertices; tests/bench/obb_fit_bench.cpp).
 Obb fitObbTight(const ConvexPolytope& hull);
 
 }  // namespace collision
