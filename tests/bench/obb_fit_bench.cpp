@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "collision/geometry/convex_hull.h"
-#include "collision/volumes/bounding_volumes.h"
 #include "collision/test_meshes.h"
+#include "collision/volumes/bounding_volumes.h"
 
 namespace {
 

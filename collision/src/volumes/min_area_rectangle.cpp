@@ -43,11 +43,10 @@ std::vector<Point2> convexHull2(std::vector<Point2> points) {
     std::sort(points.begin(), points.end(), [](const Point2& a, const Point2& b) {
         return a.x < b.x || (a.x == b.x && a.y < b.y);
     });
-    points.erase(std::unique(points.begin(), points.end(),
-                             [](const Point2& a, const Point2& b) {
-                                 return a.x == b.x && a.y == b.y;
-                             }),
-                 points.end());
+    points.erase(
+        std::unique(points.begin(), points.end(),
+                    [](const Point2& a, const Point2& b) { return a.x == b.x && a.y == b.y; }),
+        points.end());
     if (points.size() < 3) return points;
     // Andrew 1979: lower chain left to right, upper chain right to left; a vertex stays only
     // on a strict left turn, so collinear points are dropped.

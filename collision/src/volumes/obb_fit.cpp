@@ -33,14 +33,16 @@ constexpr std::size_t kMaxFaceAxes = 128;
 constexpr std::size_t kMaxEdgeAxes = 64;
 // Alternating refinement rounds on the best box's own axes (each round: its three axes).
 constexpr int kMaxRefineRounds = 4;
-// Two unit axes are the same candidate when |cos| is within this of 1 (about 1.4e-6 rad).
-constexpr Real kSameAxisCos = Real(1e-12);
+// Two unit axes are the same candidate when |cos| is within this of 1 (double: 2.2e-12, about
+// 2e-6 rad).
+constexpr Real kSameAxisCos = Real(1e4) * kEpsilon;
 // Adjacent hull triangles belong to one planar patch when their unit normals agree this closely.
-constexpr Real kCoplanarCos = Real(1e-12);
+constexpr Real kCoplanarCos = Real(1e4) * kEpsilon;
 // A vertex is on the silhouette along axis a when its incident faces' normals n have both
 // n.a >= -kSilhouetteCos and n.a <= kSilhouetteCos: a superset of the exact silhouette, so no
-// extreme vertex of the projection is lost to the rounding of the normals.
-constexpr Real kSilhouetteCos = Real(1e-9);
+// extreme vertex of the projection is lost to the rounding of the normals (double: 2.2e-9; in
+// float every vertex qualifies, which costs time only).
+constexpr Real kSilhouetteCos = Real(1e7) * kEpsilon;
 
 Real magnitude(const Vec3& origin, const Vec3& lo, const Vec3& hi) {
     return (hi - lo).maxCoeff() + origin.cwiseAbs().maxCoeff();
@@ -174,7 +176,7 @@ std::vector<Vec3> edgeDirections(const ConvexPolytope& hull) {
 // around such a normal, so only the normals are needed. O(V).
 std::vector<Vec3> ditoAxes(const std::vector<Vec3>& v) {
     const Vec3 origin = v[0];
-    const Vec3 dirs[7] = {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 1, 1),
+    const Vec3 dirs[7] = {Vec3(1, 0, 0),  Vec3(0, 1, 0),  Vec3(0, 0, 1),  Vec3(1, 1, 1),
                           Vec3(1, 1, -1), Vec3(1, -1, 1), Vec3(1, -1, -1)};
     std::vector<Vec3> ext;
     Real size = 0;
