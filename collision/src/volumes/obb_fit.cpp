@@ -4,6 +4,10 @@
 // Invariant: every box returned here is the exact projection range of all the hull's vertices on
 // its (orthonormal, right-handed) axes, enlarged by kFitSlack times the hull's size; the
 // candidate search only chooses the axes, so it can never cost containment.
+// What is exact: for each axis tried, the smallest box with that axis (Freeman & Shapira 1975 in
+// the plane normal to it). What is not: the choice of axes. O'Rourke 1985, "Finding minimal
+// enclosing boxes", shows a minimum-volume box has two adjacent faces each flush with a hull
+// edge, not necessarily a face flush with a hull face; his O(n^3) edge-pair search is not done.
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
