@@ -1,9 +1,9 @@
-// collision/src/volumes/bounding_volumes.cpp -- fitting and overlap tests of spheres, AABBs and
-// OBBs. Every fitted volume contains its shape: analytically for the primitives, and for point sets
-// after a final relative enlargement that absorbs the rounding of the fit (conservative).
+// collision/src/volumes/bounding_volumes.cpp -- fitting of spheres and AABBs (the OBB fits are in
+// obb_fit.cpp) and the overlap tests of spheres, AABBs and OBBs. Every fitted volume contains its
+// shape: analytically for the primitives, and for point sets after a final relative enlargement
+// that absorbs the rounding of the fit (conservative).
 #include "collision/volumes/bounding_volumes.h"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -13,15 +13,11 @@
 #include "collision/geometry/shape.h"
 #include "collision/narrowphase/narrow_phase.h"
 #include "volumes/box_sat.h"
-#include "volumes/covariance.h"
+#include "volumes/fit_slack.h"
 
 namespace collision {
 
 namespace {
-
-// Relative enlargement of fitted point-set volumes: a few ulps of the set's size, so every
-// input point tests inside even after the rounding of the circumsphere/projection maths.
-constexpr Real kFitSlack = Real(16) * kEpsilon;
 
 struct Ball {
     Vec3 c = Vec3::Zero();
@@ -138,42 +134,6 @@ BoundingSphere minimalEnclosingSphere(const std::vector<Vec3>& input) {
     return BoundingSphere{ball.c, r + kFitSlack * (r + ball.c.cwiseAbs().maxCoeff())};
 }
 
-Obb fitObbPrincipal(const ConvexPolytope& hull) {
-    const std::vector<Vec3>& v = hull.vertices;
-    CDLAB_ASSERT(!v.empty(), "OBB of an empty hull");
-    // Covariance of the hull's surface, area weighted, about its first vertex.
-    const Vec3 origin = v[0];
-    const Mat3 cov = surfaceCovariance(
-        origin, hull.faces.size(),
-        [&](std::size_t k) {
-            const auto& f = hull.faces[k];
-            return std::array<Vec3, 3>{v[f[0]], v[f[1]], v[f[2]]};
-        },
-        v);
-    Eigen::SelfAdjointEigenSolver<Mat3> solver(cov);
-    Mat3 axes = Mat3::Identity();
-    if (solver.info() == Eigen::Success && solver.eigenvectors().allFinite()) {
-        // Eigen sorts eigenvalues ascending; take the largest-variance axis first.
-        axes.col(0) = solver.eigenvectors().col(2).normalized();
-        axes.col(1) = solver.eigenvectors().col(1).normalized();
-        axes.col(2) = axes.col(0).cross(axes.col(1)).normalized();
-        axes.col(1) = axes.col(2).cross(axes.col(0));
-    }
-    Vec3 lo = Vec3::Constant(std::numeric_limits<Real>::max());
-    Vec3 hi = Vec3::Constant(std::numeric_limits<Real>::lowest());
-    for (const Vec3& p : v) {
-        const Vec3 proj = axes.transpose() * (p - origin);
-        lo = lo.cwiseMin(proj);
-        hi = hi.cwiseMax(proj);
-    }
-    Obb box;
-    box.axes = axes;
-    box.center = origin + axes * ((lo + hi) * Real(0.5));
-    const Real size = (hi - lo).maxCoeff() + origin.cwiseAbs().maxCoeff();
-    box.half_extents = (hi - lo) * Real(0.5) + Vec3::Constant(kFitSlack * size);
-    return box;
-}
-
 LocalBounds fitLocalBounds(const Shape& shape) {
     LocalBounds b;
     switch (shape.type) {
@@ -194,7 +154,7 @@ LocalBounds fitLocalBounds(const Shape& shape) {
         case ShapeType::Mesh:
             // The minimal sphere of a set is that of its hull's vertices.
             b.sphere = minimalEnclosingSphere(shape.hull->vertices);
-            b.obb = fitObbPrincipal(*shape.hull);
+            b.obb = fitObbTight(*shape.hull);
             break;
     }
     return b;

@@ -60,10 +60,11 @@ struct Obb {
 /// Local-frame bounding volumes of a shape, computed once per shape.
 struct LocalBounds {
     BoundingSphere sphere;  ///< minimal enclosing sphere of the shape (Welzl for point sets)
-    Obb obb;                ///< exact for boxes; principal axes of the hull for hulls and meshes
+    Obb obb;                ///< exact for primitives; fitObbTight of the hull for hulls and meshes
 };
 
-/// Fits the local volumes for `shape`. Cost O(n) expected in the hull's vertex count.
+/// Fits the local volumes for `shape`: analytic for spheres, boxes and capsules; for hulls and
+/// meshes the minimal sphere of the hull's vertices (expected O(V)) and fitObbTight.
 LocalBounds fitLocalBounds(const Shape& shape);
 
 /// The shape's exact world AABB at `pose` (the tightest axis-aligned box of the rotated shape).
@@ -84,5 +85,21 @@ BoundingSphere minimalEnclosingSphere(const std::vector<Vec3>& points);
 /// extents are the exact projections of the hull's vertices on those axes. A hull without faces
 /// (fewer than 4 non-coplanar points) falls back to the vertex covariance.
 Obb fitObbPrincipal(const ConvexPolytope& hull);
+
+/// The smallest-volume box among candidate frames, each box the exact projection range of every
+/// hull vertex (plus a relative slack of a few ulps of the hull's size, so containment holds
+/// after rounding). Candidates: the principal frame above (so never larger than it), then for
+/// each candidate axis the minimum-area rectangle of the hull projected along it (exact for that
+/// axis: Freeman & Shapira 1975) -- axes: the principal and coordinate axes, the normals of the
+/// hull's planar faces (the 128 largest), DiTO's triangle normals (Larsson & Källberg 2011), the
+/// hull's edge directions (the 64 longest), and finally each axis of the best box so far (a few
+/// rounds of coordinate descent).
+/// Exact when some minimum-volume box has a face flush with a hull face (boxes, prisms, the
+/// cube whatever its triangulation and vertex order); otherwise a heuristic: O'Rourke 1985 only
+/// guarantees two adjacent box faces each flush with a hull edge, which is not searched.
+/// Deterministic. Cost O(k (F + V + s log s)) for k <= 128 + 64 + 25 axes, F faces, V vertices
+/// and s silhouette vertices per axis (measured: 2 ms for a 2,000-triangle torus, 30 ms for a
+/// hull of 10,000 vertices; tests/bench/obb_fit_bench.cpp).
+Obb fitObbTight(const ConvexPolytope& hull);
 
 }  // namespace collision
