@@ -290,8 +290,8 @@ bool measureAll(const SweepOptions& options, const engine::Scene& reference_scen
         out << "[" << i + 1 << "/" << scenes.size() << "] " << labelOf(combos[i]) << ": "
             << run.steps << " steps, " << fmt(run.ms_step.median, "%.3f") << " ms/step (repeat 1/"
             << options.repeat << "), " << fmt(run.broad_false_positives, "%.2f")
-            << " broad false positives/step, " << run.missed_pairs << " missed, "
-            << run.extra_pairs << " extra\n";
+            << " broad false positives/step, " << run.missed_pairs << " missed, " << run.extra_pairs
+            << " extra\n";
         repeats[i + 1].push_back(std::move(run));
     }
     for (int pass = 1; pass < options.repeat; ++pass) {

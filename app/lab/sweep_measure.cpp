@@ -1,22 +1,22 @@
 // app/lab/sweep_measure.cpp -- see sweep_measure.h.
 #include "sweep_measure.h"
 
-#include <iostream>
 #include <malloc.h>
-#include <memory>
-#include <string>
 #include <sys/wait.h>
-#include <vector>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iostream>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <ostream>
 #include <sstream>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "exit_codes.h"
 #include "output_files.h"
@@ -212,8 +212,7 @@ std::string deterministicDifference(const SweepRun& first, const SweepRun& repea
 Timed summarize(std::vector<double> samples) {
     std::sort(samples.begin(), samples.end());
     const std::size_t n = samples.size();
-    const double median =
-        n % 2 == 1 ? samples[n / 2] : 0.5 * (samples[n / 2 - 1] + samples[n / 2]);
+    const double median = n % 2 == 1 ? samples[n / 2] : 0.5 * (samples[n / 2 - 1] + samples[n / 2]);
     return {median, samples.front(), samples.back()};
 }
 
@@ -221,8 +220,8 @@ SweepRun combineRepeats(const std::vector<SweepRun>& repeats) {
     SweepRun run = repeats.front();
     run.repeats = int(repeats.size());
     for (Timed SweepRun::*field :
-         {&SweepRun::ms_integrate, &SweepRun::ms_volumes, &SweepRun::ms_broad,
-          &SweepRun::ms_narrow, &SweepRun::ms_ccd, &SweepRun::ms_response, &SweepRun::ms_step,
+         {&SweepRun::ms_integrate, &SweepRun::ms_volumes, &SweepRun::ms_broad, &SweepRun::ms_narrow,
+          &SweepRun::ms_ccd, &SweepRun::ms_response, &SweepRun::ms_step,
           &SweepRun::ms_per_simulated_s}) {
         std::vector<double> samples;
         for (const SweepRun& r : repeats) samples.push_back((r.*field).median);

@@ -85,9 +85,12 @@ namespace {
 // Where the dt column says a run sits against the reference's step.
 const char* stepVsReferenceName(StepVsReference s) {
     switch (s) {
-        case StepVsReference::Same: return "same";
-        case StepVsReference::Finer: return "finer";
-        case StepVsReference::Coarser: break;
+        case StepVsReference::Same:
+            return "same";
+        case StepVsReference::Finer:
+            return "finer";
+        case StepVsReference::Coarser:
+            break;
     }
     return "coarser";
 }
@@ -96,9 +99,8 @@ const char* stepVsReferenceName(StepVsReference s) {
 
 std::string csvTable(const std::vector<SweepRun>& runs) {
     std::ostringstream csv;
-    const char* timed_names[] = {"ms_integrate", "ms_volumes", "ms_broad",
-                                 "ms_narrow",    "ms_ccd",     "ms_response",
-                                 "ms_step",      "ms_per_simulated_s"};
+    const char* timed_names[] = {"ms_integrate", "ms_volumes",  "ms_broad", "ms_narrow",
+                                 "ms_ccd",       "ms_response", "ms_step",  "ms_per_simulated_s"};
     csv << "run,time_step,dt_vs_reference,steps,repeats,clock";
     for (const char* name : timed_names) {
         csv << ',' << name << "_median," << name << "_min," << name << "_max";
@@ -170,8 +172,8 @@ Ranking rankLowest(const std::vector<Timed>& values, int repeats) {
     for (std::size_t k = 1; k < order.size(); ++k) {
         if (!(best.max < values[order[k]].min)) ranking.overlapping.push_back(order[k]);
     }
-    ranking.state = ranking.overlapping.size() == 1 ? Ranking::State::Separated
-                                                    : Ranking::State::WithinSpread;
+    ranking.state =
+        ranking.overlapping.size() == 1 ? Ranking::State::Separated : Ranking::State::WithinSpread;
     if (ranking.state == Ranking::State::Separated) ranking.overlapping.clear();
     return ranking;
 }
@@ -247,22 +249,22 @@ std::string costReading(const std::string& what, const std::vector<const SweepRu
     const Ranking ranking = rankLowest(cost, repeats);
     const SweepRun& best = *runs[ranking.best];
     std::ostringstream md;
-    const std::string spread = "ms per simulated second, median (min..max of " +
-                               std::to_string(repeats) + " repeats)";
+    const std::string spread =
+        "ms per simulated second, median (min..max of " + std::to_string(repeats) + " repeats)";
     switch (ranking.state) {
-        case Ranking::State::Empty: break;
+        case Ranking::State::Empty:
+            break;
         case Ranking::State::Only:
-            md << "- Only one of the " << what << ": **" << best.label << "** ("
-               << costFigure(best) << " ms per simulated second).\n";
+            md << "- Only one of the " << what << ": **" << best.label << "** (" << costFigure(best)
+               << " ms per simulated second).\n";
             break;
         case Ranking::State::NoSpread:
             md << "- Cheapest of the " << what << ": none named, each was timed once "
                << "(--repeat 1), so there is no spread to compare the differences with.\n";
             break;
         case Ranking::State::Separated:
-            md << "- Cheapest of the " << what << ": **" << best.label << "** ("
-               << costFigure(best) << " " << spread
-               << "); its slowest repeat beat every other run's fastest.\n";
+            md << "- Cheapest of the " << what << ": **" << best.label << "** (" << costFigure(best)
+               << " " << spread << "); its slowest repeat beat every other run's fastest.\n";
             break;
         case Ranking::State::WithinSpread: {
             md << "- Cheapest of the " << what << ": none named, the lowest costs are within "
@@ -287,10 +289,9 @@ std::string referenceStepReading(const std::vector<SweepRun>& runs, const SweepR
         const bool same = r.step_vs_reference == StepVsReference::Same;
         md << "- **" << r.label << "** runs at "
            << (same ? "the reference's time step" : "a time step finer than the reference's")
-           << " (" << fmt(r.time_step) << " s against "
-           << fmt(reference.time_step) << " s): its missed, extra and first-contact figures "
-           << (same ? "compare the reference's step with itself"
-                    : "compare it with a coarser run")
+           << " (" << fmt(r.time_step) << " s against " << fmt(reference.time_step)
+           << " s): its missed, extra and first-contact figures "
+           << (same ? "compare the reference's step with itself" : "compare it with a coarser run")
            << ", so they prove nothing about the time step. Choose a finer reference "
               "(--reference-refine, or --reference world.time_step=...).\n";
     }
@@ -329,8 +330,8 @@ std::string readingSection(const SweepOptions& options, const engine::Scene& bas
     if (options.report_timing && runs.size() > 1) {
         std::vector<const SweepRun*> all;
         for (const SweepRun& r : runs) all.push_back(&r);
-        const SweepRun* lowest = *std::min_element(
-            all.begin(), all.end(), [](const SweepRun* a, const SweepRun* b) {
+        const SweepRun* lowest =
+            *std::min_element(all.begin(), all.end(), [](const SweepRun* a, const SweepRun* b) {
                 return a->ms_per_simulated_s.median < b->ms_per_simulated_s.median;
             });
         if (std::find(accurate.begin(), accurate.end(), lowest) == accurate.end()) {

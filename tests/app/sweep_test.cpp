@@ -11,11 +11,11 @@
 #include <string>
 #include <vector>
 
+#include "cli_run.h"
 #include "render/image.h"
 #include "sweep.h"
 #include "sweep_measure.h"
 #include "sweep_report.h"
-#include "cli_run.h"
 
 namespace {
 
@@ -319,8 +319,7 @@ TEST(Sweep, RepeatBelowOneIsBadInput) {
         o.repeat = n;
         const Outcome r = sweep(o);
         EXPECT_EQ(r.code, 2) << n;
-        EXPECT_NE(r.err.find("--repeat " + std::to_string(n) + ": must be >= 1"),
-                  std::string::npos)
+        EXPECT_NE(r.err.find("--repeat " + std::to_string(n) + ": must be >= 1"), std::string::npos)
             << r.err;
         EXPECT_EQ(r.out, "") << n;
     }
@@ -354,8 +353,7 @@ TEST(Sweep, RunAtTheReferenceTimeStepIsFlagged) {
     const std::string report = slurp(o.out_dir / "report.md");
     EXPECT_NE(report.find("| world.time_step=0.001 | 0.001 (= reference) |"), std::string::npos)
         << report;
-    EXPECT_NE(report.find("| world.time_step=0.0005 | 0.0005 (< reference) |"),
-              std::string::npos)
+    EXPECT_NE(report.find("| world.time_step=0.0005 | 0.0005 (< reference) |"), std::string::npos)
         << report;
     EXPECT_NE(report.find("| world.time_step=0.005 | 0.005 |"), std::string::npos) << report;
     EXPECT_NE(report.find("- **world.time_step=0.001** runs at the reference's time step (0.001 "
