@@ -30,11 +30,25 @@ Command addSweepCommand(CLI::App& cli) {
         ->expected(1)
         ->take_all();
     cmd->add_option("--reference", f->sweep.reference,
-                    "KEY=VALUE override for the reference run (repeatable)")
+                    "KEY=VALUE (repeatable): a setting of the reference run, the yardstick every "
+                    "run's missed and extra contacts and first-contact errors are measured "
+                    "against. The reference is the scene at its time step divided by "
+                    "--reference-refine (default dt / 10), then these overrides: give it your "
+                    "most accurate choices (e.g. world.ccd=conservative_advancement) and a step "
+                    "finer than every --vary step (world.time_step=... here overrides the "
+                    "refined step). A run at the reference's step or finer is flagged: its "
+                    "accuracy figures prove nothing. Check the reference is fine enough by "
+                    "raising --reference-refine: the figures should not change")
         ->expected(1)
         ->take_all();
     cmd->add_option("--reference-refine", f->sweep.reference_refine,
-                    "the reference's time step is the scene's divided by this")
+                    "the reference's time step is the scene's divided by this (>= 1)")
+        ->capture_default_str();
+    cmd->add_option("--repeat", f->sweep.repeat,
+                    "time every run (the reference too) N times, N >= 1; tables give the median "
+                    "and min..max range of each wall-clock column (steady_clock), and the reading "
+                    "names a cheapest run only when its range lies below the others'; repeats "
+                    "must reproduce every deterministic column")
         ->capture_default_str();
     cmd->add_option("--duration", f->duration,
                     "simulated seconds per run (default: the scene's frames)");

@@ -185,6 +185,11 @@ bool parseSweepOptions(const SweepOptions& options, std::ostream& err, Axes& axe
         err << "--reference-refine: must be a finite number >= 1\n";
         return false;
     }
+    if (options.repeat < 1) {
+        err << "--repeat " << options.repeat
+            << ": must be >= 1 (each run is timed this many times; 3 gives a min..max spread)\n";
+        return false;
+    }
     if (options.duration && !(*options.duration > 0 && std::isfinite(*options.duration))) {
         err << "--duration: must be a finite number > 0\n";
         return false;
@@ -217,8 +222,8 @@ void writeCharts(const SweepOptions& options, const fs::path& out_dir,
         render::BarChart chart;
         chart.title = c.title;
         chart.log_scale = c.log_scale;
-        for (const SweepRun& r : runs) chart.bars.push_back({r.label, r.*(c.field), false});
-        chart.bars.push_back({"reference", reference.*(c.field), true});
+        for (const SweepRun& r : runs) chart.bars.push_back({r.label, c.value(r), false});
+        chart.bars.push_back({"reference", c.value(reference), true});
         render::writePng(out_dir / c.file, render::drawBarChart(chart));
     }
 }
@@ -261,6 +266,63 @@ std::vector<FloatRun> compareFloatBuild(
     return floats;
 }
 
+// Runs every scene `options.repeat` times, the reference first, the repeats interleaved (all
+// runs once, then all again) so that a slow spell of the machine spreads over every run instead
+// of one run's repeats. The first pass measures everything; later passes only time the steps
+// and must reproduce the first pass's deterministic columns. False (with a message) when one
+// does not: determinism is a guarantee of the engine.
+bool measureAll(const SweepOptions& options, const engine::Scene& reference_scene,
+                const std::vector<engine::Scene>& scenes,
+                const std::vector<std::vector<engine::SceneOverride>>& combos,
+                const std::vector<engine::SceneOverride>& reference_overrides, double duration,
+                std::ostream& out, std::ostream& err, SweepRun& reference,
+                std::vector<SweepRun>& runs) {
+    // repeats[0] is the reference, repeats[i + 1] scene i; each holds one SweepRun per pass.
+    std::vector<std::vector<SweepRun>> repeats(scenes.size() + 1);
+    FirstContacts reference_contacts;
+    repeats[0].push_back(measure(reference_scene, duration, &reference_contacts));
+    out << "reference: dt " << fmt(repeats[0][0].time_step) << " s, " << repeats[0][0].steps
+        << " steps, " << repeats[0][0].pairs_confirmed_total << " pairs confirmed\n";
+    for (std::size_t i = 0; i < scenes.size(); ++i) {
+        FirstContacts contacts;
+        SweepRun run = measure(scenes[i], duration, &contacts);
+        compareWithReference(run, contacts, reference_contacts);
+        out << "[" << i + 1 << "/" << scenes.size() << "] " << labelOf(combos[i]) << ": "
+            << run.steps << " steps, " << fmt(run.ms_step.median, "%.3f") << " ms/step (repeat 1/"
+            << options.repeat << "), " << fmt(run.broad_false_positives, "%.2f")
+            << " broad false positives/step, " << run.missed_pairs << " missed, " << run.extra_pairs
+            << " extra\n";
+        repeats[i + 1].push_back(std::move(run));
+    }
+    for (int pass = 1; pass < options.repeat; ++pass) {
+        for (std::size_t i = 0; i < repeats.size(); ++i) {
+            const engine::Scene& scene = i == 0 ? reference_scene : scenes[i - 1];
+            SweepRun again = measure(scene, duration, nullptr);
+            const std::string difference = sweep::deterministicDifference(repeats[i][0], again);
+            if (!difference.empty()) {
+                err << "sweep " << (i == 0 ? "reference" : "run '" + labelOf(combos[i - 1]) + "'")
+                    << ": repeat " << pass + 1 << " of " << options.repeat
+                    << " differs from repeat 1 in " << difference
+                    << ": the simulation is not deterministic\n";
+                return false;
+            }
+            repeats[i].push_back(std::move(again));
+        }
+        out << "repeat " << pass + 1 << "/" << options.repeat << ": " << repeats.size()
+            << " runs timed again, deterministic columns identical\n";
+    }
+    reference = sweep::combineRepeats(repeats[0]);
+    reference.label = labelOf(reference_overrides);
+    for (std::size_t i = 0; i < scenes.size(); ++i) {
+        SweepRun run = sweep::combineRepeats(repeats[i + 1]);
+        run.overrides = combos[i];
+        run.label = labelOf(combos[i]);
+        run.step_vs_reference = sweep::stepVsReference(run.time_step, reference.time_step);
+        runs.push_back(std::move(run));
+    }
+    return true;
+}
+
 }  // namespace
 
 int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) {
@@ -276,7 +338,6 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
             return kExitBadInput;
         }
     }
-    // Every combination is loaded (and so validated) before anything runs.
     // Every combination is loaded (and so validated) before anything runs.
     const std::vector<std::vector<engine::SceneOverride>> combos = combinations(axes);
     engine::Scene base;
@@ -334,25 +395,12 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
         }
         for (const Chart& c : charts()) fs::remove(out_dir / c.file);
 
-        FirstContacts reference_contacts;
-        SweepRun reference = measure(reference_scene, duration, reference_contacts);
-        reference.label = labelOf(reference_overrides);
-        out << "reference: dt " << fmt(reference.time_step) << " s, " << reference.steps
-            << " steps, " << reference.pairs_confirmed_total << " pairs confirmed\n";
         std::vector<SweepRun> runs;
-        for (std::size_t i = 0; i < scenes.size(); ++i) {
-            FirstContacts contacts;
-            SweepRun run = measure(scenes[i], duration, contacts);
-            run.overrides = combos[i];
-            run.label = labelOf(combos[i]);
-            compareWithReference(run, contacts, reference_contacts);
-            out << "[" << i + 1 << "/" << scenes.size() << "] " << run.label << ": " << run.steps
-                << " steps, " << fmt(run.ms_step, "%.3f") << " ms/step, "
-                << fmt(run.broad_false_positives, "%.2f") << " broad false positives/step, "
-                << run.missed_pairs << " missed, " << run.extra_pairs << " extra\n";
-            runs.push_back(std::move(run));
+        SweepRun reference;
+        if (!measureAll(options, reference_scene, scenes, combos, reference_overrides, duration,
+                        out, err, reference, runs)) {
+            return kExitFailure;
         }
-
         writeCharts(options, out_dir, runs, reference);
         const std::vector<FloatRun> floats =
             options.float_binary ? compareFloatBuild(options, combos, out_dir, out)

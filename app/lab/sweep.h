@@ -37,18 +37,35 @@ struct SweepOptions {
     /// Timings in report.md (off: the report is bit-identical from run to run; the CSV keeps
     /// them).
     bool report_timing = true;
+    /// Every run (the reference included) is timed this many times (>= 1; 0 or less is bad
+    /// input); tables give the median and the min..max range. The first repeat also measures
+    /// accuracy; the others only step the world, and must end in the same state with the same
+    /// counters.
+    int repeat = 3;
 };
 
-/// What one run measured. Times are wall-clock means per step (ms); counts are means per step
-/// unless named total.
+/// A wall-clock figure over the repeats of one run (ms): median and range.
+struct Timed {
+    double median = 0;
+    double min = 0;
+    double max = 0;
+};
+
+/// Where a run's time step sits against the reference's (relative tolerance 1e-9).
+enum class StepVsReference { Coarser, Same, Finer };
+
+/// What one run measured. Times are wall-clock (std::chrono::steady_clock, inside World::step)
+/// means per step (ms), summarised over the repeats; counts are means per step unless named
+/// total.
 struct SweepRun {
     std::string label;  ///< "broadphase=hgrid world.time_step=0.01", or "reference"
     std::vector<engine::SceneOverride> overrides;
     double time_step = 0;
     std::int64_t steps = 0;
-    double ms_integrate = 0, ms_volumes = 0, ms_broad = 0, ms_narrow = 0, ms_ccd = 0,
-           ms_response = 0, ms_step = 0;
-    double ms_per_simulated_s = 0;
+    int repeats = 1;  ///< times the run was timed
+    Timed ms_integrate, ms_volumes, ms_broad, ms_narrow, ms_ccd, ms_response, ms_step;
+    Timed ms_per_simulated_s;
+    StepVsReference step_vs_reference = StepVsReference::Coarser;
     double flagged = 0;                ///< broad-phase pairs per step
     double confirmed = 0;              ///< narrow-phase confirmed pairs per step
     double broad_false_positives = 0;  ///< flagged - confirmed, per step
@@ -70,7 +87,7 @@ struct SweepRun {
     /// MiB: the process's peak resident set during the run (Linux VmHWM, reset at the run's
     /// start) less its resident set at the start: what building and stepping this world took.
     /// Process-wide, so allocator reuse between runs makes it a lower bound; 0 where /proc is
-    /// not available.
+    /// not available. Measured in the first repeat only.
     double memory_mib = 0;
     std::uint64_t state_hash = 0;
 };
@@ -106,7 +123,9 @@ TraceComparison compareTraces(const std::filesystem::path& a, const std::filesys
 bool parseVary(const std::string& text, std::string& key, std::vector<std::string>& values,
                std::string& error);
 
-/// Exit codes: 0 success, 1 output failure, 2 bad input (flags, a combination's scene error).
+/// Exit codes: 0 success, 1 output failure or a repeat that differs from the first in a
+/// deterministic column (pairs, tests, CCD stops, final state), 2 bad input (flags, a
+/// combination's scene error).
 int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err);
 
 }  // namespace app

@@ -80,21 +80,47 @@ std::string fmt(double v, const char* spec) {
     return text;
 }
 
+namespace {
+
+// Where the dt column says a run sits against the reference's step.
+const char* stepVsReferenceName(StepVsReference s) {
+    switch (s) {
+        case StepVsReference::Same:
+            return "same";
+        case StepVsReference::Finer:
+            return "finer";
+        case StepVsReference::Coarser:
+            break;
+    }
+    return "coarser";
+}
+
+}  // namespace
+
 std::string csvTable(const std::vector<SweepRun>& runs) {
     std::ostringstream csv;
-    csv << "run,time_step,steps,ms_integrate,ms_volumes,ms_broad,ms_narrow,ms_ccd,ms_response,"
-           "ms_step,ms_per_simulated_s,flagged,confirmed,broad_false_positives,bv_tests,"
-           "narrow_tests,triangle_tests,mesh_bv_tests,toi_events,max_penetration_m,pairs_confirmed_"
-           "total,"
-           "missed_pairs,extra_pairs,"
+    const char* timed_names[] = {"ms_integrate", "ms_volumes",  "ms_broad", "ms_narrow",
+                                 "ms_ccd",       "ms_response", "ms_step",  "ms_per_simulated_s"};
+    csv << "run,time_step,dt_vs_reference,steps,repeats,clock";
+    for (const char* name : timed_names) {
+        csv << ',' << name << "_median," << name << "_min," << name << "_max";
+    }
+    csv << ",flagged,confirmed,broad_false_positives,bv_tests,"
+           "narrow_tests,triangle_tests,mesh_bv_tests,toi_events,max_penetration_m,"
+           "pairs_confirmed_total,missed_pairs,extra_pairs,"
            "max_first_contact_error_s,mean_first_contact_error_s,max_energy_drift,"
            "max_angular_momentum_drift,memory_mib,state_hash\n";
     for (const SweepRun& r : runs) {
-        csv << csvField(r.label) << ',' << fmt(r.time_step, "%.17g") << ',' << r.steps;
-        for (double v :
-             {r.ms_integrate, r.ms_volumes, r.ms_broad, r.ms_narrow, r.ms_ccd, r.ms_response,
-              r.ms_step, r.ms_per_simulated_s, r.flagged, r.confirmed, r.broad_false_positives,
-              r.bv_tests, r.narrow_tests, r.triangle_tests, r.mesh_bv_tests}) {
+        csv << csvField(r.label) << ',' << fmt(r.time_step, "%.17g") << ','
+            << stepVsReferenceName(r.step_vs_reference) << ',' << r.steps << ',' << r.repeats
+            << ",steady_clock";
+        for (const Timed& t : {r.ms_integrate, r.ms_volumes, r.ms_broad, r.ms_narrow, r.ms_ccd,
+                               r.ms_response, r.ms_step, r.ms_per_simulated_s}) {
+            csv << ',' << fmt(t.median, "%.6g") << ',' << fmt(t.min, "%.6g") << ','
+                << fmt(t.max, "%.6g");
+        }
+        for (double v : {r.flagged, r.confirmed, r.broad_false_positives, r.bv_tests,
+                         r.narrow_tests, r.triangle_tests, r.mesh_bv_tests}) {
             csv << ',' << fmt(v, "%.6g");
         }
         csv << ',' << r.toi_events << ',' << fmt(r.max_penetration, "%.6g");
@@ -110,27 +136,70 @@ std::string csvTable(const std::vector<SweepRun>& runs) {
 
 const std::vector<Chart>& charts() {
     static const std::vector<Chart> kCharts{
-        {"cost.png", "wall-clock ms per simulated second (lower is cheaper)",
-         &SweepRun::ms_per_simulated_s, false, true},
+        {"cost.png", "wall-clock ms per simulated second, median of the repeats (lower is cheaper)",
+         [](const SweepRun& r) { return r.ms_per_simulated_s.median; }, false, true},
         {"broad_false_positives.png", "broad-phase false positives per step (flagged - confirmed)",
-         &SweepRun::broad_false_positives, false, false},
-        {"bv_tests.png", "bounding-volume tests per step (Nv)", &SweepRun::bv_tests, false, false},
+         [](const SweepRun& r) { return r.broad_false_positives; }, false, false},
+        {"bv_tests.png", "bounding-volume tests per step (Nv)",
+         [](const SweepRun& r) { return r.bv_tests; }, false, false},
         {"first_contact_error.png", "max first-contact time error vs reference (s)",
-         &SweepRun::max_first_contact_error, false, false},
-        {"energy_drift.png", "max relative energy drift (log scale)", &SweepRun::max_energy_drift,
-         true, false},
+         [](const SweepRun& r) { return r.max_first_contact_error; }, false, false},
+        {"energy_drift.png", "max relative energy drift (log scale)",
+         [](const SweepRun& r) { return r.max_energy_drift; }, true, false},
     };
     return kCharts;
 }
 
+Ranking rankLowest(const std::vector<Timed>& values, int repeats) {
+    Ranking ranking;
+    if (values.empty()) return ranking;
+    std::vector<std::size_t> order(values.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        return values[a].median < values[b].median;
+    });
+    ranking.best = order.front();
+    if (values.size() == 1) {
+        ranking.state = Ranking::State::Only;
+        return ranking;
+    }
+    if (repeats < 2) {
+        ranking.state = Ranking::State::NoSpread;
+        return ranking;
+    }
+    const Timed& best = values[ranking.best];
+    ranking.overlapping.push_back(ranking.best);
+    for (std::size_t k = 1; k < order.size(); ++k) {
+        if (!(best.max < values[order[k]].min)) ranking.overlapping.push_back(order[k]);
+    }
+    ranking.state =
+        ranking.overlapping.size() == 1 ? Ranking::State::Separated : Ranking::State::WithinSpread;
+    if (ranking.state == Ranking::State::Separated) ranking.overlapping.clear();
+    return ranking;
+}
+
 namespace {
+
+// A timed figure as a table cell: "median (min..max)", the median alone for one repeat.
+std::string timedCell(const Timed& t, int repeats, const char* spec) {
+    if (repeats < 2) return fmt(t.median, spec);
+    std::string cell = fmt(t.median, spec);
+    cell += " (";
+    cell += fmt(t.min, spec);
+    cell += "..";
+    cell += fmt(t.max, spec);
+    cell += ")";
+    return cell;
+}
 
 // The table of every run and the reference, one row each.
 std::string resultsTable(const SweepOptions& options, const std::vector<SweepRun>& runs,
                          const SweepRun& reference) {
     std::ostringstream md;
     md << "\n| run | dt (s) | steps |";
-    if (options.report_timing) md << " ms/step | ms per sim. s | memory (MiB) |";
+    if (options.report_timing) {
+        md << " ms/step, median (min..max) | ms per sim. s, median (min..max) | memory (MiB) |";
+    }
     md << " flagged/step | confirmed/step | BP false pos./step | Nv/step | mesh Nv/step | Np/step "
           "| "
           "CCD stops | "
@@ -138,11 +207,17 @@ std::string resultsTable(const SweepOptions& options, const std::vector<SweepRun
           "|\n|---|---|---|";
     if (options.report_timing) md << "---|---|---|";
     md << "---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-    auto row = [&](const SweepRun& r) {
-        md << "| " << r.label << " | " << fmt(r.time_step) << " | " << r.steps << " |";
+    auto row = [&](const SweepRun& r, bool is_reference) {
+        md << "| " << r.label << " | " << fmt(r.time_step);
+        if (!is_reference && r.step_vs_reference != StepVsReference::Coarser) {
+            md << (r.step_vs_reference == StepVsReference::Same ? " (= reference)"
+                                                                : " (< reference)");
+        }
+        md << " | " << r.steps << " |";
         if (options.report_timing) {
-            md << ' ' << fmt(r.ms_step, "%.3f") << " | " << fmt(r.ms_per_simulated_s, "%.1f")
-               << " | " << fmt(r.memory_mib, "%.3g") << " |";
+            md << ' ' << timedCell(r.ms_step, r.repeats, "%.3f") << " | "
+               << timedCell(r.ms_per_simulated_s, r.repeats, "%.3g") << " | "
+               << fmt(r.memory_mib, "%.3g") << " |";
         }
         md << ' ' << fmt(r.flagged, "%.2f") << " | " << fmt(r.confirmed, "%.2f") << " | "
            << fmt(r.broad_false_positives, "%.2f") << " | " << fmt(r.bv_tests, "%.0f") << " | "
@@ -152,10 +227,74 @@ std::string resultsTable(const SweepOptions& options, const std::vector<SweepRun
            << " | " << fmt(r.max_energy_drift, "%.2e") << " | "
            << fmt(r.max_angular_momentum_drift, "%.2e") << " |\n";
     };
-    for (const SweepRun& r : runs) row(r);
+    for (const SweepRun& r : runs) row(r, false);
     SweepRun ref_row = reference;
     ref_row.label = "reference";
-    row(ref_row);
+    row(ref_row, true);
+    return md.str();
+}
+
+// "ms per simulated second" of a run for the reading: median (min..max).
+std::string costFigure(const SweepRun& r) {
+    return timedCell(r.ms_per_simulated_s, r.repeats, "%.3g");
+}
+
+// The reading's line on cost among `runs`: the cheapest is named only when its whole min..max
+// range lies below every other run's (rankLowest), otherwise the runs within its spread are
+// listed and no winner is named.
+std::string costReading(const std::string& what, const std::vector<const SweepRun*>& runs) {
+    std::vector<Timed> cost;
+    for (const SweepRun* r : runs) cost.push_back(r->ms_per_simulated_s);
+    const int repeats = runs.front()->repeats;
+    const Ranking ranking = rankLowest(cost, repeats);
+    const SweepRun& best = *runs[ranking.best];
+    std::ostringstream md;
+    const std::string spread =
+        "ms per simulated second, median (min..max of " + std::to_string(repeats) + " repeats)";
+    switch (ranking.state) {
+        case Ranking::State::Empty:
+            break;
+        case Ranking::State::Only:
+            md << "- Only one of the " << what << ": **" << best.label << "** (" << costFigure(best)
+               << " ms per simulated second).\n";
+            break;
+        case Ranking::State::NoSpread:
+            md << "- Cheapest of the " << what << ": none named, each was timed once "
+               << "(--repeat 1), so there is no spread to compare the differences with.\n";
+            break;
+        case Ranking::State::Separated:
+            md << "- Cheapest of the " << what << ": **" << best.label << "** (" << costFigure(best)
+               << " " << spread << "); its slowest repeat beat every other run's fastest.\n";
+            break;
+        case Ranking::State::WithinSpread: {
+            md << "- Cheapest of the " << what << ": none named, the lowest costs are within "
+               << "measurement spread of each other (" << spread << "): ";
+            for (std::size_t k = 0; k < ranking.overlapping.size(); ++k) {
+                const SweepRun& r = *runs[ranking.overlapping[k]];
+                md << (k == 0 ? "" : ", ") << "**" << r.label << "** " << costFigure(r);
+            }
+            md << ".\n";
+            break;
+        }
+    }
+    return md.str();
+}
+
+// A reading line for every run at the reference's time step or finer: its missed, extra and
+// first-contact figures measure no time-step error.
+std::string referenceStepReading(const std::vector<SweepRun>& runs, const SweepRun& reference) {
+    std::ostringstream md;
+    for (const SweepRun& r : runs) {
+        if (r.step_vs_reference == StepVsReference::Coarser) continue;
+        const bool same = r.step_vs_reference == StepVsReference::Same;
+        md << "- **" << r.label << "** runs at "
+           << (same ? "the reference's time step" : "a time step finer than the reference's")
+           << " (" << fmt(r.time_step) << " s against " << fmt(reference.time_step)
+           << " s): its missed, extra and first-contact figures "
+           << (same ? "compare the reference's step with itself" : "compare it with a coarser run")
+           << ", so they prove nothing about the time step. Choose a finer reference "
+              "(--reference-refine, or --reference world.time_step=...).\n";
+    }
     return md.str();
 }
 
@@ -165,24 +304,39 @@ std::string readingSection(const SweepOptions& options, const engine::Scene& bas
                            const std::vector<FloatRun>& floats) {
     std::ostringstream md;
     md << "## Reading\n\n";
-    const SweepRun* accurate = nullptr;
+    md << referenceStepReading(runs, reference);
+    // Accurate: confirms exactly the reference's pairs at a coarser step than the reference's
+    // (at its step or finer the comparison proves nothing about the step).
+    std::vector<const SweepRun*> accurate;
     for (const SweepRun& r : runs) {
-        if (r.missed_pairs != 0 || r.extra_pairs != 0) continue;
-        if (accurate == nullptr ||
-            (options.report_timing ? r.ms_per_simulated_s < accurate->ms_per_simulated_s
-                                   : r.bv_tests < accurate->bv_tests)) {
-            accurate = &r;
+        if (r.missed_pairs == 0 && r.extra_pairs == 0 &&
+            r.step_vs_reference == StepVsReference::Coarser) {
+            accurate.push_back(&r);
         }
     }
-    if (accurate != nullptr) {
-        md << "- " << (options.report_timing ? "Cheapest" : "Fewest BV tests among the")
-           << " runs that confirm exactly the reference's pairs: **" << accurate->label << "**";
-        if (options.report_timing)
-            md << " (" << fmt(accurate->ms_per_simulated_s, "%.1f") << " ms per simulated second)";
-        md << ".\n";
+    if (accurate.empty()) {
+        md << "- No run coarser than the reference confirms exactly the reference's pairs: "
+              "every choice here trades contacts for speed; see the missed and extra columns.\n";
+    } else if (options.report_timing) {
+        md << costReading("runs that confirm exactly the reference's pairs", accurate);
     } else {
-        md << "- No run confirms exactly the reference's pairs: every choice here trades "
-              "contacts for speed; see the missed and extra columns.\n";
+        const SweepRun* fewest = *std::min_element(
+            accurate.begin(), accurate.end(),
+            [](const SweepRun* a, const SweepRun* b) { return a->bv_tests < b->bv_tests; });
+        md << "- Fewest BV tests among the runs that confirm exactly the reference's pairs: **"
+           << fewest->label << "**.\n";
+    }
+    // Among all runs too, unless the lowest median is an accurate run (the line above said it).
+    if (options.report_timing && runs.size() > 1) {
+        std::vector<const SweepRun*> all;
+        for (const SweepRun& r : runs) all.push_back(&r);
+        const SweepRun* lowest =
+            *std::min_element(all.begin(), all.end(), [](const SweepRun* a, const SweepRun* b) {
+                return a->ms_per_simulated_s.median < b->ms_per_simulated_s.median;
+            });
+        if (std::find(accurate.begin(), accurate.end(), lowest) == accurate.end()) {
+            md << costReading("runs, whatever their accuracy", all);
+        }
     }
     const auto tightest = std::min_element(runs.begin(), runs.end(), [](auto& a, auto& b) {
         return a.broad_false_positives < b.broad_false_positives;
@@ -261,9 +415,13 @@ std::string markdownReport(const SweepOptions& options, const engine::Scene& bas
     md << "# Sweep of `" << options.scene.filename().string() << "`\n\n";
     md << "- " << base.bodies.size() << " bodies, " << fmt(duration) << " s simulated per run, "
        << "broad phase `" << base.world.broad_phase << "` unless varied.\n";
-    md << "- Reference: time step " << fmt(reference.time_step) << " s (" << reference.steps
-       << " steps)" << (options.reference.empty() ? "" : ", " + reference.label)
-       << "; it confirmed " << reference.pairs_confirmed_total << " distinct pairs.\n";
+    md << "- Reference: the same scene at time step " << fmt(reference.time_step) << " s ("
+       << reference.steps << " steps; the scene's " << fmt(base.world.time_step)
+       << " s divided by --reference-refine " << fmt(options.reference_refine)
+       << (options.reference.empty() ? "" : ", then --reference " + reference.label)
+       << "); it confirmed " << reference.pairs_confirmed_total << " distinct pairs. A run at "
+       << "its time step or finer is marked in the dt column: its accuracy figures prove "
+          "nothing about the step.\n";
     md << "- A pair is *missed* when the reference confirms it and the run never does; "
           "*extra* the other way round; a pair the CCD stage stopped at its time of impact "
           "(*CCD stops*) counts as a contact at that time, and a pair the contact solver "
@@ -276,9 +434,15 @@ std::string markdownReport(const SweepOptions& options, const engine::Scene& bas
           "t = 0); |L| drift: max over bodies and steps of the relative change of a body's "
           "angular momentum.\n";
     if (options.report_timing) {
-        md << "- Times are wall-clock, this machine, this build; they vary from run to run "
-              "(results.csv keeps every stage). Memory: the process's peak resident set during "
-              "the run less its resident set at the start (Linux VmHWM, reset per run).\n";
+        const int repeats = runs.empty() ? reference.repeats : runs.front().repeats;
+        md << "- Times are wall-clock (std::chrono::steady_clock inside World::step), this "
+              "machine, this build; they vary from run to run. Every run, the reference too, "
+              "was timed "
+           << repeats << (repeats == 1 ? " time" : " times, the repeats interleaved across runs")
+           << "; the table gives the median and the min..max range (results.csv: every stage). "
+              "The reading names a run cheapest only when its slowest repeat beat every other "
+              "run's fastest. Memory: the process's peak resident set during the first repeat "
+              "less its resident set at the start (Linux VmHWM, reset per run).\n";
     }
     md << resultsTable(options, runs, reference);
     md << '\n';

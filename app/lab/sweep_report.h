@@ -16,19 +16,40 @@ std::string fmt(double v, const char* spec = "%.4g");
 /// `s` as one CSV field (quoted when it holds a comma, quote or newline).
 std::string csvField(const std::string& s);
 
-/// results.csv: one row per run, deterministic columns and timings.
+/// results.csv: one row per run, deterministic columns and timings (median, min and max over
+/// the repeats of each timed column, the clock named in a column).
 std::string csvTable(const std::vector<SweepRun>& runs);
 
-/// One chart of the sweep: a column of results.csv against the runs.
+/// One chart of the sweep: a column of results.csv against the runs (timed columns: medians).
 struct Chart {
     std::string file;
     std::string title;
-    double SweepRun::*field;
+    double (*value)(const SweepRun&);
     bool log_scale;
     bool timing;
 };
 /// The charts the sweep draws, in report order.
 const std::vector<Chart>& charts();
+
+/// Which of several timed figures (lower is better) is measurably the lowest.
+struct Ranking {
+    enum class State {
+        Empty,         ///< no figure
+        Only,          ///< one figure: nothing to compare
+        NoSpread,      ///< one repeat each: no spread to compare the differences with
+        WithinSpread,  ///< the lowest median's range overlaps another's: no winner
+        Separated,     ///< `best`'s whole range lies below every other range: the winner
+    };
+    State state = State::Empty;
+    std::size_t best = 0;  ///< index of the lowest median (ties: the first)
+    /// WithinSpread: indices whose range overlaps best's, best first, then by median.
+    std::vector<std::size_t> overlapping;
+};
+
+/// Ranks `values` (timed over `repeats` repeats each) by median and names the lowest only when
+/// the difference exceeds the spread: its max is below every other value's min, so its slowest
+/// repeat beat every other run's fastest. A pure function of the numbers given.
+Ranking rankLowest(const std::vector<Timed>& values, int repeats);
 
 /// report.md: the table, the reading of it, the float comparison when there was one.
 std::string markdownReport(const SweepOptions& options, const engine::Scene& base,

@@ -11,9 +11,11 @@
 #include <string>
 #include <vector>
 
+#include "cli_run.h"
 #include "render/image.h"
 #include "sweep.h"
-#include "cli_run.h"
+#include "sweep_measure.h"
+#include "sweep_report.h"
 
 namespace {
 
@@ -229,6 +231,223 @@ TEST(Sweep, MemoryPerRunIsMeasured) {
     }
     EXPECT_NE(slurp(o.out_dir / "report.md").find("memory (MiB)"), std::string::npos);
     fs::remove_all(o.out_dir);
+}
+
+// Regression: single wall-clock samples ranked the runs (sphere at dt 0.0333 measured 0.011,
+// 0.079 and 0.010 ms/step in three identical sweeps, and report.md named "the cheapest run").
+// The ranking is a pure function of medians and min..max ranges: a winner only when its range
+// lies wholly below every other's. Fixed numbers, no timing.
+TEST(Sweep, RankingNamesAWinnerOnlyWhenTheRangesAreSeparated) {
+    using State = app::sweep::Ranking::State;
+    // The three samples: median 0.011, range 0.010..0.079.
+    const app::Timed sphere = app::sweep::summarize({0.011, 0.079, 0.010});
+    EXPECT_EQ(sphere.median, 0.011);
+    EXPECT_EQ(sphere.min, 0.010);
+    EXPECT_EQ(sphere.max, 0.079);
+    EXPECT_EQ(app::sweep::summarize({4, 1, 3, 2}).median, 2.5);
+    const app::Timed sap{0.014, 0.013, 0.020};
+    const app::Timed octree{0.30, 0.28, 0.33};
+    // sphere's lower median, but its range covers sap's: no winner, both listed, best first.
+    app::sweep::Ranking r = app::sweep::rankLowest({sap, sphere, octree}, 3);
+    EXPECT_EQ(r.state, State::WithinSpread);
+    EXPECT_EQ(r.best, 1u);
+    EXPECT_EQ(r.overlapping, (std::vector<std::size_t>{1, 0}));
+    // sap's slowest repeat (0.020) beats octree's fastest (0.28): sap is named.
+    r = app::sweep::rankLowest({octree, sap}, 3);
+    EXPECT_EQ(r.state, State::Separated);
+    EXPECT_EQ(r.best, 1u);
+    EXPECT_TRUE(r.overlapping.empty());
+    // Touching ranges are not separated.
+    r = app::sweep::rankLowest({{1.0, 0.9, 1.1}, {1.2, 1.1, 1.3}}, 3);
+    EXPECT_EQ(r.state, State::WithinSpread);
+    // One repeat has no spread: no winner, however far apart; one run: nothing to rank.
+    EXPECT_EQ(app::sweep::rankLowest({{1, 1, 1}, {9, 9, 9}}, 1).state, State::NoSpread);
+    EXPECT_EQ(app::sweep::rankLowest({sap}, 3).state, State::Only);
+    EXPECT_EQ(app::sweep::rankLowest({}, 3).state, State::Empty);
+}
+
+// The reading of report.md on fixed runs: the cheapest accurate run is named when separated,
+// and "none named" with every run within the spread otherwise.
+TEST(Sweep, ReadingNamesTheCheapestRunOnlyBeyondTheSpread) {
+    auto run = [](const std::string& label, app::Timed cost) {
+        app::SweepRun r;
+        r.label = label;
+        r.time_step = 0.01;
+        r.steps = 10;
+        r.repeats = 3;
+        r.ms_per_simulated_s = cost;
+        r.ms_step = {cost.median / 100, cost.min / 100, cost.max / 100};
+        return r;
+    };
+    app::SweepOptions o;
+    o.scene = kScene;
+    app::SweepRun reference = run("", {10, 9, 11});
+    reference.time_step = 0.001;
+    engine::Scene base;
+    base.world.time_step = 0.01;
+    std::vector<app::SweepRun> runs = {run("broadphase=sap", {1.4, 1.3, 2.0}),
+                                       run("broadphase=sphere", {1.1, 1.0, 7.9})};
+    std::string md = app::sweep::markdownReport(o, base, 0.1, runs, reference, {});
+    EXPECT_NE(md.find("- Cheapest of the runs that confirm exactly the reference's pairs: none "
+                      "named, the lowest costs are within measurement spread of each other"),
+              std::string::npos)
+        << md;
+    EXPECT_NE(md.find("**broadphase=sphere** 1.1 (1..7.9), **broadphase=sap** 1.4 (1.3..2)"),
+              std::string::npos)
+        << md;
+    EXPECT_EQ(md.find("Cheapest of the runs that confirm exactly the reference's pairs: **"),
+              std::string::npos)
+        << md;
+    runs[1].ms_per_simulated_s = {3.0, 2.9, 3.2};
+    md = app::sweep::markdownReport(o, base, 0.1, runs, reference, {});
+    EXPECT_NE(md.find("- Cheapest of the runs that confirm exactly the reference's pairs: "
+                      "**broadphase=sap** (1.4 (1.3..2) ms per simulated second, median "
+                      "(min..max of 3 repeats))"),
+              std::string::npos)
+        << md;
+    EXPECT_EQ(md.find("within measurement spread"), std::string::npos) << md;
+    EXPECT_NE(md.find("| 1.4 (1.3..2) |"), std::string::npos) << md;
+}
+
+// Regression: `--repeat 0` (or less) must be refused before anything runs, on the command line
+// too.
+TEST(Sweep, RepeatBelowOneIsBadInput) {
+    app::SweepOptions o;
+    o.scene = kScene;
+    o.out_dir = tempDir("repeat0");
+    for (int n : {0, -2}) {
+        o.repeat = n;
+        const Outcome r = sweep(o);
+        EXPECT_EQ(r.code, 2) << n;
+        EXPECT_NE(r.err.find("--repeat " + std::to_string(n) + ": must be >= 1"), std::string::npos)
+            << r.err;
+        EXPECT_EQ(r.out, "") << n;
+    }
+    EXPECT_FALSE(fs::exists(o.out_dir / "results.csv"));
+    const cdlab_test::CliResult cli = cdlab_test::runCdlab(
+        "sweep tests/data/tunnel_small.yaml --repeat 0 --out " + (o.out_dir / "cli").string(),
+        o.out_dir);
+    EXPECT_EQ(cli.exit_code, 2) << cli.err;
+    EXPECT_NE(cli.err.find("--repeat 0: must be >= 1"), std::string::npos) << cli.err;
+    EXPECT_FALSE(fs::exists(o.out_dir / "cli" / "results.csv"));
+    fs::remove_all(o.out_dir);
+}
+
+// Regression: a varied run at the reference's time step (the scene's 0.01 / 10 = 0.001, typed
+// as 0.001) compared the reference with itself and reported "0 missed" as if it proved
+// something. It is flagged in results.csv, in the table's dt cell and in the reading; a finer
+// run too.
+TEST(Sweep, RunAtTheReferenceTimeStepIsFlagged) {
+    app::SweepOptions o;
+    o.scene = kScene;
+    o.vary = {"world.time_step=0.005,0.001,0.0005"};
+    o.repeat = 1;
+    o.out_dir = tempDir("at_reference");
+    const Outcome r = sweep(o);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto rows = readCsv(o.out_dir / "results.csv");
+    ASSERT_EQ(rows.size(), 3u);
+    EXPECT_EQ(rows[0].at("dt_vs_reference"), "coarser");
+    EXPECT_EQ(rows[1].at("dt_vs_reference"), "same");
+    EXPECT_EQ(rows[2].at("dt_vs_reference"), "finer");
+    const std::string report = slurp(o.out_dir / "report.md");
+    EXPECT_NE(report.find("| world.time_step=0.001 | 0.001 (= reference) |"), std::string::npos)
+        << report;
+    EXPECT_NE(report.find("| world.time_step=0.0005 | 0.0005 (< reference) |"), std::string::npos)
+        << report;
+    EXPECT_NE(report.find("| world.time_step=0.005 | 0.005 |"), std::string::npos) << report;
+    EXPECT_NE(report.find("- **world.time_step=0.001** runs at the reference's time step (0.001 "
+                          "s against 0.001 s): its missed, extra and first-contact figures "
+                          "compare the reference's step with itself, so they prove nothing"),
+              std::string::npos)
+        << report;
+    EXPECT_NE(report.find("- **world.time_step=0.0005** runs at a time step finer than the "
+                          "reference's"),
+              std::string::npos)
+        << report;
+    fs::remove_all(o.out_dir);
+    EXPECT_EQ(app::sweep::stepVsReference(0.01 / 10, 0.001), app::StepVsReference::Same);
+    EXPECT_EQ(app::sweep::stepVsReference(0.0010001, 0.001), app::StepVsReference::Coarser);
+}
+
+// results.csv gives every timed column as median, min and max over the repeats and names the
+// clock; the deterministic columns of a sweep timed 3 times equal those of one timed once.
+TEST(Sweep, RepeatsGiveMedianAndRangeAndIdenticalDeterministicColumns) {
+    app::SweepOptions o;
+    o.scene = kScene;
+    o.vary = {"broadphase=sap,hgrid", "world.time_step=0.05,0.005"};
+    o.out_dir = tempDir("repeats");
+    o.repeat = 1;
+    Outcome r = sweep(o);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto once = readCsv(o.out_dir / "results.csv");
+    o.repeat = 3;
+    r = sweep(o);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("repeat 3/3: 5 runs timed again, deterministic columns identical"),
+              std::string::npos)
+        << r.out;
+    const auto thrice = readCsv(o.out_dir / "results.csv");
+    ASSERT_EQ(thrice.size(), 4u);
+    ASSERT_EQ(once.size(), 4u);
+    for (std::size_t i = 0; i < thrice.size(); ++i) {
+        const auto& row = thrice[i];
+        EXPECT_EQ(row.at("repeats"), "3");
+        EXPECT_EQ(once[i].at("repeats"), "1");
+        EXPECT_EQ(row.at("clock"), "steady_clock");
+        for (const char* timed : {"ms_integrate", "ms_volumes", "ms_broad", "ms_narrow", "ms_ccd",
+                                  "ms_response", "ms_step", "ms_per_simulated_s"}) {
+            const std::string t = timed;
+            const double median = std::stod(row.at(t + "_median"));
+            EXPECT_LE(std::stod(row.at(t + "_min")), median) << t;
+            EXPECT_LE(median, std::stod(row.at(t + "_max"))) << t;
+        }
+        for (const char* det :
+             {"run", "time_step", "steps", "flagged", "confirmed", "broad_false_positives",
+              "bv_tests", "narrow_tests", "triangle_tests", "toi_events", "max_penetration_m",
+              "pairs_confirmed_total", "missed_pairs", "extra_pairs", "max_first_contact_error_s",
+              "max_energy_drift", "max_angular_momentum_drift", "state_hash"}) {
+            EXPECT_EQ(row.at(det), once[i].at(det)) << det << " row " << i;
+        }
+    }
+    const std::string report = slurp(o.out_dir / "report.md");
+    EXPECT_NE(report.find("std::chrono::steady_clock"), std::string::npos);
+    EXPECT_NE(report.find("ms/step, median (min..max)"), std::string::npos);
+    fs::remove_all(o.out_dir);
+}
+
+// A timing repeat must reproduce the first's deterministic columns; the check names the first
+// column that differs (the sweep then fails: determinism is a guarantee of the engine).
+TEST(Sweep, DeterministicDifferenceNamesTheColumnThatDiffers) {
+    app::SweepRun first;
+    first.steps = 20;
+    first.flagged = 1.5;
+    first.bv_tests = 12;
+    first.toi_events = 2;
+    first.state_hash = 42;
+    first.ms_step = {0.1, 0.1, 0.1};
+    app::SweepRun again = first;
+    again.ms_step = {0.7, 0.7, 0.7};  // times may differ
+    again.memory_mib = 3;             // measured in the first repeat only
+    EXPECT_EQ(app::sweep::deterministicDifference(first, again), "");
+    again.state_hash = 43;
+    EXPECT_EQ(app::sweep::deterministicDifference(first, again), "state_hash: 42 vs 43");
+    again = first;
+    again.bv_tests = 12.5;
+    EXPECT_EQ(app::sweep::deterministicDifference(first, again), "bv_tests: 12 vs 12.5");
+    again = first;
+    again.toi_events = 3;
+    EXPECT_EQ(app::sweep::deterministicDifference(first, again), "toi_events: 2 vs 3");
+    // Combining keeps the first repeat's deterministic columns and summarises the times.
+    std::vector<app::SweepRun> repeats = {first, first, first};
+    repeats[1].ms_step = {0.3, 0.3, 0.3};
+    repeats[2].ms_step = {0.2, 0.2, 0.2};
+    const app::SweepRun combined = app::sweep::combineRepeats(repeats);
+    EXPECT_EQ(combined.repeats, 3);
+    EXPECT_EQ(combined.ms_step.median, 0.2);
+    EXPECT_EQ(combined.ms_step.min, 0.1);
+    EXPECT_EQ(combined.ms_step.max, 0.3);
+    EXPECT_EQ(combined.state_hash, 42u);
 }
 
 TEST(Sweep, ParseVaryKeepsBracketedValuesWhole) {
