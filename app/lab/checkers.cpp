@@ -17,6 +17,7 @@
 #include "output_files.h"
 #include "pause_dump.h"
 #include "render/image.h"
+#include "render/volume_states.h"
 
 namespace app {
 
@@ -341,7 +342,7 @@ public:
             if (expect_[k].frame != frame) continue;
             // No HUD: its legend shows every colour whatever the state.
             render::FrameOptions options;
-            options.draw = run.scene.draw;
+            options.draw = render::drawSettingsFor(run.scene.draw, run.world);  // as cdlab run
             options.draw.hud = false;
             counts_[k] =
                 countStateColors(run.renderer().render(run.world, run.scene.camera, options));
