@@ -238,6 +238,27 @@ void shockPasses(std::vector<Point>& points, const std::vector<std::size_t>& sho
     }
 }
 
+// Speculative manifold (Catto, GDC 2013 "Continuous collision"): `query(pose_b)` (contact of a
+// with b at pose_b) at b's pose, then, unless the pair is farther apart than `margin` or the
+// query failed, again with b pushed `shift` = max(gap, 0) + margin deeper along the normal, so
+// that corners within the margin of touching are in the manifold `c` (the caller moves them
+// back: a negative depth is their gap) and a resting box keeps all four contacts from step to
+// step. A point with a gap may approach by at most the gap in the step. False: no points.
+template <class Query>
+bool speculativeContact(const Query& query, const Pose& pose_b, Real margin,
+                        collision::ContactOutput& c, Pose& moved, Real& shift) {
+    const collision::ContactOutput c0 = query(pose_b);
+    if (c0.state == collision::ContactState::Failed) return false;
+    if (c0.state == collision::ContactState::Separated && !(c0.signed_distance < margin)) {
+        return false;
+    }
+    shift = std::max(c0.signed_distance, Real(0)) + margin;
+    moved = pose_b;
+    moved.position -= shift * c0.normal;
+    c = query(moved);
+    return collision::isColliding(c.state) && c.manifold_size > 0;
+}
+
 }  // namespace
 
 Body ContactSolver::makeWallBody() {
@@ -254,23 +275,14 @@ void ContactSolver::addPairPoints(const SolverBodies& bodies, const collision::P
     const Body& b = bodies[pair.b];
     if (a.is_static && b.is_static) return;
     const Real size = std::min(boundingRadius(a), boundingRadius(b));
-    const collision::ContactOutput c0 =
-        collision::contact(a.shape, a.pose(), b.shape, b.pose());
     const Real margin = settings.margin_fraction * size;
-    if (c0.state == collision::ContactState::Failed) return;
-    if (c0.state == collision::ContactState::Separated && !(c0.signed_distance < margin)) {
-        return;
-    }
-    // Speculative manifold (Catto, GDC 2013 "Continuous collision"): the manifold of the
-    // pair with B pushed `shift` deeper along the normal, its points moved back, so that
-    // corners within the margin of touching are kept (with a negative depth = their gap)
-    // and a resting box keeps all four contacts from step to step. A point with a gap may
-    // approach by at most the gap in this step.
-    const Real shift = std::max(c0.signed_distance, Real(0)) + margin;
-    Pose moved = b.pose();
-    moved.position -= shift * c0.normal;
-    collision::ContactOutput c = collision::contact(a.shape, a.pose(), b.shape, moved);
-    if (!collision::isColliding(c.state) || c.manifold_size == 0) return;
+    collision::ContactOutput c;
+    Pose moved;
+    Real shift = 0;
+    const auto query = [&](const Pose& pose_b) {
+        return collision::contact(a.shape, a.pose(), b.shape, pose_b);
+    };
+    if (!speculativeContact(query, b.pose(), margin, c, moved, shift)) return;
     if (c.manifold_size < 3 && a.shape.type == collision::ShapeType::Box &&
         b.shape.type == collision::ShapeType::Box) {
         std::array<collision::ManifoldPoint, 4> face{};
@@ -293,17 +305,14 @@ void ContactSolver::addWallPoints(const SolverBodies& bodies, const Wall& wall, 
     const Body& b = bodies[body];
     if (b.is_static) return;
     const Real size = boundingRadius(b);
-    const collision::ContactOutput c0 = collision::contact(wall.plane, b.shape, b.pose());
     const Real margin = settings.margin_fraction * size;
-    if (c0.state == collision::ContactState::Failed) return;
-    if (c0.state == collision::ContactState::Separated && !(c0.signed_distance < margin)) {
-        return;
-    }
-    const Real shift = std::max(c0.signed_distance, Real(0)) + margin;
-    Pose moved = b.pose();
-    moved.position -= shift * c0.normal;
-    collision::ContactOutput c = collision::contact(wall.plane, b.shape, moved);
-    if (!collision::isColliding(c.state) || c.manifold_size == 0) return;
+    collision::ContactOutput c;
+    Pose moved;
+    Real shift = 0;
+    const auto query = [&](const Pose& pose_b) {
+        return collision::contact(wall.plane, b.shape, pose_b);
+    };
+    if (!speculativeContact(query, b.pose(), margin, c, moved, shift)) return;
     addManifoldPoints(bodies, wall_id, body, c, shift, size,
                       std::max(wall.restitution, b.restitution),
                       std::sqrt(wall.friction * b.friction), inv_inertia, vel, dt, settings);
