@@ -136,6 +136,10 @@ struct Scene {
     DrawSettings draw;
     std::vector<Body> bodies;
     Expectations expect;  ///< `expect:` (self-grading), empty when absent
+    /// What loading assumed or changed that the user should know, one line each,
+    /// "FILE:LINE:COL: path: what" (an open mesh's mass properties from its hull, triangles an
+    /// import dropped): the commands print them on stderr. Not errors: the scene loaded.
+    std::vector<std::string> notes;
 };
 
 /// A bad scene file. what() is "FILE:LINE:COL: key.path: what is wrong" (1-based line and column).
