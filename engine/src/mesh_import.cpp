@@ -332,14 +332,14 @@ std::string describeImportChanges(const MeshImportReport& r) {
     }
     const std::string way_out =
         "float coordinates (assimp's, and some formats' own, as binary STL's) keep about 7 "
-        "significant digits of the largest, here " +
+        "significant digits of the largest coordinate (here " +
         brief(r.max_coordinate) + ", for a mesh of size " + brief(r.size) +
-        "): move the mesh's coordinates near its own origin (subtract its centre when exporting) "
+        "); move the mesh's coordinates near its own origin (subtract its centre when exporting) "
         "and place it with the body's position";
     if (!r.coordinates_checked) {
         return what + "; this format's coordinates are not checked against float rounding, " +
                "which collapses the triangles of a mesh far from its own origin; if that is the " +
-               "cause, " + way_out;
+               "cause: " + way_out;
     }
     if (r.vertices_merged == 0 && !rounding) {
         return what + "; they are degenerate in the file itself (nothing was lost to rounding)";
