@@ -55,12 +55,34 @@ double timePerCall(Fn&& fn) {
 }
 
 // The rows as JSON (every volume type's own pair list, so a reader can compare them).
+// What importing changed in one mesh (engine::MeshImportReport), for --json.
+nlohmann::json importJson(const engine::MeshImportReport& r) {
+    nlohmann::json j = {{"triangles_read", r.triangles_read},
+                        {"degenerate_dropped", r.degenerate_dropped},
+                        {"coordinates_checked", r.coordinates_checked},
+                        {"changed", r.changed()},
+                        {"max_coordinate", r.max_coordinate},
+                        {"size", r.size},
+                        {"recentred", r.recentred}};
+    if (r.coordinates_checked) {
+        j["vertices_merged"] = r.vertices_merged;
+        j["max_rounding"] = r.max_rounding;
+    }
+    if (r.changed()) j["warning"] = engine::describeImportChanges(r);
+    return j;
+}
+
 void writeQueryJson(std::ostream& out, const std::filesystem::path (&paths)[2],
-                    const collision::TriangleMesh (&meshes)[2], const collision::Pose& pose_b,
+                    const collision::TriangleMesh (&meshes)[2],
+                    const engine::MeshImportReport (&reports)[2], const collision::Pose& pose_b,
                     const std::vector<Row>& rows, bool agree) {
     nlohmann::json j;
-    j["mesh_a"] = {{"path", paths[0].string()}, {"triangles", meshes[0].triangles.size()}};
-    j["mesh_b"] = {{"path", paths[1].string()}, {"triangles", meshes[1].triangles.size()}};
+    j["mesh_a"] = {{"path", paths[0].string()},
+                   {"triangles", meshes[0].triangles.size()},
+                   {"import", importJson(reports[0])}};
+    j["mesh_b"] = {{"path", paths[1].string()},
+                   {"triangles", meshes[1].triangles.size()},
+                   {"import", importJson(reports[1])}};
     const auto& q = pose_b.orientation;
     j["pose_b"] = {pose_b.position.x(),
                    pose_b.position.y(),
@@ -203,6 +225,7 @@ int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err) 
         }
     }
     collision::TriangleMesh meshes[2];
+    engine::MeshImportReport reports[2];
     const std::filesystem::path paths[2] = {options.mesh_a, options.mesh_b};
     for (int i = 0; i < 2; ++i) {
         engine::MeshImportOutput imported = engine::importMesh(paths[i], 1.0);
@@ -211,6 +234,11 @@ int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err) 
             return 2;
         }
         meshes[i] = std::move(imported.mesh);
+        reports[i] = imported.report;
+        if (reports[i].changed()) {
+            err << "warning: " << paths[i].string() << ": "
+                << engine::describeImportChanges(reports[i]) << "\n";
+        }
     }
 
     std::vector<Row> rows;
@@ -236,7 +264,7 @@ int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err) 
     }
 
     if (options.json) {
-        writeQueryJson(out, paths, meshes, pose_b, rows, agree);
+        writeQueryJson(out, paths, meshes, reports, pose_b, rows, agree);
     } else {
         writeQueryTable(out, paths, meshes, rows);
     }

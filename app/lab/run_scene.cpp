@@ -144,6 +144,7 @@ int loadRunScene(const RunOptions& options, std::ostream& err, engine::Scene& sc
         err << e.what() << "\n";
         return kExitBadInput;
     }
+    for (const std::string& note : scene.notes) err << note << "\n";
     if (options.frames) {
         if (*options.frames < 1) {
             err << "--frames: must be >= 1\n";

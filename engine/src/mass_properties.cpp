@@ -8,10 +8,15 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <iomanip>
 #include <map>
+#include <sstream>
+#include <string>
 #include <numbers>
 #include <utility>
 #include <vector>
+
+#include <Eigen/Eigenvalues>
 
 namespace engine {
 
@@ -24,6 +29,10 @@ constexpr Real kPi = std::numbers::pi_v<Real>;
 // Signed volume below this fraction of the bounding box volume counts as "no volume": a flat or
 // open-and-cancelling surface, never a solid.
 constexpr Real kMinVolumeFraction = Real(1e3) * collision::kEpsilon;
+
+// Given inertia tensors are symmetric, and satisfy the triangle inequality, to this fraction of
+// their size (values typed with a few digits, or computed by another program, round).
+constexpr Real kInertiaRelativeTolerance = Real(1e-9);
 
 // Volume integrals of 1, x, y, z, x^2, y^2, z^2, xy, yz, zx over the solid (Eberly 2002 §3,
 // Mirtich 1996 §3): each boundary triangle contributes through the divergence theorem.
@@ -101,28 +110,6 @@ Polyhedron polyhedronOf(const collision::Shape& shape) {
     return {};
 }
 
-// Closed in the sense the divergence theorem needs: every directed edge a->b is matched by as
-// many b->a (a 2-manifold satisfies this with one each).
-bool isClosed(const std::vector<std::array<std::int32_t, 3>>& triangles) {
-    std::map<std::pair<std::int32_t, std::int32_t>, int> balance;
-    for (const auto& t : triangles) {
-        for (int e = 0; e < 3; ++e) {
-            const std::int32_t a = t[e];
-            const std::int32_t b = t[(e + 1) % 3];
-            if (a == b) continue;
-            if (a < b) {
-                ++balance[{a, b}];
-            } else {
-                --balance[{b, a}];
-            }
-        }
-    }
-    for (const auto& [edge, count] : balance) {
-        if (count != 0) return false;
-    }
-    return true;
-}
-
 MassPropertiesOutput polyhedronMass(const Polyhedron& poly, Real density) {
     MassPropertiesOutput out;
     const std::vector<Vec3>& verts = *poly.vertices;
@@ -139,8 +126,9 @@ MassPropertiesOutput polyhedronMass(const Polyhedron& poly, Real density) {
             }
         }
     }
-    if (!isClosed(tris)) {
-        out.error = "mesh is not closed (some edges have no opposite edge)";
+    if (const std::int64_t open = boundaryEdgeCount(tris); open != 0) {
+        out.error = "mesh is not closed (" + std::to_string(open) + " boundary edge" +
+                    (open == 1 ? "" : "s") + " have no opposite edge)";
         return out;
     }
     Vec3 lo = verts[tris[0][0]];
@@ -184,6 +172,49 @@ MassPropertiesOutput polyhedronMass(const Polyhedron& poly, Real density) {
 }
 
 }  // namespace
+
+// Closed in the sense the divergence theorem needs: every directed edge a->b is matched by as
+// many b->a (a 2-manifold satisfies this with one each).
+std::int64_t boundaryEdgeCount(const std::vector<std::array<std::int32_t, 3>>& triangles) {
+    std::map<std::pair<std::int32_t, std::int32_t>, int> balance;
+    for (const auto& t : triangles) {
+        for (int e = 0; e < 3; ++e) {
+            const std::int32_t a = t[e];
+            const std::int32_t b = t[(e + 1) % 3];
+            if (a == b) continue;
+            if (a < b) {
+                ++balance[{a, b}];
+            } else {
+                --balance[{b, a}];
+            }
+        }
+    }
+    std::int64_t open = 0;
+    for (const auto& [edge, count] : balance) open += count < 0 ? -count : count;
+    return open;
+}
+
+std::string inertiaProblem(const Mat3& inertia) {
+    if (!inertia.allFinite()) return "must be finite";
+    const Real largest = inertia.cwiseAbs().maxCoeff();
+    if ((inertia - inertia.transpose()).cwiseAbs().maxCoeff() > kInertiaRelativeTolerance * largest) {
+        return "must be symmetric";
+    }
+    const Eigen::SelfAdjointEigenSolver<Mat3> eig(inertia);
+    if (eig.info() != Eigen::Success) return "has no principal moments";
+    const Vec3 m = eig.eigenvalues();  // ascending
+    std::ostringstream moments;
+    moments << std::setprecision(6) << "principal moments " << m.x() << ", " << m.y() << ", "
+            << m.z() << " kg m^2";
+    if (!(m.x() > 0)) return "must be positive definite (" + moments.str() + ")";
+    const Real slack = kInertiaRelativeTolerance * (m.x() + m.y() + m.z());
+    if (m.z() > m.x() + m.y() + slack) {
+        return "violates the triangle inequality of principal moments, largest <= sum of the "
+               "other two (" +
+               moments.str() + "): no mass distribution has it";
+    }
+    return "";
+}
 
 Real shapeVolume(const collision::Shape& shape) {
     switch (shape.type) {

@@ -2,6 +2,8 @@
 // Output invariant: vertices are unique by position (welded exactly, after scaling), every vertex
 // is used, every triangle has three distinct vertices and non-zero area, and the order of both
 // follows the file (meshes in scene order, faces in mesh order), so imports are deterministic.
+// Every triangle dropped is counted in the report; for text formats the report also measures what
+// float coordinates cost against the file's coordinates read in double (mesh_text_coordinates.h).
 #include "engine/mesh_import.h"
 
 #include <assimp/config.h>
@@ -16,12 +18,16 @@
 #include <cstdint>
 #include <exception>
 #include <fstream>
+#include <iomanip>
 #include <map>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <system_error>
 #include <utility>
 #include <vector>
+
+#include "mesh_text_coordinates.h"
 
 namespace engine {
 
@@ -32,6 +38,15 @@ using collision::Vec3;
 
 // A triangle is degenerate when |(b-a) x (c-a)| is at rounding level of its longest edge squared.
 constexpr Real kDegenerateArea = Real(4) * collision::kEpsilon;
+
+// Text formats whose largest coordinate exceeds this multiple of the mesh's largest extent go to
+// assimp recentred: float keeps 24 bits relative to the coordinate, so at 16 sizes from the origin
+// the mesh already has 4 bits less than around its own centre.
+constexpr Real kRecentreRatio = 16;
+
+// Rounding below this fraction of the mesh's size is what float gives any mesh near its own origin
+// (2^-24 of coordinates up to 16 sizes): not worth a warning.
+constexpr Real kRoundingWarnFraction = Real(0x1.0p-20);
 
 // Model files past this size are refused before assimp reads them (a binary STL of 256 MiB holds
 // 5.4 million triangles); assimp's memory grows with the file.
@@ -179,8 +194,11 @@ std::string fileError(const std::filesystem::path& file) {
 // Every triangle of every mesh of `scene` into `mesh`, scaled, welding equal positions across
 // meshes too (exact comparison: the file's shared vertices are bit-identical after the same
 // transform and scale) and dropping degenerate triangles. Returns an error, or "".
-std::string mergeMeshes(const aiScene& scene, Real scale, const std::filesystem::path& file,
-                        collision::TriangleMesh& mesh) {
+// `offset` is added (in double) to assimp's coordinates before scaling: the file's text was handed
+// to assimp recentred by it. Counts the triangles read and dropped in `report`.
+std::string mergeMeshes(const aiScene& scene, Real scale, const Vec3& offset,
+                        const std::filesystem::path& file, collision::TriangleMesh& mesh,
+                        MeshImportReport& report) {
     std::map<std::array<Real, 3>, std::int32_t> index_of;
     for (unsigned mi = 0; mi < scene.mNumMeshes; ++mi) {
         const aiMesh* am = scene.mMeshes[mi];
@@ -199,7 +217,7 @@ std::string mergeMeshes(const aiScene& scene, Real scale, const std::filesystem:
                 }
                 if (local[vi] < 0) {
                     const aiVector3D& v = am->mVertices[vi];
-                    const Vec3 p = Vec3(Real(v.x), Real(v.y), Real(v.z)) * scale;
+                    const Vec3 p = (Vec3(Real(v.x), Real(v.y), Real(v.z)) + offset) * scale;
                     if (!p.allFinite()) {
                         return "non-finite vertex in '" + file.string() + "'";
                     }
@@ -212,20 +230,122 @@ std::string mergeMeshes(const aiScene& scene, Real scale, const std::filesystem:
                 tri[k] = local[vi];
             }
             if (!valid) continue;
-            if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) continue;
+            ++report.triangles_read;
+            if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) {
+                ++report.degenerate_dropped;
+                continue;
+            }
             const Vec3& a = mesh.vertices[tri[0]];
             const Vec3& b = mesh.vertices[tri[1]];
             const Vec3& c = mesh.vertices[tri[2]];
             const Real longest2 =
                 std::max({(b - a).squaredNorm(), (c - a).squaredNorm(), (c - b).squaredNorm()});
-            if (!((b - a).cross(c - a).norm() > kDegenerateArea * longest2)) continue;
+            if (!((b - a).cross(c - a).norm() > kDegenerateArea * longest2)) {
+                ++report.degenerate_dropped;
+                continue;
+            }
             mesh.triangles.push_back(tri);
         }
     }
     return "";
 }
 
+// The file's coordinates against what float makes of them (relative to `offset`, as assimp reads
+// the recentred text): the largest rounding of one coordinate and the distinct positions that
+// coincide after it. Assumes correctly rounded parsing, which assimp's fast_atof approaches to an
+// ulp or two.
+// x rounded to float and back. Through a volatile: GCC 12's vectorizer at -O2 was seen to drop
+// such a round trip in a loop over triangle corners (1250 collapsed triangles counted as 0).
+Real roundedToFloat(Real x) {
+    const volatile float f = static_cast<float>(x);
+    return Real(f);
+}
+
+void measureRounding(const std::vector<Vec3>& points, const Vec3& offset,
+                     MeshImportReport& report) {
+    std::vector<std::array<Real, 3>> read;
+    std::vector<std::array<Real, 3>> rounded;
+    read.reserve(points.size());
+    rounded.reserve(points.size());
+    for (const Vec3& p : points) {
+        std::array<Real, 3> r{};
+        for (int a = 0; a < 3; ++a) {
+            r[a] = roundedToFloat(p[a] - offset[a]) + offset[a];
+            report.max_rounding = std::max(report.max_rounding, std::abs(r[a] - p[a]));
+        }
+        read.push_back({p.x(), p.y(), p.z()});
+        rounded.push_back(r);
+    }
+    const auto distinct = [](std::vector<std::array<Real, 3>>& v) {
+        std::sort(v.begin(), v.end());
+        return std::unique(v.begin(), v.end()) - v.begin();
+    };
+    report.vertices_merged = distinct(read) - distinct(rounded);
+}
+
+// Largest |coordinate| and bounding-box diagonal of `points`.
+void measureExtent(const std::vector<Vec3>& points, Real scale, MeshImportReport& report) {
+    if (points.empty()) return;
+    Vec3 lo = points.front() / scale;
+    Vec3 hi = lo;
+    for (const Vec3& p : points) {
+        lo = lo.cwiseMin(p / scale);
+        hi = hi.cwiseMax(p / scale);
+    }
+    report.max_coordinate = std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff());
+    report.size = (hi - lo).norm();
+}
+
+// 3 significant digits, for the numbers of a warning.
+std::string brief(Real v) {
+    std::ostringstream s;
+    s << std::setprecision(3) << v;
+    return s.str();
+}
+
 }  // namespace
+
+bool MeshImportReport::changed() const {
+    return degenerate_dropped > 0 || vertices_merged > 0 ||
+           max_rounding > kRoundingWarnFraction * size;
+}
+
+std::string describeImportChanges(const MeshImportReport& r) {
+    if (!r.changed()) return "";
+    const bool rounding = r.max_rounding > kRoundingWarnFraction * r.size;
+    std::string what = "import changed the geometry:";
+    std::string sep = " ";
+    if (r.degenerate_dropped > 0) {
+        what += sep + "dropped " + std::to_string(r.degenerate_dropped) + " of " +
+                std::to_string(r.triangles_read) +
+                " triangles as degenerate (a repeated vertex or no area)";
+        sep = ", ";
+    }
+    if (r.vertices_merged > 0) {
+        what += sep + "merged " + std::to_string(r.vertices_merged) + " vertices";
+        sep = ", ";
+    }
+    if (rounding) {
+        what += sep + "rounded coordinates by up to " + brief(r.max_rounding) + " (" +
+                brief(100 * r.max_rounding / r.size) + "% of the mesh's size " + brief(r.size) +
+                ")";
+    }
+    const std::string way_out =
+        "float coordinates (assimp's, and some formats' own, as binary STL's) keep about 7 "
+        "significant digits of the largest coordinate (here " +
+        brief(r.max_coordinate) + ", for a mesh of size " + brief(r.size) +
+        "); move the mesh's coordinates near its own origin (subtract its centre when exporting) "
+        "and place it with the body's position";
+    if (!r.coordinates_checked) {
+        return what + "; this format's coordinates are not checked against float rounding, " +
+               "which collapses the triangles of a mesh far from its own origin; if that is the " +
+               "cause: " + way_out;
+    }
+    if (r.vertices_merged == 0 && !rounding) {
+        return what + "; they are degenerate in the file itself (nothing was lost to rounding)";
+    }
+    return what + ": " + way_out;
+}
 
 MeshImportOutput importMesh(const std::filesystem::path& file, collision::Real scale) {
     MeshImportOutput out;
@@ -250,9 +370,33 @@ MeshImportOutput importMesh(const std::filesystem::path& file, collision::Real s
     const unsigned flags = aiProcess_RemoveComponent | aiProcess_Triangulate |
                            aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices |
                            aiProcess_SortByPType | aiProcess_ValidateDataStructure;
+    // Text formats: the coordinates in double, to measure the rounding and, far from the origin,
+    // to hand assimp the text recentred on the bounding box (every other byte unchanged).
+    MeshImportReport& report = out.report;
+    const TextCoordinates text = readTextCoordinates(file);
+    std::string recentred_text;
+    if (text.ok && !text.points.empty()) {
+        report.coordinates_checked = true;
+        measureExtent(text.points, 1, report);
+        Vec3 lo = text.points.front();
+        Vec3 hi = lo;
+        for (const Vec3& p : text.points) {
+            lo = lo.cwiseMin(p);
+            hi = hi.cwiseMax(p);
+        }
+        if (report.max_coordinate > kRecentreRatio * (hi - lo).maxCoeff()) {
+            report.recentred = true;
+            report.offset = (lo + hi) / 2;
+            recentred_text = shiftedText(text, report.offset);
+        }
+        measureRounding(text.points, report.offset, report);
+    }
     const aiScene* scene = nullptr;
     try {
-        scene = importer.ReadFile(file.string(), flags);
+        scene = report.recentred
+                    ? importer.ReadFileFromMemory(recentred_text.data(), recentred_text.size(),
+                                                  flags, text.hint.c_str())
+                    : importer.ReadFile(file.string(), flags);
     } catch (const std::exception& e) {
         out.error = std::string("assimp failed: ") + e.what();
         return out;
@@ -268,14 +412,16 @@ MeshImportOutput importMesh(const std::filesystem::path& file, collision::Real s
     }
 
     collision::TriangleMesh& mesh = out.mesh;
-    out.error = mergeMeshes(*scene, scale, file, mesh);
+    out.error = mergeMeshes(*scene, scale, report.offset, file, mesh, report);
     if (!out.error.empty()) {
         mesh = {};
         return out;
     }
+    if (!report.coordinates_checked) measureExtent(mesh.vertices, scale, report);
     if (mesh.triangles.empty()) {
         mesh = {};
         out.error = "no triangles in '" + file.string() + "'";
+        if (report.triangles_read > 0) out.error += ": " + describeImportChanges(report);
         return out;
     }
     // Drop vertices only referenced by dropped triangles, keeping first-use order.

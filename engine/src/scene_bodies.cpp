@@ -28,6 +28,42 @@
 
 namespace engine::scene_parsing {
 
+// A point set without a convex hull (flat, on a line, one point) is the file's shape, not a
+// failure of the hull: say so, and what to use instead.
+void SceneParser::failFlatMesh(ShapeType type, const std::string& hull_error,
+                               const collision::TriangleMesh& mesh, const fs::path& resolved,
+                               const Entry& file_entry, const std::string& path) const {
+    const std::size_t n = mesh.vertices.size();
+    const std::string counts = std::to_string(n) + (n == 1 ? " vertex" : " vertices") + ", " +
+                               std::to_string(mesh.triangles.size()) + " triangle" +
+                               (mesh.triangles.size() == 1 ? "" : "s");
+    std::string flat;
+    if (hull_error == "points are coplanar" || n == 3) {
+        flat = "lie in one plane";
+    } else if (hull_error == "points are collinear" || n == 2) {
+        flat = "lie on one line";
+    } else if (hull_error == "all points coincide" || n < 2) {
+        flat = "coincide";
+    }
+    if (flat.empty()) {
+        fail(file_entry.key_node, path,
+             "cannot build the convex hull of '" + resolved.string() + "': " + hull_error);
+    }
+    std::string what = "'" + resolved.string() + "' has no volume: its points " + flat + " (" +
+                       counts + "); ";
+    if (type == ShapeType::ConvexHull) {
+        what += "a body is a solid, so its hull needs points in three dimensions";
+    } else {
+        // Contact response, CCD against convex bodies and the bounding volumes all use a mesh's
+        // convex hull (collision/geometry/shape.h), which flat points do not have.
+        what +=
+            "a mesh body needs its convex hull (contact response, bounds), which flat points "
+            "do not have: give the surface a thickness, or use 'shape: box' with a zero half "
+            "extent and 'mass' for a flat plate";
+    }
+    fail(file_entry.key_node, path, what);
+}
+
 const PreparedShape& SceneParser::prepareMeshShape(ShapeType type, const std::string& file,
                                                    Real scale, const Entry& file_entry,
                                                    const std::string& path,
@@ -49,6 +85,13 @@ const PreparedShape& SceneParser::prepareMeshShape(ShapeType type, const std::st
                         .emplace(canonical.string(),
                                  std::make_shared<const MeshImportOutput>(importMesh(resolved, 1)))
                         .first;
+        // What the import changed (triangles dropped, vertices merged by float rounding): said
+        // once per file, at the first body that uses it.
+        const std::string changes = describeImportChanges(import_it->second->report);
+        if (import_it->second->ok && !changes.empty()) {
+            notes_.push_back(formatMessage(file_, file_entry.key_node.Mark(), path,
+                                           "'" + file + "': " + changes));
+        }
     }
     // Scaling after the import gives importMesh(file, scale)'s mesh unless rounding at an extreme
     // scale made a kept triangle degenerate (vertices merge, or the area vanishes) or the file
@@ -72,45 +115,31 @@ const PreparedShape& SceneParser::prepareMeshShape(ShapeType type, const std::st
         if (!imported.ok) fail(file_entry.key_node, path, imported.error);
     }
     const collision::ConvexHullOutput hull = collision::computeConvexHull(imported.mesh.vertices);
-    if (!hull.ok) {
-        // A flat or degenerate point set is the file's shape, not a failure of the hull: say so.
-        const std::size_t n = imported.mesh.vertices.size();
-        const std::string counts = std::to_string(n) + (n == 1 ? " vertex" : " vertices") + ", " +
-                                   std::to_string(imported.mesh.triangles.size()) + " triangle" +
-                                   (imported.mesh.triangles.size() == 1 ? "" : "s");
-        std::string flat;
-        if (hull.error == "points are coplanar" || n == 3) {
-            flat = "lie in one plane";
-        } else if (hull.error == "points are collinear" || n == 2) {
-            flat = "lie on one line";
-        } else if (hull.error == "all points coincide" || n < 2) {
-            flat = "coincide";
+    if (!hull.ok) failFlatMesh(type, hull.error, imported.mesh, resolved, file_entry, path);
+    // Mass properties of the solid the body is: the hull; a closed mesh's own volume; an open
+    // mesh's hull (a surface bounds no volume: its hull is the solid it most plausibly stands
+    // for, and is always closed). Then the geometry moves so that the local origin is the centre
+    // of mass.
+    PreparedShape prepared;
+    const Shape hull_shape =
+        Shape::convexHull(std::make_shared<const collision::ConvexPolytope>(hull.hull));
+    MassPropertiesOutput mp;
+    if (type == ShapeType::Mesh) {
+        prepared.boundary_edges = boundaryEdgeCount(imported.mesh.triangles);
+        if (prepared.boundary_edges == 0) {
+            mp = computeMassProperties(
+                Shape::triangleMesh(std::make_shared<const collision::TriangleMesh>(imported.mesh),
+                                    std::make_shared<const collision::ConvexPolytope>(hull.hull),
+                                    nullptr),  // only for the mass properties: no hierarchy
+                1);
+            if (!mp.ok) prepared.volume_error = mp.error;
         }
-        if (!flat.empty()) {
-            fail(
-                file_entry.key_node, path,
-                "'" + resolved.string() + "' has no volume: its points " + flat + " (" + counts +
-                    "); a body is a solid, so its " +
-                    (type == ShapeType::ConvexHull ? "hull" : "mesh's hull (for mass properties)") +
-                    " needs points in three dimensions");
-        }
-        fail(file_entry.key_node, path,
-             "cannot build the convex hull of '" + resolved.string() + "': " + hull.error);
     }
-    // Mass properties of the solid the body is (the hull, or the mesh's own volume), then move
-    // the geometry so that the local origin is the centre of mass.
-    Shape raw =
-        type == ShapeType::ConvexHull
-            ? Shape::convexHull(std::make_shared<const collision::ConvexPolytope>(hull.hull))
-            : Shape::triangleMesh(std::make_shared<const collision::TriangleMesh>(imported.mesh),
-                                  std::make_shared<const collision::ConvexPolytope>(hull.hull),
-                                  nullptr);  // only for the mass properties: no hierarchy
-    const MassPropertiesOutput mp = computeMassProperties(raw, 1);
+    if (!mp.ok) mp = computeMassProperties(hull_shape, 1);
     if (!mp.ok) fail(file_entry.key_node, path, "'" + resolved.string() + "': " + mp.error);
     const Vec3 com = mp.props.center_of_mass;
     collision::ConvexPolytope centred_hull = hull.hull;
     for (Vec3& v : centred_hull.vertices) v -= com;
-    PreparedShape prepared;
     prepared.unit = mp.props;
     if (type == ShapeType::ConvexHull) {
         prepared.shape = Shape::convexHull(
@@ -274,6 +303,9 @@ BodyValues SceneParser::readBodyValues(const std::vector<Entry>& es, const YAML:
             b.mass = readReal(v, p);
             if (!(b.mass > 0)) fail(v, p, "must be > 0 (kg)");
             b.mass_entry = &e;
+        } else if (e.key == "inertia") {
+            b.inertia = readInertia(v, p);
+            b.inertia_entry = &e;
         } else if (e.key == "density") {
             b.density = readReal(v, p);
             if (!(b.density > 0)) fail(v, p, "must be > 0 (kg/m^3)");
@@ -287,6 +319,11 @@ BodyValues SceneParser::readBodyValues(const std::vector<Entry>& es, const YAML:
             b.friction = readReal(v, p);
             if (!(b.friction >= 0)) fail(v, p, "must be >= 0");
         }
+    }
+    if (b.inertia_entry != nullptr && b.mass_entry == nullptr) {
+        fail(b.inertia_entry->key_node, childPath(path, "inertia"),
+             "needs 'mass' (the inertia of a given mass, kg m^2; with a density both come from "
+             "the shape)");
     }
     if (b.is_static) {
         for (const Entry& e : es) {
@@ -318,6 +355,7 @@ MassProperties SceneParser::bodyMassProperties(const std::vector<Entry>& es,
                              childPath(path, "file"), scene.world.mesh_bvh);
         shape = prepared.shape;
         unit = prepared.unit;
+        noteMeshMass(prepared, b, path);
     } else {
         shape = type == ShapeType::Sphere ? Shape::sphere(b.radius)
                 : type == ShapeType::Box  ? Shape::box(b.half_extents)
@@ -348,6 +386,7 @@ MassProperties SceneParser::bodyMassProperties(const std::vector<Entry>& es,
     props.mass = unit.mass * scale_to;
     props.inertia = unit.inertia * scale_to;
     if (b.mass_entry != nullptr) props.mass = b.mass;
+    if (b.inertia_entry != nullptr) props.inertia = b.inertia;
     const Mat3 inv = props.inertia.inverse();
     if (!std::isfinite(props.mass) || !(props.mass > 0) || !props.inertia.allFinite() ||
         !inv.allFinite() || !(props.inertia.diagonal().minCoeff() > 0)) {
@@ -357,6 +396,59 @@ MassProperties SceneParser::bodyMassProperties(const std::vector<Entry>& es,
         fail(mass_node, mass_path, what.str());
     }
     return props;
+}
+
+// Where a mesh body's mass properties come from when not from its own closed volume: a note for
+// an open mesh; an error naming the ways out for a closed mesh whose volume is unusable, unless
+// `mass` and `inertia` give them.
+void SceneParser::noteMeshMass(const PreparedShape& prepared, const BodyValues& b,
+                               const std::string& path) {
+    const bool given = b.mass_entry != nullptr && b.inertia_entry != nullptr;
+    const std::string file = b.file_entry->value.Scalar();
+    if (!prepared.volume_error.empty() && !given) {
+        fail(b.file_entry->key_node, childPath(path, "file"),
+             "'" + file + "': " + prepared.volume_error +
+                 "; use 'shape: hull' (its convex hull as the solid), or give 'mass' and "
+                 "'inertia' (the centre of mass is then its convex hull's)");
+    }
+    if (prepared.boundary_edges == 0 && prepared.volume_error.empty()) return;
+    std::string what = "mesh '" + file + "' ";
+    if (prepared.boundary_edges > 0) {
+        what += "is open (" + std::to_string(prepared.boundary_edges) + " boundary edge" +
+                (prepared.boundary_edges == 1 ? "" : "s") + ")";
+    } else {
+        what += "gives no volume (" + prepared.volume_error + ")";
+    }
+    if (given) {
+        what += "; centre of mass from its convex hull, mass and inertia as given";
+    } else if (b.mass_entry != nullptr) {
+        what += "; centre of mass and inertia per kg from its convex hull";
+    } else {
+        what += "; mass properties from its convex hull";
+    }
+    what += " (collision: its triangles, surface contact only)";
+    notes_.push_back(formatMessage(file_, b.file_entry->key_node.Mark(), path + " (" + b.name + ")",
+                                   what));
+}
+
+Mat3 SceneParser::readInertia(const YAML::Node& n, const std::string& path) const {
+    const std::string expected =
+        "expected [ix, iy, iz] (principal moments) or a 3x3 list of rows [[ixx, ixy, ixz], "
+        "[ixy, iyy, iyz], [ixz, iyz, izz]], kg m^2";
+    if (!n.IsSequence() || n.size() != 3) fail(n, path, expected);
+    Mat3 inertia = Mat3::Zero();
+    if (n[0].IsSequence()) {
+        for (std::size_t r = 0; r < 3; ++r) {
+            const YAML::Node row = n[r];
+            if (!row.IsSequence() || row.size() != 3) fail(row, indexPath(path, r), expected);
+            inertia.row(static_cast<Eigen::Index>(r)) = readVec3(row, indexPath(path, r));
+        }
+    } else {
+        inertia.diagonal() = readVec3(n, path);
+    }
+    const std::string problem = inertiaProblem(inertia);
+    if (!problem.empty()) fail(n, path, problem);
+    return inertia;
 }
 
 std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,

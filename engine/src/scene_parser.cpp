@@ -385,6 +385,7 @@ Scene SceneParser::parse(const std::string& text) {
         }
     }
     if (const Entry* e = find(es, "expect")) parseExpect(*e, scene);
+    scene.notes = std::move(notes_);
     return scene;
 }
 

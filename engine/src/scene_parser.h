@@ -9,6 +9,7 @@
 
 #include <filesystem>
 #include <initializer_list>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
@@ -42,7 +43,8 @@ inline constexpr Real kMinGyrationFraction = Real(1e-3);
 inline constexpr std::string_view kBodyKeys[] = {
     "name",  "shape",    "radius",           "half_height", "half_extents", "file",
     "scale", "position", "orientation_wxyz", "euler_deg",   "velocity",     "angular_velocity",
-    "mass",  "density",  "repeat",           "static",      "restitution",  "friction"};
+    "mass",  "density",  "repeat",           "static",      "restitution",  "friction",
+    "inertia"};
 
 inline constexpr std::string_view kRepeatKeys[] = {
     "count", "seed", "region", "speed", "spin", "random_orientation", "separated"};
@@ -110,6 +112,8 @@ struct BodyValues {
     const Entry* file_entry = nullptr;
     const Entry* mass_entry = nullptr;
     const Entry* density_entry = nullptr;
+    const Entry* inertia_entry = nullptr;  ///< `inertia:` given (with `mass:`)
+    Mat3 inertia = Mat3::Zero();           ///< kg m^2 about the centre of mass, body frame
     Real mass = 0;
     Real density = 1000;
     bool is_static = false;
@@ -135,6 +139,11 @@ struct RepeatSpec {
 struct PreparedShape {
     Shape shape;
     MassProperties unit;  // mass = volume
+    /// Mesh: its boundary edges (0: closed). An open mesh's `unit` is its convex hull's.
+    std::int64_t boundary_edges = 0;
+    /// Mesh: why its own volume gives no mass properties although it is closed (inward, no
+    /// volume), or "". Then `unit` is its hull's and only `mass` + `inertia` make it a body.
+    std::string volume_error;
 };
 
 class SceneParser {
@@ -170,6 +179,8 @@ private:
     bool readBool(const YAML::Node& n, const std::string& path) const;
     std::string readString(const YAML::Node& n, const std::string& path) const;
     Vec3 readVec3(const YAML::Node& n, const std::string& path) const;
+    /// `inertia:` as [ix, iy, iz] (principal, diagonal) or a 3x3 list of rows, validated.
+    Mat3 readInertia(const YAML::Node& n, const std::string& path) const;
 
     void parseWorld(const YAML::Node& n, Scene& scene) const;
     void parseOutput(const YAML::Node& n, Scene& scene) const;
@@ -198,6 +209,10 @@ private:
     const PreparedShape& prepareMeshShape(ShapeType type, const std::string& file, Real scale,
                                           const Entry& file_entry, const std::string& path,
                                           const std::string& bvh_name);
+    void noteMeshMass(const PreparedShape& prepared, const BodyValues& b, const std::string& path);
+    [[noreturn]] void failFlatMesh(ShapeType type, const std::string& hull_error,
+                                   const collision::TriangleMesh& mesh, const fs::path& resolved,
+                                   const Entry& file_entry, const std::string& path) const;
     /// `expect:` (after the bodies, whose names it refers to).
     void parseExpect(const Entry& entry, Scene& scene) const;
     RepeatSpec readRepeat(const Entry& entry, const std::string& path, const Scene& scene) const;
@@ -216,6 +231,7 @@ private:
     std::vector<std::pair<YAML::Node, const SceneOverride*>> override_nodes_;
     std::map<std::string, std::shared_ptr<const MeshImportOutput>> import_cache_;  // scale 1
     std::map<std::tuple<std::string, Real, int>, PreparedShape> mesh_cache_;
+    std::vector<std::string> notes_;  // Scene::notes
 };
 
 /// `v` with 6 significant digits, for limits in messages.

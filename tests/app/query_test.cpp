@@ -119,6 +119,38 @@ TEST(Query, BadInputExitsTwoWithAMessage) {
     EXPECT_NE(r.err.find("no/such/mesh.obj"), std::string::npos) << r.err;
 }
 
+// Issue "Meshes from the real world": import dropped triangles without a word. The query warns on
+// stderr with the counts and puts the import report beside each mesh in --json.
+TEST(Query, ImportChangesAreReportedOnStderrAndInJson) {
+    const fs::path dir = fs::temp_directory_path() / ("cdlab_query_import_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const fs::path near = dir / "near.obj";
+    // Vertex 5 is 1e-9 from vertex 2: one vertex in float, and the sliver 2-5-4 collapses.
+    std::ofstream(near) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1.000000001 0 0\n"
+                           "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\nf 2 5 4\n";
+    QueryResult r = runQueryCli(near.string() + " assets/torus.obj --bv obb --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: " + near.string() +
+                         ": import changed the geometry: dropped 1 of 5 triangles"),
+              std::string::npos)
+        << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    const nlohmann::json& a = j["mesh_a"]["import"];
+    EXPECT_EQ(a["triangles_read"], 5);
+    EXPECT_EQ(a["degenerate_dropped"], 1);
+    EXPECT_EQ(a["vertices_merged"], 1);
+    EXPECT_TRUE(a["changed"].get<bool>());
+    EXPECT_NE(a["warning"].get<std::string>().find("near its own origin"), std::string::npos);
+    const nlohmann::json& b = j["mesh_b"]["import"];
+    EXPECT_FALSE(b["changed"].get<bool>());
+    EXPECT_EQ(b["degenerate_dropped"], 0);
+    EXPECT_FALSE(b.contains("warning"));
+    // The shipped meshes: nothing to say.
+    r = runQueryCli("assets/torus.obj assets/crystal.obj --bv obb");
+    EXPECT_EQ(r.err, "");
+    fs::remove_all(dir);
+}
+
 TEST(Query, ParsePose) {
     std::string error;
     const auto pose = app::parsePose("1, 2, 3, 2, 0, 0, 0", &error);

@@ -191,6 +191,43 @@ TEST(MassProperties, OpenMeshIsAnError) {
     EXPECT_NE(out.error.find("not closed"), std::string::npos) << out.error;
 }
 
+TEST(MassProperties, BoundaryEdgesAreCounted) {
+    TriangleMesh m = boxMesh(Vec3(1, 1, 1));
+    EXPECT_EQ(boundaryEdgeCount(m.triangles), 0);
+    // One quad face (two triangles) missing: its four edges are the boundary.
+    m.triangles.pop_back();
+    EXPECT_EQ(boundaryEdgeCount(m.triangles), 3);
+    m.triangles.pop_back();
+    EXPECT_EQ(boundaryEdgeCount(m.triangles), 4);
+    const MassPropertiesOutput out = computeMassProperties(meshShape(m), 1000);
+    EXPECT_NE(out.error.find("4 boundary edges"), std::string::npos) << out.error;
+}
+
+TEST(MassProperties, InertiaProblems) {
+    EXPECT_EQ(inertiaProblem(Vec3(1, 2, 2.5).asDiagonal()), "");
+    // A flat lamina: I_z = I_x + I_y exactly is a valid tensor.
+    EXPECT_EQ(inertiaProblem(Vec3(1, 2, 3).asDiagonal()), "");
+    // The unit cube's tensor rotated: not diagonal, still valid.
+    const Mat3 r = Eigen::AngleAxis<Real>(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+    EXPECT_EQ(inertiaProblem(r * Vec3(1, 1.5, 2).asDiagonal() * r.transpose()), "");
+    EXPECT_NE(inertiaProblem(Vec3(1, 0, 1).asDiagonal()).find("positive definite"),
+              std::string::npos);
+    EXPECT_NE(inertiaProblem(Vec3(1, -1, 1).asDiagonal()).find("positive definite"),
+              std::string::npos);
+    EXPECT_NE(inertiaProblem(Vec3(1, 1, 3).asDiagonal()).find("triangle inequality"),
+              std::string::npos);
+    Mat3 asym = Mat3::Identity();
+    asym(0, 1) = 0.1;
+    EXPECT_EQ(inertiaProblem(asym), "must be symmetric");
+    Mat3 nan = Mat3::Identity();
+    nan(2, 2) = std::nan("");
+    EXPECT_EQ(inertiaProblem(nan), "must be finite");
+    // The triangle inequality holds for every principal frame: a rotated violation is caught.
+    EXPECT_NE(inertiaProblem(r * Vec3(1, 1, 3).asDiagonal() * r.transpose())
+                  .find("triangle inequality"),
+              std::string::npos);
+}
+
 TEST(MassProperties, InwardMeshIsAnError) {
     TriangleMesh m = boxMesh(Vec3(1, 1, 1));
     for (auto& t : m.triangles) std::swap(t[1], t[2]);

@@ -3,12 +3,18 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace engine {
 namespace {
@@ -135,6 +141,8 @@ f 1 2 4
     ASSERT_TRUE(out.ok) << out.error;
     EXPECT_EQ(out.mesh.triangles.size(), 1u);
     EXPECT_EQ(out.mesh.vertices.size(), 3u);  // the unused vertex is dropped too
+    EXPECT_EQ(out.report.triangles_read, 2);
+    EXPECT_EQ(out.report.degenerate_dropped, 1);
 }
 
 TEST_F(MeshImport, MissingFileIsAClearError) {
@@ -239,6 +247,223 @@ TEST_F(MeshImport, FilesPastTheSizeLimitAreRefusedUnread) {
         << out.error;
 }
 
+// x rounded to float and back; volatile, since GCC 12's vectorizer at -O2 dropped the round trip
+// in degenerateInFloat's loop (it counted 0 collapsed triangles instead of 1250).
+double roundedToFloat(double x) {
+    const volatile float f = static_cast<float>(x);
+    return double(f);
+}
+
+// A fine grid near (1e6, 1e6): n x n cells of `h` (1 cm), z a small ripple; two triangles a cell.
+// Float keeps 1/16 at 1e6, so most of its vertices collapse onto each other in float.
+struct FarGrid {
+    static constexpr int kN = 30;
+    static constexpr double kH = 0.01;
+    static constexpr double kOrigin = 1e6;
+    std::vector<std::array<double, 3>> vertices;
+    std::vector<std::array<int, 3>> triangles;
+    FarGrid() {
+        for (int i = 0; i <= kN; ++i) {
+            for (int j = 0; j <= kN; ++j) {
+                vertices.push_back({kOrigin + i * kH, kOrigin + j * kH, 0.001 * ((i + j) % 3)});
+            }
+        }
+        const auto at = [](int i, int j) { return i * (kN + 1) + j; };
+        for (int i = 0; i < kN; ++i) {
+            for (int j = 0; j < kN; ++j) {
+                triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+                triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+            }
+        }
+    }
+    std::string obj() const {
+        std::string text;
+        char line[128];
+        for (const auto& v : vertices) {
+            std::snprintf(line, sizeof line, "v %.10f %.10f %.10f\n", v[0], v[1], v[2]);
+            text += line;
+        }
+        for (const auto& t : triangles) {
+            text += "f " + std::to_string(t[0] + 1) + " " + std::to_string(t[1] + 1) + " " +
+                    std::to_string(t[2] + 1) + "\n";
+        }
+        return text;
+    }
+    // Binary STL: float in the file itself.
+    std::string binaryStl() const {
+        std::string bytes(80, '\0');
+        const auto put = [&bytes](const void* p, std::size_t n) {
+            bytes.append(static_cast<const char*>(p), n);
+        };
+        const std::uint32_t count = static_cast<std::uint32_t>(triangles.size());
+        put(&count, 4);
+        for (const auto& t : triangles) {
+            const float normal[3] = {0, 0, 1};
+            put(normal, sizeof normal);
+            for (const int k : t) {
+                const float v[3] = {float(vertices[k][0]), float(vertices[k][1]),
+                                    float(vertices[k][2])};
+                put(v, sizeof v);
+            }
+            const std::uint16_t attribute = 0;
+            put(&attribute, 2);
+        }
+        return bytes;
+    }
+    // Triangles that have a repeated corner or no area once their corners are floats: computed
+    // here from the grid itself, independently of the importer. The rounded corners lie on a
+    // lattice of exactly representable steps, so the cross product is exact and zero means zero.
+    int degenerateInFloat() const {
+        int n = 0;
+        for (const auto& t : triangles) {
+            std::array<Vec3, 3> c;
+            for (int k = 0; k < 3; ++k) {
+                const auto& v = vertices[t[k]];
+                c[k] = Vec3(roundedToFloat(v[0]), roundedToFloat(v[1]), roundedToFloat(v[2]));
+            }
+            if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2] ||
+                (c[1] - c[0]).cross(c[2] - c[0]).squaredNorm() == 0) {
+                ++n;
+            }
+        }
+        return n;
+    }
+};
+
+// Issue "Meshes from the real world": a fine grid near 1e6 lost 2,686 of 3,732 triangles in
+// assimp's float coordinates, silently. An OBJ is read in double as well, so the importer hands
+// assimp its text recentred on the mesh: every triangle is kept, the coordinates come back to
+// float's precision relative to the mesh's size, and there is nothing to warn about.
+TEST_F(MeshImport, FarFromOriginTextMeshKeepsEveryTriangle) {
+    const FarGrid grid;
+    ASSERT_GT(grid.degenerateInFloat(), 1000);  // what a float import of it would lose
+    const MeshImportOutput out = importMesh(write("far.obj", grid.obj()), 1);
+    ASSERT_TRUE(out.ok) << out.error;
+    EXPECT_EQ(out.mesh.triangles.size(), grid.triangles.size());
+    EXPECT_EQ(out.mesh.vertices.size(), grid.vertices.size());
+    const MeshImportReport& r = out.report;
+    EXPECT_TRUE(r.coordinates_checked);
+    EXPECT_TRUE(r.recentred);
+    EXPECT_EQ(r.triangles_read, static_cast<std::int64_t>(grid.triangles.size()));
+    EXPECT_EQ(r.degenerate_dropped, 0);
+    EXPECT_EQ(r.vertices_merged, 0);
+    // Float relative to the grid's half-size (0.15): 2^-24 * 0.15 ~ 1e-8.
+    EXPECT_LE(r.max_rounding, 2e-8);
+    EXPECT_FALSE(r.changed());
+    EXPECT_EQ(describeImportChanges(r), "");
+    // Each vertex within float's rounding (relative to the mesh) of the grid vertex it is.
+    for (const Vec3& v : out.mesh.vertices) {
+        const long i = std::lround((v.x() - FarGrid::kOrigin) / FarGrid::kH);
+        const long j = std::lround((v.y() - FarGrid::kOrigin) / FarGrid::kH);
+        ASSERT_TRUE(i >= 0 && i <= FarGrid::kN && j >= 0 && j <= FarGrid::kN) << v.transpose();
+        const auto& g = grid.vertices[static_cast<std::size_t>(i * (FarGrid::kN + 1) + j)];
+        EXPECT_LE((v - Vec3(g[0], g[1], g[2])).cwiseAbs().maxCoeff(), 2e-8) << v.transpose();
+    }
+}
+
+// The same grid in a binary STL is float in the file itself: the importer cannot recover it, but
+// it counts every triangle it drops and says how to get them back.
+TEST_F(MeshImport, FarFromOriginFloatMeshIsReportedWithTheWayOut) {
+    const FarGrid grid;
+    const int expected = grid.degenerateInFloat();
+    ASSERT_GT(expected, 1000);
+    const MeshImportOutput out = importMesh(write("far.stl", grid.binaryStl()), 1);
+    ASSERT_TRUE(out.ok) << out.error;
+    const MeshImportReport& r = out.report;
+    EXPECT_FALSE(r.coordinates_checked);
+    EXPECT_EQ(r.triangles_read, static_cast<std::int64_t>(grid.triangles.size()));
+    EXPECT_EQ(r.degenerate_dropped, expected);
+    EXPECT_EQ(out.mesh.triangles.size(), grid.triangles.size() - expected);
+    EXPECT_NEAR(r.max_coordinate, 1e6 + 0.3, 0.1);
+    EXPECT_TRUE(r.changed());
+    const std::string w = describeImportChanges(r);
+    EXPECT_NE(w.find("dropped " + std::to_string(expected) + " of 1800 triangles as degenerate"),
+              std::string::npos)
+        << w;
+    EXPECT_NE(w.find("move the mesh's coordinates near its own origin"), std::string::npos) << w;
+    EXPECT_NE(w.find("place it with the body's position"), std::string::npos) << w;
+}
+
+// Two vertices 1e-9 apart near the origin of a unit mesh are one vertex in float: the report
+// counts the merge, the triangle it collapses, and blames rounding (not the file).
+TEST_F(MeshImport, VerticesMergedByRoundingAreCounted) {
+    const std::string text =
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1.000000001 0 0\n"
+        "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\nf 2 5 4\n";
+    const MeshImportOutput out = importMesh(write("near.obj", text), 1);
+    ASSERT_TRUE(out.ok) << out.error;
+    const MeshImportReport& r = out.report;
+    EXPECT_TRUE(r.coordinates_checked);
+    EXPECT_FALSE(r.recentred);
+    EXPECT_EQ(r.triangles_read, 5);
+    EXPECT_EQ(r.degenerate_dropped, 1);
+    EXPECT_EQ(r.vertices_merged, 1);
+    EXPECT_NEAR(r.max_rounding, 1e-9, 1e-10);
+    const std::string w = describeImportChanges(r);
+    EXPECT_NE(w.find("dropped 1 of 5 triangles as degenerate"), std::string::npos) << w;
+    EXPECT_NE(w.find("merged 1 vertices"), std::string::npos) << w;
+    EXPECT_NE(w.find("near its own origin"), std::string::npos) << w;
+}
+
+// A triangle degenerate in the file itself is counted too, and not blamed on rounding.
+TEST_F(MeshImport, DegenerateInTheFileIsNotBlamedOnRounding) {
+    const MeshImportOutput out =
+        importMesh(write("d.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\n"), 1);
+    ASSERT_TRUE(out.ok) << out.error;
+    EXPECT_EQ(out.report.degenerate_dropped, 1);
+    EXPECT_EQ(out.report.vertices_merged, 0);
+    const std::string w = describeImportChanges(out.report);
+    EXPECT_NE(w.find("degenerate in the file itself"), std::string::npos) << w;
+}
+
+// The text readers agree with assimp on OFF, ASCII PLY and ASCII STL far from the origin: each is
+// recentred and loses nothing.
+TEST_F(MeshImport, FarFromOriginOffPlyAndAsciiStlAreRecentred) {
+    const FarGrid grid;
+    std::string verts;
+    char line[128];
+    for (const auto& v : grid.vertices) {
+        std::snprintf(line, sizeof line, "%.10f %.10f %.10f\n", v[0], v[1], v[2]);
+        verts += line;
+    }
+    std::string faces;
+    for (const auto& t : grid.triangles) {
+        faces += "3 " + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " +
+                 std::to_string(t[2]) + "\n";
+    }
+    const std::string nv = std::to_string(grid.vertices.size());
+    const std::string nf = std::to_string(grid.triangles.size());
+    std::string stl = "solid grid\n";
+    for (const auto& t : grid.triangles) {
+        stl += "facet normal 0 0 1\nouter loop\n";
+        for (const int k : t) {
+            const auto& v = grid.vertices[k];
+            std::snprintf(line, sizeof line, "vertex %.10f %.10f %.10f\n", v[0], v[1], v[2]);
+            stl += line;
+        }
+        stl += "endloop\nendfacet\n";
+    }
+    stl += "endsolid grid\n";
+    const std::pair<const char*, std::string> files[] = {
+        {"far.off", "OFF\n" + nv + " " + nf + " 0\n" + verts + faces},
+        {"far.ply", "ply\nformat ascii 1.0\nelement vertex " + nv +
+                        "\nproperty double x\nproperty double y\nproperty double z\n"
+                        "element face " + nf +
+                        "\nproperty list uchar int vertex_indices\nend_header\n" + verts + faces},
+        {"far_ascii.stl", stl},
+    };
+    for (const auto& [name, text] : files) {
+        SCOPED_TRACE(name);
+        const MeshImportOutput out = importMesh(write(name, text), 1);
+        ASSERT_TRUE(out.ok) << out.error;
+        EXPECT_TRUE(out.report.coordinates_checked);
+        EXPECT_TRUE(out.report.recentred);
+        EXPECT_EQ(out.mesh.triangles.size(), grid.triangles.size());
+        EXPECT_EQ(out.report.degenerate_dropped, 0);
+        EXPECT_FALSE(out.report.changed()) << describeImportChanges(out.report);
+    }
+}
+
 TEST_F(MeshImport, ProjectAssetsAreClosedMeshes) {
     for (const char* name : {"torus.obj", "crystal.obj", "spaceship.obj"}) {
         const fs::path p = fs::path(CDLAB_SOURCE_DIR) / "assets" / name;
@@ -246,6 +471,10 @@ TEST_F(MeshImport, ProjectAssetsAreClosedMeshes) {
         ASSERT_TRUE(out.ok) << name << ": " << out.error;
         EXPECT_TRUE(closedAndOriented(out.mesh)) << name;
         EXPECT_GE(out.mesh.triangles.size(), 20u) << name;
+        // Read in double too, near their origin (not recentred), and nothing lost.
+        EXPECT_TRUE(out.report.coordinates_checked) << name;
+        EXPECT_FALSE(out.report.recentred) << name;
+        EXPECT_FALSE(out.report.changed()) << name << ": " << describeImportChanges(out.report);
     }
 }
 

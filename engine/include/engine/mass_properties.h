@@ -3,7 +3,10 @@
 // Mass Properties" (JGT 1996), via the divergence theorem over the boundary triangles.
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "collision/geometry/shape.h"
 #include "engine/body.h"
@@ -22,5 +25,18 @@ MassPropertiesOutput computeMassProperties(const collision::Shape& shape, Real d
 
 /// Volume of the shape (m^3). Meshes: signed volume of the closed surface.
 Real shapeVolume(const collision::Shape& shape);
+
+/// Edges of `triangles` that do not bound a closed surface: for each undirected edge, the
+/// imbalance between its two directions (a 2-manifold's boundary edge counts 1, a closed
+/// consistently oriented mesh has none). 0 <=> closed in the sense the volume integrals need.
+/// O(n log n) in the triangle count.
+std::int64_t boundaryEdgeCount(const std::vector<std::array<std::int32_t, 3>>& triangles);
+
+/// Why `inertia` (kg m^2, about the centre of mass, in the body frame) cannot be a rigid
+/// body's inertia tensor, or "" when it can: it must be finite, symmetric (to 1e-9 of its
+/// largest entry), positive definite, and its principal moments must satisfy the triangle
+/// inequality I1 <= I2 + I3 (to 1e-9 of the trace: a flat lamina has I1 = I2 + I3), since
+/// every mass distribution does (Goldstein, Classical Mechanics, §5.3).
+std::string inertiaProblem(const Mat3& inertia);
 
 }  // namespace engine

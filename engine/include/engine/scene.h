@@ -142,6 +142,10 @@ struct Scene {
     DrawSettings draw;
     std::vector<Body> bodies;
     Expectations expect;  ///< `expect:` (self-grading), empty when absent
+    /// What loading assumed or changed that the user should know, one line each,
+    /// "FILE:LINE:COL: path: what" (an open mesh's mass properties from its hull, triangles an
+    /// import dropped): the commands print them on stderr. Not errors: the scene loaded.
+    std::vector<std::string> notes;
 };
 
 /// Simulated seconds per second of the scene's video: time_step * steps_per_frame * fps
