@@ -65,6 +65,7 @@ int runCheck(const CheckOptions& options, std::ostream& out, std::ostream& err) 
     for (const fs::path& file : options.scenes) {
         try {
             scenes.push_back(engine::loadScene(file));
+            for (const std::string& note : scenes.back().notes) err << note << "\n";
         } catch (const engine::SceneError& e) {
             err << e.what() << "\n";
             bad = true;

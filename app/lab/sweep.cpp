@@ -344,6 +344,7 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
     std::vector<engine::Scene> scenes;
     try {
         base = engine::loadScene(options.scene);
+        for (const std::string& note : base.notes) err << note << "\n";
     } catch (const engine::SceneError& e) {
         err << e.what() << "\n";
         return kExitBadInput;
