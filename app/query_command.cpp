@@ -235,7 +235,7 @@ int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err) 
         }
         meshes[i] = std::move(imported.mesh);
         reports[i] = imported.report;
-        if (reports[i].changed()) {
+        if (reports[i].changed() && !(i == 1 && paths[1] == paths[0])) {  // once per file
             err << "warning: " << paths[i].string() << ": "
                 << engine::describeImportChanges(reports[i]) << "\n";
         }
