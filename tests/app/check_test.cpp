@@ -78,6 +78,31 @@ TEST(Check, ExpectationsThatHoldPass) {
     fs::remove_all(dir);
 }
 
+// Colour expectations are graded on the picture `cdlab run` draws: without draw.volumes, the
+// volume the broad phase tests. Two parallel bars turned 45 degrees, 0.6 m apart: their OBBs
+// are apart, their AABBs and bounding spheres overlap. Under the obb broad phase the frame shows
+// two green OBBs; a checker drawing the default spheres would see them yellow.
+TEST(Check, ColoursAreGradedOnTheVolumeTheBroadPhaseTests) {
+    const fs::path dir = tempDir("colours");
+    const engine::Scene scene = parse(
+        "world: {bounds: {min: [-4, -4, -4], max: [4, 4, 4]}, frames: 2}\n"
+        "broadphase: obb\n"
+        "output: {width: 160, height: 120}\n"
+        "camera: {position: [0, 0, 12], look_at: [0, 0, 0]}\n"
+        "bodies:\n"
+        "  - {name: p, shape: box, half_extents: [2, 0.1, 0.1], position: [0, 0, 0], "
+        "euler_deg: [0, 0, 45]}\n"
+        "  - {name: q, shape: box, half_extents: [2, 0.1, 0.1], position: [-0.42426, 0.42426, 0], "
+        "euler_deg: [0, 0, 45]}\n"
+        "expect:\n"
+        "  colors:\n"
+        "    - {frame: 0, present: [green], absent: [yellow, red]}\n");
+    const std::vector<CheckRow> rows = checkScene(scene, 2, dir);
+    ASSERT_EQ(rows.size(), 1u);
+    EXPECT_TRUE(rows[0].pass) << rows[0].expectation << ": " << rows[0].reason;
+    fs::remove_all(dir);
+}
+
 TEST(Check, WrongExpectationsFailWithTheReason) {
     const fs::path dir = tempDir("fail");
     // Gravity makes semi-implicit Euler drift in energy; nothing rotates.
