@@ -288,25 +288,66 @@ TEST(Sweep, ReadingNamesTheCheapestRunOnlyBeyondTheSpread) {
     std::vector<app::SweepRun> runs = {run("broadphase=sap", {1.4, 1.3, 2.0}),
                                        run("broadphase=sphere", {1.1, 1.0, 7.9})};
     std::string md = app::sweep::markdownReport(o, base, 0.1, runs, reference, {});
-    EXPECT_NE(md.find("- Cheapest of the runs that confirm exactly the reference's pairs: none "
+    EXPECT_NE(md.find("- Cheapest of the runs that confirm exactly the reference's pairs in time: none "
                       "named, the lowest costs are within measurement spread of each other"),
               std::string::npos)
         << md;
     EXPECT_NE(md.find("**broadphase=sphere** 1.1 (1..7.9), **broadphase=sap** 1.4 (1.3..2)"),
               std::string::npos)
         << md;
-    EXPECT_EQ(md.find("Cheapest of the runs that confirm exactly the reference's pairs: **"),
+    EXPECT_EQ(md.find("Cheapest of the runs that confirm exactly the reference's pairs in time: **"),
               std::string::npos)
         << md;
     runs[1].ms_per_simulated_s = {3.0, 2.9, 3.2};
     md = app::sweep::markdownReport(o, base, 0.1, runs, reference, {});
-    EXPECT_NE(md.find("- Cheapest of the runs that confirm exactly the reference's pairs: "
+    EXPECT_NE(md.find("- Cheapest of the runs that confirm exactly the reference's pairs in time: "
                       "**broadphase=sap** (1.4 (1.3..2) ms per simulated second, median "
                       "(min..max of 3 repeats))"),
               std::string::npos)
         << md;
     EXPECT_EQ(md.find("within measurement spread"), std::string::npos) << md;
     EXPECT_NE(md.find("| 1.4 (1.3..2) |"), std::string::npos) << md;
+}
+
+// Regression: tunnel_sphere's reading named a CCD-off run the cheapest accurate one: it confirms
+// the reference's pair, but 0.48 s late, on a later pass after a bounce. A run is accurate only
+// when every first contact is within its step plus the reference's.
+TEST(Sweep, LateFirstContactIsNotAccurate) {
+    auto run = [](const std::string& label, double cost, double late) {
+        app::SweepRun r;
+        r.label = label;
+        r.time_step = 0.01;
+        r.steps = 10;
+        r.repeats = 3;
+        r.ms_per_simulated_s = {cost, cost, cost};
+        r.ms_step = {cost / 100, cost / 100, cost / 100};
+        r.max_first_contact_error = late;
+        return r;
+    };
+    app::SweepOptions o;
+    o.scene = kScene;
+    app::SweepRun reference = run("", 10, 0);
+    reference.time_step = 0.001;
+    engine::Scene base;
+    base.world.time_step = 0.01;
+    // On time: late by less than 0.01 + 0.001 s.
+    std::vector<app::SweepRun> runs = {run("world.ccd=off", 1, 0.48),
+                                       run("world.ccd=conservative_advancement", 2, 0.0105)};
+    const std::string md = app::sweep::markdownReport(o, base, 0.1, runs, reference, {});
+    EXPECT_NE(md.find("- **world.ccd=off** confirms the reference's pairs, but a first contact "
+                      "comes 0.48 s off the reference's, more than its step plus the reference's "
+                      "(0.011 s): found by chance"),
+              std::string::npos)
+        << md;
+    EXPECT_NE(md.find("- Only one of the runs that confirm exactly the reference's pairs in "
+                      "time: **world.ccd=conservative_advancement**"),
+              std::string::npos)
+        << md;
+    runs.pop_back();
+    EXPECT_NE(app::sweep::markdownReport(o, base, 0.1, runs, reference, {})
+                  .find("- No run coarser than the reference confirms exactly the reference's "
+                        "pairs in time"),
+              std::string::npos);
 }
 
 // Regression: `--repeat 0` (or less) must be refused before anything runs, on the command line
