@@ -12,12 +12,11 @@
 
 #include "collision/assert.h"
 #include "volumes/covariance.h"
+#include "volumes/fit_slack.h"
 
 namespace collision {
 
 namespace {
-
-constexpr Real kFitSlack = Real(16) * kEpsilon;
 
 // Largest |coordinate| plus the largest extent of the set: the magnitude the rounding of any
 // projection of these points is relative to.
@@ -162,13 +161,8 @@ Obb BvTraits<Obb>::fit(const std::vector<Vec3>& corners) {
 Obb BvTraits<Obb>::fitWithAxes(const std::vector<Vec3>& corners, const Mat3& axes) {
     CDLAB_ASSERT(!corners.empty(), "fitting a volume to no points");
     const Vec3 origin = corners[0];
-    Vec3 lo = Vec3::Zero();
-    Vec3 hi = Vec3::Zero();
-    for (const Vec3& p : corners) {
-        const Vec3 proj = axes.transpose() * (p - origin);
-        lo = lo.cwiseMin(proj);
-        hi = hi.cwiseMax(proj);
-    }
+    Vec3 lo, hi;
+    projectionRange(axes, corners, origin, lo, hi);  // corners[0] projects to exactly 0
     Obb box;
     box.axes = axes;
     box.center = origin + axes * ((lo + hi) * Real(0.5));

@@ -54,13 +54,8 @@ Real magnitude(const Vec3& origin, const Vec3& lo, const Vec3& hi) {
 
 // The exact projection box of `v` on `axes` about `origin`, enlarged by the fit slack.
 Obb boxOnAxes(const Mat3& axes, const std::vector<Vec3>& v, const Vec3& origin, Real* volume) {
-    Vec3 lo = Vec3::Constant(std::numeric_limits<Real>::max());
-    Vec3 hi = Vec3::Constant(std::numeric_limits<Real>::lowest());
-    for (const Vec3& p : v) {
-        const Vec3 proj = axes.transpose() * (p - origin);
-        lo = lo.cwiseMin(proj);
-        hi = hi.cwiseMax(proj);
-    }
+    Vec3 lo, hi;
+    projectionRange(axes, v, origin, lo, hi);
     Obb box;
     box.axes = axes;
     box.center = origin + axes * ((lo + hi) * Real(0.5));
