@@ -80,49 +80,16 @@ bool blowUpToTetrahedron(const MinkowskiDifference& cso, Polytope& poly, EpaOutp
 
     while (poly.vertex_count < 4) {
         if (++out.iterations > kEpaMaxIterations) return false;  // Failed
-        const Vec3 w0 = poly.vert[0].w;
         std::array<Vec3, 6> dirs{};
-        int dir_count = 0;
-        if (poly.vertex_count == 1) {
-            dirs = {Vec3::UnitX(),  -Vec3::UnitX(), Vec3::UnitY(),
-                    -Vec3::UnitY(), Vec3::UnitZ(),  -Vec3::UnitZ()};
-            dir_count = 6;
-        } else if (poly.vertex_count == 2) {
-            const Vec3 e = poly.vert[1].w - w0;
-            const Real e_len = e.norm();
-            if (!(e_len > poly.eps)) {
-                poly.vertex_count = 1;  // duplicate vertex: restart from one
-                continue;
-            }
-            int axis = 0;
-            e.cwiseAbs().minCoeff(&axis);
-            const Vec3 d1 = e.cross(Vec3::Unit(axis)).normalized();
-            const Vec3 d2 = (e / e_len).cross(d1);
-            dirs = {d1, -d1, d2, -d2, Vec3::Zero(), Vec3::Zero()};
-            dir_count = 4;
-        } else {
-            const Vec3 n = (poly.vert[1].w - w0).cross(poly.vert[2].w - w0);
-            const Real len = n.norm();
-            if (!(len > poly.eps * poly.eps)) {
-                poly.vertex_count = 2;  // collinear: drop the third vertex and probe again
-                continue;
-            }
-            dirs = {n / len, -n / len, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
-            dir_count = 2;
+        const int dir_count = poly.blowUpDirections(dirs);
+        if (dir_count == 0) {
+            --poly.vertex_count;  // a duplicate or collinear last vertex: drop it, probe again
+            continue;
         }
         bool grown = false;
         for (int k = 0; k < dir_count && !grown; ++k) {
             const SupportVertex s = probe(dirs[static_cast<std::size_t>(k)]);
-            Real off = 0;
-            if (poly.vertex_count == 1) {
-                off = (s.w - w0).norm();
-            } else if (poly.vertex_count == 2) {
-                const Vec3 e = poly.vert[1].w - w0;
-                off = e.cross(s.w - w0).norm() / e.norm();
-            } else {
-                off = std::abs(dirs[static_cast<std::size_t>(k)].dot(s.w - w0));
-            }
-            if (off > poly.eps) {
+            if (poly.offSpan(dirs[static_cast<std::size_t>(k)], s.w) > poly.eps) {
                 poly.vert[static_cast<std::size_t>(poly.vertex_count++)] = s;
                 grown = true;
             }
@@ -201,42 +168,18 @@ ContactState epaDecide(const MinkowskiDifference& cso, const GjkSimplex<Vec3>& s
     // Blow a lower-dimensional simplex up to a tetrahedron (the CSO is 3-D unless it is flat, and
     // a flat CSO has penetration depth zero).
     while (poly.vertex_count < 4) {
-        const Vec3 w0 = poly.vert[0];
         std::array<Vec3, 6> dirs{};
-        int dir_count = 0;
-        if (poly.vertex_count == 1) {
-            dirs = {Vec3::UnitX(),  -Vec3::UnitX(), Vec3::UnitY(),
-                    -Vec3::UnitY(), Vec3::UnitZ(),  -Vec3::UnitZ()};
-            dir_count = 6;
-        } else if (poly.vertex_count == 2) {
-            const Vec3 e = poly.vert[1] - w0;
-            int axis = 0;
-            e.cwiseAbs().minCoeff(&axis);
-            const Vec3 d1 = e.cross(Vec3::Unit(axis)).normalized();
-            const Vec3 d2 = e.cross(d1).normalized();
-            dirs = {d1, -d1, d2, -d2, Vec3::Zero(), Vec3::Zero()};
-            dir_count = 4;
-        } else {
-            const Vec3 n = (poly.vert[1] - w0).cross(poly.vert[2] - w0);
-            const Real len = n.norm();
-            if (!(len > poly.eps * poly.eps)) return ContactState::Touching;
-            dirs = {n / len, -n / len, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
-            dir_count = 2;
+        const int dir_count = poly.blowUpDirections(dirs);
+        if (dir_count == 0) {
+            if (poly.vertex_count == 3) return ContactState::Touching;  // collinear: flat CSO
+            --poly.vertex_count;  // a duplicate second vertex: probe from the first
+            continue;
         }
         bool grown = false;
         for (int k = 0; k < dir_count && !grown; ++k) {
             Vec3 w;
             if (probe(dirs[k], w)) return ContactState::Touching;
-            Real off = 0;
-            if (poly.vertex_count == 1) {
-                off = (w - w0).norm();
-            } else if (poly.vertex_count == 2) {
-                const Vec3 e = poly.vert[1] - w0;
-                off = e.cross(w - w0).norm() / e.norm();
-            } else {
-                off = std::abs(dirs[k].dot(w - w0));
-            }
-            if (off > poly.eps) {
+            if (poly.offSpan(dirs[k], w) > poly.eps) {
                 poly.vert[poly.vertex_count++] = w;
                 grown = true;
             }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <utility>
 #include <cstddef>
 #include <limits>
@@ -52,6 +53,48 @@ struct EpaPolytope {
             f.dist = std::numeric_limits<Real>::infinity();
         }
         return true;
+    }
+
+    /// Directions to probe for a support point off the span of a start simplex of 1 to 3
+    /// vertices (GJK's final simplex when it is not a tetrahedron): the six axis directions
+    /// from a point, four normals of a segment, the two normals of a triangle. 0 when the
+    /// simplex is degenerate: a segment shorter than eps, a triangle of area below eps^2.
+    int blowUpDirections(std::array<Vec3, 6>& dirs) const {
+        const Vec3& w0 = point(0);
+        if (vertex_count == 1) {
+            dirs = {Vec3::UnitX(),  -Vec3::UnitX(), Vec3::UnitY(),
+                    -Vec3::UnitY(), Vec3::UnitZ(),  -Vec3::UnitZ()};
+            return 6;
+        }
+        if (vertex_count == 2) {
+            const Vec3 e = point(1) - w0;
+            const Real e_len = e.norm();
+            if (!(e_len > eps)) return 0;
+            int axis = 0;
+            e.cwiseAbs().minCoeff(&axis);
+            const Vec3 d1 = e.cross(Vec3::Unit(axis)).normalized();
+            const Vec3 d2 = (e / e_len).cross(d1);
+            dirs = {d1, -d1, d2, -d2, Vec3::Zero(), Vec3::Zero()};
+            return 4;
+        }
+        const Vec3 n = (point(1) - w0).cross(point(2) - w0);
+        const Real len = n.norm();
+        if (!(len > eps * eps)) return 0;
+        dirs = {n / len, -n / len, Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+        return 2;
+    }
+
+    /// How far `w`, found along probe direction `dir`, lies off the span of the start simplex
+    /// (distance from the point, from the segment's line, from the triangle's plane): above eps,
+    /// it is the next vertex.
+    Real offSpan(const Vec3& dir, const Vec3& w) const {
+        const Vec3& w0 = point(0);
+        if (vertex_count == 1) return (w - w0).norm();
+        if (vertex_count == 2) {
+            const Vec3 e = point(1) - w0;
+            return e.cross(w - w0).norm() / e.norm();
+        }
+        return std::abs(dir.dot(w - w0));
     }
 
     /// Closes the first four vertices (a tetrahedron) into four outward faces (RTCD 5.1.6 face
