@@ -563,7 +563,7 @@ void SceneParser::requireRoomToSeparate(const RepeatSpec& r, Real radius,
     if (need > kMaxRepeatPacking * room) {
         fail(r.node, path,
              std::to_string(r.count) + " bounding spheres of radius " + formatLimit(radius) +
-                 " fill " + formatLimit(Real(100 * need / room)) +
+                 " fill " + std::to_string(std::llround(100 * need / room)) +
                  "% of the region (grown by the radius); randomly placed spheres stay apart "
                  "only below about 38%: enlarge region, lower count, or set separated: false");
     }
