@@ -119,7 +119,8 @@ Command addBenchNarrowphaseCommand(CLI::App& bench) {
     cmd->add_option("--seed", o.seed, "pose seed")->capture_default_str();
     cmd->add_option("--methods", o.methods,
                     "comma-separated (default all): volume names (NAME-bu: bottom-up build) "
-                    "and fcl-obbrss, fcl-obb, fcl-rss, fcl-kios, fcl-aabb, fcl-kdop18")
+                    "and fcl-obbrss, fcl-obb, fcl-rss, fcl-kios, fcl-aabb, fcl-kdop18 "
+                    "(FCL-NAME-median, FCL-NAME-center: FCL's other split rules)")
         ->delimiter(',');
     cmd->add_option("--json", f->json, "also write the table as JSON to FILE");
     return {cmd, [f]() { return runBenchNarrowphase(f->resolved(), std::cout, std::cerr); }};
