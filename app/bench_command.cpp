@@ -107,10 +107,10 @@ Command addBenchConvexCommand(CLI::App& bench) {
 Command addBenchNarrowphaseCommand(CLI::App& bench) {
     auto f = std::make_shared<OptionsWithJson<BenchNarrowphaseOptions>>();
     BenchNarrowphaseOptions& o = f->options;
-    CLI::App* cmd = bench.add_subcommand(
-        "narrowphase",
-        "mesh-mesh queries on two tori: every BVH volume type beside FCL's "
-        "BVHModel types (build, first contact, all pairs, Nv, Np)");
+    CLI::App* cmd =
+        bench.add_subcommand("narrowphase",
+                             "mesh-mesh queries on two tori: every BVH volume type beside FCL's "
+                             "BVHModel types (build, first contact, all pairs, Nv, Np)");
     cmd->add_option("--triangles", o.triangles, "triangles per torus")->capture_default_str();
     cmd->add_flag("--large", o.large, "100k-triangle tori");
     cmd->add_option("--poses", o.poses, "poses, even: half collide")->capture_default_str();

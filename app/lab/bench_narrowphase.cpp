@@ -1,10 +1,10 @@
-// app/lab/bench_narrowphase.cpp -- `cdlab bench narrowphase`. Wiring and timing only: trees and queries
-// are collision/bvh.h; FCL (when CMake found it, CDLAB_HAVE_FCL) stays in this file.
-// Same inputs for every method: one torus mesh for A and B, B placed by the pose (A at the
-// identity). The reference answer per pose is cdlab's brute-force triangle loop
-// (intersectMeshMeshBruteForce; for --large its sweep form, the same list); cdlab methods must
-// return its pair list exactly, FCL's boolean and pair count are compared and mismatches reported
-// (FCL's triangle test is not exact).
+// app/lab/bench_narrowphase.cpp -- `cdlab bench narrowphase`. Wiring and timing only: trees and
+// queries are collision/bvh.h; FCL (when CMake found it, CDLAB_HAVE_FCL) stays in this file. Same
+// inputs for every method: one torus mesh for A and B, B placed by the pose (A at the identity).
+// The reference answer per pose is cdlab's brute-force triangle loop (intersectMeshMeshBruteForce;
+// for --large its sweep form, the same list); cdlab methods must return its pair list exactly,
+// FCL's boolean and pair count are compared and mismatches reported (FCL's triangle test is not
+// exact).
 #include "bench_narrowphase.h"
 
 #include <algorithm>
@@ -202,10 +202,9 @@ std::unique_ptr<NarrowMethod> makeMethod(const std::string& name) {
     // fcl-<volume>[-median|-center]: FCL's BVHModel with its split rule (default: mean).
     std::string base = name;
     fcl::detail::SplitMethodType split = fcl::detail::SPLIT_METHOD_MEAN;
-    for (const auto& [suffix, method] :
-         {std::pair<std::string_view, fcl::detail::SplitMethodType>{
-              "-median", fcl::detail::SPLIT_METHOD_MEDIAN},
-          {"-center", fcl::detail::SPLIT_METHOD_BV_CENTER}}) {
+    for (const auto& [suffix, method] : {std::pair<std::string_view, fcl::detail::SplitMethodType>{
+                                             "-median", fcl::detail::SPLIT_METHOD_MEDIAN},
+                                         {"-center", fcl::detail::SPLIT_METHOD_BV_CENTER}}) {
         if (base.ends_with(suffix)) {
             base.resize(base.size() - suffix.size());
             split = method;
