@@ -107,10 +107,10 @@ Command addBenchConvexCommand(CLI::App& bench) {
 Command addBenchNarrowphaseCommand(CLI::App& bench) {
     auto f = std::make_shared<OptionsWithJson<BenchNarrowphaseOptions>>();
     BenchNarrowphaseOptions& o = f->options;
-    CLI::App* cmd = bench.add_subcommand(
-        "narrowphase",
-        "mesh-mesh queries on two tori: every BVH volume type beside FCL's "
-        "BVHModel types (build, first contact, all pairs, Nv, Np)");
+    CLI::App* cmd =
+        bench.add_subcommand("narrowphase",
+                             "mesh-mesh queries on two tori: every BVH volume type beside FCL's "
+                             "BVHModel types (build, first contact, all pairs, Nv, Np)");
     cmd->add_option("--triangles", o.triangles, "triangles per torus")->capture_default_str();
     cmd->add_flag("--large", o.large, "100k-triangle tori");
     cmd->add_option("--poses", o.poses, "poses, even: half collide")->capture_default_str();
@@ -119,7 +119,8 @@ Command addBenchNarrowphaseCommand(CLI::App& bench) {
     cmd->add_option("--seed", o.seed, "pose seed")->capture_default_str();
     cmd->add_option("--methods", o.methods,
                     "comma-separated (default all): volume names (NAME-bu: bottom-up build) "
-                    "and fcl-obbrss, fcl-obb, fcl-rss, fcl-kios, fcl-aabb, fcl-kdop18")
+                    "and fcl-obbrss, fcl-obb, fcl-rss, fcl-kios, fcl-aabb, fcl-kdop18 "
+                    "(FCL-NAME-median, FCL-NAME-center: FCL's other split rules)")
         ->delimiter(',');
     cmd->add_option("--json", f->json, "also write the table as JSON to FILE");
     return {cmd, [f]() { return runBenchNarrowphase(f->resolved(), std::cout, std::cerr); }};

@@ -1,15 +1,15 @@
-// app/lab/bench_narrowphase.cpp -- `cdlab bench narrowphase`. Wiring and timing only: trees and queries
-// are collision/bvh.h; FCL (when CMake found it, CDLAB_HAVE_FCL) stays in this file.
-// Same inputs for every method: one torus mesh for A and B, B placed by the pose (A at the
-// identity). The reference answer per pose is cdlab's brute-force triangle loop
-// (intersectMeshMeshBruteForce; for --large its sweep form, the same list); cdlab methods must
-// return its pair list exactly, FCL's boolean and pair count are compared and mismatches reported
-// (FCL's triangle test is not exact).
+// app/lab/bench_narrowphase.cpp -- `cdlab bench narrowphase`. Wiring and timing only: trees and
+// queries are collision/bvh.h; FCL (when CMake found it, CDLAB_HAVE_FCL) stays in this file. Same
+// inputs for every method: one torus mesh for A and B, B placed by the pose (A at the identity).
+// The reference answer per pose is cdlab's brute-force triangle loop (intersectMeshMeshBruteForce;
+// for --large its sweep form, the same list); cdlab methods must return its pair list exactly,
+// FCL's boolean and pair count are compared and mismatches reported (FCL's triangle test is not
+// exact).
 #include "bench_narrowphase.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
+#include <ctime>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -20,6 +20,7 @@
 #include <ostream>
 #include <random>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "bvh_unit_costs.h"
@@ -29,6 +30,7 @@
 
 #ifdef CDLAB_HAVE_FCL
 #include <fcl/geometry/bvh/BVH_model.h>
+#include <fcl/geometry/bvh/detail/BV_splitter.h>
 #include <fcl/math/bv/AABB.h>
 #include <fcl/math/bv/OBB.h>
 #include <fcl/math/bv/OBBRSS.h>
@@ -37,21 +39,26 @@
 #include <fcl/math/bv/kIOS.h>
 #include <fcl/narrowphase/collision.h>
 #include <fcl/narrowphase/collision_object.h>
+#include <fcl/narrowphase/detail/traversal/collision/mesh_collision_traversal_node.h>
+#include <fcl/narrowphase/detail/traversal/collision_node.h>
 #endif
 
 namespace app {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
 using collision::Pose;
 using collision::Real;
 using collision::TriangleMesh;
 using collision::Vec3;
 
-double secondsSince(Clock::time_point t) {
-    return std::chrono::duration<double>(Clock::now() - t).count();
+// Thread CPU time: what another process on a shared machine takes does not count.
+double threadCpuSeconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
+double secondsSince(double t) { return threadCpuSeconds() - t; }
 
 // A torus around local z, ring radius 1, tube radius 0.4: nu segments around the ring, nv around
 // the tube, 2 nu nv triangles.
@@ -111,7 +118,8 @@ private:
 template <class BV>
 class FclMethod final : public NarrowMethod {
 public:
-    explicit FclMethod(std::string name) : name_(std::move(name)) {}
+    FclMethod(std::string name, fcl::detail::SplitMethodType split)
+        : name_(std::move(name)), split_(split) {}
     std::string name() const override { return name_; }
     bool hasCounters() const override { return false; }
     void build(const TriangleMesh& mesh) override {
@@ -126,37 +134,60 @@ public:
         }
         auto make = [&] {
             auto model = std::make_shared<fcl::BVHModel<BV>>();
+            model->bv_splitter = std::make_shared<fcl::detail::BVSplitter<BV>>(split_);
             model->beginModel();
             model->addSubModel(vertices, triangles);
             model->endModel();
             return model;
         };
         a_ = std::make_unique<fcl::CollisionObjectd>(make(), fcl::Transform3d::Identity());
-        model_b_ = make();
+        b_ = std::make_unique<fcl::CollisionObjectd>(make(), fcl::Transform3d::Identity());
     }
     bool first(const Pose& b_in_a, collision::BvhQueryStats*) override {
-        return run(b_in_a, 1) > 0;
+        return run(b_in_a, first_request_) > 0;
     }
     std::size_t all(const Pose& b_in_a, collision::BvhQueryStats*,
                     std::vector<collision::TrianglePair>*) override {
-        return run(b_in_a, std::numeric_limits<std::size_t>::max());
+        return run(b_in_a, all_request_);
     }
 
 private:
-    std::size_t run(const Pose& b_in_a, std::size_t max_contacts) {
+    // As an FCL user queries a moving object: the objects are made once (the constructor walks
+    // every vertex for the local AABB), each query only sets B's transform. fcl::collide on two
+    // BVH models reads neither object's world AABB, so computeAABB is not called.
+    std::size_t run(const Pose& b_in_a, const fcl::CollisionRequestd& request) {
         fcl::Transform3d tf = fcl::Transform3d::Identity();
         tf.linear() = b_in_a.rotation().cast<double>();
         tf.translation() = b_in_a.position.cast<double>();
-        const fcl::CollisionObjectd b(model_b_, tf);
-        fcl::CollisionRequestd request(max_contacts, false);
+        b_->setTransform(tf);
         fcl::CollisionResultd result;
-        fcl::collide(a_.get(), &b, request, result);
+        if constexpr (std::is_same_v<BV, fcl::RSSd>) {
+            // fcl::collide has no oriented dispatch for RSS (it copies and re-fits both models
+            // per query, ~19 ms at 10k triangles); FCL's own RSS traversal node is the path its
+            // tests use for RSS trees.
+            fcl::detail::MeshCollisionTraversalNodeRSSd node;
+            fcl::detail::initialize(node, rssModel(*a_), a_->getTransform(), rssModel(*b_),
+                                    b_->getTransform(), request, result);
+            fcl::detail::collide(&node);
+        } else {
+            fcl::collide(a_.get(), b_.get(), request, result);
+        }
         return result.numContacts();
     }
 
+    // No contact points or normals (enable_contact false: FCL stops at the triangle test);
+    // first contact stops at one pair, all pairs never stops.
+    const fcl::CollisionRequestd first_request_{1, false};
+    const fcl::CollisionRequestd all_request_{std::numeric_limits<std::size_t>::max(), false};
+    static const fcl::BVHModel<fcl::RSSd>& rssModel(const fcl::CollisionObjectd& o) {
+        return static_cast<const fcl::BVHModel<fcl::RSSd>&>(*o.collisionGeometry());
+    }
+
     std::string name_;
+    fcl::detail::SplitMethodType split_;
+
     std::unique_ptr<fcl::CollisionObjectd> a_;
-    std::shared_ptr<fcl::BVHModel<BV>> model_b_;
+    std::unique_ptr<fcl::CollisionObjectd> b_;
 };
 #endif
 
@@ -168,12 +199,23 @@ std::unique_ptr<NarrowMethod> makeMethod(const std::string& name) {
         }
     }
 #ifdef CDLAB_HAVE_FCL
-    if (name == "fcl-obbrss") return std::make_unique<FclMethod<fcl::OBBRSSd>>(name);
-    if (name == "fcl-obb") return std::make_unique<FclMethod<fcl::OBBd>>(name);
-    if (name == "fcl-rss") return std::make_unique<FclMethod<fcl::RSSd>>(name);
-    if (name == "fcl-kios") return std::make_unique<FclMethod<fcl::kIOSd>>(name);
-    if (name == "fcl-aabb") return std::make_unique<FclMethod<fcl::AABBd>>(name);
-    if (name == "fcl-kdop18") return std::make_unique<FclMethod<fcl::KDOPd<18>>>(name);
+    // fcl-<volume>[-median|-center]: FCL's BVHModel with its split rule (default: mean).
+    std::string base = name;
+    fcl::detail::SplitMethodType split = fcl::detail::SPLIT_METHOD_MEAN;
+    for (const auto& [suffix, method] : {std::pair<std::string_view, fcl::detail::SplitMethodType>{
+                                             "-median", fcl::detail::SPLIT_METHOD_MEDIAN},
+                                         {"-center", fcl::detail::SPLIT_METHOD_BV_CENTER}}) {
+        if (base.ends_with(suffix)) {
+            base.resize(base.size() - suffix.size());
+            split = method;
+        }
+    }
+    if (base == "fcl-obbrss") return std::make_unique<FclMethod<fcl::OBBRSSd>>(name, split);
+    if (base == "fcl-obb") return std::make_unique<FclMethod<fcl::OBBd>>(name, split);
+    if (base == "fcl-rss") return std::make_unique<FclMethod<fcl::RSSd>>(name, split);
+    if (base == "fcl-kios") return std::make_unique<FclMethod<fcl::kIOSd>>(name, split);
+    if (base == "fcl-aabb") return std::make_unique<FclMethod<fcl::AABBd>>(name, split);
+    if (base == "fcl-kdop18") return std::make_unique<FclMethod<fcl::KDOPd<18>>>(name, split);
 #endif
     return nullptr;
 }
@@ -282,7 +324,7 @@ Row measureMethod(const std::string& n, const TriangleMesh& mesh, const Workload
     row.counters = method->hasCounters();
     double best_build = std::numeric_limits<double>::infinity();
     for (int r = 0; r < std::min(reps, 3); ++r) {
-        const Clock::time_point t = Clock::now();
+        const double t = threadCpuSeconds();
         method->build(mesh);
         best_build = std::min(best_build, secondsSince(t) / 2);  // two trees built
     }
@@ -299,11 +341,11 @@ Row measureMethod(const std::string& n, const TriangleMesh& mesh, const Workload
         std::size_t count = 0;
         for (int r = 0; r < reps; ++r) {
             collision::BvhQueryStats s1;
-            Clock::time_point t = Clock::now();
+            double t = threadCpuSeconds();
             hit = method->first(p, &s1);
             best_first = std::min(best_first, secondsSince(t));
             collision::BvhQueryStats s2;
-            t = Clock::now();
+            t = threadCpuSeconds();
             count = method->all(p, &s2, r == 0 ? &pairs : nullptr);
             best_all = std::min(best_all, secondsSince(t));
             first_stats = s1;
@@ -329,7 +371,7 @@ Row measureMethod(const std::string& n, const TriangleMesh& mesh, const Workload
         // refitted tree does the same work), then check its answer at the first pose.
         double best_refit = std::numeric_limits<double>::infinity();
         for (int r = 0; r < std::min(reps, 3); ++r) {
-            const Clock::time_point t = Clock::now();
+            const double t = threadCpuSeconds();
             row.refit_nu = method->treeA()->refit(deformed);
             best_refit = std::min(best_refit, secondsSince(t));
         }
@@ -341,7 +383,7 @@ Row measureMethod(const std::string& n, const TriangleMesh& mesh, const Workload
 }
 
 void printRows(const std::vector<Row>& rows, std::ostream& out) {
-    out << std::left << std::setw(12) << "method" << std::right << std::setw(10) << "build_ms"
+    out << std::left << std::setw(18) << "method" << std::right << std::setw(10) << "build_ms"
         << std::setw(11) << "first_us" << std::setw(11) << "all_us" << std::setw(11) << "first_Nv"
         << std::setw(10) << "first_Np" << std::setw(11) << "all_Nv" << std::setw(10) << "all_Np"
         << std::setw(8) << "Cv_ns" << std::setw(8) << "Cp_ns" << std::setw(10) << "refit_ms"
@@ -349,7 +391,7 @@ void printRows(const std::vector<Row>& rows, std::ostream& out) {
         << '\n';
     out << std::fixed;
     for (const Row& r : rows) {
-        out << std::left << std::setw(12) << r.method << std::right << std::setprecision(2)
+        out << std::left << std::setw(18) << r.method << std::right << std::setprecision(2)
             << std::setw(10) << r.build_ms << std::setprecision(1) << std::setw(11) << r.first_us
             << std::setw(11) << r.all_us;
         if (r.counters) {
@@ -369,6 +411,42 @@ void printRows(const std::vector<Row>& rows, std::ostream& out) {
     out << "(Cv, Cp: ns per BV test and per triangle test, timed by replaying the tests the "
            "all-pairs"
            " queries made; refit: one tree to a deformed torus, Nu nodes updated)\n";
+}
+
+// The fastest cdlab row and the fastest FCL row of one column, and their ratio.
+struct Best {
+    const Row* cdlab = nullptr;
+    const Row* fcl = nullptr;
+    double ratio() const { return cdlab && fcl ? value(*cdlab) / value(*fcl) : 0; }
+    double (*value)(const Row&) = nullptr;
+};
+
+Best bestOf(const std::vector<Row>& rows, double (*value)(const Row&)) {
+    Best b;
+    b.value = value;
+    for (const Row& r : rows) {
+        const Row*& slot = r.counters ? b.cdlab : b.fcl;
+        if (!slot || value(r) < value(*slot)) slot = &r;
+    }
+    return b;
+}
+
+// One line per column: cdlab's fastest volume against FCL's fastest, as a ratio (below 1:
+// cdlab faster). Printed only when both libraries ran.
+void printBest(const std::vector<Row>& rows, std::ostream& out) {
+    const std::pair<const char*, double (*)(const Row&)> columns[] = {
+        {"build", [](const Row& r) { return r.build_ms; }},
+        {"first contact", [](const Row& r) { return r.first_us; }},
+        {"all pairs", [](const Row& r) { return r.all_us; }}};
+    for (const auto& [label, value] : columns) {
+        const Best b = bestOf(rows, value);
+        if (!b.cdlab || !b.fcl) return;
+        out << std::fixed << std::setprecision(2) << "best " << label << ": cdlab "
+            << b.cdlab->method << ' ' << value(*b.cdlab) << ", FCL " << b.fcl->method << ' '
+            << value(*b.fcl) << ", ratio " << b.ratio() << '\n';
+        out.unsetf(std::ios::fixed);
+        out << std::setprecision(6);
+    }
 }
 
 nlohmann::json rowsJson(const std::vector<Row>& rows) {
@@ -456,6 +534,7 @@ int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& ou
     }
 
     printRows(rows, out);
+    printBest(rows, out);
 
     if (options.json) {
         nlohmann::json j;

@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -82,6 +83,31 @@ TEST(NarrowphaseBench, BottomUpBuildsAreCheckedToo) {
     for (const auto& row : j["rows"]) {
         EXPECT_EQ(row["library"], "cdlab");
         EXPECT_EQ(row["pair_mismatches"], 0) << row["method"];
+    }
+}
+
+// Every FCL row runs the path an FCL user gets (one object per mesh, setTransform per query;
+// RSS through FCL's RSS traversal node) and any of FCL's split rules by suffix, and answers as
+// the brute force does on every pose.
+TEST(NarrowphaseBench, FclRowsTakeSplitRulesAndAgreeWithBruteForce) {
+    const auto& names = app::narrowphaseBenchMethods();
+    if (std::find(names.begin(), names.end(), "fcl-obb") == names.end()) {
+        GTEST_SKIP() << "built without FCL";
+    }
+    const fs::path work = tempDir("fcl");
+    const fs::path json = work / "np.json";
+    const Result r = runCdlab(
+        "bench narrowphase --triangles 600 --poses 6 --reps 1 --methods "
+        "fcl-obb,fcl-rss,fcl-obb-median,fcl-kios-center --json " +
+            json.string(),
+        work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(slurp(json));
+    ASSERT_EQ(j["rows"].size(), 4u);
+    EXPECT_EQ(j["rows"][2]["method"], "fcl-obb-median");
+    for (const auto& row : j["rows"]) {
+        EXPECT_EQ(row["library"], "fcl");
+        EXPECT_EQ(row["bool_mismatches"], 0) << row["method"];
     }
 }
 

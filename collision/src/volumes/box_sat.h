@@ -6,8 +6,8 @@
 
 #include <algorithm>
 #include <array>
-#include <cstddef>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 
 #include "collision/math.h"
@@ -20,8 +20,8 @@ namespace collision {
 /// every axis L the projection grows by radius_sum |L|. Fifteen axes only: for swept volumes this
 /// is conservative (the rounded edges are treated as the enclosing box edges).
 template <bool kSwept>
-inline bool testSat15(const Vec3& a, const Mat3& rot, const Vec3& t, const Vec3& b, Real tol,
-                      Real radius_sum) {
+[[gnu::always_inline]] inline bool testSat15(const Vec3& a, const Mat3& rot, const Vec3& t,
+                                             const Vec3& b, Real tol, Real radius_sum) {
     // |R| + eps keeps near-parallel edge pairs (cross product ~ 0) from false separations.
     const Mat3 abs_rot = rot.cwiseAbs().array() + Real(16) * kEpsilon;
     const Real face_slack = tol + (kSwept ? radius_sum : Real(0));
@@ -126,8 +126,7 @@ private:
 
 /// Measures the 15 axes in A's box frame: `ea`, `eb` half extents, `rot` B's axes in A's frame,
 /// `t` B's centre there.
-inline BoxSatMeasure measureBoxSat(const Vec3& ea, const Mat3& rot, const Vec3& t,
-                                   const Vec3& eb) {
+inline BoxSatMeasure measureBoxSat(const Vec3& ea, const Mat3& rot, const Vec3& t, const Vec3& eb) {
     BoxSatMeasure m;
     forEachBoxSatAxis(ea, rot, t, eb, [&m](Real dist, Real ra, Real rb, const Vec3& axis, int id) {
         const Real sep = dist - ra - rb;

@@ -168,7 +168,8 @@ struct BvTraits<Obb> {
         return Obb{x.apply(b.center), x.r * b.axes, b.half_extents};
     }
     /// overlaps() with B already moved (the same products in the same order: the same answer).
-    static bool overlapsMoved(const Obb& a, const Obb& moved, const BvhTransform& x) {
+    [[gnu::always_inline]] static bool overlapsMoved(const Obb& a, const Obb& moved,
+                                                     const BvhTransform& x) {
         const Mat3 rot = a.axes.transpose() * moved.axes;
         const Vec3 t = a.axes.transpose() * (moved.center - a.center);
         return testSat15<false>(a.half_extents, rot, t, moved.half_extents, x.tol, 0);
