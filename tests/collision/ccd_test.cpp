@@ -447,6 +447,51 @@ TEST(CcdPrimitives, RandomContactsAreFoundNoLaterThanConstructed) {
     EXPECT_EQ(ee_hits, 300);
 }
 
+TEST(CcdPrimitives, SlidesParallelToThePrimitiveResolveInFewBoxes) {
+    // A vertex sliding across a face 1e-5 above it, and an edge sliding across another edge
+    // 1e-5 above it, for the whole step; rotated off the axes so no coordinate axis separates
+    // them. Per-axis bounds of F need (u, v) cells about 1e-5 wide along the whole slide (tens
+    // of thousands of boxes); projected on the plane normal the gap shows at once.
+    //
+    //      v(0) ------------------> v(1)     1e-5 above
+    //   ====================================  face (or edge b)
+    const collision::Mat3 rot =
+        (Eigen::AngleAxis<Real>(0.7, Vec3(1, 2, 3).normalized())).toRotationMatrix();
+    auto rotate = [&](std::array<Vec3, 4>& ps) {
+        for (Vec3& p : ps) p = rot * p;
+    };
+    VertexFaceCcdInput vf;
+    vf.t0 = {Vec3(-0.9, 0.1, 1e-5), Vec3(-1, -1, 0), Vec3(2, -1, 0), Vec3(-1, 2, 0)};
+    vf.t1 = {Vec3(0.9, 0.2, 1e-5), Vec3(-1, -1, 0), Vec3(2, -1, 0), Vec3(-1, 2, 0)};
+    rotate(vf.t0);
+    rotate(vf.t1);
+    const CcdOutput o = collision::vertexFaceCcd(vf);
+    EXPECT_EQ(o.state, CcdState::Separated);
+    RecordProperty("vertex_face_slide_boxes", o.iterations);
+    EXPECT_LT(o.iterations, 200);
+
+    EdgeEdgeCcdInput ee;
+    ee.t0 = {Vec3(-1, -0.9, 1e-5), Vec3(1, -0.9, 1e-5), Vec3(0.1, -1, 0), Vec3(-0.1, 1, 0)};
+    ee.t1 = {Vec3(-1, 0.9, 1e-5), Vec3(1, 0.9, 1e-5), Vec3(0.1, -1, 0), Vec3(-0.1, 1, 0)};
+    rotate(ee.t0);
+    rotate(ee.t1);
+    const CcdOutput e = collision::edgeEdgeCcd(ee);
+    EXPECT_EQ(e.state, CcdState::Separated);
+    RecordProperty("edge_edge_slide_boxes", e.iterations);
+    EXPECT_LT(e.iterations, 200);
+
+    // The same vertex slide descending through the face at t = 0.5 (height 1e-5 (1 - 2t)):
+    // a Hit, never later than 0.5, found as cheaply.
+    VertexFaceCcdInput down = vf;
+    down.t0[0] = rot * Vec3(-0.9, 0.1, 1e-5);
+    down.t1[0] = rot * Vec3(0.9, 0.2, -1e-5);
+    const CcdOutput d = collision::vertexFaceCcd(down);
+    ASSERT_EQ(d.state, CcdState::Hit);
+    EXPECT_LE(d.t, 0.5);
+    EXPECT_GT(d.t, 0.5 - 1e-3);
+    EXPECT_LT(d.iterations, 200);
+}
+
 TEST(CcdPrimitives, CapReturnsFailedWithASafeTime) {
     // Pathological: a vertex sliding in the face's plane, 1e-5 outside its edge for the whole
     // step (coplanar motion: the cubic is identically zero), needs many boxes near the edge.
