@@ -9,6 +9,15 @@
 // order of t_lo, so the t returned (the popped box's t_lo) is never later than the first
 // contact, and a Separated answer is never a false negative.
 //
+// Exclusion. A box is dropped when its image provably misses the origin (inflated by the min
+// separation). F is multilinear, so the image lies in the convex hull of the 8 corner values:
+// per coordinate axis that is the corners' range; along any direction n it is the range of
+// n . F over the corners. Three projections are tried: the axes, the primitives' plane normal
+// at the box's mid time (a vertex or edge sliding close and parallel to the other primitive,
+// the spike/crack/wedge queries, is excluded in one box instead of ~10^4 thin (u, v) cells),
+// and the mean corner value (the direction towards a small image, which also separates a
+// vertex passing just outside a face's edge in its plane). Each carries its rounding bound.
+//
 // Search order. Boxes are split on the variable that moves F most (largest corner difference),
 // except that t is bisected first whenever one half of the box's t interval is provably empty
 // (look-ahead): along a curve or patch of contacts (parallel edges, a collinear face, a large
