@@ -141,7 +141,15 @@ double errorBound(double max_abs) {
 /// corner differs from the exact one by <= err per axis, and the three-term dot product adds
 /// <= gamma_3 sum |n_a| |F_a| (Higham §3.1), both in dir_err; a point within the min separation
 /// (max norm) has |n . F| <= gap sum |n_a|.
-bool excludedAlong(const Query& q, const double vals[8][3], const double n[3]) {
+/// n is first scaled to max |n_a| ~ 1 (any direction is as valid as n): a raw plane normal is
+/// quadratic in the coordinates, and its products with F would overflow (to +-inf, NaN) at
+/// coordinates near 1e100 while the bound stayed finite. Scaled, |n . F| <= 3 (4 max_abs + err),
+/// finite for every accepted input (finiteInput).
+bool excludedAlong(const Query& q, const double vals[8][3], const double raw[3]) {
+    const double scale = std::max({std::abs(raw[0]), std::abs(raw[1]), std::abs(raw[2])});
+    if (!(scale > 0) || !std::isfinite(scale)) return false;  // no direction
+    const double inv = 1.0 / scale;
+    const double n[3] = {raw[0] * inv, raw[1] * inv, raw[2] * inv};
     double lo = std::numeric_limits<double>::infinity();
     double hi = -lo;
     for (int c = 0; c < 8; ++c) {
