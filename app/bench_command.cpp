@@ -67,8 +67,13 @@ Command addBenchCcdCommand(CLI::App& bench) {
         "ccd", "vertex-face and edge-edge CCD methods on the sample queries: FN, FP, us/query");
     cmd->add_option("dirs", f->dirs, "query directories (default tests/data/ccd-sample-queries)");
     cmd->add_option("--json", f->json, "also write the table as JSON to FILE");
-    cmd->add_option("--method", f->options.method, "conservative, naive or all")
-        ->check(CLI::IsMember({"conservative", "naive", "all"}))
+    cmd->add_option("--method", f->options.method,
+                    "conservative, naive, tight-inclusion (when configured with it) or all")
+        ->check(CLI::IsMember({"conservative", "naive", "tight-inclusion", "all"}))
+        ->capture_default_str();
+    cmd->add_option("--reps", f->options.reps,
+                    "runs per query; a query's time is its fastest run")
+        ->check(CLI::PositiveNumber)
         ->capture_default_str();
     cmd->add_option("--scenes", f->scenes,
                     "folder with tunnel_sphere.yaml and tunnel_bar.yaml (default scenes): "

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -19,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_ccd_peer.h"
 #include "collision/ccd/ccd.h"
 #include "engine/scene.h"
 #include "engine/world.h"
@@ -186,16 +188,22 @@ struct Row {
     std::string method, set, kind;
     int queries = 0, positives = 0, false_negatives = 0, false_positives = 0, failed = 0;
     int inexact_inputs = 0, inexact_false_negatives = 0;
-    double mean_us = 0, median_us = 0, p99_us = 0;
+    double mean_us = 0, median_us = 0, p99_us = 0, max_us = 0;
 };
+
+const char* const kTightInclusion = "tight-inclusion";
 
 CcdOutput runOne(const std::string& method, const std::string& kind, const Query& q) {
     if (kind == "vertex-face") {
         const collision::VertexFaceCcdInput in{q.t0, q.t1};
-        return method == "naive" ? collision::vertexFaceCcdNaive(in) : collision::vertexFaceCcd(in);
+        if (method == "naive") return collision::vertexFaceCcdNaive(in);
+        if (method == kTightInclusion) return tightInclusionVertexFace(in);
+        return collision::vertexFaceCcd(in);
     }
     const collision::EdgeEdgeCcdInput in{q.t0, q.t1};
-    return method == "naive" ? collision::edgeEdgeCcdNaive(in) : collision::edgeEdgeCcd(in);
+    if (method == "naive") return collision::edgeEdgeCcdNaive(in);
+    if (method == kTightInclusion) return tightInclusionEdgeEdge(in);
+    return collision::edgeEdgeCcd(in);
 }
 
 /// Fills the timing columns from per-query microseconds (nearest-rank percentiles).
@@ -209,9 +217,12 @@ void summarise(std::vector<double>& us, Row& row) {
     row.median_us = n % 2 ? us[n / 2] : 0.5 * (us[n / 2 - 1] + us[n / 2]);
     const size_t rank = static_cast<size_t>(std::ceil(0.99 * static_cast<double>(n)));
     row.p99_us = us[std::max<size_t>(rank, 1) - 1];
+    row.max_us = us.back();
 }
 
-Row runGroup(const std::string& method, const Group& g, std::vector<double>& all_us) {
+/// Each query runs `reps` times; its time is the fastest run (the others lost time to the
+/// machine, not to the method). The answer is the last run's (every method is deterministic).
+Row runGroup(const std::string& method, const Group& g, int reps, std::vector<double>& all_us) {
     Row row;
     row.method = method;
     row.set = g.set;
@@ -219,10 +230,15 @@ Row runGroup(const std::string& method, const Group& g, std::vector<double>& all
     std::vector<double> us;
     us.reserve(g.queries.size());
     for (const Query& q : g.queries) {
-        const auto start = std::chrono::steady_clock::now();
-        const CcdOutput o = runOne(method, g.kind, q);
-        const auto stop = std::chrono::steady_clock::now();
-        us.push_back(std::chrono::duration<double, std::micro>(stop - start).count());
+        CcdOutput o;
+        double best = std::numeric_limits<double>::infinity();
+        for (int r = 0; r < reps; ++r) {
+            const auto start = std::chrono::steady_clock::now();
+            o = runOne(method, g.kind, q);
+            const auto stop = std::chrono::steady_clock::now();
+            best = std::min(best, std::chrono::duration<double, std::micro>(stop - start).count());
+        }
+        us.push_back(best);
         // Failed counts as a reported contact: the caller must treat the pair as colliding.
         const bool hit = o.state != CcdState::Separated;
         ++row.queries;
@@ -254,23 +270,52 @@ nlohmann::json rowJson(const Row& r) {
                           {"inexact_false_negatives", r.inexact_false_negatives},
                           {"mean_us", r.mean_us},
                           {"median_us", r.median_us},
-                          {"p99_us", r.p99_us}};
+                          {"p99_us", r.p99_us},
+                          {"max_us", r.max_us}};
 }
 
 void printTable(const std::vector<Row>& rows, std::ostream& out) {
-    out << std::left << std::setw(13) << "method" << std::setw(29) << "set" << std::setw(12)
+    size_t method_width = 13;
+    for (const Row& r : rows) method_width = std::max(method_width, r.method.size() + 1);
+    const int mw = static_cast<int>(method_width);
+    out << std::left << std::setw(mw) << "method" << std::setw(29) << "set" << std::setw(12)
         << "kind" << std::right << std::setw(8) << "queries" << std::setw(6) << "FN" << std::setw(6)
         << "FP" << std::setw(7) << "failed" << std::setw(8) << "inexact" << std::setw(11)
         << "mean_us" << std::setw(11) << "median_us" << std::setw(11) << "p99_us"
+        << std::setw(11) << "max_us"
         << "\n";
     for (const Row& r : rows) {
-        out << std::left << std::setw(13) << r.method << std::setw(29) << r.set << std::setw(12)
+        out << std::left << std::setw(mw) << r.method << std::setw(29) << r.set << std::setw(12)
             << r.kind << std::right << std::setw(8) << r.queries << std::setw(6)
             << r.false_negatives << std::setw(6) << r.false_positives << std::setw(7) << r.failed
             << std::setw(8) << r.inexact_inputs << std::fixed << std::setprecision(2)
             << std::setw(11) << r.mean_us << std::setw(11) << r.median_us << std::setw(11)
-            << r.p99_us << std::defaultfloat << "\n";
+            << r.p99_us << std::setw(11) << r.max_us << std::defaultfloat << "\n";
     }
+}
+
+/// The conservative method's time over the peer's, per kind over all sets, when both ran.
+nlohmann::json printRatios(const std::vector<Row>& rows, std::ostream& out) {
+    nlohmann::json ratios = nlohmann::json::array();
+    for (const Row& ours : rows) {
+        if (ours.method != "conservative" || ours.set != "all") continue;
+        for (const Row& peer : rows) {
+            if (peer.method != kTightInclusion || peer.set != "all" || peer.kind != ours.kind) {
+                continue;
+            }
+            if (ratios.empty()) out << "\nconservative / tight-inclusion, all sets:\n";
+            const double median = ours.median_us / peer.median_us;
+            const double p99 = ours.p99_us / peer.p99_us;
+            const double max = ours.max_us / peer.max_us;
+            out << "  " << std::left << std::setw(12) << ours.kind << std::right
+                << std::setprecision(3) << " median " << median << "x  p99 " << p99 << "x  max "
+                << max << "x\n"
+                << std::setprecision(6);
+            ratios.push_back(
+                {{"kind", ours.kind}, {"median", median}, {"p99", p99}, {"max", max}});
+        }
+    }
+    return ratios;
 }
 
 struct SceneRow {
@@ -310,17 +355,34 @@ SceneRow runScene(const engine::Scene& scene, engine::CcdMethod method) {
 
 }  // namespace
 
-std::vector<std::string> ccdBenchMethods() { return {"conservative", "naive"}; }
+std::vector<std::string> ccdBenchMethods() {
+    std::vector<std::string> methods = {"conservative", "naive"};
+    if (tightInclusionBuiltIn()) methods.push_back(kTightInclusion);
+    return methods;
+}
 
 int runBenchCcd(const BenchCcdOptions& options, std::ostream& out, std::ostream& err) {
     std::vector<std::string> methods;
     if (options.method == "all") {
         methods = ccdBenchMethods();
-    } else if (options.method == "conservative" || options.method == "naive") {
+        if (!tightInclusionBuiltIn()) {
+            err << "cdlab bench ccd: Tight-Inclusion: not found at configure time ("
+                << kTightInclusionHint << ")\n";
+        }
+    } else if (options.method == kTightInclusion && !tightInclusionBuiltIn()) {
+        err << "cdlab bench ccd: Tight-Inclusion: not found at configure time ("
+            << kTightInclusionHint << ")\n";
+        return 2;
+    } else if (options.method == "conservative" || options.method == "naive" ||
+               options.method == kTightInclusion) {
         methods = {options.method};
     } else {
         err << "cdlab bench ccd: unknown method '" << options.method
-            << "' (conservative, naive, all)\n";
+            << "' (conservative, naive, tight-inclusion, all)\n";
+        return 2;
+    }
+    if (options.reps < 1) {
+        err << "cdlab bench ccd: --reps must be >= 1\n";
         return 2;
     }
     std::vector<fs::path> dirs = options.dirs;
@@ -355,7 +417,7 @@ int runBenchCcd(const BenchCcdOptions& options, std::ostream& out, std::ostream&
             for (const auto& [key, g] : groups) {
                 if (g.kind != kind) continue;
                 any = true;
-                const Row r = runGroup(method, g, all_us);
+                const Row r = runGroup(method, g, options.reps, all_us);
                 total.queries += r.queries;
                 total.positives += r.positives;
                 total.false_negatives += r.false_negatives;
@@ -371,6 +433,7 @@ int runBenchCcd(const BenchCcdOptions& options, std::ostream& out, std::ostream&
         }
     }
     printTable(rows, out);
+    const nlohmann::json ratios = printRatios(rows, out);
 
     int status = 0;
     for (const Row& r : rows) {
@@ -429,7 +492,9 @@ int runBenchCcd(const BenchCcdOptions& options, std::ostream& out, std::ostream&
         nlohmann::json doc;
         doc["benchmark"] = "ccd";
         doc["rows"] = nlohmann::json::array();
+        doc["reps"] = options.reps;
         for (const Row& r : rows) doc["rows"].push_back(rowJson(r));
+        doc["ratios"] = ratios;
         doc["scenes"] = nlohmann::json::array();
         for (const SceneRow& r : scene_rows) {
             doc["scenes"].push_back(nlohmann::json{{"scene", r.scene},

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "bench_ccd.h"
+#include "bench_ccd_peer.h"
 #include "cli_run.h"
 
 namespace {
@@ -61,6 +62,7 @@ TEST(CcdBench, UnitTestSetTableAndJsonWithNoFalseNegatives) {
             EXPECT_TRUE(row.contains(key)) << key;
         }
         EXPECT_GE(row["p99_us"].get<double>(), row["median_us"].get<double>());
+        EXPECT_GE(row["max_us"].get<double>(), row["p99_us"].get<double>());
         if (row["set"] != "unit-tests") continue;
         const int queries = row["queries"].get<int>();
         EXPECT_EQ(queries, row["kind"] == "vertex-face" ? 250 : 74);
@@ -130,6 +132,34 @@ TEST(CcdBench, MethodFilterAndBadInput) {
     options.dirs = {work / "broken"};
     EXPECT_EQ(app::runBenchCcd(options, out, err), 2);
     EXPECT_NE(err.str().find("data.csv:8:5: not an integer"), std::string::npos) << err.str();
+}
+
+// Tight-Inclusion is a peer only when the build found an installed copy: then its rows and the
+// ratio lines appear (with its own FN/FP counts); without it, asking for it is an error that
+// says what to configure, and `all` says so once on stderr and runs the rest.
+TEST(CcdBench, TightInclusionPeerWhenBuiltInElseAClearNote) {
+    const fs::path work = tempDir("peer");
+    const std::string set = "bench ccd tests/data/ccd-sample-queries/unit-tests --no-scenes";
+    const Result all = runCdlab(set, work);
+    ASSERT_EQ(all.exit_code, 0) << all.err;
+    if (app::tightInclusionBuiltIn()) {
+        EXPECT_NE(all.out.find("tight-inclusion unit-tests"), std::string::npos) << all.out;
+        EXPECT_NE(all.out.find("conservative / tight-inclusion"), std::string::npos) << all.out;
+        EXPECT_EQ(all.err.find("not found"), std::string::npos) << all.err;
+    } else {
+        const Result peer = runCdlab(set + " --method tight-inclusion", work);
+        EXPECT_EQ(peer.exit_code, 2);
+        EXPECT_NE(peer.err.find("Tight-Inclusion: not found"), std::string::npos) << peer.err;
+        EXPECT_NE(peer.err.find("CDLAB_TIGHT_INCLUSION_ROOT"), std::string::npos) << peer.err;
+        EXPECT_NE(all.err.find("Tight-Inclusion: not found"), std::string::npos) << all.err;
+        EXPECT_EQ(all.out.find("tight-inclusion"), std::string::npos) << all.out;
+    }
+    std::ostringstream out, err;
+    app::BenchCcdOptions options;
+    options.dirs = {fs::path(CDLAB_SOURCE_DIR) / "tests/data/ccd-sample-queries/unit-tests"};
+    options.reps = 0;
+    EXPECT_EQ(app::runBenchCcd(options, out, err), 2);
+    EXPECT_NE(err.str().find("--reps"), std::string::npos) << err.str();
 }
 
 }  // namespace

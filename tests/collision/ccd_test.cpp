@@ -447,6 +447,94 @@ TEST(CcdPrimitives, RandomContactsAreFoundNoLaterThanConstructed) {
     EXPECT_EQ(ee_hits, 300);
 }
 
+TEST(CcdPrimitives, SlidesParallelToThePrimitiveResolveInFewBoxes) {
+    // A vertex sliding across a face 1e-5 above it, and an edge sliding across another edge
+    // 1e-5 above it, for the whole step; rotated off the axes so no coordinate axis separates
+    // them. Per-axis bounds of F need (u, v) cells about 1e-5 wide along the whole slide (tens
+    // of thousands of boxes); projected on the plane normal the gap shows at once.
+    //
+    //      v(0) ------------------> v(1)     1e-5 above
+    //   ====================================  face (or edge b)
+    const collision::Mat3 rot =
+        (Eigen::AngleAxis<Real>(0.7, Vec3(1, 2, 3).normalized())).toRotationMatrix();
+    auto rotate = [&](std::array<Vec3, 4>& ps) {
+        for (Vec3& p : ps) p = rot * p;
+    };
+    VertexFaceCcdInput vf;
+    vf.t0 = {Vec3(-0.9, 0.1, 1e-5), Vec3(-1, -1, 0), Vec3(2, -1, 0), Vec3(-1, 2, 0)};
+    vf.t1 = {Vec3(0.9, 0.2, 1e-5), Vec3(-1, -1, 0), Vec3(2, -1, 0), Vec3(-1, 2, 0)};
+    rotate(vf.t0);
+    rotate(vf.t1);
+    const CcdOutput o = collision::vertexFaceCcd(vf);
+    EXPECT_EQ(o.state, CcdState::Separated);
+    RecordProperty("vertex_face_slide_boxes", o.iterations);
+    EXPECT_LT(o.iterations, 200);
+
+    EdgeEdgeCcdInput ee;
+    ee.t0 = {Vec3(-1, -0.9, 1e-5), Vec3(1, -0.9, 1e-5), Vec3(0.1, -1, 0), Vec3(-0.1, 1, 0)};
+    ee.t1 = {Vec3(-1, 0.9, 1e-5), Vec3(1, 0.9, 1e-5), Vec3(0.1, -1, 0), Vec3(-0.1, 1, 0)};
+    rotate(ee.t0);
+    rotate(ee.t1);
+    const CcdOutput e = collision::edgeEdgeCcd(ee);
+    EXPECT_EQ(e.state, CcdState::Separated);
+    RecordProperty("edge_edge_slide_boxes", e.iterations);
+    EXPECT_LT(e.iterations, 200);
+
+    // The same vertex slide descending through the face at t = 0.5 (height 1e-5 (1 - 2t)):
+    // a Hit, never later than 0.5, found as cheaply.
+    VertexFaceCcdInput down = vf;
+    down.t0[0] = rot * Vec3(-0.9, 0.1, 1e-5);
+    down.t1[0] = rot * Vec3(0.9, 0.2, -1e-5);
+    const CcdOutput d = collision::vertexFaceCcd(down);
+    ASSERT_EQ(d.state, CcdState::Hit);
+    EXPECT_LE(d.t, 0.5);
+    EXPECT_GT(d.t, 0.5 - 1e-3);
+    EXPECT_LT(d.iterations, 200);
+}
+
+TEST(CcdPrimitives, HugeCoordinatesFindTheSameContacts) {
+    // Metamorphic: contacts constructed as in RandomContactsAreFoundNoLaterThanConstructed, then
+    // every coordinate scaled by 2^320..2^379 (1e96..1e114, inside the accepted input range).
+    // A projection of F on the raw plane normal (coordinates squared, then times F) overflows
+    // to +-inf and NaN there while its rounding bound is still finite: NaN corners were skipped
+    // and a box holding the contact was excluded (about a quarter of these came back
+    // Separated). Every contact must still be a Hit, never later than constructed.
+    if (sizeof(Real) < sizeof(double)) GTEST_SKIP() << "float coordinates cannot be this large";
+    std::mt19937 rng(77);
+    std::uniform_real_distribution<Real> coord(-1, 1), unit(0.05, 0.95);
+    int hits = 0;
+    constexpr int kQueries = 600;
+    for (int i = 0; i < kQueries; ++i) {
+        const Real scale = std::ldexp(Real(1), 320 + i % 60);
+        const Real ts = unit(rng);
+        Real us = unit(rng), vs = unit(rng);
+        if (us + vs > 1) {
+            us = 1 - us;
+            vs = 1 - vs;
+        }
+        auto randVec = [&] { return Vec3(coord(rng), coord(rng), coord(rng)); };
+        VertexFaceCcdInput vf;
+        for (int k = 1; k < 4; ++k) {
+            vf.t0[k] = randVec();
+            vf.t1[k] = randVec();
+        }
+        auto at = [&](const Vec3& a, const Vec3& b) { return Vec3(a + ts * (b - a)); };
+        const Vec3 target = (1 - us - vs) * at(vf.t0[1], vf.t1[1]) + us * at(vf.t0[2], vf.t1[2]) +
+                            vs * at(vf.t0[3], vf.t1[3]);
+        vf.t0[0] = randVec();
+        vf.t1[0] = vf.t0[0] + (target - vf.t0[0]) / ts;
+        for (int k = 0; k < 4; ++k) {
+            vf.t0[k] *= scale;  // exact: a power of two
+            vf.t1[k] *= scale;
+        }
+        const CcdOutput o = collision::vertexFaceCcd(vf);
+        EXPECT_NE(o.state, CcdState::Separated) << i;
+        EXPECT_LE(o.t, ts + 1e-9) << i;
+        hits += o.state == CcdState::Hit;
+    }
+    EXPECT_EQ(hits, kQueries);
+}
+
 TEST(CcdPrimitives, CapReturnsFailedWithASafeTime) {
     // Pathological: a vertex sliding in the face's plane, 1e-5 outside its edge for the whole
     // step (coplanar motion: the cubic is identically zero), needs many boxes near the edge.

@@ -9,6 +9,15 @@
 // order of t_lo, so the t returned (the popped box's t_lo) is never later than the first
 // contact, and a Separated answer is never a false negative.
 //
+// Exclusion. A box is dropped when its image provably misses the origin (inflated by the min
+// separation). F is multilinear, so the image lies in the convex hull of the 8 corner values:
+// per coordinate axis that is the corners' range; along any direction n it is the range of
+// n . F over the corners. Three projections are tried: the axes, the primitives' plane normal
+// at the box's mid time (a vertex or edge sliding close and parallel to the other primitive,
+// the spike/crack/wedge queries, is excluded in one box instead of ~10^4 thin (u, v) cells),
+// and the mean corner value (the direction towards a small image, which also separates a
+// vertex passing just outside a face's edge in its plane). Each carries its rounding bound.
+//
 // Search order. Boxes are split on the variable that moves F most (largest corner difference),
 // except that t is bisected first whenever one half of the box's t interval is provably empty
 // (look-ahead): along a curve or patch of contacts (parallel edges, a collinear face, a large
@@ -68,6 +77,9 @@ struct Query {
     double x0[4][3];  ///< positions at t = 0
     double dx[4][3];  ///< fl(x1 - x0), the same rounding the error bound accounts for
     double err[3];    ///< bound on |computed F - exact F| at any corner, per axis
+    /// Per-axis coefficient of the error of a projection n . F: err plus the rounding of the
+    /// three-term dot product (see excludedAlong).
+    double dir_err[3];
     double gap;       ///< min_separation
     double accept;    ///< acceptance width of the image box
 };
@@ -121,22 +133,87 @@ double errorBound(double max_abs) {
     return 64.0 * u * max_abs + 64.0 * std::numeric_limits<double>::denorm_min();
 }
 
-/// True when the box's image provably misses the origin inflated by the min separation: the
-/// exact range of F per axis lies within [min - err, max + err] of the computed corners.
+/// True when n . F > 0 (or < 0) on the whole box, with the min separation: then the box holds
+/// no contact. Each point of the box is a convex combination of its corners (weights products
+/// of s and 1 - s per variable) and F is multilinear, so F(box) lies in the convex hull of the 8
+/// corner values (the convex-hull property of the tensor-product Bernstein form) and
+/// min_c n . F_c bounds n . F from below on the box, for any direction n. Rounding: the computed
+/// corner differs from the exact one by <= err per axis, and the three-term dot product adds
+/// <= gamma_3 sum |n_a| |F_a| (Higham §3.1), both in dir_err; a point within the min separation
+/// (max norm) has |n . F| <= gap sum |n_a|.
+/// n is first scaled to max |n_a| ~ 1 (any direction is as valid as n): a raw plane normal is
+/// quadratic in the coordinates, and its products with F would overflow (to +-inf, NaN) at
+/// coordinates near 1e100 while the bound stayed finite. Scaled, |n . F| <= 3 (4 max_abs + err),
+/// finite for every accepted input (finiteInput).
+bool excludedAlong(const Query& q, const double vals[8][3], const double raw[3]) {
+    const double scale = std::max({std::abs(raw[0]), std::abs(raw[1]), std::abs(raw[2])});
+    if (!(scale > 0) || !std::isfinite(scale)) return false;  // no direction
+    const double inv = 1.0 / scale;
+    const double n[3] = {raw[0] * inv, raw[1] * inv, raw[2] * inv};
+    double lo = std::numeric_limits<double>::infinity();
+    double hi = -lo;
+    for (int c = 0; c < 8; ++c) {
+        const double s = n[0] * vals[c][0] + n[1] * vals[c][1] + n[2] * vals[c][2];
+        lo = std::min(lo, s);
+        hi = std::max(hi, s);
+    }
+    // (1 + 8u) covers the rounding of this sum of non-negative terms.
+    constexpr double kUp = 1.0 + 8.0 * (std::numeric_limits<double>::epsilon() / 2);
+    const double bound = kUp * (std::abs(n[0]) * (q.dir_err[0] + q.gap) +
+                                std::abs(n[1]) * (q.dir_err[1] + q.gap) +
+                                std::abs(n[2]) * (q.dir_err[2] + q.gap));
+    return lo > bound || hi < -bound;
+}
+
+/// The normal of the primitives' common plane at time t: the face's normal (vertex-face) or
+/// the cross product of the edges (edge-edge). Along it F is, at that t, independent of u and
+/// v, so a vertex or an edge sliding near and parallel to the other primitive is excluded by
+/// one projection instead of a fine grid of (u, v) cells. Zero for degenerate primitives
+/// (the projection then excludes nothing, which is safe).
+void planeNormal(const Query& q, double t, double n[3]) {
+    double p[4][3];
+    for (int i = 0; i < 4; ++i) {
+        for (int a = 0; a < 3; ++a) p[i][a] = q.x0[i][a] + t * q.dx[i][a];
+    }
+    double e[3], f[3];
+    for (int a = 0; a < 3; ++a) {
+        if (q.pair == PrimitivePair::VertexFace) {
+            e[a] = p[2][a] - p[1][a];
+            f[a] = p[3][a] - p[1][a];
+        } else {
+            e[a] = p[1][a] - p[0][a];
+            f[a] = p[3][a] - p[2][a];
+        }
+    }
+    n[0] = e[1] * f[2] - e[2] * f[1];
+    n[1] = e[2] * f[0] - e[0] * f[2];
+    n[2] = e[0] * f[1] - e[1] * f[0];
+}
+
+/// True when the box's image provably misses the origin inflated by the min separation:
+/// first per axis (the exact range of F per axis lies within [min - err, max + err] of the
+/// computed corners), then along the primitives' plane normal at the box's mid time, then
+/// along the mean of the corner values (the direction from the origin towards a small image).
 /// `width` gets the largest computed image width over the axes.
-bool excludedBox(const Query& q, const double vals[8][3], double& width) {
+bool excludedBox(const Query& q, const ParamBox& box, const double vals[8][3], double& width) {
     width = 0;
+    double mean[3];
     for (int a = 0; a < 3; ++a) {
         double lo = vals[0][a];
         double hi = vals[0][a];
+        double sum = vals[0][a];
         for (int c = 1; c < 8; ++c) {
             lo = std::min(lo, vals[c][a]);
             hi = std::max(hi, vals[c][a]);
+            sum += vals[c][a];
         }
         if (lo - q.err[a] > q.gap || hi + q.err[a] < -q.gap) return true;
         width = std::max(width, hi - lo);
+        mean[a] = sum;
     }
-    return false;
+    double n[3];
+    planeNormal(q, 0.5 * (box.t_lo + box.t_hi), n);
+    return excludedAlong(q, vals, n) || excludedAlong(q, vals, mean);
 }
 
 /// True when every point of the box is provably within the min separation (max norm) of
@@ -174,8 +251,12 @@ Query makeQuery(PrimitivePair pair, const std::array<Vec3, 4>& t0, const std::ar
     }
     double size = 0;
     double max_err = 0;
+    constexpr double u = std::numeric_limits<double>::epsilon() / 2;
     for (int a = 0; a < 3; ++a) {
         q.err[a] = errorBound(max_abs[a]);
+        // |computed F_a| <= 4 max_abs + err (weights of magnitude <= 1, at most 3 of them on
+        // the face side), and gamma_3 <= 4u.
+        q.dir_err[a] = q.err[a] + 4.0 * u * (4.0 * max_abs[a] + q.err[a]);
         max_err = std::max(max_err, q.err[a]);
         size = std::max(size, hi[a] - lo[a]);
     }
@@ -248,9 +329,9 @@ bool lookAheadInT(const Query& q, const ParamBox& box, Certain& certain,
     double child_vals[8][3];
     double child_width = 0;
     cornerValues(q, early, child_vals);
-    const bool early_out = excludedBox(q, child_vals, child_width);
+    const bool early_out = excludedBox(q, early, child_vals, child_width);
     cornerValues(q, late, child_vals);
-    bool late_out = excludedBox(q, child_vals, child_width);
+    bool late_out = excludedBox(q, late, child_vals, child_width);
     if (!late_out && certainBox(q, child_vals)) {
         // The late half is all contact: remember its start, drop it.
         if (mid < certain.t) {
@@ -337,7 +418,7 @@ CcdOutput inclusionCcd(PrimitivePair pair, const std::array<Vec3, 4>& t0,
 
         cornerValues(q, box, vals);
         double width = 0;
-        if (excludedBox(q, vals, width)) continue;
+        if (excludedBox(q, box, vals, width)) continue;
         if (certainBox(q, vals)) {
             // Every point of the box is a contact, the earliest at t_lo, and nothing before it.
             out.state = CcdState::Hit;

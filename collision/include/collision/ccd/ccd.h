@@ -86,7 +86,9 @@ struct CcdSettings {
 /// subdivision of (t, u, v) with a rigorous floating-point error bound (Wang, Ferguson,
 /// Schneider, Jiang, Attene, Panozzo, "A Large-scale Benchmark and an Inclusion-based
 /// Algorithm for Continuous Collision Detection", ACM TOG 2021); see ccd/inclusion.cpp for why
-/// this method and the guarantee. Cost: typically tens of boxes; bounded by `max_boxes`.
+/// this method and the guarantee. Cost: one box for most queries, up to a few hundred on the
+/// sample queries' spikes and cracks (a box is excluded by projections of F on the axes, the
+/// primitives' plane normal and the mean corner value); bounded by `max_boxes`.
 CcdOutput vertexFaceCcd(const VertexFaceCcdInput& input, const CcdSettings& settings = {});
 
 /// Conservative edge-edge CCD; same method and guarantee as vertexFaceCcd.
