@@ -107,13 +107,6 @@ public:
     ContactAnswer best;
 };
 
-struct DispatchEntry {
-    std::unique_ptr<btCollisionObject> a;
-    std::unique_ptr<btCollisionObject> b;
-    btCollisionAlgorithm* algorithm = nullptr;
-    bool owned = false;  ///< made with new (SphereBoxAlgorithm), not by the dispatcher
-};
-
 std::string algorithmName(const btCollisionAlgorithm* algorithm, const Shape& a, const Shape& b) {
     if (dynamic_cast<const btBoxBoxCollisionAlgorithm*>(algorithm)) return "btBoxBoxDetector";
     if (dynamic_cast<const btSphereSphereCollisionAlgorithm*>(algorithm)) return "btSphereSphere";
@@ -130,25 +123,31 @@ std::string algorithmName(const btCollisionAlgorithm* algorithm, const Shape& a,
 
 struct BulletConvexPeer::State {
     BulletPath path = BulletPath::GeneralGjkEpa;
-    const std::vector<ConvexPair>* pairs = nullptr;
     std::vector<std::unique_ptr<btConvexShape>> shapes_a;
     std::vector<std::unique_ptr<btConvexShape>> shapes_b;
+    std::vector<btTransform> poses_a;
+    std::vector<btTransform> poses_b;
+    // Dispatcher paths: one algorithm for the row (every pair has the same shape types) and one
+    // pair of collision objects; each query passes its pair's shapes and transforms through the
+    // wrappers, which is all the algorithms read, so the peer touches no per-pair state beyond
+    // what cdlab's query reads.
     std::unique_ptr<btDefaultCollisionConfiguration> config;
     std::unique_ptr<btCollisionDispatcher> dispatcher;
-    std::vector<DispatchEntry> entries;
+    btCollisionObject object_a;
+    btCollisionObject object_b;
+    btCollisionAlgorithm* algorithm = nullptr;
+    bool owned = false;  ///< made with new (SphereBoxAlgorithm), not by the dispatcher
     btDispatcherInfo info;
     std::string name = "btGjkPairDetector+EPA";
 
     ~State() {
-        for (DispatchEntry& e : entries) {
-            if (e.algorithm == nullptr) continue;
-            if (e.owned) {
-                delete e.algorithm;
-                continue;
-            }
-            e.algorithm->~btCollisionAlgorithm();
-            dispatcher->freeCollisionAlgorithm(e.algorithm);
+        if (algorithm == nullptr) return;
+        if (owned) {
+            delete algorithm;
+            return;
         }
+        algorithm->~btCollisionAlgorithm();
+        dispatcher->freeCollisionAlgorithm(algorithm);
     }
 };
 
@@ -158,40 +157,30 @@ BulletConvexPeer::BulletConvexPeer(BulletPath path, const std::vector<ConvexPair
     : state_(std::make_unique<State>()) {
     State& s = *state_;
     s.path = path;
-    s.pairs = &pairs;
     for (const ConvexPair& p : pairs) {
         s.shapes_a.push_back(bulletShape(p.a));
         s.shapes_b.push_back(bulletShape(p.b));
+        s.poses_a.push_back(bulletTransform(p.pose_a));
+        s.poses_b.push_back(bulletTransform(p.pose_b));
     }
-    if (path == BulletPath::GeneralGjkEpa) return;
+    if (path == BulletPath::GeneralGjkEpa || pairs.empty()) return;
     s.config = std::make_unique<btDefaultCollisionConfiguration>();
     s.dispatcher = std::make_unique<btCollisionDispatcher>(s.config.get());
-    s.entries.resize(pairs.size());
-    for (std::size_t i = 0; i < pairs.size(); ++i) {
-        DispatchEntry& e = s.entries[i];
-        e.a = std::make_unique<btCollisionObject>();
-        e.b = std::make_unique<btCollisionObject>();
-        e.a->setCollisionShape(s.shapes_a[i].get());
-        e.b->setCollisionShape(s.shapes_b[i].get());
-        e.a->setWorldTransform(bulletTransform(pairs[i].pose_a));
-        e.b->setWorldTransform(bulletTransform(pairs[i].pose_b));
-        const btCollisionObjectWrapper wa(nullptr, e.a->getCollisionShape(), e.a.get(),
-                                          e.a->getWorldTransform(), -1, -1);
-        const btCollisionObjectWrapper wb(nullptr, e.b->getCollisionShape(), e.b.get(),
-                                          e.b->getWorldTransform(), -1, -1);
-        if (path == BulletPath::SphereBoxAlgorithm) {
-            btCollisionAlgorithmConstructionInfo ci;
-            ci.m_dispatcher1 = s.dispatcher.get();
-            e.algorithm = new btSphereBoxCollisionAlgorithm(nullptr, ci, &wa, &wb, false);
-            e.owned = true;
-        } else {
-            e.algorithm =
-                s.dispatcher->findAlgorithm(&wa, &wb, nullptr, BT_CONTACT_POINT_ALGORITHMS);
-        }
+    s.object_a.setCollisionShape(s.shapes_a[0].get());
+    s.object_b.setCollisionShape(s.shapes_b[0].get());
+    const btCollisionObjectWrapper wa(nullptr, s.shapes_a[0].get(), &s.object_a, s.poses_a[0], -1,
+                                      -1);
+    const btCollisionObjectWrapper wb(nullptr, s.shapes_b[0].get(), &s.object_b, s.poses_b[0], -1,
+                                      -1);
+    if (path == BulletPath::SphereBoxAlgorithm) {
+        btCollisionAlgorithmConstructionInfo ci;
+        ci.m_dispatcher1 = s.dispatcher.get();
+        s.algorithm = new btSphereBoxCollisionAlgorithm(nullptr, ci, &wa, &wb, false);
+        s.owned = true;
+    } else {
+        s.algorithm = s.dispatcher->findAlgorithm(&wa, &wb, nullptr, BT_CONTACT_POINT_ALGORITHMS);
     }
-    if (!s.entries.empty()) {
-        s.name = algorithmName(s.entries[0].algorithm, pairs[0].a, pairs[0].b);
-    }
+    s.name = algorithmName(s.algorithm, pairs[0].a, pairs[0].b);
 }
 
 BulletConvexPeer::~BulletConvexPeer() = default;
@@ -201,22 +190,20 @@ std::string BulletConvexPeer::pathName() const { return state_->name; }
 ContactAnswer BulletConvexPeer::query(std::size_t i) const {
     const State& s = *state_;
     if (s.path != BulletPath::GeneralGjkEpa) {
-        const DispatchEntry& e = s.entries[i];
-        const btCollisionObjectWrapper wa(nullptr, e.a->getCollisionShape(), e.a.get(),
-                                          e.a->getWorldTransform(), -1, -1);
-        const btCollisionObjectWrapper wb(nullptr, e.b->getCollisionShape(), e.b.get(),
-                                          e.b->getWorldTransform(), -1, -1);
+        const btCollisionObjectWrapper wa(nullptr, s.shapes_a[i].get(), &s.object_a, s.poses_a[i],
+                                          -1, -1);
+        const btCollisionObjectWrapper wb(nullptr, s.shapes_b[i].get(), &s.object_b, s.poses_b[i],
+                                          -1, -1);
         RecordingResult result(&wa, &wb);
-        e.algorithm->processCollision(&wa, &wb, s.info, &result);
+        s.algorithm->processCollision(&wa, &wb, s.info, &result);
         return result.best;
     }
-    const ConvexPair& p = (*s.pairs)[i];
     btVoronoiSimplexSolver simplex;
     btGjkEpaPenetrationDepthSolver depth_solver;
     btGjkPairDetector detector(s.shapes_a[i].get(), s.shapes_b[i].get(), &simplex, &depth_solver);
     btGjkPairDetector::ClosestPointInput in;
-    in.m_transformA = bulletTransform(p.pose_a);
-    in.m_transformB = bulletTransform(p.pose_b);
+    in.m_transformA = s.poses_a[i];
+    in.m_transformB = s.poses_b[i];
     btPointCollector result;
     detector.getClosestPoints(in, result, nullptr);
     if (!result.m_hasResult) return ContactAnswer{};
