@@ -98,6 +98,8 @@ Command addBenchConvexCommand(CLI::App& bench) {
     cmd->add_option("--queries", o.queries, "random pairs per workload")->capture_default_str();
     cmd->add_option("--passes", o.passes, "timed passes (median kept)")->capture_default_str();
     cmd->add_option("--seed", o.seed, "pose seed")->capture_default_str();
+    cmd->add_option("--workload", o.workload,
+                    "only the workloads whose name contains this text (e.g. box-box)");
     cmd->add_option("--tolerance", o.tolerance,
                     "relative tolerance for counting answers as wrong")
         ->capture_default_str();

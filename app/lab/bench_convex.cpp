@@ -424,12 +424,25 @@ int runBenchConvex(const BenchConvexOptions& options, std::ostream& out, std::os
         return 2;
     }
     const std::vector<Workload> list = workloads();
+    const auto selected = [&](const Workload& w) {
+        return w.name.find(options.workload) != std::string::npos;
+    };
+    if (std::none_of(list.begin(), list.end(), selected)) {
+        std::string message = "cdlab bench convex: --workload '";
+        message += options.workload;
+        message += "' matches no workload\n";
+        err << message;
+        return 2;
+    }
     std::vector<Row> rows;
     PairSet set;
     for (std::size_t k = 0; k < list.size(); ++k) {
-        // Rows of the same name answer the same pairs.
-        if (k == 0 || list[k].name != list[k - 1].name) {
-            set = makePairSet(list[k], options.seed * 1000 + k, options.queries);
+        if (!selected(list[k])) continue;
+        // Rows of the same name answer the same pairs (the seed of the name's first row).
+        std::size_t first = k;
+        while (first > 0 && list[first - 1].name == list[k].name) --first;
+        if (rows.empty() || rows.back().workload != list[k].name) {
+            set = makePairSet(list[first], options.seed * 1000 + first, options.queries);
         }
         rows.push_back(runWorkload(list[k], set, options));
     }

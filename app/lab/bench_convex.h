@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <iosfwd>
 #include <optional>
+#include <string>
 
 namespace app {
 
@@ -18,6 +19,8 @@ struct BenchConvexOptions {
     /// Relative tolerance of the accuracy count: |signed distance - exact| above
     /// tolerance * (larger bounding radius) counts as a wrong answer.
     double tolerance = 1e-6;
+    /// Run only the workloads whose name contains this text (all when empty).
+    std::string workload;
     std::optional<std::filesystem::path> json;  ///< also write the rows as JSON
 };
 

@@ -91,6 +91,24 @@ TEST(ConvexBench, FewQueriesNoMismatchAndCompleteJson) {
     fs::remove_all(work);
 }
 
+TEST(ConvexBench, WorkloadOptionSelectsRowsByName) {
+    const fs::path work = tempDir("select");
+    const fs::path json = work / "convex.json";
+    const Result r = runCdlab(
+        "bench convex --queries 20 --passes 1 --workload sphere-sphere --json " + json.string(),
+        work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json doc = nlohmann::json::parse(slurp(json));
+    ASSERT_EQ(doc["rows"].size(), 2u);
+    for (const nlohmann::json& row : doc["rows"]) {
+        EXPECT_EQ(row["workload"].get<std::string>().rfind("sphere-sphere", 0), 0u);
+    }
+    const Result none = runCdlab("bench convex --queries 20 --workload cone-cone", work);
+    EXPECT_EQ(none.exit_code, 2);
+    EXPECT_NE(none.err.find("cone-cone"), std::string::npos) << none.err;
+    fs::remove_all(work);
+}
+
 TEST(ConvexBench, BadOptionExitsTwo) {
     const fs::path work = tempDir("bad");
     const Result r = runCdlab("bench convex --queries 0", work);
