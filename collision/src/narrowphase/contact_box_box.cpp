@@ -251,6 +251,15 @@ bool satDetails(const Shape& a, const Shape& b, const RelativePose& rel, const C
 
 CollideOutput boxBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
                      Local& out) {
+    // Clear overlaps (satBoxState's first test) need only the best axes.
+    const BoxSatMeasure best =
+        measureBoxSatBest(a.half_extents, rel.rotation, rel.position, b.half_extents);
+    if (best.max_sep + best.err_bound < -ctx.tolerance) {
+        if (!satDetails(a, b, rel, ctx, best, out)) convexConvex(a, b, rel, ctx, out);
+        CollideOutput decision;
+        decision.state = ContactState::Penetrating;
+        return decision;
+    }
     const BoxSatMeasure sat =
         measureBoxSat(a.half_extents, rel.rotation, rel.position, b.half_extents);
     if (const std::optional<ContactState> proven = collide_pairs::satBoxState(sat, ctx.tolerance)) {

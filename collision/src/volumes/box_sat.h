@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 
+#include "collision/assert.h"
 #include "collision/math.h"
 
 namespace collision {
@@ -67,25 +68,56 @@ inline bool testSat15(const Vec3& a, const Mat3& rot, const Vec3& t, const Vec3&
 // Calls visit(dist, ra, rb, axis, id) for each measured axis (unit L, A's frame): face axes of A
 // (id 0..2), face axes of B (3..5), then the edge axes A_i x B_j (6 + 3 i + j), with dist = |t.L|
 // and ra, rb the boxes' projection radii.
+// One measured axis: dist = |t.L|, ra and rb the boxes' projection radii, on unit L (A's frame).
+struct BoxSatAxis {
+    Real dist;
+    Real ra;
+    Real rb;
+    Vec3 axis;
+};
+
+inline BoxSatAxis boxSatFaceAxisA(const Vec3& ea, const Mat3& rot, const Vec3& t, const Vec3& eb,
+                                  int i) {
+    return {std::abs(t[i]), ea[i], eb.dot(rot.row(i).transpose().cwiseAbs()), Vec3::Unit(i)};
+}
+
+inline BoxSatAxis boxSatFaceAxisB(const Vec3& ea, const Mat3& rot, const Vec3& t, const Vec3& eb,
+                                  int j) {
+    const Vec3 axis = rot.col(j);
+    return {std::abs(t.dot(axis)), ea.dot(axis.cwiseAbs()), eb[j], axis};
+}
+
+// The edge axis A_i x B_j normalised; false for exactly parallel edges (|A_i x B_j|^2 below the
+// smallest normal number), which the face axes cover.
+inline bool boxSatEdgeAxis(const Vec3& ea, const Mat3& rot, const Vec3& t, const Vec3& eb, int i,
+                           int j, BoxSatAxis& out) {
+    constexpr Real kParallelCross = std::numeric_limits<Real>::min();
+    const Vec3 axis = Vec3::Unit(i).cross(rot.col(j));
+    const Real len2 = axis.squaredNorm();
+    if (!(len2 >= kParallelCross)) return false;
+    const Vec3 unit = axis / std::sqrt(len2);
+    out = {std::abs(t.dot(unit)), ea.dot(unit.cwiseAbs()),
+           eb.dot((rot.transpose() * unit).cwiseAbs()), unit};
+    return true;
+}
+
 template <class Visit>
 inline void forEachBoxSatAxis(const Vec3& ea, const Mat3& rot, const Vec3& t, const Vec3& eb,
                               Visit&& visit) {
-    constexpr Real kParallelCross = std::numeric_limits<Real>::min();
     for (int i = 0; i < 3; ++i) {
-        visit(std::abs(t[i]), ea[i], eb.dot(rot.row(i).transpose().cwiseAbs()), Vec3::Unit(i), i);
+        const BoxSatAxis a = boxSatFaceAxisA(ea, rot, t, eb, i);
+        visit(a.dist, a.ra, a.rb, a.axis, i);
     }
     for (int j = 0; j < 3; ++j) {
-        const Vec3 axis = rot.col(j);
-        visit(std::abs(t.dot(axis)), ea.dot(axis.cwiseAbs()), eb[j], axis, 3 + j);
+        const BoxSatAxis a = boxSatFaceAxisB(ea, rot, t, eb, j);
+        visit(a.dist, a.ra, a.rb, a.axis, 3 + j);
     }
     for (int i = 0; i < 3; ++i) {
         for (int j = 0; j < 3; ++j) {
-            const Vec3 axis = Vec3::Unit(i).cross(rot.col(j));
-            const Real len2 = axis.squaredNorm();
-            if (!(len2 >= kParallelCross)) continue;
-            const Vec3 unit = axis / std::sqrt(len2);
-            visit(std::abs(t.dot(unit)), ea.dot(unit.cwiseAbs()),
-                  eb.dot((rot.transpose() * unit).cwiseAbs()), unit, 6 + 3 * i + j);
+            BoxSatAxis a;
+            if (boxSatEdgeAxis(ea, rot, t, eb, i, j, a)) {
+                visit(a.dist, a.ra, a.rb, a.axis, 6 + 3 * i + j);
+            }
         }
     }
 }
@@ -109,6 +141,9 @@ struct BoxSatMeasure {
     /// need no per-axis bound.
     Real err_bound = 0;
 
+    /// False for measureBoxSatBest's result: sep, mag and axis_count are not filled.
+    bool per_axis = true;
+
     /// Max over the axes of sep - err: the largest gap the axes prove.
     Real gapLo() const { return gap(-1); }
     /// Max over the axes of sep + err: below -tolerance, every axis proves the overlap.
@@ -116,6 +151,7 @@ struct BoxSatMeasure {
 
 private:
     Real gap(Real sign) const {
+        CDLAB_ASSERT(per_axis, "BoxSatMeasure::gap on a best-axes measure");
         Real g = -std::numeric_limits<Real>::infinity();
         for (std::size_t k = 0; k < static_cast<std::size_t>(axis_count); ++k) {
             g = std::max(g, sep[k] + sign * (Real(8) * kEpsilon * mag[k]));
@@ -150,6 +186,82 @@ inline BoxSatMeasure measureBoxSat(const Vec3& ea, const Mat3& rot, const Vec3& 
     m.max_sep = std::max(m.face_sep, m.edge_sep);
     m.err_bound = Real(16) * kEpsilon *
                   (t.lpNorm<1>() + ea.lpNorm<1>() + eb.lpNorm<1>());  // 1-norms >= 2-norms
+    return m;
+}
+
+/// The fields of measureBoxSat(...) that need no per-axis arrays -- face_sep, face_box,
+/// face_axis, edge_sep, edge_a, edge_b, edge_axis, max_sep, err_bound -- bit for bit, with
+/// per_axis false. The nine edge axes are first estimated without normalising their vectors
+/// (Gottschalk, Lin, Manocha 1996, "OBBTree" §4: with L = A_i x B_j, t.L, ra and rb are two
+/// products each of entries of R and |R|) and divided by |L|; only the edges whose estimate can
+/// be within rounding of the best are measured as measureBoxSat measures them, in the same order
+/// with the same tie rule, so the best edge, its separation and its axis are the same numbers.
+/// Both the estimate and measureBoxSat's value are within 8 eps (|t.L| + ra + rb) <= err_bound / 2
+/// of the true separation, so an edge whose estimate is below the best estimate by more than
+/// 2 err_bound is below the measured value of the edge with the best estimate.
+inline BoxSatMeasure measureBoxSatBest(const Vec3& ea, const Mat3& rot, const Vec3& t,
+                                       const Vec3& eb) {
+    BoxSatMeasure m;
+    m.per_axis = false;
+    for (int i = 0; i < 3; ++i) {
+        const BoxSatAxis a = boxSatFaceAxisA(ea, rot, t, eb, i);
+        const Real sep = a.dist - a.ra - a.rb;
+        if (sep > m.face_sep) {
+            m.face_sep = sep;
+            m.face_box = 0;
+            m.face_axis = i;
+        }
+    }
+    for (int j = 0; j < 3; ++j) {
+        const BoxSatAxis a = boxSatFaceAxisB(ea, rot, t, eb, j);
+        const Real sep = a.dist - a.ra - a.rb;
+        if (sep > m.face_sep) {
+            m.face_sep = sep;
+            m.face_box = 1;
+            m.face_axis = j;
+        }
+    }
+    m.err_bound = Real(16) * kEpsilon *
+                  (t.lpNorm<1>() + ea.lpNorm<1>() + eb.lpNorm<1>());  // 1-norms >= 2-norms
+    // Edges closer to parallel than this are always measured (their estimate divides by a small
+    // |L|; measuring them costs nothing when they are rare).
+    constexpr Real kNearParallel2 = Real(1e-8);
+    std::array<Real, 9> estimate;
+    Real best_estimate = -std::numeric_limits<Real>::infinity();
+    for (int i = 0; i < 3; ++i) {
+        const int i1 = (i + 1) % 3;
+        const int i2 = (i + 2) % 3;
+        for (int j = 0; j < 3; ++j) {
+            const int j1 = (j + 1) % 3;
+            const int j2 = (j + 2) % 3;
+            const Real r1 = rot(i1, j);
+            const Real r2 = rot(i2, j);
+            const Real len2 = r1 * r1 + r2 * r2;
+            const Real dist = std::abs(t[i2] * r1 - t[i1] * r2);
+            const Real ra = ea[i1] * std::abs(r2) + ea[i2] * std::abs(r1);
+            const Real rb = eb[j1] * std::abs(rot(i, j2)) + eb[j2] * std::abs(rot(i, j1));
+            const bool measurable = len2 >= kNearParallel2;
+            const Real e = measurable ? (dist - ra - rb) / std::sqrt(len2)
+                                      : std::numeric_limits<Real>::infinity();
+            estimate[static_cast<std::size_t>(3 * i + j)] = e;
+            if (measurable) best_estimate = std::max(best_estimate, e);
+        }
+    }
+    const Real cut = best_estimate - Real(2) * m.err_bound;
+    for (int k = 0; k < 9; ++k) {
+        // NaN estimates (non-finite input) are measured too.
+        if (estimate[static_cast<std::size_t>(k)] < cut) continue;
+        BoxSatAxis a;
+        if (!boxSatEdgeAxis(ea, rot, t, eb, k / 3, k % 3, a)) continue;
+        const Real sep = a.dist - a.ra - a.rb;
+        if (sep > m.edge_sep) {
+            m.edge_sep = sep;
+            m.edge_a = k / 3;
+            m.edge_b = k % 3;
+            m.edge_axis = a.axis;
+        }
+    }
+    m.max_sep = std::max(m.face_sep, m.edge_sep);
     return m;
 }
 
