@@ -21,7 +21,7 @@ int clipPolygon(const std::array<Vec3, 8>& in, int n, int axis, Real sign, Real 
     int m = 0;
     for (int i = 0; i < n; ++i) {
         const Vec3& p = in[static_cast<std::size_t>(i)];
-        const Vec3& q = in[static_cast<std::size_t>((i + 1) % n)];
+        const Vec3& q = in[static_cast<std::size_t>(i + 1 == n ? 0 : i + 1)];
         const Real dp = sign * p[axis] - limit;
         const Real dq = sign * q[axis] - limit;
         if (dp <= 0 && m < 8) out[static_cast<std::size_t>(m++)] = p;

@@ -10,6 +10,10 @@
 #include <cmath>
 #include <limits>
 
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
+
 #include "collision/assert.h"
 #include "collision/math.h"
 
@@ -189,16 +193,27 @@ inline BoxSatMeasure measureBoxSat(const Vec3& ea, const Mat3& rot, const Vec3& 
     return m;
 }
 
+/// 1 / sqrt of 12 floats (> 0, 16-byte aligned), to a relative error below 1.5 * 2^-12: SSE's
+/// rsqrtps (in the x86-64 baseline), else exact.
+inline void boxSatRsqrt(const float* in, float* out) {
+#if defined(__SSE__)
+    for (int k = 0; k < 12; k += 4) _mm_store_ps(out + k, _mm_rsqrt_ps(_mm_load_ps(in + k)));
+#else
+    for (int k = 0; k < 12; ++k) out[k] = 1.0f / std::sqrt(in[k]);
+#endif
+}
+
 /// The fields of measureBoxSat(...) that need no per-axis arrays -- face_sep, face_box,
 /// face_axis, edge_sep, edge_a, edge_b, edge_axis, max_sep, err_bound -- bit for bit, with
 /// per_axis false. The nine edge axes are first estimated without normalising their vectors
 /// (Gottschalk, Lin, Manocha 1996, "OBBTree" §4: with L = A_i x B_j, t.L, ra and rb are two
-/// products each of entries of R and |R|) and divided by |L|; only the edges whose estimate can
-/// be within rounding of the best are measured as measureBoxSat measures them, in the same order
-/// with the same tie rule, so the best edge, its separation and its axis are the same numbers.
-/// Both the estimate and measureBoxSat's value are within 8 eps (|t.L| + ra + rb) <= err_bound / 2
-/// of the true separation, so an edge whose estimate is below the best estimate by more than
-/// 2 err_bound is below the measured value of the edge with the best estimate.
+/// products each of entries of R and |R|) and scaled by an approximate 1 / |L|; only the edges
+/// whose estimate can be within rounding of the best are measured as measureBoxSat measures
+/// them, in the same order with the same tie rule, so the best edge, its separation and its axis
+/// are the same numbers. Unnormalised separation / |L| and measureBoxSat's value are both within
+/// 8 eps (|t.L| + ra + rb) <= err_bound / 2 of the true separation, and the approximate 1 / |L|
+/// is within kRsqrtRelative of 1 / |L|, so an edge whose estimate interval lies below another's
+/// by more than 2 err_bound is below that edge's measured value.
 inline BoxSatMeasure measureBoxSatBest(const Vec3& ea, const Mat3& rot, const Vec3& t,
                                        const Vec3& eb) {
     BoxSatMeasure m;
@@ -223,34 +238,53 @@ inline BoxSatMeasure measureBoxSatBest(const Vec3& ea, const Mat3& rot, const Ve
     }
     m.err_bound = Real(16) * kEpsilon *
                   (t.lpNorm<1>() + ea.lpNorm<1>() + eb.lpNorm<1>());  // 1-norms >= 2-norms
-    // Edges closer to parallel than this are always measured (their estimate divides by a small
-    // |L|; measuring them costs nothing when they are rare).
+    // Unnormalised estimates s / |L|, 1 / |L| from the SSE reciprocal square root (relative
+    // error below 1.5 * 2^-12): an edge is measured unless its estimate plus that error is below
+    // the best estimate minus that error by more than 2 err_bound. Edges closer to parallel than
+    // kNearParallel2 are always measured.
     constexpr Real kNearParallel2 = Real(1e-8);
-    std::array<Real, 9> estimate;
-    Real best_estimate = -std::numeric_limits<Real>::infinity();
-    for (int i = 0; i < 3; ++i) {
+    constexpr Real kRsqrtRelative = Real(1e-3);
+    alignas(16) std::array<float, 12> len2f{};
+    std::array<Real, 9> unnormalised;
+    std::array<bool, 9> measurable;
+    // Edge k = 3 i + j: i1, i2 follow i and j1, j2 follow j cyclically.
+    constexpr std::array<int, 9> kI{0, 0, 0, 1, 1, 1, 2, 2, 2};
+    constexpr std::array<int, 9> kJ{0, 1, 2, 0, 1, 2, 0, 1, 2};
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC unroll 9
+#endif
+    for (std::size_t k = 0; k < 9; ++k) {
+        const int i = kI[k];
+        const int j = kJ[k];
         const int i1 = (i + 1) % 3;
         const int i2 = (i + 2) % 3;
-        for (int j = 0; j < 3; ++j) {
-            const int j1 = (j + 1) % 3;
-            const int j2 = (j + 2) % 3;
-            const Real r1 = rot(i1, j);
-            const Real r2 = rot(i2, j);
-            const Real len2 = r1 * r1 + r2 * r2;
-            const Real dist = std::abs(t[i2] * r1 - t[i1] * r2);
-            const Real ra = ea[i1] * std::abs(r2) + ea[i2] * std::abs(r1);
-            const Real rb = eb[j1] * std::abs(rot(i, j2)) + eb[j2] * std::abs(rot(i, j1));
-            const bool measurable = len2 >= kNearParallel2;
-            const Real e = measurable ? (dist - ra - rb) / std::sqrt(len2)
-                                      : std::numeric_limits<Real>::infinity();
-            estimate[static_cast<std::size_t>(3 * i + j)] = e;
-            if (measurable) best_estimate = std::max(best_estimate, e);
-        }
+        const int j1 = (j + 1) % 3;
+        const int j2 = (j + 2) % 3;
+        const Real r1 = rot(i1, j);
+        const Real r2 = rot(i2, j);
+        const Real len2 = r1 * r1 + r2 * r2;
+        const Real dist = std::abs(t[i2] * r1 - t[i1] * r2);
+        const Real ra = ea[i1] * std::abs(r2) + ea[i2] * std::abs(r1);
+        const Real rb = eb[j1] * std::abs(rot(i, j2)) + eb[j2] * std::abs(rot(i, j1));
+        unnormalised[k] = dist - ra - rb;
+        measurable[k] = len2 >= kNearParallel2;  // also false for NaN
+        len2f[k] = measurable[k] ? static_cast<float>(len2) : 1.0f;
     }
-    const Real cut = best_estimate - Real(2) * m.err_bound;
+    len2f[9] = len2f[10] = len2f[11] = 1.0f;
+    alignas(16) std::array<float, 12> inv_len{};
+    boxSatRsqrt(len2f.data(), inv_len.data());
+    std::array<Real, 9> hi;
+    Real cut = -std::numeric_limits<Real>::infinity();
+    for (std::size_t k = 0; k < 9; ++k) {
+        const Real e = unnormalised[k] * static_cast<Real>(inv_len[k]);
+        const Real slack = kRsqrtRelative * std::abs(e);
+        hi[k] = measurable[k] ? e + slack : std::numeric_limits<Real>::infinity();
+        if (measurable[k]) cut = std::max(cut, e - slack);
+    }
+    cut -= Real(2) * m.err_bound;
     for (int k = 0; k < 9; ++k) {
         // NaN estimates (non-finite input) are measured too.
-        if (estimate[static_cast<std::size_t>(k)] < cut) continue;
+        if (hi[static_cast<std::size_t>(k)] < cut) continue;
         BoxSatAxis a;
         if (!boxSatEdgeAxis(ea, rot, t, eb, k / 3, k % 3, a)) continue;
         const Real sep = a.dist - a.ra - a.rb;
