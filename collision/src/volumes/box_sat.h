@@ -204,8 +204,10 @@ inline void boxSatRsqrt(const float* in, float* out) {
 }
 
 /// The fields of measureBoxSat(...) that need no per-axis arrays -- face_sep, face_box,
-/// face_axis, edge_sep, edge_a, edge_b, edge_axis, max_sep, err_bound -- bit for bit, with
-/// per_axis false. The nine edge axes are first estimated without normalising their vectors
+/// face_axis, max_sep, err_bound, and edge_sep, edge_a, edge_b, edge_axis -- bit for bit, with
+/// per_axis false; except that when every edge axis is provably below the best face axis the
+/// edge fields keep their defaults (edge_sep = -infinity): the measure's edge_sep is then below
+/// face_sep too, so max_sep and every choice between a face and an edge axis are the same. The nine edge axes are first estimated without normalising their vectors
 /// (Gottschalk, Lin, Manocha 1996, "OBBTree" §4: with L = A_i x B_j, t.L, ra and rb are two
 /// products each of entries of R and |R|) and scaled by an approximate 1 / |L|; only the edges
 /// whose estimate can be within rounding of the best are measured as measureBoxSat measures
@@ -275,11 +277,19 @@ inline BoxSatMeasure measureBoxSatBest(const Vec3& ea, const Mat3& rot, const Ve
     boxSatRsqrt(len2f.data(), inv_len.data());
     std::array<Real, 9> hi;
     Real cut = -std::numeric_limits<Real>::infinity();
+    Real max_hi = -std::numeric_limits<Real>::infinity();
     for (std::size_t k = 0; k < 9; ++k) {
         const Real e = unnormalised[k] * static_cast<Real>(inv_len[k]);
         const Real slack = kRsqrtRelative * std::abs(e);
         hi[k] = measurable[k] ? e + slack : std::numeric_limits<Real>::infinity();
         if (measurable[k]) cut = std::max(cut, e - slack);
+        max_hi = std::max(max_hi, hi[k]);
+    }
+    // Every edge provably below the best face: no edge is the best axis nor beats the face, and
+    // the edge fields stay unset.
+    if (max_hi + Real(2) * m.err_bound < m.face_sep) {
+        m.max_sep = m.face_sep;
+        return m;
     }
     cut -= Real(2) * m.err_bound;
     for (int k = 0; k < 9; ++k) {
