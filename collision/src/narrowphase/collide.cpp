@@ -155,7 +155,8 @@ CollideOutput collideBoxBox(const Shape& a, const Shape& b, const RelativePose& 
                             const PairContext& ctx) {
     // Clear overlaps (satBoxState's first test) need only the best axes.
     const BoxSatMeasure best =
-        measureBoxSatBest(a.half_extents, b_in_a.rotation, b_in_a.position, b.half_extents);
+        measureBoxSatBest(a.half_extents, b_in_a.rotation, b_in_a.position, b.half_extents,
+                          -ctx.tolerance);
     if (best.max_sep + best.err_bound < -ctx.tolerance) {
         CollideOutput out;
         out.state = ContactState::Penetrating;

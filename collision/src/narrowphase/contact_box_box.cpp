@@ -253,7 +253,8 @@ CollideOutput boxBox(const Shape& a, const Shape& b, const RelativePose& rel, co
                      Local& out) {
     // Clear overlaps (satBoxState's first test) need only the best axes.
     const BoxSatMeasure best =
-        measureBoxSatBest(a.half_extents, rel.rotation, rel.position, b.half_extents);
+        measureBoxSatBest(a.half_extents, rel.rotation, rel.position, b.half_extents,
+                          -ctx.tolerance);
     if (best.max_sep + best.err_bound < -ctx.tolerance) {
         if (!satDetails(a, b, rel, ctx, best, out)) convexConvex(a, b, rel, ctx, out);
         CollideOutput decision;

@@ -216,8 +216,14 @@ inline void boxSatRsqrt(const float* in, float* out) {
 /// 8 eps (|t.L| + ra + rb) <= err_bound / 2 of the true separation, and the approximate 1 / |L|
 /// is within kRsqrtRelative of 1 / |L|, so an edge whose estimate interval lies below another's
 /// by more than 2 err_bound is below that edge's measured value.
-inline BoxSatMeasure measureBoxSatBest(const Vec3& ea, const Mat3& rot, const Vec3& t,
-                                       const Vec3& eb) {
+///
+/// With `stop_above` finite it returns early, the edge fields unset and max_sep only a lower
+/// bound on the measure's, once max_sep + err_bound >= stop_above is certain: callers that only
+/// act on a clear overlap (max_sep + err_bound < -tolerance) pass -tolerance and fall back to the
+/// full measure, so pairs apart or touching pay little for the attempt.
+inline BoxSatMeasure measureBoxSatBest(
+    const Vec3& ea, const Mat3& rot, const Vec3& t, const Vec3& eb,
+    Real stop_above = std::numeric_limits<Real>::infinity()) {
     BoxSatMeasure m;
     m.per_axis = false;
     for (int i = 0; i < 3; ++i) {
@@ -240,6 +246,10 @@ inline BoxSatMeasure measureBoxSatBest(const Vec3& ea, const Mat3& rot, const Ve
     }
     m.err_bound = Real(16) * kEpsilon *
                   (t.lpNorm<1>() + ea.lpNorm<1>() + eb.lpNorm<1>());  // 1-norms >= 2-norms
+    if (m.face_sep + m.err_bound >= stop_above) {
+        m.max_sep = m.face_sep;
+        return m;
+    }
     // Unnormalised estimates s / |L|, 1 / |L| from the SSE reciprocal square root (relative
     // error below 1.5 * 2^-12): an edge is measured unless its estimate plus that error is below
     // the best estimate minus that error by more than 2 err_bound. Edges closer to parallel than
@@ -284,6 +294,11 @@ inline BoxSatMeasure measureBoxSatBest(const Vec3& ea, const Mat3& rot, const Ve
         hi[k] = measurable[k] ? e + slack : std::numeric_limits<Real>::infinity();
         if (measurable[k]) cut = std::max(cut, e - slack);
         max_hi = std::max(max_hi, hi[k]);
+    }
+    // The edge with the best lower estimate measures at least cut - err_bound.
+    if (cut >= stop_above) {
+        m.max_sep = std::max(m.face_sep, cut - m.err_bound);
+        return m;
     }
     // Every edge provably below the best face: no edge is the best axis nor beats the face, and
     // the edge fields stay unset.
