@@ -97,13 +97,16 @@ Command addBenchConvexCommand(CLI::App& bench) {
     BenchConvexOptions& o = f->options;
     CLI::App* cmd = bench.add_subcommand(
         "convex",
-        "convex contact queries (GJK, EPA, SAT, closed forms) beside Bullet's GJK/EPA: "
-        "us/query, answers compared");
+        "convex contact queries (GJK, EPA, SAT, closed forms) beside Bullet's own path per pair "
+        "(btBoxBoxDetector, its closed forms) and its general GJK/EPA: us/query, errors against "
+        "an exact reference");
     cmd->add_option("--queries", o.queries, "random pairs per workload")->capture_default_str();
-    cmd->add_option("--passes", o.passes, "timed passes (fastest kept)")->capture_default_str();
+    cmd->add_option("--passes", o.passes, "timed passes (median kept)")->capture_default_str();
     cmd->add_option("--seed", o.seed, "pose seed")->capture_default_str();
+    cmd->add_option("--workload", o.workload,
+                    "only the workloads whose name contains this text (e.g. box-box)");
     cmd->add_option("--tolerance", o.tolerance,
-                    "relative answer tolerance for counting disagreements")
+                    "relative tolerance for counting answers as wrong")
         ->capture_default_str();
     cmd->add_option("--json", f->json, "also write the rows as JSON to FILE");
     return {cmd, [f]() { return runBenchConvex(f->resolved(), std::cout, std::cerr); }};

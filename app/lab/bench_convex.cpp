@@ -1,68 +1,47 @@
-// app/lab/bench_convex.cpp -- `cdlab bench convex`: the convex contact query against Bullet's GJK/EPA.
-// Each workload is a fixed-seed list of random pairs (sizes 0.2..1.5, random orientations) of
-// one kind; both libraries answer every pair; timing is the fastest of `passes` passes over the
-// whole list divided by the pair count (no per-call clock overhead). Answers are compared as
-// signed distances (negative = penetration depth) relative to the pair's size; the "ext" columns
-// repeat every pair translated by 1e6 and scaled by 1e-4 and 1e4 and report the largest change
-// of the (rescaled) answer, the accuracy at the extremes. Bullet's headers and libraries stay in
-// this file (CDLAB_HAVE_BULLET). Fairness: Bullet gets the same geometry with zero margins (a
-// btBoxShape in box rows, a btConvexHullShape of the same points in hull rows), and the pairs of
-// the separated/penetrating rows are chosen by a ground truth neither library computes
-// (signedDistanceReference: closed forms, or the exact projection-overlap reference for boxes).
+// app/lab/bench_convex.cpp -- `cdlab bench convex`: cdlab's convex contact query beside Bullet,
+// each pair family against the path Bullet itself runs for it (its dispatcher's algorithm:
+// btBoxBoxDetector for boxes, the sphere-sphere and sphere-box algorithms, the capsule cases of
+// btConvexConvexAlgorithm) and against Bullet's general GJK/EPA (bench_convex_peers.h). Each
+// workload is a fixed-seed list of random pairs (sizes 0.2..1.5, random orientations) of one
+// kind, chosen by the long-double ground truth (convex_reference.h) to be separated or
+// penetrating by more than 1e-3 of their size; rows of the same name share their pairs. Timing:
+// thread CPU time of whole passes over the list divided by the pair count, the median of
+// `passes` passes (no per-call clock overhead). Accuracy: every answer's signed distance, normal
+// and witness points are checked against the ground truth, relative to the pair's size; the
+// "ext" columns repeat every pair translated by 1e6 and scaled by 1e-4 and 1e4 and report the
+// largest change of the (rescaled) answer.
 #include "bench_convex.h"
+
+#include <time.h>
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <random>
 #include <string>
 #include <vector>
 
+#include "bench_convex_peers.h"
 #include "collision/narrowphase/contact.h"
-#include "collision/narrowphase/contact_reference.h"
-#include "collision/narrowphase/narrow_phase.h"
 #include "collision/test_random.h"
 #include "collision/test_shapes.h"
+#include "convex_reference.h"
 #include "output_files.h"
-
-#ifdef CDLAB_HAVE_BULLET
-#include <BulletCollision/CollisionShapes/btBoxShape.h>
-#include <BulletCollision/CollisionShapes/btCapsuleShape.h>
-#include <BulletCollision/CollisionShapes/btConvexHullShape.h>
-#include <BulletCollision/CollisionShapes/btSphereShape.h>
-#include <BulletCollision/NarrowPhaseCollision/btGjkEpaPenetrationDepthSolver.h>
-#include <BulletCollision/NarrowPhaseCollision/btGjkPairDetector.h>
-#include <BulletCollision/NarrowPhaseCollision/btPointCollector.h>
-#include <BulletCollision/NarrowPhaseCollision/btVoronoiSimplexSolver.h>
-#endif
 
 namespace app {
 namespace {
 
-namespace fs = std::filesystem;
 using collision::ContactState;
 using collision::Pose;
-using collision::Quat;
 using collision::Real;
 using collision::Shape;
 using collision::ShapeType;
 using collision::Vec3;
 
 constexpr Real kFarOffset = 1e6;
-
-struct Pair {
-    Shape a;
-    Shape b;
-    Pose pose_a;
-    Pose pose_b;
-    Real scale = 1;  ///< larger bounding radius
-};
 
 enum class Want { Separated, Penetrating, Either };
 
@@ -73,6 +52,7 @@ struct Workload {
     ShapeType type_b;
     bool as_hulls = false;  ///< boxes given as 8-point hulls: contact() takes GJK/EPA
     Want want;
+    BulletPath peer;
 };
 
 using Random = cdlab_test::Rng;
@@ -107,11 +87,13 @@ Shape asHull(const Shape& box) {
     return Shape::convexHull(hull);
 }
 
-std::vector<Pair> makePairs(const Workload& w, int count, Random& rng) {
-    std::vector<Pair> pairs;
+std::vector<ConvexPair> makePairs(const Workload& w, int count, Random& rng,
+                                  std::vector<Real>& truth) {
+    std::vector<ConvexPair> pairs;
     pairs.reserve(static_cast<std::size_t>(count));
+    truth.clear();
     while (static_cast<int>(pairs.size()) < count) {
-        Pair p;
+        ConvexPair p;
         p.a = randomShape(w.type_a, rng);
         p.b = randomShape(w.type_b, rng);
         p.scale = std::max(boundingRadius(p.a), boundingRadius(p.b));
@@ -126,14 +108,11 @@ std::vector<Pair> makePairs(const Workload& w, int count, Random& rng) {
                 pose->position[k] = std::ldexp(std::round(std::ldexp(pose->position[k], 20)), -20);
             }
         }
-        // A ground truth neither library computes picks the pairs (closed forms; boxes: the
-        // exact projection-overlap reference); pairs within 1e-3 * size of touching, or that
-        // the reference cannot place, are left out so the comparison is where the answer is
-        // well defined.
-        const collision::SignedDistanceBounds truth =
-            collision::signedDistanceReference(p.a, p.pose_a, p.b, p.pose_b);
-        const bool separated = truth.lower > 1e-3 * p.scale;
-        const bool penetrating = truth.upper < -1e-3 * p.scale;
+        // Pairs within 1e-3 * size of touching are left out, so the comparison is where the
+        // answer is well defined.
+        const Real d = exactSignedDistance(p.a, p.pose_a, p.b, p.pose_b);
+        const bool separated = d > 1e-3 * p.scale;
+        const bool penetrating = d < -1e-3 * p.scale;
         if (w.want == Want::Separated && !separated) continue;
         if (w.want == Want::Penetrating && !penetrating) continue;
         if (w.want == Want::Either && !separated && !penetrating) continue;
@@ -142,6 +121,7 @@ std::vector<Pair> makePairs(const Workload& w, int count, Random& rng) {
             p.b = asHull(p.b);
         }
         pairs.push_back(std::move(p));
+        truth.push_back(d);
     }
     return pairs;
 }
@@ -159,11 +139,11 @@ constexpr std::array<Variant, 3> kVariants{
 
 using cdlab_test::scaledShape;
 
-std::vector<Pair> transformed(const std::vector<Pair>& pairs, const Variant& v) {
-    std::vector<Pair> out;
+std::vector<ConvexPair> transformed(const std::vector<ConvexPair>& pairs, const Variant& v) {
+    std::vector<ConvexPair> out;
     out.reserve(pairs.size());
-    for (const Pair& p : pairs) {
-        Pair q;
+    for (const ConvexPair& p : pairs) {
+        ConvexPair q;
         q.a = scaledShape(p.a, v.factor);
         q.b = scaledShape(p.b, v.factor);
         q.pose_a =
@@ -176,129 +156,85 @@ std::vector<Pair> transformed(const std::vector<Pair>& pairs, const Variant& v) 
     return out;
 }
 
+double threadCpuMicroseconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) * 1e6 + static_cast<double>(ts.tv_nsec) * 1e-3;
+}
+
 struct Answers {
-    std::vector<Real> signed_distance;
+    std::vector<ContactAnswer> answers;
     int failed = 0;
-    double us = 0;  ///< fastest pass, microseconds per query
+    double us = 0;  ///< median pass, thread CPU microseconds per query
 };
 
-// query(i) answers pair i; the fastest of `passes` passes over all pairs is kept.
+// query(i) answers pair i; the median of `passes` passes over all pairs is kept.
 template <typename Query>
 Answers timeQueries(std::size_t n, int passes, Query&& query) {
-    Answers ans;
-    ans.signed_distance.assign(n, 0);
-    double best = std::numeric_limits<double>::infinity();
+    Answers out;
+    out.answers.assign(n, ContactAnswer{});
+    std::vector<double> times;
     for (int pass = 0; pass < std::max(passes, 1); ++pass) {
-        const auto start = std::chrono::steady_clock::now();
-        for (std::size_t i = 0; i < n; ++i) ans.signed_distance[i] = query(i);
-        const auto stop = std::chrono::steady_clock::now();
-        best = std::min(best, std::chrono::duration<double, std::micro>(stop - start).count());
+        const double start = threadCpuMicroseconds();
+        for (std::size_t i = 0; i < n; ++i) out.answers[i] = query(i);
+        times.push_back(threadCpuMicroseconds() - start);
     }
-    ans.us = n > 0 ? best / static_cast<double>(n) : 0;
-    for (std::size_t i = 0; i < n; ++i) {
-        if (!std::isfinite(ans.signed_distance[i])) ++ans.failed;
+    std::sort(times.begin(), times.end());
+    const double median = times[times.size() / 2];
+    out.us = n > 0 ? median / static_cast<double>(n) : 0;
+    for (const ContactAnswer& a : out.answers) {
+        if (!std::isfinite(a.signed_distance)) ++out.failed;
     }
-    return ans;
+    return out;
 }
 
-#ifdef CDLAB_HAVE_BULLET
-// Used only beside Bullet: the pairs Bullet and cdlab disagree on are retried on cdlab's other path.
-bool isBoxLike(const Shape& s) {
-    return s.type == ShapeType::Box || s.type == ShapeType::ConvexHull;
-}
-
-// The same geometry through cdlab's other code path: a box as its 8-point hull (GJK/EPA) and a
-// box-hull back as a box (SAT, closed forms); round shapes stay.
-Shape otherPath(const Shape& s) {
-    if (s.type == ShapeType::Box) return asHull(s);
-    if (s.type == ShapeType::ConvexHull) return Shape::box(s.hull->vertices.back().cwiseAbs());
-    return s;
-}
-#endif
-
-Real cdlabQuery(const Pair& p) {
+ContactAnswer cdlabQuery(const ConvexPair& p) {
     const collision::ContactOutput out = contact(p.a, p.pose_a, p.b, p.pose_b);
-    if (out.state == ContactState::Failed) return std::numeric_limits<Real>::quiet_NaN();
-    return out.signed_distance;
+    if (out.state == ContactState::Failed) return ContactAnswer{};
+    return {out.signed_distance, out.normal, out.point_a, out.point_b};
 }
 
-#ifdef CDLAB_HAVE_BULLET
-std::unique_ptr<btConvexShape> bulletShape(const Shape& s) {
-    switch (s.type) {
-        // Spheres and capsules keep Bullet's implicit margin: it is their radius (a point or a
-        // segment inflated by it, as cdlab's cores), so the geometry is exact.
-        case ShapeType::Sphere:
-            return std::make_unique<btSphereShape>(s.radius);
-        case ShapeType::Capsule:
-            return std::make_unique<btCapsuleShape>(s.radius, 2 * s.half_height);  // along y
-        case ShapeType::Box: {
-            auto box = std::make_unique<btBoxShape>(
-                btVector3(s.half_extents.x(), s.half_extents.y(), s.half_extents.z()));
-            box->setMargin(0);  // the exact box: no rounded margin shell
-            return box;
-        }
-        default: {
-            // Hulls: the same points (a box's 8 corners in the hull rows), no margin, so Bullet
-            // runs the same point-cloud support as cdlab's GJK/EPA path.
-            auto hull = std::make_unique<btConvexHullShape>();
-            for (const Vec3& v : s.hull->vertices)
-                hull->addPoint(btVector3(v.x(), v.y(), v.z()), false);
-            hull->recalcLocalAabb();
-            hull->setMargin(0);
-            return hull;
-        }
-    }
-}
-
-btTransform bulletTransform(const Pose& p) {
-    const Quat& q = p.orientation;
-    return btTransform(btQuaternion(q.x(), q.y(), q.z(), q.w()),
-                       btVector3(p.position.x(), p.position.y(), p.position.z()));
-}
-
-struct BulletPair {
-    std::unique_ptr<btConvexShape> a;
-    std::unique_ptr<btConvexShape> b;
+/// Errors of one library's answers against the ground truth, relative to each pair's size.
+struct Accuracy {
+    double depth = 0;    ///< max |signed distance - exact|
+    int wrong = 0;       ///< answers whose signed distance is off by more than the tolerance
+    double normal = 0;   ///< max overlap(normal) + exact: 0 iff the normal is a valid one
+    double witness = 0;  ///< max distance of a witness point from its shape's surface
 };
 
-std::vector<BulletPair> bulletShapes(const std::vector<Pair>& pairs) {
-    std::vector<BulletPair> shapes(pairs.size());
+Accuracy accuracy(const std::vector<ConvexPair>& pairs, const std::vector<Real>& truth,
+                  const std::vector<ContactAnswer>& answers, double tolerance) {
+    Accuracy acc;
     for (std::size_t i = 0; i < pairs.size(); ++i) {
-        shapes[i].a = bulletShape(pairs[i].a);
-        shapes[i].b = bulletShape(pairs[i].b);
+        const ConvexPair& p = pairs[i];
+        const ContactAnswer& a = answers[i];
+        if (!std::isfinite(a.signed_distance)) continue;  // counted as failed
+        const double depth = std::abs(a.signed_distance - truth[i]) / p.scale;
+        acc.depth = std::max(acc.depth, depth);
+        if (!(depth <= tolerance)) ++acc.wrong;
+        const Real len = a.normal.norm();
+        const double normal =
+            len > 0 ? (exactOverlapAlong(p.a, p.pose_a, p.b, p.pose_b, a.normal / len) + truth[i]) /
+                          p.scale
+                    : std::numeric_limits<double>::infinity();
+        acc.normal = std::max(acc.normal, normal);
+        acc.witness = std::max({acc.witness,
+                                std::abs(surfaceDistance(p.a, p.pose_a, a.point_a)) / p.scale,
+                                std::abs(surfaceDistance(p.b, p.pose_b, a.point_b)) / p.scale});
     }
-    return shapes;
+    return acc;
 }
-
-// btGjkPairDetector with Bullet's EPA (btGjkEpaPenetrationDepthSolver); m_distance is negative
-// when penetrating. No result counts as a failure.
-Real bulletQuery(const BulletPair& shapes, const Pair& p) {
-    btVoronoiSimplexSolver simplex;
-    btGjkEpaPenetrationDepthSolver depth_solver;
-    btGjkPairDetector detector(shapes.a.get(), shapes.b.get(), &simplex, &depth_solver);
-    btGjkPairDetector::ClosestPointInput in;
-    in.m_transformA = bulletTransform(p.pose_a);
-    in.m_transformB = bulletTransform(p.pose_b);
-    btPointCollector result;
-    detector.getClosestPoints(in, result, nullptr);
-    if (!result.m_hasResult) return std::numeric_limits<Real>::quiet_NaN();
-    return result.m_distance;
-}
-#endif
 
 struct Row {
     std::string workload;
     std::string method;
+    std::string peer = "n/a";
     int queries = 0;
     int colliding = 0;
     double cdlab_us = 0;
     double bullet_us = -1;  ///< -1 when Bullet is not built in
-    int disagreements = 0;
-    /// Disagreements where cdlab's other path (boxes as hulls through GJK/EPA, or hulls as boxes
-    /// through SAT / closed forms) gives cdlab's answer too; -1 when the pair has no box.
-    int disagreements_confirmed = -1;
-    nlohmann::json disagreement_examples = nlohmann::json::array();
-    double max_difference = 0;  ///< max |ours - Bullet's| / size
+    Accuracy cdlab;
+    Accuracy bullet;
     /// Per variant (far, small, large): max |answer / factor - answer| / size; NaN answers are
     /// counted in *_variant_failed instead.
     std::array<double, 3> cdlab_variant_error{0, 0, 0};
@@ -309,25 +245,38 @@ struct Row {
     int bullet_failed = 0;
 };
 
-// Largest relative change of the answers under variant k; NaNs counted in `failed`.
-void variantError(const std::vector<Pair>& pairs, const std::vector<Real>& base,
-                  const std::vector<Real>& moved, Real factor, double& error, int& failed) {
+// Largest relative change of the answers under a variant; NaNs counted in `failed`.
+void variantError(const std::vector<ConvexPair>& pairs, const std::vector<ContactAnswer>& base,
+                  const std::vector<ContactAnswer>& moved, Real factor, double& error,
+                  int& failed) {
     error = 0;
     for (std::size_t i = 0; i < pairs.size(); ++i) {
-        const double e = std::abs(moved[i] / factor - base[i]) / pairs[i].scale;
+        const double e =
+            std::abs(moved[i].signed_distance / factor - base[i].signed_distance) / pairs[i].scale;
         if (std::isfinite(e)) {
             error = std::max(error, e);
-        } else if (std::isfinite(base[i])) {
+        } else if (std::isfinite(base[i].signed_distance)) {
             ++failed;
         }
     }
 }
 
-Row runWorkload(const Workload& w, int index, const BenchConvexOptions& options) {
-    Random rng(options.seed * 1000 + static_cast<std::uint64_t>(index));
-    const std::vector<Pair> pairs = makePairs(w, options.queries, rng);
-    std::vector<std::vector<Pair>> variants;
-    for (const Variant& v : kVariants) variants.push_back(transformed(pairs, v));
+struct PairSet {
+    std::vector<ConvexPair> pairs;
+    std::vector<Real> truth;
+    std::vector<std::vector<ConvexPair>> variants;
+};
+
+PairSet makePairSet(const Workload& w, std::uint64_t seed, int queries) {
+    PairSet set;
+    Random rng(seed);
+    set.pairs = makePairs(w, queries, rng, set.truth);
+    for (const Variant& v : kVariants) set.variants.push_back(transformed(set.pairs, v));
+    return set;
+}
+
+Row runWorkload(const Workload& w, const PairSet& set, const BenchConvexOptions& options) {
+    const std::vector<ConvexPair>& pairs = set.pairs;
     Row row;
     row.workload = w.name;
     row.method = w.method;
@@ -336,66 +285,42 @@ Row runWorkload(const Workload& w, int index, const BenchConvexOptions& options)
                                      [&](std::size_t i) { return cdlabQuery(pairs[i]); });
     row.cdlab_us = ours.us;
     row.cdlab_failed = ours.failed;
-    for (std::size_t i = 0; i < pairs.size(); ++i) {
-        if (ours.signed_distance[i] <= 0) ++row.colliding;
+    row.cdlab = accuracy(pairs, set.truth, ours.answers, options.tolerance);
+    for (const ContactAnswer& a : ours.answers) {
+        if (a.signed_distance <= 0) ++row.colliding;
     }
     for (std::size_t k = 0; k < kVariants.size(); ++k) {
-        std::vector<Real> moved(pairs.size());
-        for (std::size_t i = 0; i < pairs.size(); ++i) moved[i] = cdlabQuery(variants[k][i]);
-        variantError(pairs, ours.signed_distance, moved, kVariants[k].factor,
-                     row.cdlab_variant_error[k], row.cdlab_variant_failed);
+        std::vector<ContactAnswer> moved(pairs.size());
+        for (std::size_t i = 0; i < pairs.size(); ++i) moved[i] = cdlabQuery(set.variants[k][i]);
+        variantError(pairs, ours.answers, moved, kVariants[k].factor, row.cdlab_variant_error[k],
+                     row.cdlab_variant_failed);
     }
-#ifdef CDLAB_HAVE_BULLET
-    const std::vector<BulletPair> shapes = bulletShapes(pairs);
-    const Answers theirs = timeQueries(pairs.size(), options.passes, [&](std::size_t i) {
-        return bulletQuery(shapes[i], pairs[i]);
-    });
+    if (!bulletAvailable()) return row;
+    const BulletConvexPeer peer(w.peer, pairs);
+    row.peer = peer.pathName();
+    const Answers theirs =
+        timeQueries(pairs.size(), options.passes, [&](std::size_t i) { return peer.query(i); });
     row.bullet_us = theirs.us;
     row.bullet_failed = theirs.failed;
-    for (std::size_t i = 0; i < pairs.size(); ++i) {
-        const double diff = std::abs(ours.signed_distance[i] - theirs.signed_distance[i]);
-        const double rel = diff / pairs[i].scale;
-        if (!(rel <= options.tolerance)) {  // NaN (a failure) disagrees too
-            ++row.disagreements;
-            const bool has_box = isBoxLike(pairs[i].a) || isBoxLike(pairs[i].b);
-            Real other = std::numeric_limits<Real>::quiet_NaN();
-            if (has_box) {
-                Pair alt = pairs[i];
-                alt.a = otherPath(pairs[i].a);
-                alt.b = otherPath(pairs[i].b);
-                other = cdlabQuery(alt);
-                if (row.disagreements_confirmed < 0) row.disagreements_confirmed = 0;
-                if (std::abs(other - ours.signed_distance[i]) <=
-                    options.tolerance * pairs[i].scale) {
-                    ++row.disagreements_confirmed;
-                }
-            }
-            if (row.disagreement_examples.size() < 3) {
-                row.disagreement_examples.push_back(
-                    {{"pair", i},
-                     {"size", pairs[i].scale},
-                     {"cdlab", ours.signed_distance[i]},
-                     {"cdlab_other_path",
-                      has_box ? nlohmann::json(other) : nlohmann::json(nullptr)},
-                     {"bullet", theirs.signed_distance[i]}});
-            }
-        }
-        if (std::isfinite(rel)) row.max_difference = std::max(row.max_difference, rel);
-    }
+    row.bullet = accuracy(pairs, set.truth, theirs.answers, options.tolerance);
     for (std::size_t k = 0; k < kVariants.size(); ++k) {
-        const std::vector<BulletPair> moved_shapes = bulletShapes(variants[k]);
-        std::vector<Real> moved(pairs.size());
-        for (std::size_t i = 0; i < pairs.size(); ++i) {
-            moved[i] = bulletQuery(moved_shapes[i], variants[k][i]);
-        }
-        variantError(pairs, theirs.signed_distance, moved, kVariants[k].factor,
+        const BulletConvexPeer moved_peer(w.peer, set.variants[k]);
+        std::vector<ContactAnswer> moved(pairs.size());
+        for (std::size_t i = 0; i < pairs.size(); ++i) moved[i] = moved_peer.query(i);
+        variantError(pairs, theirs.answers, moved, kVariants[k].factor,
                      row.bullet_variant_error[k], row.bullet_variant_failed);
     }
-#endif
     return row;
 }
 
 double maxOf(const std::array<double, 3>& v) { return std::max({v[0], v[1], v[2]}); }
+
+nlohmann::json accuracyJson(const Accuracy& a) {
+    return {{"depth_error", a.depth},
+            {"wrong", a.wrong},
+            {"normal_error", a.normal},
+            {"witness_error", a.witness}};
+}
 
 nlohmann::json rowJson(const Row& r) {
     nlohmann::json j{{"workload", r.workload},
@@ -404,21 +329,20 @@ nlohmann::json rowJson(const Row& r) {
                      {"colliding", r.colliding},
                      {"cdlab_us", r.cdlab_us},
                      {"cdlab_failed", r.cdlab_failed},
-                     {"cdlab_variant_failed", r.cdlab_variant_failed}};
+                     {"cdlab_variant_failed", r.cdlab_variant_failed},
+                     {"cdlab_accuracy", accuracyJson(r.cdlab)}};
     for (std::size_t k = 0; k < kVariants.size(); ++k) {
         j[std::string("cdlab_") + kVariants[k].name + "_error"] = r.cdlab_variant_error[k];
     }
     if (r.bullet_us >= 0) {
+        j["bullet_path"] = r.peer;
         j["bullet_us"] = r.bullet_us;
         j["bullet_failed"] = r.bullet_failed;
         j["bullet_variant_failed"] = r.bullet_variant_failed;
+        j["bullet_accuracy"] = accuracyJson(r.bullet);
         for (std::size_t k = 0; k < kVariants.size(); ++k) {
             j[std::string("bullet_") + kVariants[k].name + "_error"] = r.bullet_variant_error[k];
         }
-        j["disagreements"] = r.disagreements;
-        j["disagreements_confirmed"] = r.disagreements_confirmed;
-        j["disagreement_examples"] = r.disagreement_examples;
-        j["max_difference"] = r.max_difference;
     } else {
         j["bullet_us"] = nullptr;
     }
@@ -426,37 +350,70 @@ nlohmann::json rowJson(const Row& r) {
 }
 
 void printTable(const std::vector<Row>& rows, double tolerance, std::ostream& out) {
-    out << std::left << std::setw(29) << "workload" << std::setw(12) << "cdlab_path" << std::right
-        << std::setw(8) << "queries" << std::setw(7) << "hits" << std::setw(10) << "cdlab_us"
-        << std::setw(10) << "bullet_us" << std::setw(7) << "ratio" << std::setw(9) << "disagree"
-        << std::setw(10) << "confirmed" << std::setw(10) << "max_diff" << std::setw(11)
-        << "cdlab_ext" << std::setw(11) << "bullet_ext" << std::setw(8) << "failed"
+    out << std::left << std::setw(28) << "workload" << std::setw(12) << "cdlab_path"
+        << std::setw(25) << "bullet_path" << std::right << std::setw(7) << "hits" << std::setw(9)
+        << "cdlab_us" << std::setw(10) << "bullet_us" << std::setw(7) << "ratio" << std::setw(10)
+        << "cdlab_err" << std::setw(11) << "bullet_err" << std::setw(7) << "wrong"
+        << std::setw(11) << "bullet_nrm" << std::setw(10) << "cdlab_ext" << std::setw(11)
+        << "bullet_ext" << std::setw(7) << "failed"
         << "\n";
     for (const Row& r : rows) {
-        out << std::left << std::setw(29) << r.workload << std::setw(12) << r.method << std::right
-            << std::setw(8) << r.queries << std::setw(7) << r.colliding << std::fixed
-            << std::setprecision(3) << std::setw(10) << r.cdlab_us;
+        out << std::left << std::setw(28) << r.workload << std::setw(12) << r.method
+            << std::setw(25) << r.peer << std::right << std::setw(7) << r.colliding << std::fixed
+            << std::setprecision(3) << std::setw(9) << r.cdlab_us;
         if (r.bullet_us >= 0) {
             out << std::setw(10) << r.bullet_us << std::setw(7) << std::setprecision(2)
-                << r.cdlab_us / r.bullet_us << std::setw(9) << r.disagreements << std::setw(10)
-                << (r.disagreements_confirmed < 0 ? std::string("-")
-                                                  : std::to_string(r.disagreements_confirmed))
-                << std::scientific << std::setprecision(1) << std::setw(10) << r.max_difference
-                << std::setw(11) << maxOf(r.cdlab_variant_error) << std::setw(11)
+                << r.cdlab_us / r.bullet_us << std::scientific << std::setprecision(1)
+                << std::setw(10) << r.cdlab.depth << std::setw(11) << r.bullet.depth
+                << std::setw(7) << r.bullet.wrong << std::setw(11) << r.bullet.normal
+                << std::setw(10) << maxOf(r.cdlab_variant_error) << std::setw(11)
                 << maxOf(r.bullet_variant_error);
         } else {
-            out << std::setw(10) << "n/a" << std::setw(7) << "n/a" << std::setw(9) << "n/a"
-                << std::setw(10) << "n/a" << std::setw(10) << "n/a" << std::scientific
-                << std::setprecision(1) << std::setw(11) << maxOf(r.cdlab_variant_error)
-                << std::setw(11) << "n/a";
+            out << std::setw(10) << "n/a" << std::setw(7) << "n/a" << std::scientific
+                << std::setprecision(1) << std::setw(10) << r.cdlab.depth << std::setw(11)
+                << "n/a" << std::setw(7) << "n/a" << std::setw(11) << "n/a" << std::setw(10)
+                << maxOf(r.cdlab_variant_error) << std::setw(11) << "n/a";
         }
-        out << std::defaultfloat << std::setw(8) << r.cdlab_failed + r.cdlab_variant_failed << "\n";
+        out << std::defaultfloat << std::setw(7) << r.cdlab_failed + r.cdlab_variant_failed
+            << "\n";
     }
-    out << "ratio = cdlab_us / bullet_us; disagree: |signed distance difference| > " << tolerance
-        << " * size; confirmed: of those, how many cdlab's other path (box <-> 8-point hull) "
-           "answers like cdlab; ext: largest change of answer / factor after translating by 1e6 or "
-           "scaling"
-           " by 1e-4 and 1e4, relative to size (JSON: per variant); failed: cdlab Failed states\n";
+    out << "us: thread CPU time per query, median pass; ratio = cdlab_us / bullet_us; *_err: "
+           "largest |signed distance - exact| / size (exact: long-double closed forms, boxes' "
+           "15-axis SAT depth or brute-force distance); wrong: Bullet answers off by more than "
+        << tolerance
+        << " * size; bullet_nrm: largest (overlap along Bullet's normal - exact depth) / size, 0 "
+           "for a valid normal; ext: largest change of answer / factor after translating by 1e6 "
+           "or scaling by 1e-4 and 1e4, relative to size; failed: cdlab Failed states (JSON: "
+           "cdlab's normal and witness errors, per variant)\n";
+}
+
+std::vector<Workload> workloads() {
+    using enum ShapeType;
+    const BulletPath general = BulletPath::GeneralGjkEpa;
+    const BulletPath own = BulletPath::Dispatcher;
+    // Bullet's dispatcher answers contacts, not distances (btBoxBoxDetector reports nothing for
+    // boxes apart, the round algorithms nothing beyond the breaking threshold): its rows are
+    // penetrating pairs; its general GJK/EPA answers the separated and mixed rows.
+    return {
+        {"box-box separated", "SAT+GJK", Box, Box, false, Want::Separated, general},
+        {"hullbox-hullbox separated", "GJK", Box, Box, true, Want::Separated, general},
+        {"box-box penetrating", "SAT+clip", Box, Box, false, Want::Penetrating, own},
+        {"box-box penetrating", "SAT+clip", Box, Box, false, Want::Penetrating, general},
+        {"hullbox-hullbox penetrating", "GJK+EPA", Box, Box, true, Want::Penetrating, general},
+        {"sphere-sphere penetrating", "closed form", Sphere, Sphere, false, Want::Penetrating,
+         own},
+        {"sphere-sphere", "closed form", Sphere, Sphere, false, Want::Either, general},
+        {"sphere-capsule penetrating", "closed form", Sphere, Capsule, false, Want::Penetrating,
+         own},
+        {"sphere-capsule", "closed form", Sphere, Capsule, false, Want::Either, general},
+        {"capsule-capsule penetrating", "closed form", Capsule, Capsule, false,
+         Want::Penetrating, own},
+        {"capsule-capsule", "closed form", Capsule, Capsule, false, Want::Either, general},
+        {"sphere-box penetrating", "closed form", Sphere, Box, false, Want::Penetrating, own},
+        {"sphere-box penetrating", "closed form", Sphere, Box, false, Want::Penetrating,
+         BulletPath::SphereBoxAlgorithm},
+        {"sphere-box", "closed form", Sphere, Box, false, Want::Either, general},
+    };
 }
 
 }  // namespace
@@ -466,23 +423,28 @@ int runBenchConvex(const BenchConvexOptions& options, std::ostream& out, std::os
         err << "cdlab bench convex: --queries and --passes must be >= 1 and --tolerance > 0\n";
         return 2;
     }
-    const std::vector<Workload> workloads{
-        {"box-box separated", "SAT+GJK", ShapeType::Box, ShapeType::Box, false, Want::Separated},
-        {"hullbox-hullbox separated", "GJK", ShapeType::Box, ShapeType::Box, true, Want::Separated},
-        {"box-box penetrating", "SAT+clip", ShapeType::Box, ShapeType::Box, false,
-         Want::Penetrating},
-        {"hullbox-hullbox penetrating", "GJK+EPA", ShapeType::Box, ShapeType::Box, true,
-         Want::Penetrating},
-        {"sphere-sphere", "closed form", ShapeType::Sphere, ShapeType::Sphere, false, Want::Either},
-        {"sphere-capsule", "closed form", ShapeType::Sphere, ShapeType::Capsule, false,
-         Want::Either},
-        {"capsule-capsule", "closed form", ShapeType::Capsule, ShapeType::Capsule, false,
-         Want::Either},
-        {"sphere-box", "closed form", ShapeType::Sphere, ShapeType::Box, false, Want::Either},
+    const std::vector<Workload> list = workloads();
+    const auto selected = [&](const Workload& w) {
+        return w.name.find(options.workload) != std::string::npos;
     };
+    if (std::none_of(list.begin(), list.end(), selected)) {
+        std::string message = "cdlab bench convex: --workload '";
+        message += options.workload;
+        message += "' matches no workload\n";
+        err << message;
+        return 2;
+    }
     std::vector<Row> rows;
-    for (std::size_t k = 0; k < workloads.size(); ++k) {
-        rows.push_back(runWorkload(workloads[k], static_cast<int>(k), options));
+    PairSet set;
+    for (std::size_t k = 0; k < list.size(); ++k) {
+        if (!selected(list[k])) continue;
+        // Rows of the same name answer the same pairs (the seed of the name's first row).
+        std::size_t first = k;
+        while (first > 0 && list[first - 1].name == list[k].name) --first;
+        if (rows.empty() || rows.back().workload != list[k].name) {
+            set = makePairSet(list[first], options.seed * 1000 + first, options.queries);
+        }
+        rows.push_back(runWorkload(list[k], set, options));
     }
     printTable(rows, options.tolerance, out);
 
@@ -494,11 +456,7 @@ int runBenchConvex(const BenchConvexOptions& options, std::ostream& out, std::os
         doc["passes"] = options.passes;
         doc["seed"] = options.seed;
         doc["far_offset"] = kFarOffset;
-#ifdef CDLAB_HAVE_BULLET
-        doc["bullet"] = true;
-#else
-        doc["bullet"] = false;
-#endif
+        doc["bullet"] = bulletAvailable();
         doc["rows"] = nlohmann::json::array();
         for (const Row& r : rows) doc["rows"].push_back(rowJson(r));
         if (!writeTextReporting(*options.json, doc.dump(2) + "\n", err)) return 1;

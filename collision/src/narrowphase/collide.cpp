@@ -153,6 +153,15 @@ CollideOutput collideConvexGeneric(const Shape& a, const Shape& b, const Relativ
 // axes' proven gap (refineBoxState).
 CollideOutput collideBoxBox(const Shape& a, const Shape& b, const RelativePose& b_in_a,
                             const PairContext& ctx) {
+    // Clear overlaps (satBoxState's first test) need only the best axes.
+    const BoxSatMeasure best =
+        measureBoxSatBest(a.half_extents, b_in_a.rotation, b_in_a.position, b.half_extents,
+                          -ctx.tolerance);
+    if (best.max_sep + best.err_bound < -ctx.tolerance) {
+        CollideOutput out;
+        out.state = ContactState::Penetrating;
+        return out;
+    }
     const BoxSatMeasure sat =
         measureBoxSat(a.half_extents, b_in_a.rotation, b_in_a.position, b.half_extents);
     if (const auto state = collide_pairs::satBoxState(sat, ctx.tolerance)) {

@@ -21,7 +21,7 @@ int clipPolygon(const std::array<Vec3, 8>& in, int n, int axis, Real sign, Real 
     int m = 0;
     for (int i = 0; i < n; ++i) {
         const Vec3& p = in[static_cast<std::size_t>(i)];
-        const Vec3& q = in[static_cast<std::size_t>((i + 1) % n)];
+        const Vec3& q = in[static_cast<std::size_t>(i + 1 == n ? 0 : i + 1)];
         const Real dp = sign * p[axis] - limit;
         const Real dq = sign * q[axis] - limit;
         if (dp <= 0 && m < 8) out[static_cast<std::size_t>(m++)] = p;
@@ -251,6 +251,16 @@ bool satDetails(const Shape& a, const Shape& b, const RelativePose& rel, const C
 
 CollideOutput boxBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
                      Local& out) {
+    // Clear overlaps (satBoxState's first test) need only the best axes.
+    const BoxSatMeasure best =
+        measureBoxSatBest(a.half_extents, rel.rotation, rel.position, b.half_extents,
+                          -ctx.tolerance);
+    if (best.max_sep + best.err_bound < -ctx.tolerance) {
+        if (!satDetails(a, b, rel, ctx, best, out)) convexConvex(a, b, rel, ctx, out);
+        CollideOutput decision;
+        decision.state = ContactState::Penetrating;
+        return decision;
+    }
     const BoxSatMeasure sat =
         measureBoxSat(a.half_extents, rel.rotation, rel.position, b.half_extents);
     if (const std::optional<ContactState> proven = collide_pairs::satBoxState(sat, ctx.tolerance)) {

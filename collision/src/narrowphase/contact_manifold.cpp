@@ -123,7 +123,7 @@ int clipByPlane(const std::array<Vec3, 2 * kMaxPolygon>& in, int n, const Vec3& 
     int k = 0;
     for (int i = 0; i < n; ++i) {
         const Vec3& p = in[static_cast<std::size_t>(i)];
-        const Vec3& q = in[static_cast<std::size_t>((i + 1) % n)];
+        const Vec3& q = in[static_cast<std::size_t>(i + 1 == n ? 0 : i + 1)];
         const Real dp = m.dot(p) - c;
         const Real dq = m.dot(q) - c;
         if (dp <= 0 && k < 2 * kMaxPolygon) out[static_cast<std::size_t>(k++)] = p;

@@ -10,6 +10,11 @@
 #include <cstddef>
 #include <limits>
 
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
+
+#include "collision/assert.h"
 #include "collision/math.h"
 
 namespace collision {
@@ -67,25 +72,56 @@ template <bool kSwept>
 // Calls visit(dist, ra, rb, axis, id) for each measured axis (unit L, A's frame): face axes of A
 // (id 0..2), face axes of B (3..5), then the edge axes A_i x B_j (6 + 3 i + j), with dist = |t.L|
 // and ra, rb the boxes' projection radii.
+// One measured axis: dist = |t.L|, ra and rb the boxes' projection radii, on unit L (A's frame).
+struct BoxSatAxis {
+    Real dist;
+    Real ra;
+    Real rb;
+    Vec3 axis;
+};
+
+inline BoxSatAxis boxSatFaceAxisA(const Vec3& ea, const Mat3& rot, const Vec3& t, const Vec3& eb,
+                                  int i) {
+    return {std::abs(t[i]), ea[i], eb.dot(rot.row(i).transpose().cwiseAbs()), Vec3::Unit(i)};
+}
+
+inline BoxSatAxis boxSatFaceAxisB(const Vec3& ea, const Mat3& rot, const Vec3& t, const Vec3& eb,
+                                  int j) {
+    const Vec3 axis = rot.col(j);
+    return {std::abs(t.dot(axis)), ea.dot(axis.cwiseAbs()), eb[j], axis};
+}
+
+// The edge axis A_i x B_j normalised; false for exactly parallel edges (|A_i x B_j|^2 below the
+// smallest normal number), which the face axes cover.
+inline bool boxSatEdgeAxis(const Vec3& ea, const Mat3& rot, const Vec3& t, const Vec3& eb, int i,
+                           int j, BoxSatAxis& out) {
+    constexpr Real kParallelCross = std::numeric_limits<Real>::min();
+    const Vec3 axis = Vec3::Unit(i).cross(rot.col(j));
+    const Real len2 = axis.squaredNorm();
+    if (!(len2 >= kParallelCross)) return false;
+    const Vec3 unit = axis / std::sqrt(len2);
+    out = {std::abs(t.dot(unit)), ea.dot(unit.cwiseAbs()),
+           eb.dot((rot.transpose() * unit).cwiseAbs()), unit};
+    return true;
+}
+
 template <class Visit>
 inline void forEachBoxSatAxis(const Vec3& ea, const Mat3& rot, const Vec3& t, const Vec3& eb,
                               Visit&& visit) {
-    constexpr Real kParallelCross = std::numeric_limits<Real>::min();
     for (int i = 0; i < 3; ++i) {
-        visit(std::abs(t[i]), ea[i], eb.dot(rot.row(i).transpose().cwiseAbs()), Vec3::Unit(i), i);
+        const BoxSatAxis a = boxSatFaceAxisA(ea, rot, t, eb, i);
+        visit(a.dist, a.ra, a.rb, a.axis, i);
     }
     for (int j = 0; j < 3; ++j) {
-        const Vec3 axis = rot.col(j);
-        visit(std::abs(t.dot(axis)), ea.dot(axis.cwiseAbs()), eb[j], axis, 3 + j);
+        const BoxSatAxis a = boxSatFaceAxisB(ea, rot, t, eb, j);
+        visit(a.dist, a.ra, a.rb, a.axis, 3 + j);
     }
     for (int i = 0; i < 3; ++i) {
         for (int j = 0; j < 3; ++j) {
-            const Vec3 axis = Vec3::Unit(i).cross(rot.col(j));
-            const Real len2 = axis.squaredNorm();
-            if (!(len2 >= kParallelCross)) continue;
-            const Vec3 unit = axis / std::sqrt(len2);
-            visit(std::abs(t.dot(unit)), ea.dot(unit.cwiseAbs()),
-                  eb.dot((rot.transpose() * unit).cwiseAbs()), unit, 6 + 3 * i + j);
+            BoxSatAxis a;
+            if (boxSatEdgeAxis(ea, rot, t, eb, i, j, a)) {
+                visit(a.dist, a.ra, a.rb, a.axis, 6 + 3 * i + j);
+            }
         }
     }
 }
@@ -109,6 +145,9 @@ struct BoxSatMeasure {
     /// need no per-axis bound.
     Real err_bound = 0;
 
+    /// False for measureBoxSatBest's result: sep, mag and axis_count are not filled.
+    bool per_axis = true;
+
     /// Max over the axes of sep - err: the largest gap the axes prove.
     Real gapLo() const { return gap(-1); }
     /// Max over the axes of sep + err: below -tolerance, every axis proves the overlap.
@@ -116,6 +155,7 @@ struct BoxSatMeasure {
 
 private:
     Real gap(Real sign) const {
+        CDLAB_ASSERT(per_axis, "BoxSatMeasure::gap on a best-axes measure");
         Real g = -std::numeric_limits<Real>::infinity();
         for (std::size_t k = 0; k < static_cast<std::size_t>(axis_count); ++k) {
             g = std::max(g, sep[k] + sign * (Real(8) * kEpsilon * mag[k]));
@@ -149,6 +189,137 @@ inline BoxSatMeasure measureBoxSat(const Vec3& ea, const Mat3& rot, const Vec3& 
     m.max_sep = std::max(m.face_sep, m.edge_sep);
     m.err_bound = Real(16) * kEpsilon *
                   (t.lpNorm<1>() + ea.lpNorm<1>() + eb.lpNorm<1>());  // 1-norms >= 2-norms
+    return m;
+}
+
+/// 1 / sqrt of 12 floats (> 0, 16-byte aligned), to a relative error below 1.5 * 2^-12: SSE's
+/// rsqrtps (in the x86-64 baseline), else exact.
+inline void boxSatRsqrt(const float* in, float* out) {
+#if defined(__SSE__)
+    for (int k = 0; k < 12; k += 4) _mm_store_ps(out + k, _mm_rsqrt_ps(_mm_load_ps(in + k)));
+#else
+    for (int k = 0; k < 12; ++k) out[k] = 1.0f / std::sqrt(in[k]);
+#endif
+}
+
+/// The fields of measureBoxSat(...) that need no per-axis arrays -- face_sep, face_box,
+/// face_axis, max_sep, err_bound, and edge_sep, edge_a, edge_b, edge_axis -- bit for bit, with
+/// per_axis false; except that when every edge axis is provably below the best face axis the
+/// edge fields keep their defaults (edge_sep = -infinity): the measure's edge_sep is then below
+/// face_sep too, so max_sep and every choice between a face and an edge axis are the same. The nine edge axes are first estimated without normalising their vectors
+/// (Gottschalk, Lin, Manocha 1996, "OBBTree" §4: with L = A_i x B_j, t.L, ra and rb are two
+/// products each of entries of R and |R|) and scaled by an approximate 1 / |L|; only the edges
+/// whose estimate can be within rounding of the best are measured as measureBoxSat measures
+/// them, in the same order with the same tie rule, so the best edge, its separation and its axis
+/// are the same numbers. Unnormalised separation / |L| and measureBoxSat's value are both within
+/// 8 eps (|t.L| + ra + rb) <= err_bound / 2 of the true separation, and the approximate 1 / |L|
+/// is within kRsqrtRelative of 1 / |L|, so an edge whose estimate interval lies below another's
+/// by more than 2 err_bound is below that edge's measured value.
+///
+/// With `stop_above` finite it returns early, the edge fields unset and max_sep only a lower
+/// bound on the measure's, once max_sep + err_bound >= stop_above is certain: callers that only
+/// act on a clear overlap (max_sep + err_bound < -tolerance) pass -tolerance and fall back to the
+/// full measure, so pairs apart or touching pay little for the attempt.
+inline BoxSatMeasure measureBoxSatBest(
+    const Vec3& ea, const Mat3& rot, const Vec3& t, const Vec3& eb,
+    Real stop_above = std::numeric_limits<Real>::infinity()) {
+    BoxSatMeasure m;
+    m.per_axis = false;
+    for (int i = 0; i < 3; ++i) {
+        const BoxSatAxis a = boxSatFaceAxisA(ea, rot, t, eb, i);
+        const Real sep = a.dist - a.ra - a.rb;
+        if (sep > m.face_sep) {
+            m.face_sep = sep;
+            m.face_box = 0;
+            m.face_axis = i;
+        }
+    }
+    for (int j = 0; j < 3; ++j) {
+        const BoxSatAxis a = boxSatFaceAxisB(ea, rot, t, eb, j);
+        const Real sep = a.dist - a.ra - a.rb;
+        if (sep > m.face_sep) {
+            m.face_sep = sep;
+            m.face_box = 1;
+            m.face_axis = j;
+        }
+    }
+    m.err_bound = Real(16) * kEpsilon *
+                  (t.lpNorm<1>() + ea.lpNorm<1>() + eb.lpNorm<1>());  // 1-norms >= 2-norms
+    if (m.face_sep + m.err_bound >= stop_above) {
+        m.max_sep = m.face_sep;
+        return m;
+    }
+    // Unnormalised estimates s / |L|, 1 / |L| from the SSE reciprocal square root (relative
+    // error below 1.5 * 2^-12): an edge is measured unless its estimate plus that error is below
+    // the best estimate minus that error by more than 2 err_bound. Edges closer to parallel than
+    // kNearParallel2 are always measured.
+    constexpr Real kNearParallel2 = Real(1e-8);
+    constexpr Real kRsqrtRelative = Real(1e-3);
+    alignas(16) std::array<float, 12> len2f{};
+    std::array<Real, 9> unnormalised;
+    std::array<bool, 9> measurable;
+    // Edge k = 3 i + j: i1, i2 follow i and j1, j2 follow j cyclically.
+    constexpr std::array<int, 9> kI{0, 0, 0, 1, 1, 1, 2, 2, 2};
+    constexpr std::array<int, 9> kJ{0, 1, 2, 0, 1, 2, 0, 1, 2};
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC unroll 9
+#endif
+    for (std::size_t k = 0; k < 9; ++k) {
+        const int i = kI[k];
+        const int j = kJ[k];
+        const int i1 = (i + 1) % 3;
+        const int i2 = (i + 2) % 3;
+        const int j1 = (j + 1) % 3;
+        const int j2 = (j + 2) % 3;
+        const Real r1 = rot(i1, j);
+        const Real r2 = rot(i2, j);
+        const Real len2 = r1 * r1 + r2 * r2;
+        const Real dist = std::abs(t[i2] * r1 - t[i1] * r2);
+        const Real ra = ea[i1] * std::abs(r2) + ea[i2] * std::abs(r1);
+        const Real rb = eb[j1] * std::abs(rot(i, j2)) + eb[j2] * std::abs(rot(i, j1));
+        unnormalised[k] = dist - ra - rb;
+        measurable[k] = len2 >= kNearParallel2;  // also false for NaN
+        len2f[k] = measurable[k] ? static_cast<float>(len2) : 1.0f;
+    }
+    len2f[9] = len2f[10] = len2f[11] = 1.0f;
+    alignas(16) std::array<float, 12> inv_len{};
+    boxSatRsqrt(len2f.data(), inv_len.data());
+    std::array<Real, 9> hi;
+    Real cut = -std::numeric_limits<Real>::infinity();
+    Real max_hi = -std::numeric_limits<Real>::infinity();
+    for (std::size_t k = 0; k < 9; ++k) {
+        const Real e = unnormalised[k] * static_cast<Real>(inv_len[k]);
+        const Real slack = kRsqrtRelative * std::abs(e);
+        hi[k] = measurable[k] ? e + slack : std::numeric_limits<Real>::infinity();
+        if (measurable[k]) cut = std::max(cut, e - slack);
+        max_hi = std::max(max_hi, hi[k]);
+    }
+    // The edge with the best lower estimate measures at least cut - err_bound.
+    if (cut >= stop_above) {
+        m.max_sep = std::max(m.face_sep, cut - m.err_bound);
+        return m;
+    }
+    // Every edge provably below the best face: no edge is the best axis nor beats the face, and
+    // the edge fields stay unset.
+    if (max_hi + Real(2) * m.err_bound < m.face_sep) {
+        m.max_sep = m.face_sep;
+        return m;
+    }
+    cut -= Real(2) * m.err_bound;
+    for (int k = 0; k < 9; ++k) {
+        // NaN estimates (non-finite input) are measured too.
+        if (hi[static_cast<std::size_t>(k)] < cut) continue;
+        BoxSatAxis a;
+        if (!boxSatEdgeAxis(ea, rot, t, eb, k / 3, k % 3, a)) continue;
+        const Real sep = a.dist - a.ra - a.rb;
+        if (sep > m.edge_sep) {
+            m.edge_sep = sep;
+            m.edge_a = k / 3;
+            m.edge_b = k % 3;
+            m.edge_axis = a.axis;
+        }
+    }
+    m.max_sep = std::max(m.face_sep, m.edge_sep);
     return m;
 }
 
