@@ -1,7 +1,7 @@
 // render/src/renderer.cpp -- OSMesa software rendering of a World: shaded bodies, bounding-volume
 // wireframes coloured by overlap state, world bounds, broad-phase structure, HUD text.
-// Invariant: a frame is a pure function of (world state, camera, options, size). Nothing reads a
-// clock, geometry is generated in a fixed order, and all vertices are eye-relative, so the same
+// Invariant: a frame is a pure function of (world state, camera, options, size). Nothing that
+// shapes a pixel reads a clock (the clock only times the stages for FrameStats), geometry is generated in a fixed order, and all vertices are eye-relative, so the same
 // state renders bit-identical pixels and large world coordinates do not lose float precision.
 #include "render/renderer.h"
 
@@ -9,6 +9,7 @@
 #include <GL/osmesa.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -101,7 +102,6 @@ struct Renderer::Impl {
     /// volume is coloured by its own test.
     bool own_tests = false;
     std::optional<VolumeKind> tested_volume;  ///< the kind the broad phase tests
-    std::vector<GLubyte> readback;
     FrameStats stats;
 
     const UnitSphereGrid& sphereGrid(int slices) {
@@ -445,29 +445,45 @@ void Renderer::Impl::drawLines(const LineBuffer& lines, float width_px) {
 }
 
 Image Renderer::Impl::readPixels() {
+    // glFinish() leaves the frame in the context's own RGBA buffer (OSMesa copies its render
+    // target there): read it in place rather than through glReadPixels, which converts RGBA to
+    // RGB in a second full pass over the supersampled frame. Same bytes, no conversion.
     const int gw = width * ss;
     const int gh = height * ss;
-    glFinish();
-    readback.resize(std::size_t(gw) * std::size_t(gh) * 3);
-    glReadPixels(0, 0, gw, gh, GL_RGB, GL_UNSIGNED_BYTE, readback.data());
+    const GLubyte* rgba = context.pixels();
 
     Image image;
     image.width = width;
     image.height = height;
     image.rgb.resize(std::size_t(width) * std::size_t(height) * 3);
-    // GL rows run bottom-up: flip so row 0 is the top, and box-filter each ss x ss block.
+    // GL rows run bottom-up: flip so row 0 is the top, and box-filter each ss x ss block,
+    // rounding the mean to nearest ((sum + n/2) / n).
+    if (ss == 2) {
+        for (int y = 0; y < height; ++y) {
+            const GLubyte* r0 = rgba + std::size_t(gh - 1 - 2 * y) * std::size_t(gw) * 4;
+            const GLubyte* r1 = rgba + std::size_t(gh - 2 - 2 * y) * std::size_t(gw) * 4;
+            std::uint8_t* dst = &image.rgb[std::size_t(y) * std::size_t(width) * 3];
+            for (int x = 0; x < width; ++x) {
+                const int o = 8 * x;
+                for (int k = 0; k < 3; ++k) {
+                    const int sum = r0[o + k] + r0[o + 4 + k] + r1[o + k] + r1[o + 4 + k];
+                    dst[3 * x + k] = static_cast<std::uint8_t>((sum + 2) >> 2);
+                }
+            }
+        }
+        return image;
+    }
     const int n = ss * ss;
     for (int y = 0; y < height; ++y) {
         for (int x = 0; x < width; ++x) {
             int sum[3] = {0, 0, 0};
             for (int dy = 0; dy < ss; ++dy) {
                 const int gl_row = gh - 1 - (y * ss + dy);
-                const GLubyte* src =
-                    &readback[(std::size_t(gl_row) * gw + std::size_t(x) * ss) * 3];
+                const GLubyte* src = &rgba[(std::size_t(gl_row) * gw + std::size_t(x) * ss) * 4];
                 for (int dx = 0; dx < ss; ++dx) {
-                    sum[0] += src[dx * 3 + 0];
-                    sum[1] += src[dx * 3 + 1];
-                    sum[2] += src[dx * 3 + 2];
+                    sum[0] += src[dx * 4 + 0];
+                    sum[1] += src[dx * 4 + 1];
+                    sum[2] += src[dx * 4 + 2];
                 }
             }
             std::uint8_t* dst = &image.rgb[(std::size_t(y) * width + x) * 3];
@@ -534,6 +550,7 @@ const FrameStats& Renderer::lastFrameStats() const { return impl_->stats; }
 
 Image Renderer::render(const engine::World& world, const engine::CameraSettings& camera,
                        const FrameOptions& options) {
+    const auto start = std::chrono::steady_clock::now();
     Impl& im = *impl_;
     im.context.makeCurrent();
     const CameraFrame cam = im.setUpCamera(world, camera, options);
@@ -551,8 +568,13 @@ Image Renderer::render(const engine::World& world, const engine::CameraSettings&
     if (error != GL_NO_ERROR) {
         throw RenderError("OpenGL error " + std::to_string(error) + " while rendering a frame");
     }
+    glFinish();
+    const auto drawn = std::chrono::steady_clock::now();
     Image image = im.readPixels();
     im.drawOverlays(image, options);
+    const auto read = std::chrono::steady_clock::now();
+    im.stats.draw_s = std::chrono::duration<double>(drawn - start).count();
+    im.stats.readback_s = std::chrono::duration<double>(read - drawn).count();
     return image;
 }
 

@@ -56,6 +56,8 @@ struct FrameStats {
     std::int64_t triangle_vertices = 0;  ///< all batches
     std::int64_t batches = 0;
     std::int64_t largest_batch_vertices = 0;
+    double draw_s = 0;      ///< wall seconds: GL calls until the picture is finished (glFinish)
+    double readback_s = 0;  ///< wall seconds: supersampled buffer -> RGB image, overlays
 };
 
 class Renderer {
