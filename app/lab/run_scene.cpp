@@ -360,8 +360,8 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
             frame_options.hud_text =
                 scene.draw.hud ? render::hudLine(world, frame, options.hud_timing) : "";
             if (!options.no_frames || want_video) {
-                auto image = std::make_shared<const render::Image>(
-                    renderer.render(world, scene.camera, frame_options));
+                std::shared_ptr<render::Image> image = writer.blankFrame();
+                renderer.render(world, scene.camera, frame_options, *image);
                 stage.add(renderer.lastFrameStats());
                 const double wait_start = wallSeconds();
                 writer.submit(std::move(image),

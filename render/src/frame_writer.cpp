@@ -6,6 +6,7 @@
 // was lost.
 #include "render/frame_writer.h"
 
+#include <pthread.h>
 #include <time.h>
 
 #include <condition_variable>
@@ -94,6 +95,14 @@ struct VideoJob {
     long repeats = 0;
 };
 
+// Images whose writers are done, kept for the next frame. Shared with every image handed out,
+// so an image released after the writer is gone still has somewhere to go.
+struct ImagePool {
+    std::mutex mutex;
+    std::vector<std::unique_ptr<Image>> free;
+    static constexpr std::size_t kMaxFree = 16;
+};
+
 }  // namespace
 
 struct FrameWriter::Impl {
@@ -106,6 +115,7 @@ struct FrameWriter::Impl {
     BoundedQueue<VideoJob> video_queue;
     std::vector<std::thread> png_threads;
     std::thread video_thread;
+    std::shared_ptr<ImagePool> pool = std::make_shared<ImagePool>();
     bool finished = false;
 
     mutable std::mutex mutex;  ///< guards everything below
@@ -126,6 +136,7 @@ struct FrameWriter::Impl {
     }
 
     void pngWorker() {
+        ::pthread_setname_np(::pthread_self(), "cdlab-png");
         while (std::optional<PngJob> job = png_queue.pop()) {
             const double t0 = threadCpuSeconds();
             try {
@@ -141,6 +152,7 @@ struct FrameWriter::Impl {
     }
 
     void videoWorker() {
+        ::pthread_setname_np(::pthread_self(), "cdlab-video");
         while (std::optional<VideoJob> job = video_queue.pop()) {
             const double t0 = wallSeconds();
             try {
@@ -184,6 +196,24 @@ FrameWriter::~FrameWriter() {
         impl_->video_queue.abort();
     }
     impl_->join();
+}
+
+std::shared_ptr<Image> FrameWriter::blankFrame() {
+    std::shared_ptr<ImagePool> pool = impl_->pool;
+    std::unique_ptr<Image> image;
+    {
+        std::lock_guard<std::mutex> lock(pool->mutex);
+        if (!pool->free.empty()) {
+            image = std::move(pool->free.back());
+            pool->free.pop_back();
+        }
+    }
+    if (!image) image = std::make_unique<Image>();
+    return std::shared_ptr<Image>(image.release(), [pool](Image* done) {
+        std::unique_ptr<Image> owned(done);
+        std::lock_guard<std::mutex> lock(pool->mutex);
+        if (pool->free.size() < ImagePool::kMaxFree) pool->free.push_back(std::move(owned));
+    });
 }
 
 void FrameWriter::submit(std::shared_ptr<const Image> image, const fs::path& png_file,

@@ -37,6 +37,10 @@ public:
     FrameWriter(const FrameWriter&) = delete;
     FrameWriter& operator=(const FrameWriter&) = delete;
 
+    /// An image to render the next frame into: one whose earlier frame every writer is done
+    /// with (its storage reused), or a new one. Holds nothing back: drop it and it returns.
+    std::shared_ptr<Image> blankFrame();
+
     /// Queues `image` to be written as the PNG `png_file` (empty path: no PNG) and added
     /// `video_repeats` times to the video (0: not at all). Blocks while a queue is full. Throws
     /// RenderError when an earlier frame failed.

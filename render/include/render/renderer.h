@@ -74,6 +74,10 @@ public:
     /// volumes and states match its bodies (volumes it lacks are not drawn).
     Image render(const engine::World& world, const engine::CameraSettings& camera,
                  const FrameOptions& options);
+    /// The same picture written into `image`, whose storage is reused when large enough (a
+    /// video's frames then cost no fresh pages, which the kernel would have to zero).
+    void render(const engine::World& world, const engine::CameraSettings& camera,
+                const FrameOptions& options, Image& image);
 
     int width() const;
     int height() const;
