@@ -273,6 +273,22 @@ TEST(Cli, AFrameThatCannotBeWrittenStopsTheRun) {
     fs::remove_all(work);
 }
 
+// --timing ends the run with one line saying where the time went, each stage named, and the
+// writers' counts: every frame's PNG written, none given to an encoder that was not asked for.
+TEST(Cli, TimingLineNamesEveryStage) {
+    const fs::path work = tempDir("timing");
+    const Result r = runCdlab("run " + kTiny + " --quiet --no-video --timing --out " +
+                                  (work / "out").string(),
+                              work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("timing: 6 frames in "), std::string::npos) << r.out;
+    for (const char* stage : {"fps", "sim ", "render ", "readback ", "waiting for writers ",
+                              "png ", "(cpu, 6 files)", "video feed ", "(cpu, 0 frames)"}) {
+        EXPECT_NE(r.out.find(stage), std::string::npos) << stage << " in " << r.out;
+    }
+    fs::remove_all(work);
+}
+
 // Regression: every output was written to X.partial and renamed over X, whatever X was, so
 // `--video /dev/null` as root replaced the machine's /dev/null with an mp4 (exit 0). An existing
 // output path that is not a regular file is refused before any work, and left as it was: here a
