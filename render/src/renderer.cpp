@@ -1,8 +1,9 @@
 // render/src/renderer.cpp -- OSMesa software rendering of a World: shaded bodies, bounding-volume
 // wireframes coloured by overlap state, world bounds, broad-phase structure, HUD text.
 // Invariant: a frame is a pure function of (world state, camera, options, size). Nothing that
-// shapes a pixel reads a clock (the clock only times the stages for FrameStats), geometry is generated in a fixed order, and all vertices are eye-relative, so the same
-// state renders bit-identical pixels and large world coordinates do not lose float precision.
+// shapes a pixel reads a clock (the clock only times the stages for FrameStats), geometry is
+// generated in a fixed order, and all vertices are eye-relative, so the same state renders
+// bit-identical pixels and large world coordinates do not lose float precision.
 #include "render/renderer.h"
 
 #include <GL/gl.h>
