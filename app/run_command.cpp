@@ -57,6 +57,9 @@ Command addRunCommand(CLI::App& cli) {
                   "report (exit 3) at the first mismatch");
     cmd->add_option("--stats", f->stats, "write per-frame counters and stage times to FILE.csv");
     cmd->add_flag("--quiet", f->quiet, "no progress bar");
+    cmd->add_flag("--timing", f->run.timing,
+                  "print where the time went: wall time and fps, and milliseconds per frame for "
+                  "simulation, rendering, readback, PNG compression and video encoding");
     cmd->add_option("--set", f->set,
                     "KEY=VALUE: replace a scene value before validation, KEY a dotted path "
                     "(world.time_step, bodies.2.radius); repeatable")

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -18,6 +19,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include "broadphase_check.h"
 #include "collision/broadphase/broad_phase.h"
@@ -25,6 +27,7 @@
 #include "exit_codes.h"
 #include "output_files.h"
 #include "pause_dump.h"
+#include "render/frame_writer.h"
 #include "render/image.h"
 #include "render/output_file.h"
 #include "render/renderer.h"
@@ -122,6 +125,50 @@ std::string traceLine(int frame, const engine::World& world) {
     for (const collision::ProxyPair& p : world.collidingPairs()) pairs.push_back({p.a, p.b});
     line["colliding_pairs"] = std::move(pairs);
     return line.dump() + "\n";
+}
+
+double wallSeconds() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+}
+
+// The main thread's share of the run, for --timing.
+struct StageTimes {
+    double sim_s = 0;       ///< world steps
+    double render_s = 0;    ///< GL drawing until the frame is finished
+    double readback_s = 0;  ///< supersampled buffer -> RGB image with overlays
+    double wait_s = 0;      ///< blocked on the frame writer's full queues
+
+    void add(const render::FrameStats& f) {
+        render_s += f.draw_s;
+        readback_s += f.readback_s;
+    }
+};
+
+// Frames wait in each of the writer's queues at most this many at a time (each a full RGB frame,
+// 2.8 MB at 1280x720): enough to absorb an encoder hiccup, bounded whatever the frame count.
+constexpr int kQueueFrames = 4;
+
+// PNG workers: all cores but the one that simulates and renders, at least one and at most four
+// (a 1280x720 PNG takes about 7 ms, so four keep up with any renderer here); the encoder process
+// runs its own threads beside them.
+int pngThreads() {
+    const int cores = int(std::thread::hardware_concurrency());
+    return std::clamp(cores - 1, 1, 4);
+}
+
+std::string timingLine(int frames, double wall_s, const StageTimes& st,
+                       const render::FrameWriterTimes& wt) {
+    const double per = frames > 0 ? 1e3 / frames : 0;
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "timing: %d frames in %.2f s wall (%.1f fps); ms per frame: sim %.2f, render "
+                  "%.2f, readback %.2f, waiting for writers %.2f (main thread); png %.2f "
+                  "(cpu, %lld files), video feed %.2f, encoder %.2f (cpu, %lld frames)\n",
+                  frames, wall_s, wall_s > 0 ? frames / wall_s : 0.0, st.sim_s * per,
+                  st.render_s * per, st.readback_s * per, st.wait_s * per, wt.png_cpu_s * per,
+                  wt.png_files, wt.video_feed_s * per, wt.encoder_cpu_s * per, wt.video_frames);
+    return line;
 }
 
 std::string frameName(int frame) {
@@ -254,6 +301,9 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
             video = std::make_unique<render::VideoWriter>(video_path, scene.output.width,
                                                           scene.output.height, scene.output.fps);
         }
+        render::FrameWriter writer(std::move(video), pngThreads(), kQueueFrames);
+        StageTimes stage;
+        const double run_start = wallSeconds();
         render::FrameOptions frame_options;
         frame_options.draw = render::drawSettingsFor(scene.draw, world);
         frame_options.draw_structure = scene.draw.structure || options.draw_structure;
@@ -286,6 +336,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
                 frame_stats.add(world.lastStats());
                 if (!checkStep(0)) return kExitCheckFailed;
             } else {
+                const double sim_start = wallSeconds();
                 for (int s = 0; s < scene.steps_per_frame; ++s) {
                     try {
                         world.step();
@@ -299,6 +350,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
                     totals.step_seconds += world.lastStats().total_s;
                     if (!checkStep(static_cast<int>(world.stepCount()))) return kExitCheckFailed;
                 }
+                stage.sim_s += wallSeconds() - sim_start;
             }
             if (options.stats_csv) stats_text += statsRow(frame, world, frame_stats);
             if (options.trace) trace_text += traceLine(frame, world);
@@ -306,23 +358,29 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
             totals.colliding += static_cast<std::int64_t>(world.collidingPairs().size());
             frame_options.hud_text =
                 scene.draw.hud ? render::hudLine(world, frame, options.hud_timing) : "";
-            if (!options.no_frames || video) {
-                const render::Image image = renderer.render(world, scene.camera, frame_options);
-                if (!options.no_frames) render::writePng(out_dir / frameName(frame), image);
-                if (video) video->addFrame(image);
+            if (!options.no_frames || want_video) {
+                std::shared_ptr<render::Image> image = writer.blankFrame();
+                renderer.render(world, scene.camera, frame_options, *image);
+                stage.add(renderer.lastFrameStats());
+                const double wait_start = wallSeconds();
+                writer.submit(std::move(image),
+                              options.no_frames ? fs::path() : out_dir / frameName(frame), 1);
+                stage.wait_s += wallSeconds() - wait_start;
             }
             if (pauses.count(frame)) {
                 pause_options.hud_text = "PAUSED  " + render::hudLine(world, frame, false);
                 const std::string stem = "pause_" + std::to_string(frame);
-                const render::Image pause_image =
-                    renderer.render(world, scene.camera, pause_options);
-                render::writePng(out_dir / (stem + ".png"), pause_image);
+                auto pause_image = std::make_shared<const render::Image>(
+                    renderer.render(world, scene.camera, pause_options));
+                writer.submit(std::move(pause_image), out_dir / (stem + ".png"), hold_frames);
                 writeTextAtomically(out_dir / (stem + ".json"), pauseDumpJson(world, frame));
-                for (long k = 0; video && k < hold_frames; ++k) video->addFrame(pause_image);
             }
             progress.update(frame + 1);
         }
-        if (video) video->finish();
+        writer.finish();
+        if (options.timing) {
+            out << timingLine(scene.frames, wallSeconds() - run_start, stage, writer.times());
+        }
         if (options.stats_csv) writeTextAtomically(*options.stats_csv, stats_text);
         if (options.trace) writeTextAtomically(*options.trace, trace_text);
 

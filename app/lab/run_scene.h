@@ -28,6 +28,7 @@ struct RunOptions {
     double pause_hold_s = 2.0;
     bool hud_timing = true;                  ///< step time in the HUD (off: bit-identical frames)
     bool progress = true;                    ///< progress bar when stderr is a terminal
+    bool timing = false;                     ///< print a per-stage time line at the end
     bool draw_structure = false;             ///< draw the broad phase's own structure
     bool check_broad_phase = false;          ///< compare every step with the brute reference
     std::optional<std::filesystem::path> stats_csv;  ///< one row of counters per frame

@@ -29,6 +29,10 @@ public:
     OsMesaContext(const OsMesaContext&) = delete;
     OsMesaContext& operator=(const OsMesaContext&) = delete;
 
+    /// The colour buffer OSMesa renders into: RGBA8, width x height, row 0 at the bottom
+    /// (OSMESA_Y_UP). Complete once glFinish() has returned.
+    const GLubyte* pixels() const { return buffer_.data(); }
+
     /// Contexts are current per thread: every frame binds its own before drawing.
     void makeCurrent() {
         if (!OSMesaMakeCurrent(context_, buffer_.data(), GL_UNSIGNED_BYTE, width_, height_)) {

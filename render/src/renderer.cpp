@@ -1,16 +1,22 @@
 // render/src/renderer.cpp -- OSMesa software rendering of a World: shaded bodies, bounding-volume
 // wireframes coloured by overlap state, world bounds, broad-phase structure, HUD text.
-// Invariant: a frame is a pure function of (world state, camera, options, size). Nothing reads a
-// clock, geometry is generated in a fixed order, and all vertices are eye-relative, so the same
-// state renders bit-identical pixels and large world coordinates do not lose float precision.
+// Invariant: a frame is a pure function of (world state, camera, options, size). Nothing that
+// shapes a pixel reads a clock (the clock only times the stages for FrameStats), geometry is
+// generated in a fixed order, and all vertices are eye-relative, so the same state renders
+// bit-identical pixels and large world coordinates do not lose float precision.
 #include "render/renderer.h"
 
 #include <GL/gl.h>
 #include <GL/osmesa.h>
+#if defined(__SSE2__) && defined(__x86_64__)
+#include <emmintrin.h>
+#endif
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <optional>
@@ -51,6 +57,41 @@ Real gridStep(Real extent, Real target) {
         if (m * p >= raw) return m * p;
     }
     return 10 * p;
+}
+
+// One output row of a 2x2 box filter: `width` RGB pixels, each the rounded mean
+// ((a + b + c + d + 2) >> 2) of two adjacent RGBA pixels in `r0` and the two below them in `r1`.
+void downsampleRow2x2(const std::uint8_t* r0, const std::uint8_t* r1, int width,
+                      std::uint8_t* dst) {
+    int x = 0;
+#if defined(__SSE2__) && defined(__x86_64__)
+    // Two output pixels per 16 bytes of each row, in 16-bit lanes (the sum of four bytes fits).
+    // Each pixel is stored as 4 bytes at 3x, its alpha overwritten by the next pixel's red, so
+    // the row's last pixel is left to the scalar loop (its 4th byte would leave the row).
+    const __m128i zero = _mm_setzero_si128();
+    const __m128i two = _mm_set1_epi16(2);
+    for (; x + 2 < width; x += 2) {
+        const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r0 + 8 * x));
+        const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r1 + 8 * x));
+        const __m128i lo = _mm_add_epi16(_mm_unpacklo_epi8(a, zero), _mm_unpacklo_epi8(b, zero));
+        const __m128i hi = _mm_add_epi16(_mm_unpackhi_epi8(a, zero), _mm_unpackhi_epi8(b, zero));
+        const __m128i sum = _mm_add_epi16(_mm_unpacklo_epi64(lo, hi), _mm_unpackhi_epi64(lo, hi));
+        const __m128i mean = _mm_srli_epi16(_mm_add_epi16(sum, two), 2);
+        const __m128i bytes = _mm_packus_epi16(mean, mean);
+        const std::uint64_t two_pixels = std::uint64_t(_mm_cvtsi128_si64(bytes));
+        const std::uint32_t p0 = std::uint32_t(two_pixels);
+        const std::uint32_t p1 = std::uint32_t(two_pixels >> 32);
+        std::memcpy(dst + 3 * x, &p0, 4);
+        std::memcpy(dst + 3 * x + 3, &p1, 4);
+    }
+#endif
+    for (; x < width; ++x) {
+        const int o = 8 * x;
+        for (int k = 0; k < 3; ++k) {
+            const int sum = r0[o + k] + r0[o + 4 + k] + r1[o + k] + r1[o + 4 + k];
+            dst[3 * x + k] = static_cast<std::uint8_t>((sum + 2) >> 2);
+        }
+    }
 }
 
 }  // namespace
@@ -101,7 +142,6 @@ struct Renderer::Impl {
     /// volume is coloured by its own test.
     bool own_tests = false;
     std::optional<VolumeKind> tested_volume;  ///< the kind the broad phase tests
-    std::vector<GLubyte> readback;
     FrameStats stats;
 
     const UnitSphereGrid& sphereGrid(int slices) {
@@ -126,7 +166,7 @@ struct Renderer::Impl {
     /// Draws the triangle buffer and empties it.
     void drawTriangles();
     void drawLines(const LineBuffer& lines, float width_px);
-    Image readPixels();
+    void readPixels(Image& image);
     void drawOverlays(Image& image, const FrameOptions& options) const;
 };
 
@@ -444,37 +484,44 @@ void Renderer::Impl::drawLines(const LineBuffer& lines, float width_px) {
     glDisable(GL_BLEND);
 }
 
-Image Renderer::Impl::readPixels() {
+void Renderer::Impl::readPixels(Image& image) {
+    // glFinish() leaves the frame in the context's own RGBA buffer (OSMesa copies its render
+    // target there): read it in place rather than through glReadPixels, which converts RGBA to
+    // RGB in a second full pass over the supersampled frame. Same bytes, no conversion.
     const int gw = width * ss;
     const int gh = height * ss;
-    glFinish();
-    readback.resize(std::size_t(gw) * std::size_t(gh) * 3);
-    glReadPixels(0, 0, gw, gh, GL_RGB, GL_UNSIGNED_BYTE, readback.data());
+    const GLubyte* rgba = context.pixels();
 
-    Image image;
     image.width = width;
     image.height = height;
     image.rgb.resize(std::size_t(width) * std::size_t(height) * 3);
-    // GL rows run bottom-up: flip so row 0 is the top, and box-filter each ss x ss block.
+    // GL rows run bottom-up: flip so row 0 is the top, and box-filter each ss x ss block,
+    // rounding the mean to nearest ((sum + n/2) / n).
+    if (ss == 2) {
+        for (int y = 0; y < height; ++y) {
+            const GLubyte* r0 = rgba + std::size_t(gh - 1 - 2 * y) * std::size_t(gw) * 4;
+            const GLubyte* r1 = rgba + std::size_t(gh - 2 - 2 * y) * std::size_t(gw) * 4;
+            downsampleRow2x2(r0, r1, width, &image.rgb[std::size_t(y) * std::size_t(width) * 3]);
+        }
+        return;
+    }
     const int n = ss * ss;
     for (int y = 0; y < height; ++y) {
         for (int x = 0; x < width; ++x) {
             int sum[3] = {0, 0, 0};
             for (int dy = 0; dy < ss; ++dy) {
                 const int gl_row = gh - 1 - (y * ss + dy);
-                const GLubyte* src =
-                    &readback[(std::size_t(gl_row) * gw + std::size_t(x) * ss) * 3];
+                const GLubyte* src = &rgba[(std::size_t(gl_row) * gw + std::size_t(x) * ss) * 4];
                 for (int dx = 0; dx < ss; ++dx) {
-                    sum[0] += src[dx * 3 + 0];
-                    sum[1] += src[dx * 3 + 1];
-                    sum[2] += src[dx * 3 + 2];
+                    sum[0] += src[dx * 4 + 0];
+                    sum[1] += src[dx * 4 + 1];
+                    sum[2] += src[dx * 4 + 2];
                 }
             }
             std::uint8_t* dst = &image.rgb[(std::size_t(y) * width + x) * 3];
             for (int k = 0; k < 3; ++k) dst[k] = static_cast<std::uint8_t>((sum[k] + n / 2) / n);
         }
     }
-    return image;
 }
 
 void Renderer::Impl::drawOverlays(Image& image, const FrameOptions& options) const {
@@ -534,6 +581,14 @@ const FrameStats& Renderer::lastFrameStats() const { return impl_->stats; }
 
 Image Renderer::render(const engine::World& world, const engine::CameraSettings& camera,
                        const FrameOptions& options) {
+    Image image;
+    render(world, camera, options, image);
+    return image;
+}
+
+void Renderer::render(const engine::World& world, const engine::CameraSettings& camera,
+                      const FrameOptions& options, Image& image) {
+    const auto start = std::chrono::steady_clock::now();
     Impl& im = *impl_;
     im.context.makeCurrent();
     const CameraFrame cam = im.setUpCamera(world, camera, options);
@@ -551,9 +606,13 @@ Image Renderer::render(const engine::World& world, const engine::CameraSettings&
     if (error != GL_NO_ERROR) {
         throw RenderError("OpenGL error " + std::to_string(error) + " while rendering a frame");
     }
-    Image image = im.readPixels();
+    glFinish();
+    const auto drawn = std::chrono::steady_clock::now();
+    im.readPixels(image);
     im.drawOverlays(image, options);
-    return image;
+    const auto read = std::chrono::steady_clock::now();
+    im.stats.draw_s = std::chrono::duration<double>(drawn - start).count();
+    im.stats.readback_s = std::chrono::duration<double>(read - drawn).count();
 }
 
 std::string hudLine(const engine::World& world, int frame, bool include_timing) {

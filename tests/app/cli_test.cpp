@@ -254,6 +254,41 @@ TEST(Cli, UnwritableOutputIsAClearFailure) {
     fs::remove_all(work);
 }
 
+// A frame that cannot be written in the middle of a run (here frame 3's name is taken by a
+// directory), while the writer threads compress PNGs and feed the encoder behind the renderer:
+// the run stops with the file named and exit 1, and leaves nothing that looks complete (no
+// summary.json, no video under its final or partial name).
+TEST(Cli, AFrameThatCannotBeWrittenStopsTheRun) {
+    if (!haveFfprobe()) GTEST_SKIP() << "ffmpeg not on PATH (Debian package ffmpeg)";
+    const fs::path work = tempDir("frame_unwritable");
+    const fs::path out = work / "out";
+    fs::create_directories(out / "frame_00003.png");
+    const Result r = runCdlab("run " + kTiny + " --quiet --out " + out.string(), work);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("frame_00003.png: exists and is a directory"), std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(out / "summary.json"));
+    EXPECT_FALSE(fs::exists(out / "tiny.mp4"));
+    EXPECT_FALSE(fs::exists(out / "tiny.partial.mp4"));
+    fs::remove_all(work);
+}
+
+// --timing ends the run with one line saying where the time went, each stage named, and the
+// writers' counts: every frame's PNG written, none given to an encoder that was not asked for.
+TEST(Cli, TimingLineNamesEveryStage) {
+    const fs::path work = tempDir("timing");
+    const Result r = runCdlab("run " + kTiny + " --quiet --no-video --timing --out " +
+                                  (work / "out").string(),
+                              work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("timing: 6 frames in "), std::string::npos) << r.out;
+    for (const char* stage : {"fps", "sim ", "render ", "readback ", "waiting for writers ",
+                              "png ", "(cpu, 6 files)", "video feed ", "(cpu, 0 frames)"}) {
+        EXPECT_NE(r.out.find(stage), std::string::npos) << stage << " in " << r.out;
+    }
+    fs::remove_all(work);
+}
+
 // Regression: every output was written to X.partial and renamed over X, whatever X was, so
 // `--video /dev/null` as root replaced the machine's /dev/null with an mp4 (exit 0). An existing
 // output path that is not a regular file is refused before any work, and left as it was: here a

@@ -58,6 +58,8 @@ public:
     void addFrame(const Image& image);
     /// Waits for ffmpeg (at most the stall timeout); throws RenderError on failure.
     void finish();
+    /// The encoder's user + system CPU seconds, once finish() has succeeded (0 before).
+    double encoderCpuSeconds() const { return encoder_cpu_s_; }
 
 private:
     void abandon() noexcept;  ///< kills ffmpeg (our child, by pid) and removes the partial file
@@ -69,6 +71,7 @@ private:
     std::chrono::milliseconds stall_timeout_;
     int pipe_fd_ = -1;  ///< write end of ffmpeg's stdin, non-blocking
     int pid_ = -1;      ///< ffmpeg's process id while it runs
+    double encoder_cpu_s_ = 0;
 };
 
 }  // namespace render

@@ -56,6 +56,8 @@ struct FrameStats {
     std::int64_t triangle_vertices = 0;  ///< all batches
     std::int64_t batches = 0;
     std::int64_t largest_batch_vertices = 0;
+    double draw_s = 0;      ///< wall seconds: GL calls until the picture is finished (glFinish)
+    double readback_s = 0;  ///< wall seconds: supersampled buffer -> RGB image, overlays
 };
 
 class Renderer {
@@ -72,6 +74,10 @@ public:
     /// volumes and states match its bodies (volumes it lacks are not drawn).
     Image render(const engine::World& world, const engine::CameraSettings& camera,
                  const FrameOptions& options);
+    /// The same picture written into `image`, whose storage is reused when large enough (a
+    /// video's frames then cost no fresh pages, which the kernel would have to zero).
+    void render(const engine::World& world, const engine::CameraSettings& camera,
+                const FrameOptions& options, Image& image);
 
     int width() const;
     int height() const;
