@@ -161,6 +161,9 @@ private:
     std::vector<std::uint32_t> previous_order_;  // repairOrder's scratch
     bool members_changed_ = true;        // a proxy inserted or removed since order_ was made
     std::int64_t order_shifts_ = 0;      // insertion-sort shifts of the last repairOrder
+    /// Frames without a repair of the order after one ran past its budget.
+    static constexpr int kRepairRest = 16;
+    int repair_rest_ = 0;                // frames left before the next repair
     Real last_top_ = 1;                  // the largest extent, last frame
     bool levels_found_ = false;          // gatherBoxes found this frame's levels
     std::vector<std::uint64_t> packed_;  // (float min x, id) sort keys
