@@ -207,30 +207,16 @@ struct LevelTally {
 }  // namespace
 
 HierarchicalGrid::Extents HierarchicalGrid::gatherBoxes() {
-    // The boxes in sorted order, with their largest extent and bounds. On one lane their levels
-    // are found on the way, for last frame's largest extent: usually it has not changed, and
-    // levelLane need not read the boxes again (levels_found_ says whether it did not).
+    // The boxes in sorted order, with their largest extent and bounds.
     Extents x = noExtents<Extents>();
-    const std::size_t n = order_.size();
-    box_.resize(n);
-    level_of_.resize(n);
-    const bool one_lane = !helper_ || n < kTwoLaneMinimum;
-    LevelTally tally(last_top_);
-    for (std::size_t p = 0; p < n; ++p) {
+    box_.resize(order_.size());
+    for (std::size_t p = 0; p < order_.size(); ++p) {
         const Aabb& b = box_[p] = table_.aabb(ProxyId(order_[p]));
         addBox(x, b);
-        if (one_lane) level_of_[p] = tally.add(p, extentOf(b));
     }
     x.lo_c /= 2;
     x.hi_c /= 2;
     if (!(x.top > 0)) x.top = 1;
-    levels_found_ = one_lane && x.top == last_top_;
-    if (levels_found_) {
-        lanes_[0].first = 0;
-        lanes_[0].last = n;
-        tally.store(lanes_[0]);
-    }
-    last_top_ = x.top;
     return x;
 }
 
@@ -553,7 +539,8 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     origin_y_ = x.lo_y;
     origin_z_ = x.lo_z;
 
-    if (!levels_found_) inLanes([this, top](int t) { levelLane(lanes_[t], top); });
+    level_of_.resize(n);
+    inLanes([this, top](int t) { levelLane(lanes_[t], top); });
     chooseLevels(top, x);
 
     inLanes([this](int t) { countLane(lanes_[t]); });

@@ -36,9 +36,8 @@ namespace collision {
 /// frame's order repaired by an insertion sort when no proxy came or went and few keys moved,
 /// else a radix sort. They are scattered into the columns stably in that order, so each column
 /// is nearly sorted; an insertion sort per column restores the exact (min x, id) order (sorting
-/// a column outright past a budget of shifts). Levels are found while the boxes are gathered,
-/// for last frame's largest extent, and found again only when it changed. Pairs are put in
-/// (a, b) order by one more radix sort, which also orders each pair's two ids. Cost per
+/// a column outright past a budget of shifts). Pairs are put in (a, b) order by one more radix
+/// sort, which also orders each pair's two ids (or left in the sweep's order: PairOrder). Cost per
 /// frame O(n + candidates + pairs) for the sizes it is planned for, and no heap allocation once
 /// the buffers have grown. Exact: every comparison is on the proxies' own coordinates,
 /// touching counts.
@@ -174,8 +173,6 @@ private:
     /// Frames without a repair of the order after one ran past its budget.
     static constexpr int kRepairRest = 16;
     int repair_rest_ = 0;                // frames left before the next repair
-    Real last_top_ = 1;                  // the largest extent, last frame
-    bool levels_found_ = false;          // gatherBoxes found this frame's levels
     std::vector<std::uint64_t> packed_;  // (float min x, id) sort keys
     std::vector<std::uint64_t> packed_scratch_;
     std::vector<Aabb> box_;               // their boxes
