@@ -478,47 +478,6 @@ TEST(BroadPhaseRegistry, NamesAreUniqueAndReferencesExist) {
     EXPECT_NE(broadPhaseNames().find("sap"), std::string::npos);
 }
 
-// hgrid keeps last frame's order of the proxies by min x and repairs it by insertion sort when
-// no proxy came or went: under small motions the repair moves some keys (swaps > 0) but far
-// fewer than a sort from scratch would compare, and the pairs stay those of brute force. A
-// proxy inserted or removed sends it back to a full sort (swaps from the columns only).
-TEST(HierarchicalGrid, CoherentMotionRepairsLastFramesOrder) {
-    std::unique_ptr<BroadPhase> hgrid = findBroadPhase("hgrid")->create();
-    std::unique_ptr<BroadPhase> ref = findBroadPhase("brute")->create();
-    Rng rng(9);
-    std::vector<MovingBox> boxes = makeScene(Layout::Uniform, 500, rng);
-    for (int i = 0; i < 500; ++i) {
-        hgrid->insert(i, boxes[i].volumes());
-        ref->insert(i, boxes[i].volumes());
-    }
-    std::vector<ProxyPair> pairs, ref_pairs;
-    BroadPhaseCounters first, rc;
-    hgrid->findPairs(pairs, first);
-    for (MovingBox& b : boxes) {
-        b.velocity *= 0.05;
-        b.spin = Quat::Identity();
-    }
-    for (int frame = 0; frame < 3; ++frame) {
-        advance(boxes, Layout::Uniform);
-        for (int i = 0; i < 500; ++i) {
-            hgrid->move(i, boxes[i].volumes());
-            ref->move(i, boxes[i].volumes());
-        }
-        BroadPhaseCounters counters;
-        hgrid->findPairs(pairs, counters);
-        ref->findPairs(ref_pairs, rc);
-        ASSERT_EQ(pairs, ref_pairs) << "frame " << frame;
-        EXPECT_GT(counters.swaps, 0) << "frame " << frame;
-        EXPECT_LT(counters.swaps, 500) << "frame " << frame;
-    }
-    hgrid->remove(7);
-    ref->remove(7);
-    hgrid->findPairs(pairs, rc);
-    ref->findPairs(ref_pairs, rc);
-    EXPECT_EQ(pairs, ref_pairs);
-    EXPECT_EQ(hgrid->validate(), "");
-}
-
 // PairOrder::Found skips the sort: the same pairs as brute force, each (a, b) with a < b, no
 // duplicates, in the sweep's order (not sorted on some frame: else the choice would be moot),
 // and the same list from two grids given the same calls.

@@ -90,16 +90,6 @@ HierarchicalGrid::HierarchicalGrid(bool two_threads, PairOrder order) : pair_ord
 
 HierarchicalGrid::~HierarchicalGrid() = default;
 
-void HierarchicalGrid::insert(ProxyId id, const ProxyVolumes& v) {
-    RebuildingBroadPhase::insert(id, v);
-    members_changed_ = true;
-}
-
-void HierarchicalGrid::remove(ProxyId id) {
-    RebuildingBroadPhase::remove(id);
-    members_changed_ = true;
-}
-
 inline std::int64_t HierarchicalGrid::column(const Level& lv, Real v, Real origin, std::int64_t n) const {
     if (n == 1) return 0;
     // v >= origin (the smallest min coordinate of all proxies), so the product is >= 0 and the
@@ -218,45 +208,6 @@ HierarchicalGrid::Extents HierarchicalGrid::gatherBoxes() {
     x.hi_c /= 2;
     if (!(x.top > 0)) x.top = 1;
     return x;
-}
-
-bool HierarchicalGrid::repairOrder(Extents& x) {
-    // Last frame's order, repaired: between frames bodies move little, so an insertion sort of
-    // the keys in last frame's order moves few of them and costs about one comparison per box
-    // (the coherence sort and sweep rests on: Baraff, "Dynamic Simulation of Non-Penetrating
-    // Rigid Bodies", 1992, §5.2; Cohen et al., I-COLLIDE, 1995). Keys are float(min x) above
-    // the box's place in last frame's order, 8 bytes to move; ties of the float are put right
-    // by fixColumns as on the other path. Past a budget of shifts it gives up, and the caller
-    // sorts from scratch.
-    const std::size_t n = order_.size();
-    packed_.resize(n);
-    std::uint64_t* const key = packed_.data();
-    for (std::size_t p = 0; p < n; ++p) {
-        const float min_x = static_cast<float>(table_.aabb(ProxyId(order_[p])).min.x());
-        key[p] = orderedBits(min_x) << 32 | std::uint64_t(p);
-    }
-    const std::size_t budget = 4 * n + 64;
-    std::size_t shifts = 0;
-    for (std::size_t i = 1; i < n; ++i) {
-        if (!(key[i] < key[i - 1])) continue;
-        const std::uint64_t moving = key[i];
-        std::size_t j = i;
-        do {
-            key[j] = key[j - 1];
-            --j;
-        } while (j > 0 && moving < key[j - 1]);
-        key[j] = moving;
-        shifts += i - j;
-        if (shifts > budget) return false;
-    }
-    order_shifts_ = static_cast<std::int64_t>(shifts);
-    previous_order_.swap(order_);
-    order_.resize(n);
-    for (std::size_t q = 0; q < n; ++q) {
-        order_[q] = previous_order_[std::uint32_t(key[q])];
-    }
-    x = gatherBoxes();
-    return true;
 }
 
 void HierarchicalGrid::levelLane(Lane& lane, Real top) {
@@ -501,22 +452,8 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     // Gathered by this thread alone: the table was just written here, by move(), and a helper
     // reading half of it from the other core made the pass slower than on one thread (10k
     // boxes: 75 against 38 us).
-    Extents x;
-    order_shifts_ = 0;
-    // A repair that ran past its budget is not tried again for kRepairRest frames: when the
-    // boxes are dense in x (100k in the bench's cube), every frame moves too many keys.
-    bool repaired = false;
-    if (!members_changed_ && repair_rest_ == 0) {
-        repaired = repairOrder(x);
-        if (!repaired) repair_rest_ = kRepairRest;
-    } else if (repair_rest_ > 0) {
-        --repair_rest_;
-    }
-    if (!repaired) {
-        sortByMinX();
-        x = gatherBoxes();
-        members_changed_ = false;
-    }
+    sortByMinX();
+    const Extents x = gatherBoxes();
     const std::size_t n = order_.size();
 
     // Lanes: lane 0 alone, or lanes 0 and 1 on two threads. Positions (for level finding,
@@ -564,7 +501,6 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
         inLanes([this](int t) { sweepLane(lanes_[t], lanes_[t].pairs); });
         mergeLanePairs(pairs);
     }
-    counters.swaps += order_shifts_;
     for (int t = 0; t < lanes; ++t) {
         counters.volume_tests += lanes_[t].tests;
         counters.swaps += lanes_[t].swaps;

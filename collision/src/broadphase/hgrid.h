@@ -32,10 +32,8 @@ namespace collision {
 /// Detection §7.1.5), so it is met once. That column is known from two bits per entry: whether
 /// the entry's own min corner is in this column's row (y) and layer (z).
 ///
-/// Each frame the proxies are put in float(min x) order (a non-decreasing image of min x): last
-/// frame's order repaired by an insertion sort when no proxy came or went and few keys moved,
-/// else a radix sort. They are scattered into the columns stably in that order, so each column
-/// is nearly sorted; an insertion sort per column restores the exact (min x, id) order (sorting
+/// Each frame the proxies are radix-sorted by float(min x) (a non-decreasing image of min x)
+/// and scattered into the columns stably in that order, so each column is nearly sorted; an insertion sort per column restores the exact (min x, id) order (sorting
 /// a column outright past a budget of shifts). Pairs are put in (a, b) order by one more radix
 /// sort, which also orders each pair's two ids (or left in the sweep's order: PairOrder). Cost per
 /// frame O(n + candidates + pairs) for the sizes it is planned for, and no heap allocation once
@@ -64,8 +62,6 @@ public:
     explicit HierarchicalGrid(bool two_threads = false, PairOrder order = PairOrder::Sorted);
     ~HierarchicalGrid() override;
     std::string_view name() const override { return helper_ ? "hgrid2" : "hgrid"; }
-    void insert(ProxyId id, const ProxyVolumes& v) override;
-    void remove(ProxyId id) override;
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
     void draw(DebugDraw& draw, const Aabb& bounds) const override;
     std::string validate() const override;
@@ -146,7 +142,6 @@ private:
                              const std::array<Real, kMaxLevels>& extent_sum, int level_count,
                              Real top, const Bounds& bounds, Plan& plan);
     Extents gatherBoxes();
-    bool repairOrder(Extents& x);
     // Steps of findPairs, in order (hgrid.cpp).
     void chooseLevels(Real top, const Extents& x);
     std::size_t layoutColumns(std::size_t& flat_columns);
@@ -167,12 +162,6 @@ private:
     Real origin_y_ = 0, origin_z_ = 0;
     std::array<Level, kMaxLevels> levels_;
     std::vector<std::uint32_t> order_;   // present proxies by (min x, id)
-    std::vector<std::uint32_t> previous_order_;  // repairOrder's scratch
-    bool members_changed_ = true;        // a proxy inserted or removed since order_ was made
-    std::int64_t order_shifts_ = 0;      // insertion-sort shifts of the last repairOrder
-    /// Frames without a repair of the order after one ran past its budget.
-    static constexpr int kRepairRest = 16;
-    int repair_rest_ = 0;                // frames left before the next repair
     std::vector<std::uint64_t> packed_;  // (float min x, id) sort keys
     std::vector<std::uint64_t> packed_scratch_;
     std::vector<Aabb> box_;               // their boxes
