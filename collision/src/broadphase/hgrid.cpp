@@ -90,7 +90,7 @@ HierarchicalGrid::HierarchicalGrid(bool two_threads, PairOrder order) : pair_ord
 
 HierarchicalGrid::~HierarchicalGrid() = default;
 
-inline std::int64_t HierarchicalGrid::column(const Level& lv, Real v, Real origin, std::int64_t n) const {
+std::int64_t HierarchicalGrid::column(const Level& lv, Real v, Real origin, std::int64_t n) const {
     if (n == 1) return 0;
     // v >= origin (the smallest min coordinate of all proxies), so the product is >= 0 and the
     // truncation is floor: non-decreasing in v, which is all the owner rule needs.
@@ -101,7 +101,7 @@ inline std::int64_t HierarchicalGrid::column(const Level& lv, Real v, Real origi
     return static_cast<std::int64_t>(c);
 }
 
-inline HierarchicalGrid::Span HierarchicalGrid::span(const Level& lv, const Aabb& b) const {
+HierarchicalGrid::Span HierarchicalGrid::span(const Level& lv, const Aabb& b) const {
     const std::int64_t y0 = column(lv, b.min.y(), origin_y_, lv.ny);
     const std::int64_t z0 = column(lv, b.min.z(), origin_z_, lv.nz);
     return Span{y0, z0, column(lv, b.max.y(), origin_y_, lv.ny) - y0,
@@ -124,98 +124,52 @@ void HierarchicalGrid::sortByMinX() {
     });
 }
 
-// Widens the bounds in `x` by one box: its largest extent, its y and z range, its centre.
-// The centres' bounds are kept doubled (min + max) and halved once at the end (exact).
-template <typename Extents>
-[[gnu::always_inline]] inline void addBox(Extents& x, const Aabb& b) {
-    x.top = std::max(x.top, extentOf(b));
-    const Vec3 c = b.min + b.max;  // centres: where the boxes are, for planLevels
-    x.lo_c = x.lo_c.cwiseMin(c);
-    x.hi_c = x.hi_c.cwiseMax(c);
-    x.lo_y = std::min(x.lo_y, b.min.y());
-    x.hi_y = std::max(x.hi_y, b.max.y());
-    x.lo_z = std::min(x.lo_z, b.min.z());
-    x.hi_z = std::max(x.hi_z, b.max.z());
-}
-
-template <typename Extents>
-inline Extents noExtents() {
+HierarchicalGrid::Extents HierarchicalGrid::gatherBoxes() {
+    // The boxes in sorted order, with their largest extent and bounds.
     Extents x;
     x.lo_y = x.lo_z = std::numeric_limits<Real>::max();
     x.hi_y = x.hi_z = std::numeric_limits<Real>::lowest();
     x.lo_c = Vec3::Constant(std::numeric_limits<Real>::max());
     x.hi_c = Vec3::Constant(std::numeric_limits<Real>::lowest());
-    return x;
-}
-
-// Level k has cells s_top / 8^k; a box goes to the finest level whose cells hold its extent.
-// Zero-size boxes fit anywhere: marked kZeroSize, they join the finest level in use. Sums and
-// counts are kept in two interleaved sets (even and odd positions), so that consecutive boxes of
-// one level do not wait on each other's update.
-namespace {
-
-struct LevelTally {
-    static constexpr int kLevels = HierarchicalGrid::kMaxLevels;
-    explicit LevelTally(Real top) : top_log(floorLog2(top)) {
-        for (int k = 0; k < kLevels; ++k) {
-            base_cell[k] = std::ldexp(top, -HierarchicalGrid::kLevelBits * k);
-        }
-    }
-    std::uint8_t add(std::size_t p, Real e) {
-        if (!(e > 0)) {
-            ++zero_size;
-            return kZeroSize;
-        }
-        // floor(log2(top / e)) is the difference of the exponents or one less (both normal),
-        // so this k is the answer or one more; the loop after it runs only for subnormal e.
-        int k = std::min((top_log - floorLog2(e)) / HierarchicalGrid::kLevelBits, kLevels - 1);
-        k -= int(k > 0) & int(base_cell[k] < e);
-        while (k > 0 && base_cell[k] < e) --k;
-        extent_sum[p & 1][k] += e;
-        ++members[p & 1][k];
-        finest = std::max(finest, k);
-        return static_cast<std::uint8_t>(k);
-    }
-    template <typename Lane>
-    void store(Lane& lane) const {
-        for (int k = 0; k < kLevels; ++k) {
-            lane.extent_sum[k] = extent_sum[0][k] + extent_sum[1][k];
-            lane.members[k] = members[0][k] + members[1][k];
-        }
-        lane.zero_size = zero_size;
-        lane.finest = finest;
-    }
-
-    int top_log;
-    std::array<Real, kLevels> base_cell;  // s_top / 8^k
-    Real extent_sum[2][kLevels] = {};
-    std::size_t members[2][kLevels] = {};
-    std::size_t zero_size = 0;
-    int finest = 0;
-};
-
-}  // namespace
-
-HierarchicalGrid::Extents HierarchicalGrid::gatherBoxes() {
-    // The boxes in sorted order, with their largest extent and bounds.
-    Extents x = noExtents<Extents>();
     box_.resize(order_.size());
     for (std::size_t p = 0; p < order_.size(); ++p) {
         const Aabb& b = box_[p] = table_.aabb(ProxyId(order_[p]));
-        addBox(x, b);
+        x.top = std::max(x.top, extentOf(b));
+        const Vec3 c = (b.min + b.max) / 2;  // centres: where the boxes are, for planLevels
+        x.lo_c = x.lo_c.cwiseMin(c);
+        x.hi_c = x.hi_c.cwiseMax(c);
+        x.lo_y = std::min(x.lo_y, b.min.y());
+        x.hi_y = std::max(x.hi_y, b.max.y());
+        x.lo_z = std::min(x.lo_z, b.min.z());
+        x.hi_z = std::max(x.hi_z, b.max.z());
     }
-    x.lo_c /= 2;
-    x.hi_c /= 2;
     if (!(x.top > 0)) x.top = 1;
     return x;
 }
 
 void HierarchicalGrid::levelLane(Lane& lane, Real top) {
-    LevelTally tally(top);
+    // Level k has cells s_top / 8^k; a box goes to the finest level whose cells hold its
+    // extent. Zero-size boxes fit anywhere: marked here, they join the finest level in use.
+    std::array<Real, kMaxLevels> base_cell;  // s_top / 8^k
+    for (int k = 0; k < kMaxLevels; ++k) base_cell[k] = std::ldexp(top, -kLevelBits * k);
+    lane.extent_sum.fill(0);
+    lane.members.fill(0);
+    lane.zero_size = 0;
+    lane.finest = 0;
     for (std::size_t p = lane.first; p < lane.last; ++p) {
-        level_of_[p] = tally.add(p, extentOf(box_[p]));
+        const Real e = extentOf(box_[p]);
+        if (!(e > 0)) {
+            level_of_[p] = kZeroSize;
+            ++lane.zero_size;
+            continue;
+        }
+        int k = std::min(floorLog2(top / e) / kLevelBits, kMaxLevels - 1);
+        while (k > 0 && base_cell[k] < e) --k;  // guard: cell >= extent
+        level_of_[p] = static_cast<std::uint8_t>(k);
+        lane.extent_sum[k] += e;
+        ++lane.members[k];
+        lane.finest = std::max(lane.finest, k);
     }
-    tally.store(lane);
 }
 
 std::int64_t HierarchicalGrid::fixColumns(const Level& lv, std::size_t from, std::size_t to) {
@@ -449,12 +403,9 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     if (table_.count() == 0) return;
     const bool two_lanes = helper_ && std::size_t(table_.count()) >= kTwoLaneMinimum;
     if (two_lanes) helper_->prepare();  // wakes while this thread sorts
-    // Gathered by this thread alone: the table was just written here, by move(), and a helper
-    // reading half of it from the other core made the pass slower than on one thread (10k
-    // boxes: 75 against 38 us).
     sortByMinX();
-    const Extents x = gatherBoxes();
     const std::size_t n = order_.size();
+    level_of_.resize(n);
 
     // Lanes: lane 0 alone, or lanes 0 and 1 on two threads. Positions (for level finding,
     // counting and scattering) are split in two fixed halves, lane 0's first, and the sweep
@@ -472,11 +423,14 @@ void HierarchicalGrid::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
             helper_->runBoth(work);
         }
     };
+    // Gathered by this thread alone: the table was just written here, by move(), and a helper
+    // reading half of it from the other core made the pass slower than on one thread (10k
+    // boxes: 75 against 38 us).
+    const Extents x = gatherBoxes();
     const Real top = x.top;
     origin_y_ = x.lo_y;
     origin_z_ = x.lo_z;
 
-    level_of_.resize(n);
     inLanes([this, top](int t) { levelLane(lanes_[t], top); });
     chooseLevels(top, x);
 

@@ -33,9 +33,10 @@ namespace collision {
 /// the entry's own min corner is in this column's row (y) and layer (z).
 ///
 /// Each frame the proxies are radix-sorted by float(min x) (a non-decreasing image of min x)
-/// and scattered into the columns stably in that order, so each column is nearly sorted; an insertion sort per column restores the exact (min x, id) order (sorting
-/// a column outright past a budget of shifts). Pairs are put in (a, b) order by one more radix
-/// sort, which also orders each pair's two ids (or left in the sweep's order: PairOrder). Cost per
+/// and scattered into the columns stably in that order, so each column is nearly sorted; an
+/// insertion sort per column restores the exact (min x, id) order (sorting a column outright
+/// past a budget of shifts). Pairs are put in (a, b) order by one more radix sort (or left in
+/// the sweep's order: PairOrder). Cost per
 /// frame O(n + candidates + pairs) for the sizes it is planned for, and no heap allocation once
 /// the buffers have grown. Exact: every comparison is on the proxies' own coordinates,
 /// touching counts.

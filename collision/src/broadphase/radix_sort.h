@@ -29,12 +29,9 @@ inline std::uint64_t orderedBits(T v) {
 // in every key costs no pass. The last pass does not store the keys: it calls emit(i, key) for
 // every key, i being its place in sorted order, so a caller writes what it needs (pairs, ids)
 // straight from it. `keys` is left in an unspecified order; `scratch` is reused storage.
-// `prepare`, when given, rewrites each key in the counting pass (before it is counted), so a
-// caller's per-key transform costs no pass of its own.
-struct KeepKeys {};
-template <typename Emit, typename Prepare = KeepKeys>
+template <typename Emit>
 void lsdRadixSort(std::span<std::uint64_t> keys, std::vector<std::uint64_t>& scratch, int low,
-                  int bits, Emit&& emit, Prepare&& prepare = {}) {
+                  int bits, Emit&& emit) {
     constexpr int kMaxDigitBits = 14;
     constexpr int kMaxDigits = (64 + kMaxDigitBits - 1) / kMaxDigitBits;
     const std::size_t n = keys.size();
@@ -47,9 +44,7 @@ void lsdRadixSort(std::span<std::uint64_t> keys, std::vector<std::uint64_t>& scr
     histogram.assign(buckets * std::size_t(digits), 0);
     std::array<std::uint32_t*, kMaxDigits> count{};
     for (int d = 0; d < digits; ++d) count[d] = histogram.data() + buckets * std::size_t(d);
-    for (std::uint64_t& key : keys) {
-        std::uint64_t k = key;
-        if constexpr (!std::is_same_v<std::remove_cvref_t<Prepare>, KeepKeys>) key = k = prepare(k);
+    for (std::uint64_t k : keys) {
         for (int d = 0; d < digits; ++d) ++count[d][(k >> (low + d * width)) & mask];
     }
     std::array<int, kMaxDigits> passes{};
@@ -104,26 +99,20 @@ inline void keysToSortedPairs(std::span<std::uint64_t> keys, std::vector<std::ui
     const auto toPair = [shift, id_mask](std::uint64_t k) {
         return ProxyPair{static_cast<ProxyId>(k >> shift), static_cast<ProxyId>(k & id_mask)};
     };
-    // (min, max) of the two ids by masks: no branch.
-    const auto ordered = [shift, id_mask](std::uint64_t k) {
-        const std::uint64_t x = k >> shift, y = k & id_mask;
-        const std::uint64_t swap = (x ^ y) & (std::uint64_t(0) - std::uint64_t(x > y));
-        return ((x ^ swap) << shift) | (y ^ swap);
-    };
-    const auto emit = [&](std::size_t i, std::uint64_t k) { pairs[i] = toPair(k); };
-    if (n <= 64) {
-        if (order_ids) {
-            for (std::uint64_t& k : keys) k = ordered(k);
+    if (order_ids) {
+        for (std::uint64_t& k : keys) {
+            const std::uint64_t x = k >> shift, y = k & id_mask;
+            const std::uint64_t swap = (x ^ y) & (std::uint64_t(0) - std::uint64_t(x > y));
+            k = ((x ^ swap) << shift) | (y ^ swap);  // (min, max) by masks: no branch
         }
+    }
+    if (n <= 64) {
         std::sort(keys.begin(), keys.end());
         for (std::size_t i = 0; i < n; ++i) pairs[i] = toPair(keys[i]);
         return;
     }
-    if (order_ids) {
-        lsdRadixSort(keys, scratch, 0, 2 * shift, emit, ordered);
-    } else {
-        lsdRadixSort(keys, scratch, 0, 2 * shift, emit);
-    }
+    lsdRadixSort(keys, scratch, 0, 2 * shift,
+                 [&](std::size_t i, std::uint64_t k) { pairs[i] = toPair(k); });
 }
 
 /// Writes `keys` (each (a << shift) | b or (b << shift) | a) to `pairs` as (a, b), a < b, in
