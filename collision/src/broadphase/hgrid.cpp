@@ -84,7 +84,7 @@ using YzTest = YzTestOf<Real>;
 
 }  // namespace
 
-HierarchicalGrid::HierarchicalGrid(bool two_threads) {
+HierarchicalGrid::HierarchicalGrid(bool two_threads, PairOrder order) : pair_order_(order) {
     if (two_threads) helper_ = std::make_unique<HelperThread>();
 }
 
@@ -617,9 +617,13 @@ void HierarchicalGrid::sweepLane(Lane& lane, std::vector<ProxyPair>& pairs) {
         }
     }
     lane.tests = tests;
+    const std::span<std::uint64_t> keys(lane.keys.data(), count);
+    if (pair_order_ == PairOrder::Found && lane_count_ == 1) {
+        radix::keysToPairs(keys, shift, pairs);
+        return;
+    }
     // (a, b) order: one radix sort of the packed keys.
-    radix::keysToSortedPairs(std::span(lane.keys.data(), count), lane.scratch, shift, pairs,
-                             /*order_ids=*/true);
+    radix::keysToSortedPairs(keys, lane.scratch, shift, pairs, /*order_ids=*/true);
 }
 
 void HierarchicalGrid::draw(DebugDraw& draw, const Aabb& /*bounds*/) const {

@@ -35,7 +35,8 @@ namespace collision {
 /// Each frame the proxies are radix-sorted by float(min x) (a non-decreasing image of min x)
 /// and scattered into the columns stably in that order, so each column is nearly sorted; an
 /// insertion sort per column restores the exact (min x, id) order (sorting a column outright
-/// past a budget of shifts). Pairs are put in (a, b) order by one more radix sort. Cost per
+/// past a budget of shifts). Pairs are put in (a, b) order by one more radix sort (or left in
+/// the sweep's order: PairOrder). Cost per
 /// frame O(n + candidates + pairs) for the sizes it is planned for, and no heap allocation once
 /// the buffers have grown. Exact: every comparison is on the proxies' own coordinates,
 /// touching counts.
@@ -47,9 +48,19 @@ namespace collision {
 /// than the jobs here), so hgrid2 keeps the second core busy while frames come quickly.
 class HierarchicalGrid : public RebuildingBroadPhase {
 public:
+    /// The order findPairs writes its pairs in.
+    enum class PairOrder {
+        Sorted,  ///< by (a, b), as every broad phase writes them (the default)
+        /// each pair as (a, b), a < b, in the order the sweep met them, with no sort: the same
+        /// list for the same sequence of calls, for a caller that needs the set, not the order
+        /// (the sort is 10-20 % of a frame, 1k to 100k boxes). One lane only: with two
+        /// (hgrid2, from kTwoLaneMinimum proxies) the pairs come sorted, since which lane
+        /// sweeps which columns varies from run to run.
+        Found,
+    };
     /// `two_threads`: count, scatter and sweep split between this thread and a helper thread
     /// (from kTwoLaneMinimum proxies); the pairs are the same either way.
-    explicit HierarchicalGrid(bool two_threads = false);
+    explicit HierarchicalGrid(bool two_threads = false, PairOrder order = PairOrder::Sorted);
     ~HierarchicalGrid() override;
     std::string_view name() const override { return helper_ ? "hgrid2" : "hgrid"; }
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
@@ -162,6 +173,7 @@ private:
     std::atomic<std::size_t> next_chunk_{0};
     std::array<Lane, 2> lanes_;
     int lane_count_ = 1;
+    PairOrder pair_order_;
     std::unique_ptr<HelperThread> helper_;
 };
 

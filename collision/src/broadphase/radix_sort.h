@@ -115,4 +115,17 @@ inline void keysToSortedPairs(std::span<std::uint64_t> keys, std::vector<std::ui
                  [&](std::size_t i, std::uint64_t k) { pairs[i] = toPair(k); });
 }
 
+/// Writes `keys` (each (a << shift) | b or (b << shift) | a) to `pairs` as (a, b), a < b, in
+/// the keys' order: keysToSortedPairs without the sort.
+inline void keysToPairs(std::span<const std::uint64_t> keys, int shift,
+                        std::vector<ProxyPair>& pairs) {
+    const std::uint64_t id_mask = (std::uint64_t(1) << shift) - 1;
+    pairs.resize(keys.size());
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+        const auto x = static_cast<ProxyId>(keys[i] >> shift);
+        const auto y = static_cast<ProxyId>(keys[i] & id_mask);
+        pairs[i] = ProxyPair{std::min(x, y), std::max(x, y)};
+    }
+}
+
 }  // namespace collision::radix
