@@ -74,8 +74,10 @@ void PackedSweepAndPrune::radixSortEntries() {
                    static_cast<std::uint32_t>(entries_[i].id);
     }
     radix::lsdRadixSort(keys_, scratch_, 32, 32, [&](std::size_t i, std::uint64_t k) {
-        const ProxyId id = static_cast<ProxyId>(k & 0xFFFFFFFFu);
-        entries_[i] = Entry{roundDown(table_.aabb(id).min.x()), id};
+        const auto bits = static_cast<std::uint32_t>(k >> 32);
+        // orderedBits inverted: a set top bit marks a non-negative float.
+        const std::uint32_t f = (bits >> 31) ? (bits & 0x7FFFFFFFu) : ~bits;
+        entries_[i] = Entry{std::bit_cast<float>(f), static_cast<ProxyId>(k & 0xFFFFFFFFu)};
     });
 }
 
@@ -111,52 +113,75 @@ void PackedSweepAndPrune::sortEntries(BroadPhaseCounters& counters) {
     counters.swaps += swaps;
 }
 
+void PackedSweepAndPrune::Lanes::resize(std::size_t n) {
+    for (std::vector<float>* v : {&min_x, &max_x, &min_y, &min_z, &neg_max_y, &neg_max_z}) {
+        v->resize(n);
+    }
+}
+
+void PackedSweepAndPrune::Lanes::copy(std::size_t to, const Lanes& from, std::size_t at) {
+    min_x[to] = from.min_x[at];
+    max_x[to] = from.max_x[at];
+    min_y[to] = from.min_y[at];
+    min_z[to] = from.min_z[at];
+    neg_max_y[to] = from.neg_max_y[at];
+    neg_max_z[to] = from.neg_max_z[at];
+}
+
+void PackedSweepAndPrune::Lanes::pad(std::size_t at) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    for (std::size_t k = at; k < at + kPad; ++k) {
+        min_x[k] = max_x[k] = min_y[k] = min_z[k] = neg_max_y[k] = neg_max_z[k] = nan;
+    }
+}
+
 void PackedSweepAndPrune::pack() {
     const std::size_t n = entries_.size();
-    min_x_.resize(n + 1);
-    max_x_.resize(n + 1);
-    yz_.resize(n);
+    all_.resize(n + kPad);
     ids_.resize(n);
     exact_.resize(n);
+    float lo_y = kInf;
+    float hi_y = -kInf;
     for (std::size_t i = 0; i < n; ++i) {
         const ProxyId id = entries_[i].id;
         const Aabb& box = table_.aabb(id);
         const float lo_x = entries_[i].key;
         const float hi_x = roundUp(box.max.x());
-        const float lo_y = roundDown(box.min.y());
+        const float lo_y_i = roundDown(box.min.y());
         const float lo_z = roundDown(box.min.z());
-        const float hi_y = roundUp(box.max.y());
+        const float hi_y_i = roundUp(box.max.y());
         const float hi_z = roundUp(box.max.z());
-        min_x_[i] = lo_x;
-        max_x_[i] = hi_x;
-        yz_[i] = PackedYz{{lo_y, lo_z, -hi_y, -hi_z}};
+        all_.min_x[i] = lo_x;
+        all_.max_x[i] = hi_x;
+        all_.min_y[i] = lo_y_i;
+        all_.min_z[i] = lo_z;
+        all_.neg_max_y[i] = -hi_y_i;
+        all_.neg_max_z[i] = -hi_z;
+        lo_y = std::min(lo_y, lo_y_i);
+        hi_y = std::max(hi_y, hi_y_i);
         ids_[i] = id;
         exact_[i] = double(lo_x) == box.min.x() && double(hi_x) == box.max.x() &&
-                    double(lo_y) == box.min.y() && double(lo_z) == box.min.z() &&
-                    double(hi_y) == box.max.y() && double(hi_z) == box.max.z();
+                    double(lo_y_i) == box.min.y() && double(lo_z) == box.min.z() &&
+                    double(hi_y_i) == box.max.y() && double(hi_z) == box.max.z();
     }
-    // No comparison with NaN is true: the sweep stops at the end without a bounds check.
-    min_x_[n] = std::numeric_limits<float>::quiet_NaN();
-    max_x_[n] = min_x_[n];
+    all_.pad(n);
+    lo_y_ = lo_y;
+    hi_y_ = hi_y;
 }
 
 void PackedSweepAndPrune::dealBands() {
     const std::size_t n = entries_.size();
     bands_ = 1;
     big_.clear();
-    // Band width: the median y extent (of a sample), which balances the entries a box adds to
-    // each band it meets against the x candidates each entry meets.
-    float lo = kInf;
-    float hi = -kInf;
-    for (std::size_t i = 0; i < n; ++i) {
-        lo = std::min(lo, yz_[i].v[0]);
-        hi = std::max(hi, -yz_[i].v[2]);
-    }
-    const float span = hi - lo;
+    // Band width: a few median y extents (of a sample). Narrower bands give each box fewer x
+    // candidates but put it in more bands, and leave shorter sweeps.
+    const float span = hi_y_ - lo_y_;
     if (n >= 2 * kMinPerBand && std::isfinite(span) && span > 0) {
         sample_.clear();
         const std::size_t stride = std::max<std::size_t>(1, n / kSample);
-        for (std::size_t i = 0; i < n; i += stride) sample_.push_back(-yz_[i].v[2] - yz_[i].v[0]);
+        for (std::size_t i = 0; i < n; i += stride) {
+            sample_.push_back(-all_.neg_max_y[i] - all_.min_y[i]);
+        }
         const auto mid = sample_.begin() + static_cast<std::ptrdiff_t>(sample_.size() / 2);
         std::nth_element(sample_.begin(), mid, sample_.end());
         const float width = std::max(*mid * kBandWidth, span / float(kMaxBands));
@@ -164,15 +189,15 @@ void PackedSweepAndPrune::dealBands() {
         bands_ = static_cast<int>(std::clamp<float>(std::ceil(span / width), 1, float(most)));
     }
     if (bands_ == 1) return;
-    band_lo_ = lo;
+    band_lo_ = lo_y_;
     band_scale_ = float(bands_) / span;
 
     first_band_.resize(n);
     last_band_.resize(n);
     band_start_.assign(static_cast<std::size_t>(bands_) + 1, 0);
     for (std::size_t i = 0; i < n; ++i) {
-        const int b0 = bandOf(yz_[i].v[0]);
-        const int b1 = bandOf(-yz_[i].v[2]);
+        const int b0 = bandOf(all_.min_y[i]);
+        const int b1 = bandOf(-all_.neg_max_y[i]);
         if (b1 - b0 >= kBigBands) {
             first_band_[i] = -1;
             big_.push_back(static_cast<std::uint32_t>(i));
@@ -182,87 +207,100 @@ void PackedSweepAndPrune::dealBands() {
         last_band_[i] = b1;
         for (int b = b0; b <= b1; ++b) ++band_start_[static_cast<std::size_t>(b) + 1];
     }
-    for (int b = 0; b < bands_; ++b) band_start_[b + 1] += band_start_[b] + 1;  // + sentinel
+    for (int b = 0; b < bands_; ++b) band_start_[b + 1] += band_start_[b] + kPad;  // sentinels
     const std::size_t total = band_start_[bands_];
-    band_min_x_.resize(total);
-    band_max_x_.resize(total);
-    band_yz_.resize(total);
+    band_.resize(total);
     band_place_.resize(total);
-    std::vector<std::uint32_t>& fill = scratch_fill_;
-    fill.assign(band_start_.begin(), band_start_.end() - 1);
+    band_first_.resize(total);
+    fill_.assign(band_start_.begin(), band_start_.end() - 1);
     // Dealt in sorted order, so every band is sorted on min x.
     for (std::size_t i = 0; i < n; ++i) {
         if (first_band_[i] < 0) continue;
         for (int b = first_band_[i]; b <= last_band_[i]; ++b) {
-            const std::uint32_t k = fill[b]++;
-            band_min_x_[k] = min_x_[i];
-            band_max_x_[k] = max_x_[i];
-            band_yz_[k] = yz_[i];
+            const std::uint32_t k = fill_[b]++;
+            band_.copy(k, all_, i);
             band_place_[k] = static_cast<std::uint32_t>(i);
+            band_first_[k] = first_band_[i];
         }
     }
     for (int b = 0; b < bands_; ++b) {
-        const std::uint32_t k = band_start_[b + 1] - 1;
-        band_min_x_[k] = std::numeric_limits<float>::quiet_NaN();
-        band_max_x_[k] = band_min_x_[k];
+        const std::uint32_t at = band_start_[b + 1] - kPad;
+        band_.pad(at);
+        for (std::uint32_t k = at; k < at + kPad; ++k) {
+            band_place_[k] = 0;
+            band_first_[k] = 0;
+        }
     }
 }
 
-namespace {
-
+/// Sweeps the sorted boxes [begin, end) of `lanes` (followed by kPad NaN sentinels): for each
+/// box, the boxes after it whose min x is within its x range get the y/z test, four at a time;
+/// hit(i, j) sees the places of each pair whose float boxes overlap. Returns the tests made.
+template <typename Hit>
+std::int64_t PackedSweepAndPrune::sweepRange(const Lanes& lanes, std::size_t begin,
+                                             std::size_t end, Hit&& hit) {
+    const float* min_x = lanes.min_x.data();
+    const float* max_x = lanes.max_x.data();
+    const float* min_y = lanes.min_y.data();
+    const float* min_z = lanes.min_z.data();
+    const float* neg_max_y = lanes.neg_max_y.data();
+    const float* neg_max_z = lanes.neg_max_z.data();
+    std::int64_t tests = 0;
+    for (std::size_t i = begin; i < end; ++i) {
+        std::size_t j = i + 1;
 #if defined(__SSE2__)
-using Yz = __m128;
-/// (max y, max z, -min y, -min z) of the box whose packed bounds are `v`: its halves swapped,
-/// negated. Another box overlaps it in y and z exactly when its packed bounds are <= these.
-inline Yz otherOf(const float* v) {
-    const __m128 own = _mm_load_ps(v);
-    return _mm_xor_ps(_mm_shuffle_ps(own, own, _MM_SHUFFLE(1, 0, 3, 2)), _mm_set1_ps(-0.0f));
-}
-inline bool overlapsYz(const float* v, Yz other) {
-    return _mm_movemask_ps(_mm_cmple_ps(_mm_load_ps(v), other)) == 0xF;
-}
+        // Box j overlaps box i when min x_j <= max x_i (min x_i <= min x_j by the sort),
+        // min y_j <= max y_i, -max y_j <= -min y_i, and the same in z.
+        const __m128 lim_x = _mm_set1_ps(max_x[i]);
+        const __m128 lim_y = _mm_set1_ps(-neg_max_y[i]);
+        const __m128 lim_z = _mm_set1_ps(-neg_max_z[i]);
+        const __m128 lim_ny = _mm_set1_ps(-min_y[i]);
+        const __m128 lim_nz = _mm_set1_ps(-min_z[i]);
+        for (;; j += 4) {
+            const __m128 in_x = _mm_cmple_ps(_mm_loadu_ps(min_x + j), lim_x);
+            __m128 m = _mm_and_ps(in_x, _mm_cmple_ps(_mm_loadu_ps(min_y + j), lim_y));
+            m = _mm_and_ps(m, _mm_cmple_ps(_mm_loadu_ps(min_z + j), lim_z));
+            m = _mm_and_ps(m, _mm_cmple_ps(_mm_loadu_ps(neg_max_y + j), lim_ny));
+            m = _mm_and_ps(m, _mm_cmple_ps(_mm_loadu_ps(neg_max_z + j), lim_nz));
+            for (int bits = _mm_movemask_ps(m); bits != 0; bits &= bits - 1) {
+                hit(i, j + static_cast<std::size_t>(std::countr_zero(unsigned(bits))));
+            }
+            // The boxes are sorted on min x (the sentinels are NaN): once one of the four is
+            // past box i's end, so is every later one.
+            if (_mm_movemask_ps(in_x) != 0xF) break;
+        }
 #else
-struct Yz {
-    float v[4];
-};
-inline Yz otherOf(const float* v) { return Yz{{-v[2], -v[3], -v[0], -v[1]}}; }
-inline bool overlapsYz(const float* v, const Yz& o) {
-    return v[0] <= o.v[0] && v[1] <= o.v[1] && v[2] <= o.v[2] && v[3] <= o.v[3];
-}
+        const float lim_x = max_x[i];
+        for (; min_x[j] <= lim_x; ++j) {
+            if (min_y[j] <= -neg_max_y[i] && min_z[j] <= -neg_max_z[i] &&
+                neg_max_y[j] <= -min_y[i] && neg_max_z[j] <= -min_z[i]) {
+                hit(i, j);
+            }
+        }
 #endif
-
-}  // namespace
+        tests += static_cast<std::int64_t>(j - i);
+    }
+    return tests;
+}
 
 void PackedSweepAndPrune::sweepBands(BroadPhaseCounters& counters) {
-    std::int64_t tests = 0;
     if (bands_ == 1) {
-        const std::size_t n = entries_.size();
-        for (std::size_t i = 0; i < n; ++i) {
-            const float hi_x = max_x_[i];
-            const Yz other = otherOf(yz_[i].v);
-            for (std::size_t j = i + 1; min_x_[j] <= hi_x; ++j) {
-                ++tests;
-                if (overlapsYz(yz_[j].v, other)) confirm(i, j);
-            }
-        }
-        counters.volume_tests += tests;
+        counters.volume_tests += sweepRange(all_, 0, entries_.size(), [this](std::size_t i,
+                                                                           std::size_t j) {
+            confirm(i, j);
+        });
         return;
     }
+    const std::uint32_t* place = band_place_.data();
+    const int* first = band_first_.data();
     for (int b = 0; b < bands_; ++b) {
-        const std::size_t end = band_start_[b + 1] - 1;
-        for (std::size_t i = band_start_[b]; i < end; ++i) {
-            const float hi_x = band_max_x_[i];
-            const Yz other = otherOf(band_yz_[i].v);
-            for (std::size_t j = i + 1; band_min_x_[j] <= hi_x; ++j) {
-                ++tests;
-                if (!overlapsYz(band_yz_[j].v, other)) continue;
-                // Report the pair only in the band of the larger min y, which both boxes meet.
-                const float lo_y = std::max(band_yz_[i].v[0], band_yz_[j].v[0]);
-                if (bandOf(lo_y) == b) confirm(band_place_[i], band_place_[j]);
-            }
-        }
+        counters.volume_tests += sweepRange(
+            band_, band_start_[b], band_start_[b + 1] - kPad, [&](std::size_t i, std::size_t j) {
+                // Report the pair only in the band of the larger min y, max(first band of
+                // each), which both boxes meet: both start at or before b, so one starts in b.
+                if (first[i] == b || first[j] == b) confirm(place[i], place[j]);
+            });
     }
-    counters.volume_tests += tests;
 }
 
 void PackedSweepAndPrune::sweepBig(BroadPhaseCounters& counters) {
@@ -270,12 +308,8 @@ void PackedSweepAndPrune::sweepBig(BroadPhaseCounters& counters) {
     std::int64_t tests = 0;
     // A big box against every box after it in the sorted list (big or not)...
     for (const std::uint32_t g : big_) {
-        const float hi_x = max_x_[g];
-        const Yz other = otherOf(yz_[g].v);
-        for (std::size_t j = g + 1; min_x_[j] <= hi_x; ++j) {
-            ++tests;
-            if (overlapsYz(yz_[j].v, other)) confirm(g, j);
-        }
+        tests += sweepRange(all_, g, g + 1,
+                            [this](std::size_t i, std::size_t j) { confirm(i, j); });
     }
     // ...and every other box against the big boxes after it.
     const std::size_t n = entries_.size();
@@ -284,11 +318,14 @@ void PackedSweepAndPrune::sweepBig(BroadPhaseCounters& counters) {
         while (first < big_.size() && big_[first] <= p) ++first;
         if (first == big_.size()) break;
         if (first_band_[p] < 0) continue;
-        const float hi_x = max_x_[p];
-        const Yz other = otherOf(yz_[p].v);
-        for (std::size_t q = first; q < big_.size() && min_x_[big_[q]] <= hi_x; ++q) {
+        const float hi_x = all_.max_x[p];
+        for (std::size_t q = first; q < big_.size() && all_.min_x[big_[q]] <= hi_x; ++q) {
             ++tests;
-            if (overlapsYz(yz_[big_[q]].v, other)) confirm(p, big_[q]);
+            const std::size_t g = big_[q];
+            if (all_.min_y[g] <= -all_.neg_max_y[p] && all_.min_z[g] <= -all_.neg_max_z[p] &&
+                all_.neg_max_y[g] <= -all_.min_y[p] && all_.neg_max_z[g] <= -all_.min_z[p]) {
+                confirm(p, g);
+            }
         }
     }
     counters.volume_tests += tests;
@@ -309,25 +346,27 @@ void PackedSweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCou
 }
 
 void PackedSweepAndPrune::draw(DebugDraw& draw, const Aabb& bounds) const {
-    // The x intervals as the sweep saw them (float, rounded outward), sorted, as a 1-D interval
-    // diagram; the intervals of proxies in an overlapping pair marked.
+    // The x intervals in the order of the last sort, as a 1-D interval diagram; the intervals
+    // of proxies in an overlapping pair marked.
     const std::size_t n = entries_.size();
-    if (n == 0 || ids_.size() != n) return;
+    if (n == 0 || dirty_) return;
     std::vector<DiagramInterval> intervals(n);
     for (std::size_t i = 0; i < n; ++i) {
-        intervals[i] = DiagramInterval{Real(min_x_[i]), Real(max_x_[i]), false};
+        const Aabb& box = table_.aabb(entries_[i].id);
+        intervals[i] = DiagramInterval{box.min.x(), box.max.x(), false};
     }
     for (std::size_t i = 0; i < n; ++i) {
-        const Aabb& box = table_.aabb(ids_[i]);
-        for (std::size_t j = i + 1; j < n && min_x_[j] <= max_x_[i]; ++j) {
-            if (box.overlaps(table_.aabb(ids_[j]))) intervals[i].marked = intervals[j].marked = true;
+        const Aabb& box = table_.aabb(entries_[i].id);
+        for (std::size_t j = i + 1; j < n && intervals[j].lo <= intervals[i].hi; ++j) {
+            if (box.overlaps(table_.aabb(entries_[j].id))) {
+                intervals[i].marked = intervals[j].marked = true;
+            }
         }
     }
     const Color& color = kStructurePalette[0];
     const Color& marked = kStructurePalette[1];
     drawIntervalDiagram(draw, bounds, 0, intervals, color, marked);
-    draw.legend("sap-packed float intervals on x (the sort axis), sorted, " +
-                    intervalDiagramPlace(0),
+    draw.legend("sap-packed intervals on x (the sort axis), sorted, " + intervalDiagramPlace(0),
                 color);
     draw.legend("interval of a proxy in an overlapping pair", marked);
 }
