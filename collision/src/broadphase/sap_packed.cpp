@@ -61,6 +61,13 @@ void PackedSweepAndPrune::remove(ProxyId id) {
 }
 
 void PackedSweepAndPrune::move(ProxyId id, const ProxyVolumes& v) {
+    // How far the box moves per frame, remembered with a slow decay: the fattening margin.
+    const Vec3 shift = (v.aabb.min + v.aabb.max - table_.aabb(id).min - table_.aabb(id).max) / 2;
+    const Real step = shift.cwiseAbs().maxCoeff();
+    if (static_cast<std::size_t>(id) < motion_.size()) {
+        const float decayed = motion_[id] * kMotionDecay;
+        motion_[id] = std::isfinite(step) ? std::max(decayed, float(step)) : decayed;
+    }
     table_.move(id, v);
     ++moved_;
 }
@@ -85,13 +92,12 @@ void PackedSweepAndPrune::sortEntries(BroadPhaseCounters& counters) {
     if (dirty_) {
         entries_.clear();
         for (ProxyId id = 0; id < table_.capacity(); ++id) {
-            if (table_.contains(id)) entries_.push_back(Entry{roundDown(table_.aabb(id).min.x()), id});
+            if (table_.contains(id)) entries_.push_back(Entry{fat_.min_x[id], id});
         }
         radixSortEntries();
-        dirty_ = false;
         return;
     }
-    for (Entry& e : entries_) e.key = roundDown(table_.aabb(e.id).min.x());
+    for (Entry& e : entries_) e.key = fat_.min_x[e.id];
     // Insertion sort of last frame's order, abandoned for the radix sort once the swaps pass a
     // few per proxy (incoherent motion would make it quadratic).
     const std::int64_t limit = 4 * static_cast<std::int64_t>(entries_.size()) + 64;
@@ -139,34 +145,138 @@ void PackedSweepAndPrune::pack() {
     const std::size_t n = entries_.size();
     all_.resize(n + kPad);
     ids_.resize(n);
-    exact_.resize(n);
     float lo_y = kInf;
     float hi_y = -kInf;
     for (std::size_t i = 0; i < n; ++i) {
         const ProxyId id = entries_[i].id;
-        const Aabb& box = table_.aabb(id);
-        const float lo_x = entries_[i].key;
-        const float hi_x = roundUp(box.max.x());
-        const float lo_y_i = roundDown(box.min.y());
-        const float lo_z = roundDown(box.min.z());
-        const float hi_y_i = roundUp(box.max.y());
-        const float hi_z = roundUp(box.max.z());
-        all_.min_x[i] = lo_x;
-        all_.max_x[i] = hi_x;
-        all_.min_y[i] = lo_y_i;
-        all_.min_z[i] = lo_z;
-        all_.neg_max_y[i] = -hi_y_i;
-        all_.neg_max_z[i] = -hi_z;
-        lo_y = std::min(lo_y, lo_y_i);
-        hi_y = std::max(hi_y, hi_y_i);
+        all_.copy(i, fat_, static_cast<std::size_t>(id));
+        lo_y = std::min(lo_y, all_.min_y[i]);
+        hi_y = std::max(hi_y, -all_.neg_max_y[i]);
         ids_[i] = id;
-        exact_[i] = double(lo_x) == box.min.x() && double(hi_x) == box.max.x() &&
-                    double(lo_y_i) == box.min.y() && double(lo_z) == box.min.z() &&
-                    double(hi_y_i) == box.max.y() && double(hi_z) == box.max.z();
     }
     all_.pad(n);
     lo_y_ = lo_y;
     hi_y_ = hi_y;
+}
+
+void PackedSweepAndPrune::fatten(ProxyId id, float margin) {
+    const Aabb& box = table_.aabb(id);
+    const std::size_t k = static_cast<std::size_t>(id);
+    const Real m = margin;
+    const float lo_x = roundDown(box.min.x() - m);
+    const float lo_y = roundDown(box.min.y() - m);
+    const float lo_z = roundDown(box.min.z() - m);
+    const float hi_x = roundUp(box.max.x() + m);
+    const float hi_y = roundUp(box.max.y() + m);
+    const float hi_z = roundUp(box.max.z() + m);
+    fat_.min_x[k] = lo_x;
+    fat_.max_x[k] = hi_x;
+    fat_.min_y[k] = lo_y;
+    fat_.min_z[k] = lo_z;
+    fat_.neg_max_y[k] = -hi_y;
+    fat_.neg_max_z[k] = -hi_z;
+}
+
+bool PackedSweepAndPrune::insideFat(ProxyId id) const {
+    const Aabb& box = table_.aabb(id);
+    const std::size_t k = static_cast<std::size_t>(id);
+    return double(fat_.min_x[k]) <= box.min.x() && box.max.x() <= double(fat_.max_x[k]) &&
+           double(fat_.min_y[k]) <= box.min.y() && box.max.y() <= -double(fat_.neg_max_y[k]) &&
+           double(fat_.min_z[k]) <= box.min.z() && box.max.z() <= -double(fat_.neg_max_z[k]);
+}
+
+void PackedSweepAndPrune::fullSweep(BroadPhaseCounters& counters) {
+    sortEntries(counters);
+    pack();
+    dealBands();
+    keys_.clear();
+    sweepBands(counters);
+    sweepBig(counters);
+    radix::keysToSortedPairs(keys_, scratch_, shift_, candidates_, /*order_ids=*/true);
+}
+
+void PackedSweepAndPrune::queryEscaped(BroadPhaseCounters& counters) {
+    // Each escaped box against every fat box, four at a time (absent ids are NaN: never hit).
+    // A pair of two escaped boxes is taken from the lower id only.
+    fresh_.clear();
+    const std::size_t blocks = (static_cast<std::size_t>(table_.capacity()) + 3) / 4;
+    std::int64_t tests = 0;
+    for (const ProxyId e : escaped_) {
+        const std::size_t k = static_cast<std::size_t>(e);
+#if defined(__SSE2__)
+        const __m128 lim_x = _mm_set1_ps(fat_.max_x[k]);
+        const __m128 lim_nx = _mm_set1_ps(-fat_.min_x[k]);
+        const __m128 lim_y = _mm_set1_ps(-fat_.neg_max_y[k]);
+        const __m128 lim_z = _mm_set1_ps(-fat_.neg_max_z[k]);
+        const __m128 lim_ny = _mm_set1_ps(-fat_.min_y[k]);
+        const __m128 lim_nz = _mm_set1_ps(-fat_.min_z[k]);
+        const __m128 sign = _mm_set1_ps(-0.0f);
+        for (std::size_t b = 0; b < blocks; ++b) {
+            const std::size_t j = 4 * b;
+            __m128 m = _mm_cmple_ps(_mm_loadu_ps(fat_.min_x.data() + j), lim_x);
+            m = _mm_and_ps(m, _mm_cmple_ps(_mm_xor_ps(_mm_loadu_ps(fat_.max_x.data() + j), sign),
+                                           lim_nx));
+            m = _mm_and_ps(m, _mm_cmple_ps(_mm_loadu_ps(fat_.min_y.data() + j), lim_y));
+            m = _mm_and_ps(m, _mm_cmple_ps(_mm_loadu_ps(fat_.min_z.data() + j), lim_z));
+            m = _mm_and_ps(m, _mm_cmple_ps(_mm_loadu_ps(fat_.neg_max_y.data() + j), lim_ny));
+            m = _mm_and_ps(m, _mm_cmple_ps(_mm_loadu_ps(fat_.neg_max_z.data() + j), lim_nz));
+            for (int bits = _mm_movemask_ps(m); bits != 0; bits &= bits - 1) {
+                const ProxyId other =
+                    static_cast<ProxyId>(j + static_cast<std::size_t>(std::countr_zero(unsigned(bits))));
+                if (other == e || (escaped_flag_[other] && other < e)) continue;
+                fresh_.push_back(e < other ? ProxyPair{e, other} : ProxyPair{other, e});
+            }
+        }
+#else
+        for (std::size_t j = 0; j < 4 * blocks; ++j) {
+            if (fat_.min_x[j] <= fat_.max_x[k] && fat_.min_x[k] <= fat_.max_x[j] &&
+                fat_.min_y[j] <= -fat_.neg_max_y[k] && fat_.min_z[j] <= -fat_.neg_max_z[k] &&
+                fat_.neg_max_y[j] <= -fat_.min_y[k] && fat_.neg_max_z[j] <= -fat_.min_z[k]) {
+                const ProxyId other = static_cast<ProxyId>(j);
+                if (other == e || (escaped_flag_[other] && other < e)) continue;
+                fresh_.push_back(e < other ? ProxyPair{e, other} : ProxyPair{other, e});
+            }
+        }
+#endif
+        tests += static_cast<std::int64_t>(4 * blocks);
+    }
+    counters.volume_tests += tests;
+    std::sort(fresh_.begin(), fresh_.end());
+    // The kept candidates (no escaped member) and the fresh ones, both sorted, merged.
+    merged_.clear();
+    std::size_t f = 0;
+    for (const ProxyPair& p : candidates_) {
+        if (escaped_flag_[p.a] | escaped_flag_[p.b]) continue;
+        while (f < fresh_.size() && fresh_[f] < p) merged_.push_back(fresh_[f++]);
+        merged_.push_back(p);
+    }
+    merged_.insert(merged_.end(), fresh_.begin() + static_cast<std::ptrdiff_t>(f), fresh_.end());
+    candidates_.swap(merged_);
+}
+
+void PackedSweepAndPrune::rebuild() {
+    const std::size_t capacity = static_cast<std::size_t>(table_.capacity());
+    const std::size_t lanes = (capacity + 3) / 4 * 4 + kPad;
+    fat_.resize(lanes);
+    fat_.pad(capacity);  // NaN from capacity on; absent ids below are set here too
+    for (std::size_t k = capacity; k < lanes; ++k) {
+        fat_.min_x[k] = fat_.max_x[k] = fat_.min_y[k] = fat_.min_z[k] = fat_.neg_max_y[k] =
+            fat_.neg_max_z[k] = std::numeric_limits<float>::quiet_NaN();
+    }
+    escaped_flag_.assign(capacity, 0);
+    motion_.resize(capacity, 0);
+    present_.clear();
+    for (ProxyId id = 0; id < table_.capacity(); ++id) {
+        if (!table_.contains(id)) {
+            const std::size_t k = static_cast<std::size_t>(id);
+            fat_.min_x[k] = fat_.max_x[k] = fat_.min_y[k] = fat_.min_z[k] = fat_.neg_max_y[k] =
+                fat_.neg_max_z[k] = std::numeric_limits<float>::quiet_NaN();
+            continue;
+        }
+        present_.push_back(id);
+        fatten(id, margins_on_ ? kMargin * motion_[id] : 0.0f);
+    }
+    shift_ = radix::bitsFor(static_cast<std::uint64_t>(capacity) + 1);
 }
 
 void PackedSweepAndPrune::dealBands() {
@@ -334,14 +444,57 @@ void PackedSweepAndPrune::sweepBig(BroadPhaseCounters& counters) {
 void PackedSweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) {
     counters.volumes_updated += moved_;
     moved_ = 0;
-    sortEntries(counters);
-    pack();
-    dealBands();
-    shift_ = radix::bitsFor(static_cast<std::uint64_t>(table_.capacity()) + 1);
-    keys_.clear();
-    sweepBands(counters);
-    sweepBig(counters);
-    radix::keysToSortedPairs(keys_, scratch_, shift_, pairs, /*order_ids=*/true);
+    if (dirty_) {
+        // A new proxy set: exact bounds (no margin) and a full sweep, the one-shot path.
+        margins_on_ = false;
+        retry_in_ = 1;
+        rebuild();
+        fullSweep(counters);
+        dirty_ = false;
+    } else {
+        escaped_.clear();
+        for (const ProxyId id : present_) {
+            if (!insideFat(id)) escaped_.push_back(id);
+        }
+        // A query scans every fat box; a full sweep costs about kQueryShare of them per box.
+        const std::size_t limit = present_.size() / kQueryShare + 1;
+        if (escaped_.empty()) {
+        } else if (margins_on_ && escaped_.size() <= limit) {
+            for (const ProxyId e : escaped_) {
+                fatten(e, kMargin * motion_[e]);
+                escaped_flag_[e] = 1;
+            }
+            queryEscaped(counters);
+            for (const ProxyId e : escaped_) escaped_flag_[e] = 0;
+        } else {
+            // Too many left their fat boxes: margins do not pay here (or not yet). Sweep
+            // everything, now and then trying margins again.
+            if (margins_on_) {
+                margins_on_ = false;
+                retry_in_ = kRetryFrames;
+            } else if (--retry_in_ <= 0) {
+                margins_on_ = true;
+            }
+            rebuild();
+            fullSweep(counters);
+        }
+    }
+    // The exact answer: every candidate (fat boxes overlap) tested on the double AABBs, as
+    // Aabb::overlaps does. Candidates are sorted, so the pairs are.
+    // Branch-free: every candidate is written, and the count advances only for an overlap
+    // (about half the candidates do, so a branch would be mispredicted as often as not).
+    pairs.resize(candidates_.size());
+    std::size_t count = 0;
+    for (const ProxyPair& p : candidates_) {
+        const Aabb& a = table_.aabb(p.a);
+        const Aabb& b = table_.aabb(p.b);
+        const bool overlap = (a.min.x() <= b.max.x()) & (b.min.x() <= a.max.x()) &
+                             (a.min.y() <= b.max.y()) & (b.min.y() <= a.max.y()) &
+                             (a.min.z() <= b.max.z()) & (b.min.z() <= a.max.z());
+        pairs[count] = p;
+        count += overlap ? 1 : 0;
+    }
+    pairs.resize(count);
     counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
 }
 

@@ -42,6 +42,10 @@ private:
     static constexpr float kBandWidth = 3.0f;  ///< band width / median y extent
     static constexpr int kBigBands = 4;        ///< a box meeting more bands than this is big
     static constexpr std::size_t kPad = 4;     ///< NaN sentinels after each swept list
+    static constexpr float kMargin = 32.0f;     ///< fat margin / recent motion per frame
+    static constexpr float kMotionDecay = 0.95f;
+    static constexpr std::size_t kQueryShare = 128;  ///< escaped boxes per full sweep's cost
+    static constexpr int kRetryFrames = 32;
 
     /// Float bounds of a sorted list of boxes, one array per bound (structure of arrays), so
     /// four consecutive boxes load as one SSE register per bound. Maxima of y and z are stored
@@ -74,21 +78,33 @@ private:
         if (t >= float(bands_ - 1)) return bands_ - 1;
         return static_cast<int>(t);
     }
-    /// Keeps the pair of sorted places i and j when its double AABBs overlap.
+    /// Records the candidate pair of sorted places i and j (their fat boxes overlap).
     void confirm(std::size_t i, std::size_t j) {
-        const ProxyId a = ids_[i];
-        const ProxyId b = ids_[j];
-        if ((exact_[i] & exact_[j]) || table_.aabb(a).overlaps(table_.aabb(b))) {
-            keys_.push_back((static_cast<std::uint64_t>(a) << shift_) |
-                            static_cast<std::uint64_t>(b));
-        }
+        keys_.push_back((static_cast<std::uint64_t>(ids_[i]) << shift_) |
+                        static_cast<std::uint64_t>(ids_[j]));
     }
+    void fatten(ProxyId id, float margin);
+    bool insideFat(ProxyId id) const;
+    void rebuild();
+    void fullSweep(BroadPhaseCounters& counters);
+    void queryEscaped(BroadPhaseCounters& counters);
 
     ProxyTable table_;
     std::vector<Entry> entries_;  ///< present proxies sorted by key (ties: unspecified)
     Lanes all_;                   ///< every box in sorted order, then kPad sentinels
     std::vector<ProxyId> ids_;    ///< per sorted place
-    std::vector<char> exact_;     ///< per sorted place: 1 when the float bounds are the AABB
+    // Fat boxes by id (absent ids NaN): the exact box grown by kMargin times the box's recent
+    // motion per frame, rounded outward; candidates_ holds every pair whose fat boxes overlap.
+    Lanes fat_;
+    std::vector<float> motion_;    ///< recent largest centre step per frame, by id
+    std::vector<ProxyId> present_;
+    std::vector<ProxyId> escaped_;
+    std::vector<char> escaped_flag_;
+    std::vector<ProxyPair> candidates_;
+    std::vector<ProxyPair> fresh_;
+    std::vector<ProxyPair> merged_;
+    bool margins_on_ = false;
+    int retry_in_ = 1;
     float lo_y_ = 0;              ///< lowest min y and highest max y (float)
     float hi_y_ = 0;
     // Bands along y: band b covers [band_lo_ + b / band_scale_, ...); the last is open above.
