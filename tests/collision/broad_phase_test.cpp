@@ -533,6 +533,56 @@ TEST(BroadPhaseRegistry, NamesAreUniqueAndReferencesExist) {
     EXPECT_NE(broadPhaseNames().find("sap"), std::string::npos);
 }
 
+// sap-packed keeps the pairs of overlapping fat boxes between frames and re-queries only the
+// boxes that left theirs. A jittering scene (Terdiman's BoxPruning, scaled down: integer centres
+// moving by -1, 0 or +1 per axis per frame, integer half sizes, so boxes touch exactly and
+// often) takes that path on most frames; every frame must still equal brute force, and the
+// coherent frames must test far fewer volumes than the full sweep of the first frame.
+TEST(PackedSweepAndPrune, JitteringBoxesEqualBruteForceWhileFatBoxesAreReused) {
+    constexpr int kBoxes = 1500;
+    Rng rng(17);
+    std::vector<Vec3> centre(kBoxes);
+    std::vector<Vec3> half(kBoxes);
+    for (int i = 0; i < kBoxes; ++i) {
+        centre[i] = Vec3(rng.integer(-300, 300), rng.integer(-300, 300), rng.integer(-300, 300));
+        half[i] = Vec3(rng.integer(0, 20), rng.integer(0, 20), rng.integer(0, 20));
+    }
+    auto volumes = [&](int i) {
+        return ProxyVolumes{Aabb{centre[i] - half[i], centre[i] + half[i]},
+                            BoundingSphere{centre[i], half[i].norm()},
+                            Obb{centre[i], Mat3::Identity(), half[i]}};
+    };
+    std::unique_ptr<BroadPhase> fast = findBroadPhase("sap-packed")->create();
+    std::unique_ptr<BroadPhase> ref = findBroadPhase("brute")->create();
+    for (int i = 0; i < kBoxes; ++i) {
+        fast->insert(i, volumes(i));
+        ref->insert(i, volumes(i));
+    }
+    std::vector<ProxyPair> fast_pairs;
+    std::vector<ProxyPair> ref_pairs;
+    BroadPhaseCounters first;
+    fast->findPairs(fast_pairs, first);
+    BroadPhaseCounters rc;
+    ref->findPairs(ref_pairs, rc);
+    ASSERT_EQ(fast_pairs, ref_pairs);
+    ASSERT_GT(ref_pairs.size(), 300u);
+    int cheap_frames = 0;
+    for (int frame = 1; frame <= 200; ++frame) {
+        for (int i = 0; i < kBoxes; ++i) {
+            for (int k = 0; k < 3; ++k) centre[i][k] += rng.integer(-1, 1);
+            fast->move(i, volumes(i));
+            ref->move(i, volumes(i));
+        }
+        BroadPhaseCounters fc;
+        fast->findPairs(fast_pairs, fc);
+        ref->findPairs(ref_pairs, rc);
+        ASSERT_EQ(fast_pairs, ref_pairs) << "frame " << frame;
+        ASSERT_EQ(fast->validate(), "") << "frame " << frame;
+        cheap_frames += fc.volume_tests < first.volume_tests / 4;
+    }
+    EXPECT_GT(cheap_frames, 150);
+}
+
 TEST(SweepAndPrune, CoherentMotionCostsFewSwaps) {
     // Behaviour, not speed: after the first frame, tiny motions reorder few endpoints, so the
     // insertion sort does far fewer swaps than a full re-sort would compare.
