@@ -1,10 +1,11 @@
 // collision/src/broadphase/sap_packed.cpp -- box pruning on packed float bounds.
-// Invariant after findPairs: entries_ holds every present proxy once, sorted by key, and min_x_,
-// max_x_, yz_, ids_ and exact_ are its bounds in that order. Why no pair is missed: each float
-// bound is the double rounded outward, so the float box contains the double box and the float
-// overlap test (closed, like Aabb::overlaps) accepts every pair the double test accepts; the
-// double test then decides each candidate unless both float boxes are exact, when the two tests
-// are the same comparisons.
+// Invariant after findPairs: every present proxy's exact AABB lies inside its fat box (fat_,
+// floats), and candidates_ holds, sorted and once each, exactly the pairs whose fat boxes overlap
+// (closed test). Why no pair is missed: a fat box is the double box grown by a margin >= 0 and
+// rounded outward, so it contains the exact box, and two exact boxes that overlap have fat boxes
+// that overlap; the pairs are the candidates that pass the exact double test. Between frames a
+// pair whose two fat boxes did not change keeps its status, so only the boxes that left their
+// fat box are re-queried (against every fat box) and their old candidates dropped.
 #include "broadphase/sap_packed.h"
 
 #include <algorithm>

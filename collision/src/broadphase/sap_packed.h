@@ -17,14 +17,20 @@ namespace collision {
 /// pair is kept only in the band holding the larger of the two minimum y, which both boxes meet,
 /// so it is reported once. Boxes meeting more than a few bands are swept against the whole
 /// sorted list instead (so one huge box costs one sweep, not one per band). The bounds are
-/// copied into structure-of-arrays float form, each double rounded outward (minimum down, maximum
-/// up), so the float test never rejects a pair the double test accepts; a candidate whose float
-/// bounds were not exact is confirmed on the double AABBs. The bounds are stored one array per
-/// bound, and the sweep tests four consecutive boxes at once with SSE2 (x, y and z in five
-/// four-wide comparisons), leaving the sweep when one of the four starts past the box's end. The
-/// sort is an LSD radix sort on the float keys after a change of the
-/// proxy set, and an insertion sort of last frame's order otherwise (O(n + swaps) when motion is
-/// coherent; it falls back to the radix sort when the order changed too much).
+/// copied into float form, each double rounded outward (minimum down, maximum up), so the float
+/// test never rejects a pair the double test accepts; every candidate is confirmed on the double
+/// AABBs. The bounds are stored one array per bound, and the sweep tests four consecutive boxes
+/// at once with SSE2 (x, y and z in five four-wide comparisons), leaving the sweep when one of the
+/// four starts past the box's end. The sort is an LSD radix sort on the float keys after a change
+/// of the proxy set, and an insertion sort of last frame's order otherwise (O(n + swaps) when
+/// motion is coherent; it falls back to the radix sort when the order changed too much).
+///
+/// Coherence (as Bullet's DBVT and Box2D's tree fatten leaves): the swept boxes are fat, the exact
+/// box grown by kMargin times its recent largest step per frame, and the candidate pairs (fat
+/// boxes overlap) are kept between frames. A frame where few boxes left their fat box re-fattens
+/// and re-queries only those; when many did, margins are not paying and everything is swept
+/// again with exact boxes, margins tried again kRetryFrames later. A new proxy set (insert,
+/// remove) is swept with exact boxes: the one-shot path.
 class PackedSweepAndPrune : public BroadPhase {
 public:
     std::string_view name() const override { return "sap-packed"; }
