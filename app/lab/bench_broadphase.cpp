@@ -498,7 +498,8 @@ std::vector<PairSummary> referencePairs(const MovingBoxes& workload, int frames)
 
 // One workload's rows: each method's ratio to the best peer, the table, the fastest cdlab
 // method, and notes on stopped runs and pair caches.
-void reportWorkload(std::ostream& out, std::vector<Row>& rows, const BenchOptions& options) {
+void reportWorkload(std::ostream& out, std::vector<Row>& rows, const BenchOptions& options,
+                    int frames) {
     double best_peer = std::numeric_limits<double>::infinity();
     const Row* best = nullptr;
     for (const Row& row : rows) {
@@ -517,7 +518,7 @@ void reportWorkload(std::ostream& out, std::vector<Row>& rows, const BenchOption
             fastest = &row;
         }
     }
-    printTable(out, rows, options.frames);
+    printTable(out, rows, frames);
     if (fastest != nullptr) {
         out << "fastest cdlab: " << fastest->method << " "
             << format("%.4f", fastest->result.median_ms) << " ms/frame";
@@ -758,12 +759,15 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
                 for (const BenchMethodEntry* m : methods) rows.push_back(runMethod(*m, run));
                 std::vector<Row> sweep;
                 if (tune) tunePeers(run, rows, sweep);
-                reportWorkload(out, rows, options);
+                reportWorkload(out, rows, options,
+                               one_shot ? oneShotRepetitions(options) : options.frames);
                 if (options.peers == "all" && !sweep.empty()) {
                     out << "peer configurations swept (up to " << kTuneFrames << " frames / "
                         << kTuneBudgetSeconds << " s each; vs_peer against the best of them):\n";
                     setRatios(sweep);
-                    printTable(out, sweep, std::min(options.frames, kTuneFrames));
+                    printTable(out, sweep,
+                               std::min(one_shot ? oneShotRepetitions(options) : options.frames,
+                                         kTuneFrames));
                 }
                 for (Row& row : rows) all_rows.push_back(std::move(row));
                 for (Row& row : sweep) {
