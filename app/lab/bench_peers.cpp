@@ -354,7 +354,8 @@ void appendFclGrid(std::vector<BenchMethodEntry>& methods) {
         {"update-each", FclUpdate::UpdateEach}, {"reinsert", FclUpdate::Reinsert},
         {"rebuild", FclUpdate::Rebuild}};
     for (const int init_level : {0, 2}) {
-        for (const auto& [update_name, update] : updates) {
+        for (const auto& [update_name, update_kind] : updates) {
+            const FclUpdate update = update_kind;  // a structured binding cannot be captured
             BenchMethodEntry m;
             m.family = "fcl-dtree";
             m.config = std::string(update_name) + ":init" + std::to_string(init_level);
@@ -368,9 +369,10 @@ void appendFclGrid(std::vector<BenchMethodEntry>& methods) {
             methods.push_back(std::move(m));
         }
     }
-    for (const auto& [update_name, update] :
+    for (const auto& [update_name, update_kind] :
          {std::pair<const char*, FclUpdate>{"update", FclUpdate::Update},
           std::pair<const char*, FclUpdate>{"rebuild", FclUpdate::Rebuild}}) {
+        const FclUpdate update = update_kind;
         BenchMethodEntry m;
         m.family = "fcl-sap";
         m.config = update_name;

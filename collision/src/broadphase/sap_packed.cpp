@@ -489,11 +489,11 @@ void PackedSweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCou
     for (const ProxyPair& p : candidates_) {
         const Aabb& a = table_.aabb(p.a);
         const Aabb& b = table_.aabb(p.b);
-        const bool overlap = (a.min.x() <= b.max.x()) & (b.min.x() <= a.max.x()) &
-                             (a.min.y() <= b.max.y()) & (b.min.y() <= a.max.y()) &
-                             (a.min.z() <= b.max.z()) & (b.min.z() <= a.max.z());
+        const int overlap = int(a.min.x() <= b.max.x()) & int(b.min.x() <= a.max.x()) &
+                            int(a.min.y() <= b.max.y()) & int(b.min.y() <= a.max.y()) &
+                            int(a.min.z() <= b.max.z()) & int(b.min.z() <= a.max.z());
         pairs[count] = p;
-        count += overlap ? 1 : 0;
+        count += static_cast<std::size_t>(overlap);
     }
     pairs.resize(count);
     counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
