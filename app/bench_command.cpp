@@ -32,8 +32,17 @@ Command addBenchBroadphaseCommand(CLI::App& bench) {
                     "comma-separated (default: every AABB broad phase and the default peers)")
         ->delimiter(',');
     cmd->add_option("--workload", o.workload,
-                    "uniform, mixed (sizes 1:100), both (those two) or wide (sizes 1:10^4)")
-        ->check(CLI::IsMember({"uniform", "mixed", "both", "wide"}))
+                    "uniform, mixed (sizes 1:100), both (those two), wide (sizes 1:10^4) or "
+                    "boxpruning (Terdiman's scene, one-shot and moving; sizes default to "
+                    "10000,100000)")
+        ->check(CLI::IsMember({"uniform", "mixed", "both", "wide", "boxpruning"}))
+        ->capture_default_str();
+    cmd->add_option("--peers", o.peers,
+                    "tuned: sweep each peer's settings (DBVT margin, prediction, deferred; SAP "
+                    "world size and handle bits; FCL update and tree build) and compare with "
+                    "the best of each; all: the same and print every configuration; default: "
+                    "each peer at its defaults")
+        ->check(CLI::IsMember({"tuned", "all", "default"}))
         ->capture_default_str();
     cmd->add_option("--json", f->json, "also write the rows as JSON to FILE");
     cmd->add_option("--seed", o.seed, "workload seed")->capture_default_str();
@@ -47,9 +56,12 @@ Command addBenchBroadphaseCommand(CLI::App& bench) {
         ->capture_default_str();
     cmd->add_flag("--in-process", f->in_process,
                   "do not fork per method (no per-method peak memory)");
-    return {cmd, [f]() {
+    return {cmd, [f, cmd]() {
                 if (!f->json.empty()) f->options.json = f->json;
                 f->options.isolate = !f->in_process;
+                if (f->options.workload == "boxpruning" && cmd->count("--sizes") == 0) {
+                    f->options.sizes = {10000, 100000};
+                }
                 return runBenchBroadphase(f->options, std::cout, std::cerr);
             }};
 }

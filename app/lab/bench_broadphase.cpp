@@ -42,6 +42,10 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr int kEdgeFrames = 100;  // frames in the "first" and "last" medians
+constexpr int kMaxOneShotRepetitions = 100;
+// The peers' tuning pass: each configuration runs at most this many frames and seconds.
+constexpr int kTuneFrames = 100;
+constexpr double kTuneBudgetSeconds = 2;
 
 double clockSeconds(clockid_t clock) {
     timespec ts{};
@@ -50,6 +54,10 @@ double clockSeconds(clockid_t clock) {
 }
 
 double threadCpuSeconds() { return clockSeconds(CLOCK_THREAD_CPUTIME_ID); }
+
+int oneShotRepetitions(const BenchOptions& options) {
+    return std::min(options.frames, kMaxOneShotRepetitions);
+}
 
 /// The clock frames are timed by: --clock thread or wall.
 clockid_t frameClock(const BenchOptions& options) {
@@ -110,8 +118,13 @@ void setNote(RunResult& r, const std::string& text) {
 }
 
 /// Runs one method on a private copy of the workload: insert + first query, then the frames.
+RunResult measureOneShot(const BenchMethodEntry& entry, const MovingBoxes& boxes,
+                         const std::vector<PairSummary>& reference, const BenchOptions& options);
+
 RunResult measure(const BenchMethodEntry& entry, const MovingBoxes& initial,
-                  const std::vector<PairSummary>& reference, const BenchOptions& options) {
+                  const std::vector<PairSummary>& reference, const BenchOptions& options,
+                  bool one_shot) {
+    if (one_shot) return measureOneShot(entry, initial, reference, options);
     RunResult r;
     MovingBoxes boxes = initial;
     std::vector<collision::ProxyVolumes> volumes;
@@ -175,9 +188,54 @@ RunResult measure(const BenchMethodEntry& entry, const MovingBoxes& initial,
     return r;
 }
 
+/// One-shot: every repetition creates the method, inserts every box and finds the pairs of frame 0,
+/// all timed; destroying it is not. No state survives between repetitions.
+RunResult measureOneShot(const BenchMethodEntry& entry, const MovingBoxes& boxes,
+                         const std::vector<PairSummary>& reference, const BenchOptions& options) {
+    RunResult r;
+    std::vector<collision::ProxyVolumes> volumes;
+    boxes.volumes(volumes);
+    const int repetitions = oneShotRepetitions(options);
+    std::vector<double> times;
+    const clockid_t clock = frameClock(options);
+    double total = 0;
+    for (int rep = 0; rep < repetitions; ++rep) {
+        const double start = clockSeconds(clock);
+        std::unique_ptr<BenchMethod> method = entry.create();
+        method->insertAll(boxes, volumes);
+        method->findPairs();
+        const double dt = clockSeconds(clock) - start;
+        times.push_back(1e3 * dt);
+        total += dt;
+        const PairSummary got = method->summary(boxes);
+        r.pairs_last = got.pairs;
+        r.raw_pairs_last = method->rawPairs();
+        if (!(got == reference[0]) && r.mismatched_frames++ == 0) {
+            r.first_mismatch_frame = 0;
+            r.expected_pairs = reference[0].pairs;
+            r.got_pairs = got.pairs;
+        }
+        method.reset();
+        if (options.budget_seconds > 0 && total > options.budget_seconds &&
+            rep + 1 < repetitions) {
+            r.budget_hit = 1;
+            break;
+        }
+    }
+    r.insert_ms = times.front();
+    r.frames_run = static_cast<int>(times.size());
+    r.median_ms = median(times);
+    r.mean_ms = std::accumulate(times.begin(), times.end(), 0.0) / double(times.size());
+    const std::size_t edge = std::min<std::size_t>(kEdgeFrames, times.size());
+    r.first_median_ms = median(std::vector<double>(times.begin(), times.begin() + edge));
+    r.last_median_ms = median(std::vector<double>(times.end() - edge, times.end()));
+    return r;
+}
+
 /// measure() in a forked child: per-method peak memory, and a crash is a row, not the end.
 RunResult measureIsolated(const BenchMethodEntry& entry, const MovingBoxes& initial,
-                          const std::vector<PairSummary>& reference, const BenchOptions& options) {
+                          const std::vector<PairSummary>& reference, const BenchOptions& options,
+                          bool one_shot) {
     RunResult r;
     int fds[2];
     if (::pipe(fds) != 0) {
@@ -207,7 +265,7 @@ RunResult measureIsolated(const BenchMethodEntry& entry, const MovingBoxes& init
             ::alarm(static_cast<unsigned>(options.budget_seconds * 10 + 600));
         RunResult child;
         try {
-            child = measure(entry, initial, reference, options);
+            child = measure(entry, initial, reference, options, one_shot);
         } catch (const std::exception& e) {
             child.failed = 1;
             setNote(child, std::string("exception: ") + e.what());
@@ -250,9 +308,11 @@ RunResult measureIsolated(const BenchMethodEntry& entry, const MovingBoxes& init
 
 struct Row {
     std::string method;
-    std::string workload;
+    std::string workload;  ///< with " one-shot" for one-shot tables
     int n = 0;
     bool peer = false;
+    std::string family;  ///< a tuned peer's name (its winning configuration is `method`)
+    int configs = 0;     ///< configurations the tuned peer was chosen from
     bool skipped = false;
     std::string skip_reason;
     RunResult result;
@@ -267,21 +327,21 @@ std::string format(const char* fmt, double value) {
 }
 
 void printTable(std::ostream& out, const std::vector<Row>& rows, int frames) {
-    char line[320];
-    std::snprintf(line, sizeof(line), "%-26s %10s %10s %10s %10s %10s %10s %10s %8s %9s  %s\n",
+    char line[400];
+    std::snprintf(line, sizeof(line), "%-34s %10s %10s %10s %10s %10s %10s %10s %8s %9s  %s\n",
                   "method", "insert_ms", "median_ms", "mean_ms", "first100", "last100", "pairs",
                   "vs_peer", "peak_MB", "frames", "check");
     out << line;
     for (const Row& row : rows) {
         if (row.skipped) {
-            std::snprintf(line, sizeof(line), "%-26s %s\n", row.method.c_str(),
+            std::snprintf(line, sizeof(line), "%-34s %s\n", row.method.c_str(),
                           row.skip_reason.c_str());
             out << line;
             continue;
         }
         const RunResult& r = row.result;
         if (r.failed) {
-            std::snprintf(line, sizeof(line), "%-26s FAILED: %s\n", row.method.c_str(), r.note);
+            std::snprintf(line, sizeof(line), "%-34s FAILED: %s\n", row.method.c_str(), r.note);
             out << line;
             continue;
         }
@@ -290,14 +350,16 @@ void printTable(std::ostream& out, const std::vector<Row>& rows, int frames) {
         const std::string check = r.mismatched_frames == 0
                                       ? "ok"
                                       : "MISMATCH(" + std::to_string(r.mismatched_frames) + ")";
+        const std::string tuned =
+            row.configs > 0 ? "  (best of " + std::to_string(row.configs) + " configs)" : "";
         std::snprintf(
-            line, sizeof(line), "%-26s %10s %10s %10s %10s %10s %10lld %10s %8s %9s  %s\n",
+            line, sizeof(line), "%-34s %10s %10s %10s %10s %10s %10lld %10s %8s %9s  %s%s\n",
             (row.method + (row.peer ? " [peer]" : "")).c_str(), format("%.2f", r.insert_ms).c_str(),
             format("%.4f", r.median_ms).c_str(), format("%.4f", r.mean_ms).c_str(),
             format("%.4f", r.first_median_ms).c_str(), format("%.4f", r.last_median_ms).c_str(),
             static_cast<long long>(r.pairs_last),
             (format("%.2f", row.ratio) + (std::isfinite(row.ratio) ? "x" : "")).c_str(),
-            format("%.1f", r.peak_mb).c_str(), frames_text.c_str(), check.c_str());
+            format("%.1f", r.peak_mb).c_str(), frames_text.c_str(), check.c_str(), tuned.c_str());
         out << line;
     }
 }
@@ -313,6 +375,10 @@ nlohmann::json rowJson(const Row& row) {
     j["workload"] = row.workload;
     j["n"] = row.n;
     j["peer"] = row.peer;
+    if (!row.family.empty()) {
+        j["tuned_peer"] = row.family;
+        j["configs_swept"] = row.configs;
+    }
     if (row.skipped) {
         j["skipped"] = row.skip_reason;
         return j;
@@ -358,7 +424,12 @@ bool resolveBenchOptions(const BenchOptions& options, std::ostream& err,
     } else if (const auto kind = parseWorkloadKind(options.workload)) {
         kinds = {*kind};
     } else {
-        err << "--workload: '" << options.workload << "' is not uniform, mixed, both or wide\n";
+        err << "--workload: '" << options.workload
+            << "' is not uniform, mixed, both, wide or boxpruning\n";
+        return false;
+    }
+    if (options.peers != "tuned" && options.peers != "all" && options.peers != "default") {
+        err << "--peers: '" << options.peers << "' is not tuned, all or default\n";
         return false;
     }
     if (options.sizes.empty()) {
@@ -383,8 +454,10 @@ bool resolveBenchOptions(const BenchOptions& options, std::ostream& err,
         return false;
     }
     if (options.methods.empty()) {
+        // Tuned peers replace the peers' default configurations (their grids hold them).
+        const bool tune = options.peers != "default";
         for (const BenchMethodEntry& m : benchMethods()) {
-            if (m.default_set) methods.push_back(&m);
+            if (m.default_set && !(tune && m.peer)) methods.push_back(&m);
         }
     } else {
         for (const std::string& name : options.methods) {
@@ -425,7 +498,8 @@ std::vector<PairSummary> referencePairs(const MovingBoxes& workload, int frames)
 
 // One workload's rows: each method's ratio to the best peer, the table, the fastest cdlab
 // method, and notes on stopped runs and pair caches.
-void reportWorkload(std::ostream& out, std::vector<Row>& rows, const BenchOptions& options) {
+void reportWorkload(std::ostream& out, std::vector<Row>& rows, const BenchOptions& options,
+                    int frames) {
     double best_peer = std::numeric_limits<double>::infinity();
     const Row* best = nullptr;
     for (const Row& row : rows) {
@@ -444,7 +518,7 @@ void reportWorkload(std::ostream& out, std::vector<Row>& rows, const BenchOption
             fastest = &row;
         }
     }
-    printTable(out, rows, options.frames);
+    printTable(out, rows, frames);
     if (fastest != nullptr) {
         out << "fastest cdlab: " << fastest->method << " "
             << format("%.4f", fastest->result.median_ms) << " ms/frame";
@@ -470,6 +544,169 @@ void reportWorkload(std::ostream& out, std::vector<Row>& rows, const BenchOption
     out.flush();
 }
 
+/// What every method of one table runs on.
+struct TableRun {
+    const MovingBoxes& workload;
+    const std::vector<PairSummary>& reference;
+    const BenchOptions& options;
+    bool one_shot;
+    std::ostream& out;
+    std::ostream& err;
+    bool& failed;
+};
+
+std::string tableName(const MovingBoxes& workload, bool one_shot) {
+    return std::string(workloadName(workload.kind())) + (one_shot ? " one-shot" : "");
+}
+
+void printWorkloadHead(std::ostream& out, const MovingBoxes& workload,
+                       const std::vector<PairSummary>& reference, const BenchOptions& options,
+                       bool one_shot) {
+    const int n = workload.size();
+    const double per_body_first = double(reference.front().pairs) / n;
+    const double per_body_last = double(reference.back().pairs) / n;
+    char head[600];
+    if (one_shot) {
+        std::snprintf(head, sizeof(head),
+                      "\n== workload %s one-shot, N = %d: cube [%.0f, %.0f]^3, seed %llu; %lld "
+                      "pairs. Each repetition (median of %d) creates the method, inserts every "
+                      "box and finds the pairs: insert_ms and median_ms are that whole time\n",
+                      std::string(workloadName(workload.kind())).c_str(), n,
+                      double(workload.lower()), double(workload.lower() + workload.side()),
+                      static_cast<unsigned long long>(options.seed),
+                      static_cast<long long>(reference.front().pairs), oneShotRepetitions(options));
+    } else {
+        std::snprintf(head, sizeof(head),
+                      "\n== workload %s, N = %d: cube side %.3f, seed %llu; pairs/body %.3f "
+                      "at frame 0, %.3f at frame %d (overlaps/body %.2f, %.2f)\n",
+                      std::string(workloadName(workload.kind())).c_str(), n,
+                      double(workload.side()), static_cast<unsigned long long>(options.seed),
+                      per_body_first, per_body_last, options.frames, 2 * per_body_first,
+                      2 * per_body_last);
+    }
+    out << head;
+}
+
+/// Runs one method on a table (or a row saying why not), reporting progress and mismatches.
+Row runMethod(const BenchMethodEntry& m, const TableRun& run, const BenchOptions& options) {
+    const int n = run.workload.size();
+    Row row;
+    row.method = m.name;
+    row.workload = tableName(run.workload, run.one_shot);
+    row.n = n;
+    row.peer = m.peer;
+    if (m.threads > 1 && options.clock == "thread") {
+        row.skipped = true;
+        row.skip_reason = "runs on " + std::to_string(m.threads) +
+                          " threads: thread CPU time would count one; use --clock wall";
+        return row;
+    }
+    if (m.hard_max_n > 0 && n >= m.hard_max_n) {
+        row.skipped = true;
+        row.skip_reason = "skipped: holds fewer than " + std::to_string(m.hard_max_n) + " boxes";
+        return row;
+    }
+    if (run.options.methods.empty() && m.default_max_n > 0 && n > m.default_max_n) {
+        row.skipped = true;
+        row.skip_reason = m.skip_reason;
+        return row;
+    }
+    row.result = options.isolate
+                     ? measureIsolated(m, run.workload, run.reference, options, run.one_shot)
+                     : measure(m, run.workload, run.reference, options, run.one_shot);
+    const RunResult& r = row.result;
+    run.err << "[" << row.workload << " N=" << n << "] " << m.name << ": ";
+    if (r.failed) {
+        run.err << "FAILED: " << r.note << '\n';
+        run.failed = true;
+    } else {
+        run.err << format("%.4f", r.median_ms) << " ms median, " << r.frames_run
+                << (run.one_shot ? " repetitions\n" : " frames\n");
+    }
+    if (r.mismatched_frames > 0) {
+        run.failed = true;
+        const std::string msg =
+            "MISMATCH: " + m.name + " (" + row.workload + ", N=" + std::to_string(n) +
+            ") disagrees with the reference on " + std::to_string(r.mismatched_frames) +
+            " frame(s); first at frame " + std::to_string(r.first_mismatch_frame) + ": " +
+            std::to_string(r.got_pairs) + " pairs, expected " + std::to_string(r.expected_pairs) +
+            "\n";
+        run.out << "!!! " << msg;
+        run.err << "!!! " << msg;
+    }
+    return row;
+}
+
+Row runMethod(const BenchMethodEntry& m, const TableRun& run) {
+    return runMethod(m, run, run.options);
+}
+
+bool usable(const Row& row) {
+    return !row.skipped && !row.result.failed && row.result.mismatched_frames == 0;
+}
+
+void setRatios(std::vector<Row>& rows) {
+    double best = std::numeric_limits<double>::infinity();
+    for (const Row& row : rows) {
+        if (usable(row)) best = std::min(best, row.result.median_ms);
+    }
+    for (Row& row : rows) {
+        if (usable(row) && std::isfinite(best)) row.ratio = row.result.median_ms / best;
+    }
+}
+
+/// Each peer's grid on a short run, then its fastest configuration on the full run, appended to
+/// `rows` as the peer; every short run goes to `sweep`.
+void tunePeers(const TableRun& run, std::vector<Row>& rows, std::vector<Row>& sweep) {
+    BenchOptions short_run = run.options;
+    short_run.frames = std::min(run.options.frames, kTuneFrames);
+    short_run.budget_seconds = run.options.budget_seconds > 0
+                                   ? std::min(run.options.budget_seconds, kTuneBudgetSeconds)
+                                   : kTuneBudgetSeconds;
+    std::vector<std::string> families;
+    for (const BenchMethodEntry& m : benchMethods()) {
+        if (!m.family.empty() &&
+            std::find(families.begin(), families.end(), m.family) == families.end()) {
+            families.push_back(m.family);
+        }
+    }
+    for (const std::string& family : families) {
+        const BenchMethodEntry* best = nullptr;
+        double best_ms = std::numeric_limits<double>::infinity();
+        int configs = 0;
+        std::string skip_reason;
+        for (const BenchMethodEntry& m : benchMethods()) {
+            if (m.family != family) continue;
+            Row row = runMethod(m, run, short_run);
+            if (row.skipped) {
+                skip_reason = row.skip_reason;
+            } else {
+                ++configs;
+                if (usable(row) && row.result.median_ms < best_ms) {
+                    best_ms = row.result.median_ms;
+                    best = &m;
+                }
+            }
+            sweep.push_back(std::move(row));
+        }
+        if (best == nullptr) {
+            Row row;
+            row.method = family;
+            row.workload = tableName(run.workload, run.one_shot);
+            row.n = run.workload.size();
+            row.peer = true;
+            row.skipped = true;
+            row.skip_reason = configs == 0 ? skip_reason : "no configuration ran cleanly";
+            rows.push_back(std::move(row));
+            continue;
+        }
+        Row row = runMethod(*best, run);
+        row.family = family;
+        row.configs = configs;
+        rows.push_back(std::move(row));
+    }
+}
+
 }  // namespace
 
 BenchOptions smallBenchOptions() {
@@ -484,6 +721,7 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
     std::vector<WorkloadKind> kinds;
     std::vector<const BenchMethodEntry*> methods;
     if (!resolveBenchOptions(options, err, kinds, methods)) return kExitBadInput;
+    const bool tune = options.methods.empty() && options.peers != "default";
 
     out << "cdlab bench broadphase: " << options.frames << " frames per method; time = "
         << (options.clock == "wall" ? "elapsed (wall-clock) time" : "thread CPU time")
@@ -493,6 +731,12 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
         << kEdgeFrames << " frames; vs_peer = median / best peer's median;\n"
         << "peak_MB = VmHWM growth of the method's own process; check = every frame's pair set "
            "(count + hash) vs an independent sort-and-sweep.\n";
+    if (tune) {
+        out << "Peers tuned: every configuration of each peer's grid runs up to " << kTuneFrames
+            << " frames / " << kTuneBudgetSeconds
+            << " s; the fastest (by median) of each peer then runs in full and is the peer "
+               "row, named peer:configuration (--peers all prints the grid).\n";
+    }
     if (!options.isolate) out << "(in-process run: peak memory not measured)\n";
 
     bool failed = false;
@@ -502,66 +746,35 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
             const double t_ref = threadCpuSeconds();
             const MovingBoxes workload(kind, n, options.seed);
             const std::vector<PairSummary> reference = referencePairs(workload, options.frames);
-            const double per_body_first = double(reference.front().pairs) / n;
-            const double per_body_last = double(reference.back().pairs) / n;
-            char head[400];
-            std::snprintf(head, sizeof(head),
-                          "\n== workload %s, N = %d: cube side %.3f, seed %llu; pairs/body %.3f "
-                          "at frame 0, %.3f at frame %d (overlaps/body %.2f, %.2f)\n",
-                          std::string(workloadName(kind)).c_str(), n, double(workload.side()),
-                          static_cast<unsigned long long>(options.seed), per_body_first,
-                          per_body_last, options.frames, 2 * per_body_first, 2 * per_body_last);
-            out << head;
             err << "[" << workloadName(kind) << " N=" << n << "] reference pairs for "
                 << options.frames + 1 << " frames in " << format("%.1f", threadCpuSeconds() - t_ref)
                 << " s\n";
-
-            std::vector<Row> rows;
-            for (const BenchMethodEntry* m : methods) {
-                Row row;
-                row.method = m->name;
-                row.workload = std::string(workloadName(kind));
-                row.n = n;
-                row.peer = m->peer;
-                if (m->threads > 1 && options.clock == "thread") {
-                    row.skipped = true;
-                    row.skip_reason = "runs on " + std::to_string(m->threads) +
-                                      " threads: thread CPU time would count one; use --clock wall";
-                    rows.push_back(std::move(row));
-                    continue;
+            const std::vector<bool> modes = kind == WorkloadKind::BoxPruning
+                                                ? std::vector<bool>{true, false}
+                                                : std::vector<bool>{false};
+            for (const bool one_shot : modes) {
+                printWorkloadHead(out, workload, reference, options, one_shot);
+                TableRun run{workload, reference, options, one_shot, out, err, failed};
+                std::vector<Row> rows;
+                for (const BenchMethodEntry* m : methods) rows.push_back(runMethod(*m, run));
+                std::vector<Row> sweep;
+                if (tune) tunePeers(run, rows, sweep);
+                reportWorkload(out, rows, options,
+                               one_shot ? oneShotRepetitions(options) : options.frames);
+                if (options.peers == "all" && !sweep.empty()) {
+                    out << "peer configurations swept (up to " << kTuneFrames << " frames / "
+                        << kTuneBudgetSeconds << " s each; vs_peer against the best of them):\n";
+                    setRatios(sweep);
+                    printTable(out, sweep,
+                               std::min(one_shot ? oneShotRepetitions(options) : options.frames,
+                                         kTuneFrames));
                 }
-                if (options.methods.empty() && m->default_max_n > 0 && n > m->default_max_n) {
-                    row.skipped = true;
-                    row.skip_reason = m->skip_reason;
-                    rows.push_back(std::move(row));
-                    continue;
+                for (Row& row : rows) all_rows.push_back(std::move(row));
+                for (Row& row : sweep) {
+                    row.workload += " sweep";
+                    all_rows.push_back(std::move(row));
                 }
-                row.result = options.isolate ? measureIsolated(*m, workload, reference, options)
-                                             : measure(*m, workload, reference, options);
-                const RunResult& r = row.result;
-                err << "[" << row.workload << " N=" << n << "] " << m->name << ": ";
-                if (r.failed) {
-                    err << "FAILED: " << r.note << '\n';
-                    failed = true;
-                } else {
-                    err << format("%.4f", r.median_ms) << " ms/frame median, " << r.frames_run
-                        << " frames\n";
-                }
-                if (r.mismatched_frames > 0) {
-                    failed = true;
-                    const std::string msg =
-                        "MISMATCH: " + m->name + " (" + row.workload + ", N=" + std::to_string(n) +
-                        ") disagrees with the reference on " + std::to_string(r.mismatched_frames) +
-                        " frame(s); first at frame " + std::to_string(r.first_mismatch_frame) +
-                        ": " + std::to_string(r.got_pairs) + " pairs, expected " +
-                        std::to_string(r.expected_pairs) + "\n";
-                    out << "!!! " << msg;
-                    err << "!!! " << msg;
-                }
-                rows.push_back(std::move(row));
             }
-            reportWorkload(out, rows, options);
-            for (Row& row : rows) all_rows.push_back(std::move(row));
         }
     }
 
@@ -570,6 +783,7 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
         doc["frames"] = options.frames;
         doc["seed"] = options.seed;
         doc["clock"] = options.clock;
+        doc["peers"] = options.peers;
         doc["rows"] = nlohmann::json::array();
         for (const Row& row : all_rows) doc["rows"].push_back(rowJson(row));
         if (!writeJsonAtomically(*options.json, doc, err)) return kExitFailure;

@@ -17,7 +17,7 @@ struct BenchOptions {
     /// Method names (see benchMethods()); empty: every AABB-based cdlab broad phase and the
     /// default peer configurations found at configure time.
     std::vector<std::string> methods;
-    std::string workload = "both";              ///< uniform | mixed | both
+    std::string workload = "both";  ///< uniform | mixed | both | wide | boxpruning
     std::optional<std::filesystem::path> json;  ///< machine-readable rows
     std::uint64_t seed = 1;
     /// A method stops early (reporting the frames it ran) once its frames took this much thread
@@ -29,6 +29,11 @@ struct BenchOptions {
     /// "thread": each frame's thread CPU time (steady under load from other processes; methods
     /// on more than one thread are left out); "wall": elapsed time, every method.
     std::string clock = "thread";
+    /// Which peer configurations run when no --methods is given. "tuned": every configuration
+    /// of each peer's tuning grid on a short run, then the fastest of each peer on the full run,
+    /// ratios against the fastest of those; "all": the same, printing the whole grid;
+    /// "default": each peer at its default settings only.
+    std::string peers = "tuned";
 };
 
 /// A small configuration for smoke tests: 200 boxes, 20 frames, both workloads, all methods.

@@ -46,6 +46,12 @@ struct BenchMethodEntry {
     /// Threads the method runs on. Thread CPU time (the default clock) would count only the
     /// calling thread's share of a method on more than one, so those run with --clock wall only.
     int threads = 1;
+    /// Peer configurations swept for the best: the peer (e.g. "bullet-dbvt") this entry is one
+    /// configuration of, and the configuration ("m0.1:deferred"). Empty family: not swept.
+    std::string family;
+    std::string config;
+    /// The method cannot run this many boxes or more (0: no limit), e.g. 16-bit handles.
+    int hard_max_n = 0;
     std::function<std::unique_ptr<BenchMethod>()> create;
 };
 

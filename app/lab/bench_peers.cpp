@@ -11,7 +11,10 @@
 //    doubles as cdlab's box.
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <limits>
+#include <string>
+#include <utility>
 
 #include "bench_method.h"
 
@@ -45,6 +48,20 @@ namespace {
 
 enum class BulletKind { Dbvt, DbvtDeferred, AxisSweep, AxisSweepRaycast };
 
+/// A tunable Bullet configuration. DBVT: the leaf fattening margin (Bullet's global gDbvtMargin,
+/// default 0.05 in scene units) as a fraction of the workload's mean box size, negative for
+/// Bullet's default; the velocity prediction m_prediction (default 0). Axis sweep: the world
+/// box handed to the quantiser as a multiple of the workload's cube about its centre, and 16-
+/// or 32-bit handles (quantisation to 2^16 or 2^32 steps).
+struct BulletTuning {
+    double margin_fraction = -1;
+    double prediction = 0;
+    double world_scale = 1;
+    int handle_bits = 0;  ///< 0: 16-bit below 16k boxes, 32-bit from there (the default)
+};
+
+constexpr btScalar kBulletDefaultMargin = btScalar(0.05);
+
 // btScalar may be float (Bullet built in single precision): round outwards so the proxy's box
 // contains the exact one and Bullet's pair cache stays a superset of the exact pairs.
 btScalar roundDown(collision::Real x) {
@@ -68,24 +85,35 @@ btVector3 upperCorner(const collision::Aabb& box) {
 
 class BulletMethod : public BenchMethod {
 public:
-    explicit BulletMethod(BulletKind kind) : kind_(kind) {}
+    explicit BulletMethod(BulletKind kind, BulletTuning tuning = {})
+        : kind_(kind), tuning_(tuning) {}
     ~BulletMethod() override {
         // btDbvtBroadphase allocates each proxy; the axis sweeps keep theirs in one array.
         if (kind_ == BulletKind::Dbvt || kind_ == BulletKind::DbvtDeferred) {
             for (btBroadphaseProxy* p : proxies_) broad_phase_->destroyProxy(p, nullptr);
         }
+        gDbvtMargin = kBulletDefaultMargin;
     }
 
     void insertAll(const MovingBoxes& boxes,
                    std::span<const collision::ProxyVolumes> /*volumes*/) override {
         const int n = boxes.size();
-        const btVector3 world_min(0, 0, 0);
-        const btVector3 world_max = btVector3(1, 1, 1) * roundUp(boxes.side());
+        const double centre = boxes.lower() + boxes.side() / 2;
+        const double half = tuning_.world_scale * boxes.side() / 2;
+        const btVector3 world_min = btVector3(1, 1, 1) * roundDown(centre - half);
+        const btVector3 world_max = btVector3(1, 1, 1) * roundUp(centre + half);
         switch (kind_) {
             case BulletKind::Dbvt:
             case BulletKind::DbvtDeferred: {
+                double mean_size = 0;
+                for (const collision::Vec3& h : boxes.halfExtents()) mean_size += 2 * h.mean();
+                mean_size /= n;
+                gDbvtMargin = tuning_.margin_fraction < 0
+                                  ? kBulletDefaultMargin
+                                  : btScalar(tuning_.margin_fraction * mean_size);
                 auto dbvt = std::make_unique<btDbvtBroadphase>();
                 dbvt->m_deferedcollide = kind_ == BulletKind::DbvtDeferred;
+                dbvt->m_prediction = btScalar(tuning_.prediction);
                 broad_phase_ = std::move(dbvt);
                 break;
             }
@@ -94,7 +122,8 @@ public:
                 // The raycast accelerator is a second broad phase (a btDbvtBroadphase) that the
                 // sweep keeps up to date for ray queries; pair finding does not need it.
                 const bool no_raycast = kind_ == BulletKind::AxisSweep;
-                if (n < 16000) {
+                const bool small = tuning_.handle_bits == 0 ? n < 16000 : tuning_.handle_bits == 16;
+                if (small) {
                     broad_phase_ = std::make_unique<btAxisSweep3>(
                         world_min, world_max, static_cast<unsigned short>(n + 2), nullptr,
                         no_raycast);
@@ -143,6 +172,7 @@ public:
 
 private:
     BulletKind kind_;
+    BulletTuning tuning_;
     std::unique_ptr<btBroadphaseInterface> broad_phase_;
     std::vector<btBroadphaseProxy*> proxies_;
     std::int64_t raw_pairs_ = 0;
@@ -175,12 +205,17 @@ bool countPair(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data)
 
 class FclMethod : public BenchMethod {
 public:
-    FclMethod(FclManager manager, FclUpdate update) : kind_(manager), update_(update) {}
+    /// init_level: DynamicAABBTreeCollisionManager::tree_init_level, how registerObjects builds
+    /// the tree (0: top-down, FCL's default; 2: bottom-up on Morton codes).
+    FclMethod(FclManager manager, FclUpdate update, int init_level = 0)
+        : kind_(manager), update_(update), init_level_(init_level) {}
 
     void insertAll(const MovingBoxes& boxes,
                    std::span<const collision::ProxyVolumes> /*volumes*/) override {
         if (kind_ == FclManager::Tree) {
-            manager_ = std::make_unique<fcl::DynamicAABBTreeCollisionManagerd>();
+            auto tree = std::make_unique<fcl::DynamicAABBTreeCollisionManagerd>();
+            tree->tree_init_level = init_level_;
+            manager_ = std::move(tree);
         } else {
             manager_ = std::make_unique<fcl::SaPCollisionManagerd>();
         }
@@ -238,6 +273,7 @@ public:
 private:
     FclManager kind_;
     FclUpdate update_;
+    int init_level_;
     // The manager holds raw pointers to the objects: destroy it first.
     std::vector<std::unique_ptr<fcl::CollisionObjectd>> objects_;
     std::vector<fcl::CollisionObjectd*> raw_;
@@ -246,6 +282,110 @@ private:
 };
 
 #endif  // CDLAB_HAVE_FCL
+
+[[maybe_unused]] std::string number(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof(buf), "%g", v);
+    return buf;
+}
+
+#ifdef CDLAB_HAVE_BULLET
+// The tuning grids. DBVT: margin 0 to 1 mean box size and Bullet's absolute default, deferred
+// collide off and on, prediction 0 and 1 frame; axis sweep: world 1, 4 and 16 times the
+// workload's cube, 16- and 32-bit handles.
+void appendBulletGrid(std::vector<BenchMethodEntry>& methods, const std::string& sweep_skip) {
+    const double margins[] = {-1, 0, 0.01, 0.05, 0.1, 0.3, 1};
+    for (const bool deferred : {false, true}) {
+        for (const double prediction : {0.0, 1.0}) {
+            for (const double margin : margins) {
+                BulletTuning t;
+                t.margin_fraction = margin;
+                t.prediction = prediction;
+                BenchMethodEntry m;
+                m.family = "bullet-dbvt";
+                m.config = std::string("m") + (margin < 0 ? "default" : number(margin)) +
+                           (deferred ? ":deferred" : "") +
+                           (prediction != 0 ? ":p" + number(prediction) : "");
+                m.name = m.family + ":" + m.config;
+                m.description = "Bullet btDbvtBroadphase: gDbvtMargin " +
+                                (margin < 0 ? std::string("0.05 (default)")
+                                            : number(margin) + " x mean box size") +
+                                ", m_deferedcollide " + (deferred ? "on" : "off") +
+                                ", m_prediction " + number(prediction);
+                m.peer = true;
+                const BulletKind kind = deferred ? BulletKind::DbvtDeferred : BulletKind::Dbvt;
+                m.create = [kind, t]() -> std::unique_ptr<BenchMethod> {
+                    return std::make_unique<BulletMethod>(kind, t);
+                };
+                methods.push_back(std::move(m));
+            }
+        }
+    }
+    for (const int bits : {16, 32}) {
+        for (const double scale : {1.0, 4.0, 16.0}) {
+            BulletTuning t;
+            t.world_scale = scale;
+            t.handle_bits = bits;
+            BenchMethodEntry m;
+            m.family = "bullet-sap";
+            m.config = "w" + number(scale) + ":q" + std::to_string(bits);
+            m.name = m.family + ":" + m.config;
+            m.description = std::string(bits == 16 ? "btAxisSweep3" : "bt32BitAxisSweep3") +
+                            ", world " + number(scale) + " x the workload's cube";
+            m.peer = true;
+            m.default_max_n = 50000;
+            m.skip_reason = sweep_skip;
+            if (bits == 16) m.hard_max_n = 16000;
+            m.create = [t]() -> std::unique_ptr<BenchMethod> {
+                return std::make_unique<BulletMethod>(BulletKind::AxisSweep, t);
+            };
+            methods.push_back(std::move(m));
+        }
+    }
+}
+#endif
+
+#ifdef CDLAB_HAVE_FCL
+// FCL: every way of telling the manager about moved objects, with the tree built top-down
+// (FCL's default) or bottom-up on Morton codes; the SaP manager updated or rebuilt.
+void appendFclGrid(std::vector<BenchMethodEntry>& methods) {
+    const std::pair<const char*, FclUpdate> updates[] = {
+        {"refit", FclUpdate::Refit},           {"update", FclUpdate::Update},
+        {"update-each", FclUpdate::UpdateEach}, {"reinsert", FclUpdate::Reinsert},
+        {"rebuild", FclUpdate::Rebuild}};
+    for (const int init_level : {0, 2}) {
+        for (const auto& [update_name, update_kind] : updates) {
+            const FclUpdate update = update_kind;  // a structured binding cannot be captured
+            BenchMethodEntry m;
+            m.family = "fcl-dtree";
+            m.config = std::string(update_name) + ":init" + std::to_string(init_level);
+            m.name = m.family + ":" + m.config;
+            m.description = "FCL DynamicAABBTreeCollisionManager, " + std::string(update_name) +
+                            ", tree_init_level " + std::to_string(init_level);
+            m.peer = true;
+            m.create = [update, init_level]() -> std::unique_ptr<BenchMethod> {
+                return std::make_unique<FclMethod>(FclManager::Tree, update, init_level);
+            };
+            methods.push_back(std::move(m));
+        }
+    }
+    for (const auto& [update_name, update_kind] :
+         {std::pair<const char*, FclUpdate>{"update", FclUpdate::Update},
+          std::pair<const char*, FclUpdate>{"rebuild", FclUpdate::Rebuild}}) {
+        const FclUpdate update = update_kind;
+        BenchMethodEntry m;
+        m.family = "fcl-sap";
+        m.config = update_name;
+        m.name = m.family + ":" + m.config;
+        m.description = "FCL SaPCollisionManager, " + std::string(update_name);
+        m.peer = true;
+        m.create = [update]() -> std::unique_ptr<BenchMethod> {
+            return std::make_unique<FclMethod>(FclManager::SweepAndPrune, update);
+        };
+        methods.push_back(std::move(m));
+    }
+}
+#endif
 
 }  // namespace
 
@@ -275,6 +415,7 @@ void appendPeerMethods([[maybe_unused]] std::vector<BenchMethodEntry>& methods) 
            BulletKind::AxisSweep, true, 50000, sweep_skip);
     bullet("bullet-sap-raycast", "Bullet btAxisSweep3 with its raycast accelerator (default)",
            BulletKind::AxisSweepRaycast, false, 50000, sweep_skip);
+    appendBulletGrid(methods, sweep_skip);
 #endif
 #ifdef CDLAB_HAVE_FCL
     auto fcl = [&](std::string name, std::string description, FclManager manager, FclUpdate update,
@@ -303,6 +444,7 @@ void appendPeerMethods([[maybe_unused]] std::vector<BenchMethodEntry>& methods) 
         FclUpdate::Update, false);
     fcl("fcl-sap-rebuild", "FCL SaPCollisionManager, clear + registerObjects",
         FclManager::SweepAndPrune, FclUpdate::Rebuild, true);
+    appendFclGrid(methods);
 #endif
 }
 

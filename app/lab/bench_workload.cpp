@@ -40,6 +40,16 @@ private:
     std::uint64_t state_;
 };
 
+/// MSVC's rand(): the linear congruential generator Terdiman's scenes were made with, so the
+/// BoxPruning workload is his boxes exactly (11,811 overlapping pairs at 10,000 boxes, seed 42).
+int msvcRand(std::uint32_t& state) {
+    state = state * 214013u + 2531011u;
+    return static_cast<int>((state >> 16) & 0x7fffu);
+}
+
+constexpr int kBoxPruningRange = 2048;  // centres in [-2048, 2047]
+constexpr int kBoxPruningHalf = 127;    // half extents in [0, 127]
+
 }  // namespace
 
 std::string_view workloadName(WorkloadKind kind) {
@@ -50,6 +60,8 @@ std::string_view workloadName(WorkloadKind kind) {
             return "mixed";
         case WorkloadKind::Wide:
             return "wide";
+        case WorkloadKind::BoxPruning:
+            return "boxpruning";
     }
     return "?";
 }
@@ -58,6 +70,7 @@ std::optional<WorkloadKind> parseWorkloadKind(std::string_view name) {
     if (name == "uniform") return WorkloadKind::Uniform;
     if (name == "mixed") return WorkloadKind::Mixed;
     if (name == "wide") return WorkloadKind::Wide;
+    if (name == "boxpruning") return WorkloadKind::BoxPruning;
     return std::nullopt;
 }
 
@@ -67,6 +80,10 @@ std::uint64_t pairHash(ProxyId a, ProxyId b) {
 }
 
 MovingBoxes::MovingBoxes(WorkloadKind kind, int n, std::uint64_t seed) : kind_(kind) {
+    if (kind == WorkloadKind::BoxPruning) {
+        generateBoxPruning(n, seed);
+        return;
+    }
     const std::uint64_t stream = kind == WorkloadKind::Uniform ? 0x1234u
                                  : kind == WorkloadKind::Mixed ? 0x5678u
                                                                : 0x9abcu;
@@ -128,6 +145,34 @@ MovingBoxes::MovingBoxes(WorkloadKind kind, int n, std::uint64_t seed) : kind_(k
     place();
 }
 
+void MovingBoxes::generateBoxPruning(int n, std::uint64_t seed) {
+    // Terdiman, "Box pruning revisited" (2017), the benchmark's RunPerformanceTest: per box three
+    // centre coordinates, then three half extents, each from one rand() call.
+    rand_state_ = static_cast<std::uint32_t>(41 + seed);
+    const std::size_t count = static_cast<std::size_t>(std::max(n, 2));
+    center_.resize(count);
+    half_.resize(count);
+    for (std::size_t i = 0; i < count; ++i) {
+        for (int k = 0; k < 3; ++k) {
+            center_[i][k] = Real((msvcRand(rand_state_) & 4095) - kBoxPruningRange);
+        }
+        for (int k = 0; k < 3; ++k) half_[i][k] = Real(msvcRand(rand_state_) & kBoxPruningHalf);
+    }
+    lower_ = -kBoxPruningRange - kBoxPruningHalf;
+    side_ = 2 * (kBoxPruningRange + kBoxPruningHalf) - 1;
+    frame_ = 0;
+}
+
+void MovingBoxes::jitter() {
+    for (Vec3& c : center_) {
+        for (int k = 0; k < 3; ++k) {
+            const Real moved = c[k] + Real(msvcRand(rand_state_) % 3 - 1);
+            c[k] = std::clamp(moved, Real(-kBoxPruningRange), Real(kBoxPruningRange - 1));
+        }
+    }
+    ++frame_;
+}
+
 void MovingBoxes::place() {
     center_.resize(unit_.size());
     for (std::size_t i = 0; i < unit_.size(); ++i) {
@@ -138,6 +183,10 @@ void MovingBoxes::place() {
 }
 
 void MovingBoxes::step() {
+    if (kind_ == WorkloadKind::BoxPruning) {
+        jitter();
+        return;
+    }
     for (std::size_t i = 0; i < center_.size(); ++i) {
         Vec3& c = center_[i];
         Vec3& v = velocity_[i];
@@ -179,8 +228,9 @@ PairSummary PairReference::count(const MovingBoxes& boxes) {
     std::nth_element(extents_.begin(), mid, extents_.end());
     const Real width = std::max(4 * *mid, boxes.side() / 4096);
     const int slabs = std::max(1, static_cast<int>(std::ceil(boxes.side() / width)));
+    const Real lower = boxes.lower();
     auto slabOf = [&](Real y) {
-        return std::clamp(static_cast<int>(std::floor(y / width)), 0, slabs - 1);
+        return std::clamp(static_cast<int>(std::floor((y - lower) / width)), 0, slabs - 1);
     };
 
     // Counting sort of (slab, box) entries by slab.

@@ -19,10 +19,14 @@ enum class WorkloadKind {
     Uniform,  ///< half extents uniform in [0.4, 0.6] per axis
     Mixed,    ///< box scale log-uniform in [0.05, 5] (1:100), each axis x U[0.8, 1.2]
     Wide,     ///< box scale log-uniform in [0.005, 50] (1:10^4), each axis x U[0.8, 1.2]
+    /// Terdiman's BoxPruning scene ("Box pruning revisited", 2017): integer centres in
+    /// [-2048, 2047]^3 and integer half extents in [0, 127] from MSVC's rand() seeded with 42
+    /// (41 + seed); each frame every centre moves by -1, 0 or +1 per axis, kept in the range.
+    BoxPruning,
 };
 
 std::string_view workloadName(WorkloadKind kind);
-/// "uniform" or "mixed"; nullopt otherwise.
+/// "uniform", "mixed", "wide" or "boxpruning"; nullopt otherwise.
 std::optional<WorkloadKind> parseWorkloadKind(std::string_view name);
 
 /// The overlapping pairs of one frame, summarised: their number and an order-independent hash
@@ -36,9 +40,9 @@ struct PairSummary {
 /// Hash contribution of the pair (a, b), a < b; a set hashes to the wrapping sum over its pairs.
 std::uint64_t pairHash(collision::ProxyId a, collision::ProxyId b);
 
-/// N boxes in the cube [0, side]^3, each with a constant velocity, reflected at the walls so the
-/// box stays inside. Per-frame displacement is 1-2 % of the box's size (twice its mean half
-/// extent). Everything is a pure function of (kind, n, seed): two objects built with the same
+/// N boxes in the cube [lower, lower + side]^3. Uniform, mixed and wide: lower = 0, each box with
+/// a constant velocity, reflected at the walls so the box stays inside; per-frame displacement is
+/// 1-2 % of the box's size (twice its mean half extent). BoxPruning: see WorkloadKind. Everything is a pure function of (kind, n, seed): two objects built with the same
 /// arguments and stepped the same number of times hold bit-identical boxes.
 class MovingBoxes {
 public:
@@ -52,6 +56,8 @@ public:
     WorkloadKind kind() const { return kind_; }
     int size() const { return static_cast<int>(center_.size()); }
     collision::Real side() const { return side_; }
+    /// The cube's lowest coordinate on every axis.
+    collision::Real lower() const { return lower_; }
     int frame() const { return frame_; }
 
     /// Advances every box by its velocity for one frame, reflecting at the walls.
@@ -69,9 +75,13 @@ public:
 
 private:
     void place();
+    void generateBoxPruning(int n, std::uint64_t seed);
+    void jitter();
 
     WorkloadKind kind_;
     collision::Real side_ = 1;
+    collision::Real lower_ = 0;
+    std::uint32_t rand_state_ = 0;  // BoxPruning: MSVC rand() state
     int frame_ = 0;
     std::vector<collision::Vec3> unit_;  // frame-0 positions in [0,1]^3, scaled into the cube
     std::vector<collision::Vec3> center_;

@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -70,7 +71,7 @@ TEST(BroadphaseBench, SmallRunReportsEveryMethodWithTheSamePairsInTableAndJson) 
     const Result r =
         runCdlab("bench broadphase --sizes " + joined(small.sizes) + " --frames " +
                      std::to_string(small.frames) + " --workload " + small.workload + " --seed " +
-                     std::to_string(small.seed) + " --json " + json.string(),
+                     std::to_string(small.seed) + " --peers default --json " + json.string(),
                  work);
     ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
     EXPECT_FALSE(fs::exists(json.string() + ".partial"));
@@ -229,6 +230,127 @@ TEST(BroadphaseBench, WallClockRunsTheTwoThreadMethodWithTheSamePairs) {
     fs::remove_all(work);
 }
 
+// Tuned peers: every configuration of each peer's grid runs (a "sweep" row each), and the peer
+// row of the table is the configuration whose sweep median was the lowest of its peer's.
+TEST(BroadphaseBench, TunedPeersRunTheirWholeGridAndReportTheFastestConfiguration) {
+    std::map<std::string, std::set<std::string>> grid;
+    for (const app::BenchMethodEntry& m : app::benchMethods()) {
+        if (!m.family.empty()) grid[m.family].insert(m.name);
+    }
+    if (grid.empty()) GTEST_SKIP() << "built without Bullet and FCL";
+    const fs::path work = tempDir("tuned");
+    const fs::path json = work / "tuned.json";
+    const Result r = runCdlab("bench broadphase --sizes 150 --frames 3 --workload uniform "
+                              "--peers all --json " + json.string(),
+                              work);
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    const nlohmann::json doc = nlohmann::json::parse(slurp(json));
+    std::map<std::string, std::map<std::string, double>> swept;  // family -> method -> median
+    std::map<std::string, std::string> chosen;                   // family -> method
+    for (const nlohmann::json& row : doc["rows"]) {
+        const std::string method = row["method"];
+        if (row["workload"] == "uniform sweep") {
+            ASSERT_FALSE(row.contains("failed")) << row.dump();
+            ASSERT_EQ(row["mismatched_frames"], 0) << row.dump();
+            const std::string family = method.substr(0, method.find(':'));
+            swept[family][method] = row["ms_per_frame_median"].get<double>();
+        } else if (row.contains("tuned_peer")) {
+            EXPECT_EQ(row["frames"], 3) << row.dump();
+            EXPECT_EQ(row["mismatched_frames"], 0) << row.dump();
+            chosen[row["tuned_peer"]] = method;
+            EXPECT_TRUE(row["peer"].get<bool>());
+        } else {
+            // No default peer configuration runs beside the tuned ones.
+            EXPECT_FALSE(row["peer"].get<bool>()) << row.dump();
+        }
+    }
+    ASSERT_EQ(swept.size(), grid.size());
+    for (const auto& [family, methods] : grid) {
+        SCOPED_TRACE(family);
+        std::set<std::string> ran;
+        for (const auto& [method, ms] : swept[family]) ran.insert(method);
+        EXPECT_EQ(ran, methods);
+        ASSERT_TRUE(chosen.count(family));
+        const auto& medians = swept[family];
+        const auto fastest = std::min_element(
+            medians.begin(), medians.end(),
+            [](const auto& a, const auto& b) { return a.second < b.second; });
+        EXPECT_EQ(medians.at(chosen[family]), fastest->second) << chosen[family];
+        // The table names the winner and how many configurations it was chosen from.
+        EXPECT_NE(r.out.find(chosen[family] + " [peer]"), std::string::npos) << r.out;
+    }
+    EXPECT_NE(r.out.find("(best of "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("peer configurations swept"), std::string::npos) << r.out;
+    fs::remove_all(work);
+}
+
+// Terdiman's BoxPruning scene ("Box pruning revisited", 2017): his generator, MSVC's rand()
+// seeded with 42, gives 11,811 overlapping pairs at 10,000 boxes, counted here by brute force.
+TEST(BroadphaseBench, BoxPruningWorkloadIsTerdimansScene) {
+    const app::MovingBoxes boxes(app::WorkloadKind::BoxPruning, 10000, /*seed=*/1);
+    EXPECT_EQ(bruteForcePairs(app::WorkloadKind::BoxPruning, 10000, 1, 0), 11811);
+    app::PairReference reference;
+    EXPECT_EQ(reference.count(boxes).pairs, 11811);
+    // Integer centres in [-2048, 2047] and half extents in [0, 127], both ends reached.
+    collision::Real lo = 1e9, hi = -1e9, half_max = 0;
+    for (int i = 0; i < boxes.size(); ++i) {
+        for (int k = 0; k < 3; ++k) {
+            const collision::Real c = boxes.centers()[i][k];
+            const collision::Real h = boxes.halfExtents()[i][k];
+            ASSERT_EQ(c, std::floor(c));
+            ASSERT_EQ(h, std::floor(h));
+            ASSERT_GE(h, 0);
+            lo = std::min(lo, c);
+            hi = std::max(hi, c);
+            half_max = std::max(half_max, h);
+        }
+    }
+    EXPECT_EQ(lo, -2048);
+    EXPECT_EQ(hi, 2047);
+    EXPECT_EQ(half_max, 127);
+    // Moving: each centre moves by -1, 0 or +1 per axis per frame (all three occur) and stays
+    // in range; the sizes do not change.
+    app::MovingBoxes moved = boxes;
+    moved.step();
+    std::set<int> steps;
+    for (int i = 0; i < boxes.size(); ++i) {
+        for (int k = 0; k < 3; ++k) {
+            const collision::Real d = moved.centers()[i][k] - boxes.centers()[i][k];
+            ASSERT_LE(std::abs(d), 1);
+            steps.insert(static_cast<int>(d));
+            ASSERT_GE(moved.centers()[i][k], -2048);
+            ASSERT_LE(moved.centers()[i][k], 2047);
+        }
+        ASSERT_EQ(moved.halfExtents()[i], boxes.halfExtents()[i]);
+    }
+    EXPECT_EQ(steps, (std::set<int>{-1, 0, 1}));
+    EXPECT_EQ(reference.count(moved).pairs, bruteForcePairs(app::WorkloadKind::BoxPruning, 10000, 1, 1));
+}
+
+// `--workload boxpruning` measures one-shot (create + insert + find pairs, repeated) and moving
+// tables, every method checked against the reference.
+TEST(BroadphaseBench, BoxPruningRunsOneShotAndMovingTables) {
+    const fs::path work = tempDir("boxpruning");
+    const fs::path json = work / "bp.json";
+    const Result r = runCdlab("bench broadphase --workload boxpruning --sizes 400 --frames 4 "
+                              "--methods brute,sap-packed,hgrid --json " + json.string(),
+                              work);
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    EXPECT_NE(r.out.find("== workload boxpruning one-shot, N = 400"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("== workload boxpruning, N = 400"), std::string::npos) << r.out;
+    const nlohmann::json doc = nlohmann::json::parse(slurp(json));
+    ASSERT_EQ(doc["rows"].size(), 6u);
+    const std::int64_t first = bruteForcePairs(app::WorkloadKind::BoxPruning, 400, 1, 0);
+    const std::int64_t last = bruteForcePairs(app::WorkloadKind::BoxPruning, 400, 1, 4);
+    for (const nlohmann::json& row : doc["rows"]) {
+        EXPECT_EQ(row["mismatched_frames"], 0) << row.dump();
+        EXPECT_EQ(row["frames"], 4) << row.dump();
+        const bool one_shot = row["workload"] == "boxpruning one-shot";
+        EXPECT_EQ(row["pairs"].get<std::int64_t>(), one_shot ? first : last) << row.dump();
+    }
+    fs::remove_all(work);
+}
+
 TEST(BroadphaseBench, BadOptionsExitTwoBeforeAnyWork) {
     const fs::path work = tempDir("bad");
     Result r = runCdlab("bench broadphase --sizes 1 --frames 2", work);
@@ -240,6 +362,9 @@ TEST(BroadphaseBench, BadOptionsExitTwoBeforeAnyWork) {
     r = runCdlab("bench broadphase --sizes 50 --frames 2 --clock cpu", work);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("--clock"), std::string::npos) << r.err;
+    r = runCdlab("bench broadphase --sizes 50 --frames 2 --peers best", work);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("--peers"), std::string::npos) << r.err;
     r = runCdlab("bench broadphase --sizes 50 --frames 2 --methods sap,nope", work);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("unknown method 'nope'"), std::string::npos) << r.err;

@@ -461,9 +461,66 @@ TEST(BroadPhaseDifferential, CellBroadPhasesReturnOnInfiniteExtents) {
     const std::vector<ProxyVolumes> volumes = extremeBoxes(true);
     const std::vector<ProxyPair> ref = pairsOf(*findBroadPhase("brute"), volumes);
     EXPECT_EQ(ref.size(), 41u + 40 + 39 + 42);
-    for (const char* name : {"grid", "hash", "hgrid", "hgrid2", "sap", "sap1"}) {
+    for (const char* name : {"grid", "hash", "hgrid", "hgrid2", "sap", "sap1", "sap-packed"}) {
         SCOPED_TRACE(name);
         EXPECT_EQ(pairsOf(*findBroadPhase(name), volumes), ref);
+    }
+}
+
+// Float-rounding edges: sap-packed sweeps bounds rounded outward to float and confirms on the
+// doubles. Along each axis a row of boxes at coordinates float cannot hold (multiples of 0.1),
+// each starting exactly where the previous one ends (touching: a pair) or one double ulp after
+// it (apart: no pair, though both bounds round to the same float):
+//
+//      [0.1 ...... 0.2][0.2 ...... 0.3] [0.3+ulp ... 0.4][0.4 ...
+//             touching              apart by one ulp
+//
+// then, near (1e7, 1e7, 1e7) where a float step is 1, boxes of half size 1e-6 every 1.5e-6
+// along x: neighbours overlap, second neighbours do not, and every float box is the same.
+std::vector<ProxyVolumes> floatEdgeBoxes() {
+    auto box = [](const Vec3& lo, const Vec3& hi) {
+        const Vec3 c = (lo + hi) / 2;
+        const Vec3 h = (hi - lo) / 2;
+        return ProxyVolumes{Aabb{lo, hi}, BoundingSphere{c, h.norm()},
+                            Obb{c, Mat3::Identity(), h}};
+    };
+    std::vector<ProxyVolumes> volumes;
+    for (int axis = 0; axis < 3; ++axis) {
+        Vec3 offset = Vec3::Constant(Real(100 * (axis + 1)));
+        Real lo = Real(0.1);
+        for (int i = 0; i < 12; ++i) {
+            const Real hi = lo + Real(0.1);
+            Vec3 a = offset;
+            Vec3 b = offset + Vec3::Constant(Real(0.1));
+            a[axis] = lo;
+            b[axis] = hi;
+            volumes.push_back(box(a, b));
+            lo = i % 2 == 0 ? hi : std::nextafter(hi, Real(1e9));
+        }
+    }
+    for (int i = 0; i < 20; ++i) {
+        const Vec3 c = Vec3::Constant(Real(1e7)) + Vec3(Real(i) * Real(1.5e-6), 0, 0);
+        volumes.push_back(box(c - Vec3::Constant(Real(1e-6)), c + Vec3::Constant(Real(1e-6))));
+    }
+    return volumes;
+}
+
+TEST(BroadPhaseDifferential, FloatRoundingEdgesEqualTheReference) {
+    const std::vector<ProxyVolumes> volumes = floatEdgeBoxes();
+    // The premise: an apart pair's bounds round to the same float, so only the double test
+    // can separate them.
+    const Real touch = volumes[0].aabb.max.x();
+    const Real apart = volumes[2].aabb.min.x();
+    ASSERT_LT(volumes[1].aabb.max.x(), apart);
+    ASSERT_EQ(static_cast<float>(volumes[1].aabb.max.x()), static_cast<float>(apart));
+    ASSERT_EQ(touch, volumes[1].aabb.min.x());
+    const std::vector<ProxyPair> ref = pairsOf(*findBroadPhase("brute"), volumes);
+    // Per axis 6 touching neighbours and 5 apart ones; 19 overlapping neighbours near 1e7.
+    ASSERT_EQ(ref.size(), 3u * 6 + 19);
+    for (const BroadPhaseEntry& entry : broadPhaseRegistry()) {
+        if (entry.volume != "aabb") continue;
+        SCOPED_TRACE(std::string(entry.name));
+        EXPECT_EQ(pairsOf(entry, volumes), ref);
     }
 }
 
@@ -513,6 +570,56 @@ TEST(HierarchicalGrid, PairsInFoundOrderAreTheSortedSetUnsorted) {
         ASSERT_GT(ref_pairs.size(), 100u);
     }
     EXPECT_GT(unsorted_frames, 0);
+}
+
+// sap-packed keeps the pairs of overlapping fat boxes between frames and re-queries only the
+// boxes that left theirs. A jittering scene (Terdiman's BoxPruning, scaled down: integer centres
+// moving by -1, 0 or +1 per axis per frame, integer half sizes, so boxes touch exactly and
+// often) takes that path on most frames; every frame must still equal brute force, and the
+// coherent frames must test far fewer volumes than the full sweep of the first frame.
+TEST(PackedSweepAndPrune, JitteringBoxesEqualBruteForceWhileFatBoxesAreReused) {
+    constexpr int kBoxes = 1500;
+    Rng rng(17);
+    std::vector<Vec3> centre(kBoxes);
+    std::vector<Vec3> half(kBoxes);
+    for (int i = 0; i < kBoxes; ++i) {
+        centre[i] = Vec3(rng.integer(-300, 300), rng.integer(-300, 300), rng.integer(-300, 300));
+        half[i] = Vec3(rng.integer(0, 20), rng.integer(0, 20), rng.integer(0, 20));
+    }
+    auto volumes = [&](int i) {
+        return ProxyVolumes{Aabb{centre[i] - half[i], centre[i] + half[i]},
+                            BoundingSphere{centre[i], half[i].norm()},
+                            Obb{centre[i], Mat3::Identity(), half[i]}};
+    };
+    std::unique_ptr<BroadPhase> fast = findBroadPhase("sap-packed")->create();
+    std::unique_ptr<BroadPhase> ref = findBroadPhase("brute")->create();
+    for (int i = 0; i < kBoxes; ++i) {
+        fast->insert(i, volumes(i));
+        ref->insert(i, volumes(i));
+    }
+    std::vector<ProxyPair> fast_pairs;
+    std::vector<ProxyPair> ref_pairs;
+    BroadPhaseCounters first;
+    fast->findPairs(fast_pairs, first);
+    BroadPhaseCounters rc;
+    ref->findPairs(ref_pairs, rc);
+    ASSERT_EQ(fast_pairs, ref_pairs);
+    ASSERT_GT(ref_pairs.size(), 300u);
+    int cheap_frames = 0;
+    for (int frame = 1; frame <= 200; ++frame) {
+        for (int i = 0; i < kBoxes; ++i) {
+            for (int k = 0; k < 3; ++k) centre[i][k] += rng.integer(-1, 1);
+            fast->move(i, volumes(i));
+            ref->move(i, volumes(i));
+        }
+        BroadPhaseCounters fc;
+        fast->findPairs(fast_pairs, fc);
+        ref->findPairs(ref_pairs, rc);
+        ASSERT_EQ(fast_pairs, ref_pairs) << "frame " << frame;
+        ASSERT_EQ(fast->validate(), "") << "frame " << frame;
+        cheap_frames += fc.volume_tests < first.volume_tests / 4;
+    }
+    EXPECT_GT(cheap_frames, 150);
 }
 
 TEST(SweepAndPrune, CoherentMotionCostsFewSwaps) {

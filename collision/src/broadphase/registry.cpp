@@ -9,6 +9,7 @@
 #include "broadphase/octree.h"
 #include "broadphase/sap.h"
 #include "broadphase/sap1.h"
+#include "broadphase/sap_packed.h"
 #include "broadphase/sphere.h"
 #include "broadphase/tree.h"
 
@@ -32,6 +33,10 @@ const BroadPhaseEntry kRegistry[] = {
     {"sap1", "single-axis sort and sweep, axis of greatest spread, insertion-sort coherence",
      "aabb", "brute",
      []() -> std::unique_ptr<BroadPhase> { return std::make_unique<SortAndSweep1>(); }},
+    {"sap-packed",
+     "box pruning: one sort on min x, float bounds rounded outward, SSE2 y/z test, exact confirm",
+     "aabb", "brute",
+     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<PackedSweepAndPrune>(); }},
     {"grid", "uniform grid over the bodies, cell size from the median body size", "aabb", "brute",
      []() -> std::unique_ptr<BroadPhase> {
          return std::make_unique<GridBroadPhase>(GridBroadPhase::Mode::Dense);

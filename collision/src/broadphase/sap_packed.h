@@ -1,0 +1,136 @@
+// collision/src/broadphase/sap_packed.h -- single-axis sort and sweep on packed float bounds,
+// the y/z overlap of each candidate tested four floats at a time with SSE2.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "broadphase/proxy_table.h"
+#include "collision/broadphase/broad_phase.h"
+
+namespace collision {
+
+/// Box pruning (Terdiman, "Box pruning revisited", 2017; Baraff 1992 for the sort and sweep):
+/// each frame the proxies are sorted once on their minimum x. Like Terdiman's buckets, the
+/// sorted boxes are then dealt, in order, into bands along y (each box into every band its y
+/// range meets, so each band stays sorted on x) and every band is swept along x on its own; a
+/// pair is kept only in the band holding the larger of the two minimum y, which both boxes meet,
+/// so it is reported once. Boxes meeting more than a few bands are swept against the whole
+/// sorted list instead (so one huge box costs one sweep, not one per band). The bounds are
+/// copied into float form, each double rounded outward (minimum down, maximum up), so the float
+/// test never rejects a pair the double test accepts; every candidate is confirmed on the double
+/// AABBs. The bounds are stored one array per bound, and the sweep tests four consecutive boxes
+/// at once with SSE2 (x, y and z in five four-wide comparisons), leaving the sweep when one of the
+/// four starts past the box's end. The sort is an LSD radix sort on the float keys after a change
+/// of the proxy set, and an insertion sort of last frame's order otherwise (O(n + swaps) when
+/// motion is coherent; it falls back to the radix sort when the order changed too much).
+///
+/// Coherence (as Bullet's DBVT and Box2D's tree fatten leaves): the swept boxes are fat, the exact
+/// box grown by kMargin times its recent largest step per frame, and the candidate pairs (fat
+/// boxes overlap) are kept between frames. A frame where few boxes left their fat box re-fattens
+/// and re-queries only those; when many did, margins are not paying and everything is swept
+/// again with exact boxes, margins tried again kRetryFrames later. A new proxy set (insert,
+/// remove) is swept with exact boxes: the one-shot path.
+class PackedSweepAndPrune : public BroadPhase {
+public:
+    std::string_view name() const override { return "sap-packed"; }
+    void insert(ProxyId id, const ProxyVolumes& v) override;
+    void remove(ProxyId id) override;
+    void move(ProxyId id, const ProxyVolumes& v) override;
+    void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
+    void draw(DebugDraw& draw, const Aabb& bounds) const override;
+    std::string validate() const override;
+
+private:
+    static constexpr std::size_t kSample = 255;     ///< boxes sampled for the band width
+    static constexpr std::size_t kMinPerBand = 16;  ///< fewer bands than n / this
+    static constexpr int kMaxBands = 1024;
+    static constexpr float kBandWidth = 3.0f;  ///< band width / median y extent
+    static constexpr int kBigBands = 4;        ///< a box meeting more bands than this is big
+    static constexpr std::size_t kPad = 4;     ///< NaN sentinels after each swept list
+    static constexpr float kMargin = 32.0f;     ///< fat margin / recent motion per frame
+    static constexpr float kMotionDecay = 0.95f;
+    static constexpr std::size_t kQueryShare = 128;  ///< escaped boxes per full sweep's cost
+    static constexpr int kRetryFrames = 32;
+
+    /// Float bounds of a sorted list of boxes, one array per bound (structure of arrays), so
+    /// four consecutive boxes load as one SSE register per bound. Maxima of y and z are stored
+    /// negated, so every test of the sweep is "lane <= limit".
+    struct Lanes {
+        std::vector<float> min_x, max_x, min_y, min_z, neg_max_y, neg_max_z;
+        void resize(std::size_t n);
+        void copy(std::size_t to, const Lanes& from, std::size_t at);
+        /// Entries [at, at + kPad): NaN minimum x ends every sweep that reaches them.
+        void pad(std::size_t at);
+    };
+    struct Entry {
+        float key;  ///< min x rounded down
+        ProxyId id;
+    };
+
+    void sortEntries(BroadPhaseCounters& counters);
+    void radixSortEntries();
+    void pack();
+    void dealBands();
+    void sweepBands(BroadPhaseCounters& counters);
+    void sweepBig(BroadPhaseCounters& counters);
+    template <typename Hit>
+    static std::int64_t sweepRange(const Lanes& lanes, std::size_t begin, std::size_t end,
+                                   Hit&& hit);
+    int bandOf(float y) const {
+        const float t = (y - band_lo_) * band_scale_;
+        // Compare before converting: a NaN or huge t must not reach the integer conversion.
+        if (!(t > 0)) return 0;
+        if (t >= float(bands_ - 1)) return bands_ - 1;
+        return static_cast<int>(t);
+    }
+    /// Records the candidate pair of sorted places i and j (their fat boxes overlap).
+    void confirm(std::size_t i, std::size_t j) {
+        keys_.push_back((static_cast<std::uint64_t>(ids_[i]) << shift_) |
+                        static_cast<std::uint64_t>(ids_[j]));
+    }
+    void fatten(ProxyId id, float margin);
+    bool insideFat(ProxyId id) const;
+    void rebuild();
+    void fullSweep(BroadPhaseCounters& counters);
+    void queryEscaped(BroadPhaseCounters& counters);
+
+    ProxyTable table_;
+    std::vector<Entry> entries_;  ///< present proxies sorted by key (ties: unspecified)
+    Lanes all_;                   ///< every box in sorted order, then kPad sentinels
+    std::vector<ProxyId> ids_;    ///< per sorted place
+    // Fat boxes by id (absent ids NaN): the exact box grown by kMargin times the box's recent
+    // motion per frame, rounded outward; candidates_ holds every pair whose fat boxes overlap.
+    Lanes fat_;
+    std::vector<float> motion_;    ///< recent largest centre step per frame, by id
+    std::vector<ProxyId> present_;
+    std::vector<ProxyId> escaped_;
+    std::vector<char> escaped_flag_;
+    std::vector<ProxyPair> candidates_;
+    std::vector<ProxyPair> fresh_;
+    std::vector<ProxyPair> merged_;
+    bool margins_on_ = false;
+    int retry_in_ = 1;
+    float lo_y_ = 0;              ///< lowest min y and highest max y (float)
+    float hi_y_ = 0;
+    // Bands along y: band b covers [band_lo_ + b / band_scale_, ...); the last is open above.
+    int bands_ = 1;
+    float band_lo_ = 0;
+    float band_scale_ = 0;
+    std::vector<int> first_band_;  ///< per sorted place; -1 for a big box (swept against all)
+    std::vector<int> last_band_;
+    std::vector<std::uint32_t> band_start_;  ///< band b's entries: [start[b], start[b+1] - kPad)
+    Lanes band_;                             ///< the bands' entries, each band sorted
+    std::vector<std::uint32_t> band_place_;  ///< the entry's sorted place
+    std::vector<int> band_first_;            ///< the entry's box's first band
+    std::vector<std::uint32_t> big_;         ///< sorted places of the big boxes, in order
+    std::vector<float> sample_;
+    std::vector<std::uint32_t> fill_;
+    std::vector<std::uint64_t> keys_;
+    std::vector<std::uint64_t> scratch_;
+    int shift_ = 1;
+    bool dirty_ = true;
+    std::int64_t moved_ = 0;
+};
+
+}  // namespace collision
