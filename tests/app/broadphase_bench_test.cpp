@@ -351,6 +351,33 @@ TEST(BroadphaseBench, BoxPruningRunsOneShotAndMovingTables) {
     fs::remove_all(work);
 }
 
+// A peer that disagrees with the reference (FCL's SaP misses pairs of the boxpruning scene) is
+// shown as a mismatch and left out of the ratios: the best peer and every ratio come from the
+// peers that agreed, and the run still succeeds, since the defect is not ours.
+TEST(BroadphaseBench, APeerThatDisagreesIsShownAndLeftOutOfTheRatios) {
+    const fs::path work = tempDir("peer_mismatch");
+    const fs::path json = work / "bp.json";
+    const Result r = runCdlab("bench broadphase --workload boxpruning --sizes 400 --frames 3 "
+                              "--methods hgrid,fcl-sap:update,bullet-dbvt --json " + json.string(),
+                              work);
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    EXPECT_NE(r.out.find("MISMATCH: fcl-sap:update"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("best peer: fcl-sap"), std::string::npos) << r.out;
+    const nlohmann::json doc = nlohmann::json::parse(slurp(json));
+    int mismatched_peers = 0;
+    for (const nlohmann::json& row : doc["rows"]) {
+        if (row["mismatched_frames"].get<int>() > 0) {
+            ++mismatched_peers;
+            EXPECT_EQ(row["method"], "fcl-sap:update") << row.dump();
+            EXPECT_TRUE(row["ratio_to_best_peer"].is_null()) << row.dump();
+        } else {
+            EXPECT_TRUE(row["ratio_to_best_peer"].is_number()) << row.dump();
+        }
+    }
+    EXPECT_GE(mismatched_peers, 1) << "the peer agreed: the test shows nothing";
+    fs::remove_all(work);
+}
+
 TEST(BroadphaseBench, BadOptionsExitTwoBeforeAnyWork) {
     const fs::path work = tempDir("bad");
     Result r = runCdlab("bench broadphase --sizes 1 --frames 2", work);
