@@ -398,31 +398,50 @@ TEST(CcdPrimitives, CrossingEdgesHitAtTheAnalyticTimeNeverLater) {
     EXPECT_GT(m.t, 0.25 - 1e-4);
 }
 
+// A vertex-face query built to touch: the vertex meets the face at barycentric (us, vs) at
+// time ts, all drawn from `rng` with corners in [-1, 1]^3; its first contact is at or before ts
+// (another may come earlier), up to the rounding of the construction.
+struct ConstructedContact {
+    VertexFaceCcdInput vf;
+    Real ts, us, vs;
+};
+
+ConstructedContact constructedVertexFaceContact(std::mt19937& rng) {
+    std::uniform_real_distribution<Real> coord(-1, 1), unit(0.05, 0.95);
+    ConstructedContact c;
+    c.ts = unit(rng);
+    c.us = unit(rng);
+    c.vs = unit(rng);
+    if (c.us + c.vs > 1) {
+        c.us = 1 - c.us;
+        c.vs = 1 - c.vs;
+    }
+    auto randVec = [&] { return Vec3(coord(rng), coord(rng), coord(rng)); };
+    VertexFaceCcdInput& vf = c.vf;
+    for (int k = 1; k < 4; ++k) {
+        vf.t0[k] = randVec();
+        vf.t1[k] = randVec();
+    }
+    auto at = [&](const Vec3& a, const Vec3& b) { return Vec3(a + c.ts * (b - a)); };
+    const Vec3 target = (1 - c.us - c.vs) * at(vf.t0[1], vf.t1[1]) +
+                        c.us * at(vf.t0[2], vf.t1[2]) + c.vs * at(vf.t0[3], vf.t1[3]);
+    vf.t0[0] = randVec();
+    vf.t1[0] = vf.t0[0] + (target - vf.t0[0]) / c.ts;
+    return c;
+}
+
 TEST(CcdPrimitives, RandomContactsAreFoundNoLaterThanConstructed) {
     // Construct a contact at a chosen (t*, u*, v*) with random motion: the first contact is at
     // or before t* (another one may come earlier), up to the rounding of the constructed input.
     std::mt19937 rng(1234);
-    std::uniform_real_distribution<Real> coord(-1, 1), unit(0.05, 0.95);
+    std::uniform_real_distribution<Real> coord(-1, 1);
     int vf_hits = 0, ee_hits = 0;
     for (int i = 0; i < 300; ++i) {
-        const Real ts = unit(rng);
-        Real us = unit(rng), vs = unit(rng);
-        if (us + vs > 1) {
-            us = 1 - us;
-            vs = 1 - vs;
-        }
+        const ConstructedContact c = constructedVertexFaceContact(rng);
+        const Real ts = c.ts, us = c.us, vs = c.vs;
         auto randVec = [&] { return Vec3(coord(rng), coord(rng), coord(rng)); };
-        VertexFaceCcdInput vf;
-        for (int k = 1; k < 4; ++k) {
-            vf.t0[k] = randVec();
-            vf.t1[k] = randVec();
-        }
         auto at = [&](const Vec3& a, const Vec3& b) { return Vec3(a + ts * (b - a)); };
-        const Vec3 target = (1 - us - vs) * at(vf.t0[1], vf.t1[1]) + us * at(vf.t0[2], vf.t1[2]) +
-                            vs * at(vf.t0[3], vf.t1[3]);
-        vf.t0[0] = randVec();
-        vf.t1[0] = vf.t0[0] + (target - vf.t0[0]) / ts;
-        const CcdOutput o = collision::vertexFaceCcd(vf);
+        const CcdOutput o = collision::vertexFaceCcd(c.vf);
         ASSERT_EQ(o.state, CcdState::Hit) << i;
         EXPECT_LE(o.t, ts + 1e-9) << i;
         vf_hits += o.state == CcdState::Hit;
@@ -501,28 +520,13 @@ TEST(CcdPrimitives, HugeCoordinatesFindTheSameContacts) {
     // Separated). Every contact must still be a Hit, never later than constructed.
     if (sizeof(Real) < sizeof(double)) GTEST_SKIP() << "float coordinates cannot be this large";
     std::mt19937 rng(77);
-    std::uniform_real_distribution<Real> coord(-1, 1), unit(0.05, 0.95);
     int hits = 0;
     constexpr int kQueries = 600;
     for (int i = 0; i < kQueries; ++i) {
         const Real scale = std::ldexp(Real(1), 320 + i % 60);
-        const Real ts = unit(rng);
-        Real us = unit(rng), vs = unit(rng);
-        if (us + vs > 1) {
-            us = 1 - us;
-            vs = 1 - vs;
-        }
-        auto randVec = [&] { return Vec3(coord(rng), coord(rng), coord(rng)); };
-        VertexFaceCcdInput vf;
-        for (int k = 1; k < 4; ++k) {
-            vf.t0[k] = randVec();
-            vf.t1[k] = randVec();
-        }
-        auto at = [&](const Vec3& a, const Vec3& b) { return Vec3(a + ts * (b - a)); };
-        const Vec3 target = (1 - us - vs) * at(vf.t0[1], vf.t1[1]) + us * at(vf.t0[2], vf.t1[2]) +
-                            vs * at(vf.t0[3], vf.t1[3]);
-        vf.t0[0] = randVec();
-        vf.t1[0] = vf.t0[0] + (target - vf.t0[0]) / ts;
+        ConstructedContact c = constructedVertexFaceContact(rng);
+        const Real ts = c.ts;
+        VertexFaceCcdInput& vf = c.vf;
         for (int k = 0; k < 4; ++k) {
             vf.t0[k] *= scale;  // exact: a power of two
             vf.t1[k] *= scale;

@@ -15,6 +15,7 @@
 
 #include "render/frame_writer.h"
 #include "render/image.h"
+#include "test_dir.h"
 
 namespace {
 
@@ -23,23 +24,10 @@ namespace fs = std::filesystem;
 constexpr int kW = 64;
 constexpr int kH = 48;
 
-class TempDir {
+// A fresh directory per test.
+class TempDir : public cdlab_test::TempDir {
 public:
-    TempDir() {
-        const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        path_ = fs::temp_directory_path() /
-                ("cdlab_frame_writer_" + std::to_string(::getpid()) + "_" + info->name());
-        fs::remove_all(path_);
-        fs::create_directories(path_);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path_, ec);
-    }
-    const fs::path& path() const { return path_; }
-
-private:
-    fs::path path_;
+    TempDir() : cdlab_test::TempDir("cdlab_frame_writer_") {}
 };
 
 // A frame with a gradient (so PNG filters have work) and a frame-specific grey level.

@@ -26,6 +26,7 @@
 #include "render/image.h"
 #include "render/renderer.h"
 #include "pixel_checks.h"
+#include "test_dir.h"
 
 namespace {
 
@@ -36,23 +37,10 @@ using engine::Real;
 using engine::Vec3;
 using namespace cdlab_test;
 
-class TempDir {
+// A fresh directory per test.
+class TempDir : public cdlab_test::TempDir {
 public:
-    TempDir() {
-        const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        path_ = fs::temp_directory_path() /
-                ("cdlab_render_" + std::to_string(::getpid()) + "_" + info->name());
-        fs::remove_all(path_);
-        fs::create_directories(path_);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path_, ec);
-    }
-    const fs::path& path() const { return path_; }
-
-private:
-    fs::path path_;
+    TempDir() : cdlab_test::TempDir("cdlab_render_") {}
 };
 
 render::Image renderThreeSpheres(render::Renderer& renderer,
