@@ -355,6 +355,10 @@ TEST(BroadphaseBench, BoxPruningRunsOneShotAndMovingTables) {
 // shown as a mismatch and left out of the ratios: the best peer and every ratio come from the
 // peers that agreed, and the run still succeeds, since the defect is not ours.
 TEST(BroadphaseBench, APeerThatDisagreesIsShownAndLeftOutOfTheRatios) {
+    if (app::findBenchMethod("fcl-sap:update") == nullptr ||
+        app::findBenchMethod("bullet-dbvt") == nullptr) {
+        GTEST_SKIP() << "built without Bullet and FCL";
+    }
     const fs::path work = tempDir("peer_mismatch");
     const fs::path json = work / "bp.json";
     const Result r = runCdlab("bench broadphase --workload boxpruning --sizes 400 --frames 3 "
