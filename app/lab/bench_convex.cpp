@@ -218,9 +218,9 @@ Accuracy accuracy(const std::vector<ConvexPair>& pairs, const std::vector<Real>&
                           p.scale
                     : std::numeric_limits<double>::infinity();
         acc.normal = std::max(acc.normal, normal);
-        acc.witness = std::max({acc.witness,
-                                std::abs(surfaceDistance(p.a, p.pose_a, a.point_a)) / p.scale,
-                                std::abs(surfaceDistance(p.b, p.pose_b, a.point_b)) / p.scale});
+        const double witness_a = std::abs(surfaceDistance(p.a, p.pose_a, a.point_a)) / p.scale;
+        const double witness_b = std::abs(surfaceDistance(p.b, p.pose_b, a.point_b)) / p.scale;
+        acc.witness = std::max({acc.witness, witness_a, witness_b});
     }
     return acc;
 }
