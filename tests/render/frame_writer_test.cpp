@@ -139,12 +139,7 @@ TEST(FrameWriter, VideoFramesComeInSubmissionOrder) {
 //   writer --frames--> [pipe] --x  fake "ffmpeg" (exit 3)
 TEST(FrameWriter, AnEncoderThatDiesIsAnError) {
     TempDir dir;
-    const fs::path fake = dir.path() / "ffmpeg";
-    std::ofstream(fake) << "#!/bin/sh\nexit 3\n";
-    fs::permissions(fake, fs::perms::owner_all);
-    const char* old_path = std::getenv("PATH");
-    const std::string saved = old_path ? old_path : "";
-    ::setenv("PATH", dir.path().c_str(), 1);
+    const cdlab_test::DeadFfmpegOnPath dead_ffmpeg(dir.path());
     std::string message;
     try {
         render::FrameWriter writer(
@@ -155,7 +150,6 @@ TEST(FrameWriter, AnEncoderThatDiesIsAnError) {
     } catch (const render::RenderError& e) {
         message = e.what();
     }
-    ::setenv("PATH", saved.c_str(), 1);
     EXPECT_NE(message.find("dead.mp4"), std::string::npos) << message;
     EXPECT_FALSE(fs::exists(dir.path() / "dead.mp4"));
     EXPECT_FALSE(fs::exists(dir.path() / "dead.partial.mp4"));

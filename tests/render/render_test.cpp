@@ -569,12 +569,7 @@ void feedPastThePipeBuffer(render::VideoWriter& video) {
 //   us --frames--> [pipe] --x  fake "ffmpeg" (exit 3)
 TEST(Video, AnFfmpegThatDiesBecomesARenderError) {
     TempDir dir;
-    const fs::path fake = dir.path() / "ffmpeg";
-    std::ofstream(fake) << "#!/bin/sh\nexit 3\n";
-    fs::permissions(fake, fs::perms::owner_all);
-    const char* old_path = std::getenv("PATH");
-    const std::string saved = old_path ? old_path : "";
-    ::setenv("PATH", dir.path().c_str(), 1);
+    const cdlab_test::DeadFfmpegOnPath dead_ffmpeg(dir.path());
     bool threw = false;
     try {
         render::VideoWriter video(dir.path() / "dead.mp4", kWidth, kHeight, 30);
@@ -583,7 +578,6 @@ TEST(Video, AnFfmpegThatDiesBecomesARenderError) {
     } catch (const render::RenderError&) {
         threw = true;
     }
-    ::setenv("PATH", saved.c_str(), 1);
     EXPECT_TRUE(threw);
     EXPECT_FALSE(fs::exists(dir.path() / "dead.mp4"));
     EXPECT_FALSE(fs::exists(dir.path() / "dead.partial.mp4"));

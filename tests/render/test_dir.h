@@ -3,7 +3,9 @@
 
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <system_error>
 
@@ -31,6 +33,26 @@ public:
 
 private:
     std::filesystem::path path_;
+};
+
+/// A fake `ffmpeg` (a shell script that exits 3) first on PATH for the object's lifetime, in
+/// `dir`; PATH is restored on destruction, also when the test fails early.
+class DeadFfmpegOnPath {
+public:
+    explicit DeadFfmpegOnPath(const std::filesystem::path& dir) {
+        const std::filesystem::path fake = dir / "ffmpeg";
+        std::ofstream(fake) << "#!/bin/sh\nexit 3\n";
+        std::filesystem::permissions(fake, std::filesystem::perms::owner_all);
+        const char* old_path = std::getenv("PATH");
+        saved_ = old_path ? old_path : "";
+        ::setenv("PATH", dir.c_str(), 1);
+    }
+    ~DeadFfmpegOnPath() { ::setenv("PATH", saved_.c_str(), 1); }
+    DeadFfmpegOnPath(const DeadFfmpegOnPath&) = delete;
+    DeadFfmpegOnPath& operator=(const DeadFfmpegOnPath&) = delete;
+
+private:
+    std::string saved_;
 };
 
 }  // namespace cdlab_test
