@@ -1,11 +1,13 @@
 // app/lab/sweep_plan.cpp -- see sweep_plan.h.
-// A plan's id covers every field of plan.json and its creation time, so the results of one plan
-// can never be taken for another's, even a re-plan of the same sweep into the same directory.
+// A plan's id covers every field of plan.json, its creation time and 64 random bits, so the
+// results of one plan can never be taken for another's, even a re-plan of the same sweep in the
+// same second.
 #include "sweep_plan.h"
 
 #include <chrono>
 #include <cstdio>
 #include <ctime>
+#include <random>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -64,6 +66,7 @@ json planContent(const SweepPlan& plan) {
             {"vary", plan.vary},
             {"reference", plan.reference},
             {"created", plan.created},
+            {"nonce", plan.nonce},
             {"runs", runs}};
 }
 
@@ -82,6 +85,7 @@ SweepPlan planFromJson(const json& j) {
     plan.vary = j.at("vary").get<std::vector<std::string>>();
     plan.reference = j.at("reference").get<std::vector<std::string>>();
     plan.created = j.at("created").get<std::string>();
+    plan.nonce = j.at("nonce").get<std::string>();
     for (const json& r : j.at("runs")) {
         PlannedRun run;
         run.label = r.at("label").get<std::string>();
@@ -133,6 +137,9 @@ SweepPlan makePlan(const SweepOptions& options, const SweepSetup& setup, const f
     plan.vary = options.vary;
     plan.reference = options.reference;
     plan.created = utcNow();
+    std::random_device random;
+    plan.nonce = fnv1aHex(std::to_string(random()) + "/" + std::to_string(random()) + "/" +
+                          plan.dir.string());
     plan.runs.push_back({labelOf(setup.reference_overrides), setup.reference_run});
     for (const auto& c : setup.combos) plan.runs.push_back({labelOf(c), c});
     plan.id = planId(plan);

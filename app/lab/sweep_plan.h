@@ -27,7 +27,7 @@ struct PlannedRun {
 /// Everything a job needs, pinned when the sweep is planned, so that jobs run anywhere the
 /// same paths hold the same scene, assets and binary.
 struct SweepPlan {
-    std::string id;  ///< FNV-1a (hex) of the plan's content and creation time; in every result
+    std::string id;  ///< FNV-1a (hex) of the plan's content; in every result file
     std::filesystem::path dir;    ///< the plan's directory (absolute; not stored, where it was read)
     std::filesystem::path scene;  ///< absolute
     std::string scene_hash;       ///< FNV-1a (hex) of the scene file's bytes when planned
@@ -38,6 +38,7 @@ struct SweepPlan {
     std::vector<std::string> vary;       ///< --vary as given (the report reads the keys)
     std::vector<std::string> reference;  ///< --reference as given
     std::string created;                 ///< UTC, ISO 8601
+    std::string nonce;                   ///< random, so two plans never share an id
     std::vector<PlannedRun> runs;        ///< runs[0] is the reference
 };
 
