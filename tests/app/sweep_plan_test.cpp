@@ -17,8 +17,10 @@
 #include <vector>
 
 #include "cli_run.h"
+#include "engine/scene.h"
 #include "sweep_job.h"
 #include "sweep_plan.h"
+#include "sweep_report.h"
 
 namespace {
 
@@ -235,7 +237,9 @@ TEST(SweepPlan, MissingAndFailedJobsAreNamed) {
     const fs::path dir = plan(scene, work);
     const std::vector<std::string> jobs = jobLines(dir);
     for (std::size_t k : {0u, 1u, 2u}) ASSERT_EQ(shell(jobs[k] + " > /dev/null 2>&1"), 0);
-    // Job 3 never runs; job 4 sees another scene than the planned one.
+    // Job 3 was killed while writing its result (a .partial file is no result); job 4 sees
+    // another scene than the planned one.
+    std::ofstream(dir / "results/3.json.partial") << "{\"format\": \"cdlab-sweep-res";
     std::ofstream(scene, std::ios::app) << "# edited after planning\n";
     EXPECT_EQ(shell(jobs[4] + " > /dev/null 2>&1"), 2);
     const auto r = runCdlab("sweep --collect " + dir.string(), work);
@@ -321,6 +325,13 @@ TEST(SweepPlan, BadInputIsExitTwoWithAClearMessage) {
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("a result of another sweep"), std::string::npos) << r.err;
 
+    // A truncated plan.
+    const std::string plan_text = slurp(dir / "plan.json");
+    std::ofstream(work / "truncated.json") << plan_text.substr(0, plan_text.size() / 2);
+    r = runCdlab("sweep --job " + (work / "truncated.json").string() + " --run 0", work);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("truncated.json: malformed plan"), std::string::npos) << r.err;
+
     // An edited plan is refused by the jobs and by collect.
     std::string text = slurp(dir / "plan.json");
     text.replace(text.find("\"repeat\": 2"), 11, "\"repeat\": 3");
@@ -328,7 +339,57 @@ TEST(SweepPlan, BadInputIsExitTwoWithAClearMessage) {
     r = runCdlab("sweep --job " + (dir / "plan.json").string() + " --run 0", work);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("does not match its id"), std::string::npos) << r.err;
+    r = runCdlab("sweep --collect " + dir.string(), work);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("does not match its id"), std::string::npos) << r.err;
     fs::remove_all(work);
+}
+
+// Jobs that shared cores: their wall-clock ranges overlap (the wait for a core is charged to
+// whichever job waited), their CPU-time ranges do not. The reading ranks by CPU time then, by
+// the same rule (a winner only beyond the spread), and says why; otherwise by wall clock.
+TEST(SweepPlan, ConcurrentRunsAreRankedByCpuTime) {
+    auto run = [](const std::string& label, app::Timed wall, app::Timed cpu) {
+        app::SweepRun r;
+        r.label = label;
+        r.time_step = 0.01;
+        r.steps = 10;
+        r.repeats = 3;
+        r.ms_per_simulated_s = wall;
+        r.cpu_ms_per_simulated_s = cpu;
+        return r;
+    };
+    app::SweepOptions o;
+    o.scene = fs::path(CDLAB_SOURCE_DIR) / "tests/data/tunnel_small.yaml";
+    o.planned = true;
+    app::SweepRun reference = run("", {10, 9, 11}, {10, 9, 11});
+    reference.time_step = 0.001;
+    engine::Scene base;
+    base.world.time_step = 0.01;
+    const std::vector<app::SweepRun> runs = {
+        run("broadphase=sap", {1.4, 1.0, 3.0}, {1.2, 1.1, 1.3}),
+        run("broadphase=tree", {2.0, 1.5, 2.5}, {1.9, 1.8, 2.0})};
+    std::string md = app::sweep::markdownReport(o, base, 0.1, runs, reference, {});
+    EXPECT_NE(md.find("none named, the lowest costs are within measurement spread of each other "
+                      "(ms per simulated second"),
+              std::string::npos)
+        << md;
+    EXPECT_EQ(md.find("ranks them by CPU time"), std::string::npos) << md;
+    o.timed_concurrently = true;
+    md = app::sweep::markdownReport(o, base, 0.1, runs, reference, {});
+    EXPECT_NE(md.find("**broadphase=sap** (1.2 (1.1..1.3) CPU ms per simulated second, median "
+                      "(min..max of 3 repeats)); its slowest repeat beat every other run's "
+                      "fastest"),
+              std::string::npos)
+        << md;
+    EXPECT_NE(md.find("the reading ranks them by CPU time"), std::string::npos) << md;
+    // CPU ranges that overlap name no winner either.
+    std::vector<app::SweepRun> close = runs;
+    close[1].cpu_ms_per_simulated_s = {1.25, 1.2, 1.4};
+    md = app::sweep::markdownReport(o, base, 0.1, close, reference, {});
+    EXPECT_NE(md.find("within measurement spread of each other (CPU ms per simulated second"),
+              std::string::npos)
+        << md;
 }
 
 // Doubles cross the result file bit for bit (shortest round-trip text; non-finite as strings).
