@@ -148,9 +148,10 @@ TraceComparison compareTraces(const std::filesystem::path& a, const std::filesys
 bool parseVary(const std::string& text, std::string& key, std::vector<std::string>& values,
                std::string& error);
 
-/// Exit codes: 0 success, 1 output failure or a repeat that differs from the first in a
-/// deterministic column (pairs, tests, CCD stops, final state), 2 bad input (flags, a
-/// combination's scene error).
+/// Runs the sweep in this process, or with options.jobs > 1 as a plan whose jobs run that many
+/// at a time (sweep_local.h). Exit codes: 0 success, 1 output failure, a repeat that differs
+/// from the first in a deterministic column (pairs, tests, CCD stops, final state) or a job
+/// that left no result, 2 bad input (flags, a combination's scene error).
 int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err);
 
 }  // namespace app

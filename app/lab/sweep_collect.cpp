@@ -76,8 +76,8 @@ std::optional<CollectedSweep> gatherResults(const SweepPlan& plan, std::ostream&
         try {
             JobResult r = parseResult(fileBytes(file), plan, k);
             if (!r.failure.empty()) {
-                collected.failures.push_back({label, "job " + std::to_string(k) +
-                                                         " failed: " + r.failure});
+                collected.failures.push_back(
+                    {label, "job " + std::to_string(k) + " failed: " + r.failure});
                 continue;
             }
             results.push_back(std::move(r));

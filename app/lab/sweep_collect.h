@@ -15,8 +15,9 @@ namespace app::sweep {
 
 /// What the jobs of a plan left.
 struct CollectedSweep {
-    std::vector<SweepRun> runs;  ///< the combinations with a result, in plan order, compared
-                                 ///< with the reference (empty without a reference)
+    /// The combinations with a result, in plan order, compared with the reference (empty
+    /// without a reference).
+    std::vector<SweepRun> runs;
     std::optional<SweepRun> reference;  ///< none when the reference job left no result
     /// Every job without a usable result (missing file, failure record), in plan order.
     std::vector<SweepFailure> failures;

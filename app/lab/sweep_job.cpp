@@ -188,7 +188,8 @@ JobResult parseResult(const std::string& text, const SweepPlan& plan, std::size_
         }
         result.measured = runFrom(j.at("measured"));
         for (const json& c : j.at("first_contacts")) {
-            result.contacts[{c.at(0).get<collision::ProxyId>(), c.at(1).get<collision::ProxyId>()}] =
+            result
+                .contacts[{c.at(0).get<collision::ProxyId>(), c.at(1).get<collision::ProxyId>()}] =
                 numberFrom(c.at(2));
         }
     } catch (const json::exception& e) {
@@ -201,8 +202,8 @@ int runSweepJob(const fs::path& plan_path, long k, std::ostream& out, std::ostre
     const std::optional<SweepPlan> plan = readPlan(plan_path, err);
     if (!plan) return kExitBadInput;
     if (k < 0 || static_cast<std::size_t>(k) >= plan->runs.size()) {
-        err << "--run " << k << ": the plan " << (plan->dir / "plan.json").string() << " has jobs 0 to "
-            << plan->runs.size() - 1 << "\n";
+        err << "--run " << k << ": the plan " << (plan->dir / "plan.json").string()
+            << " has jobs 0 to " << plan->runs.size() - 1 << "\n";
         return kExitBadInput;
     }
     const std::size_t run = static_cast<std::size_t>(k);

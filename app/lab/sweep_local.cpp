@@ -81,15 +81,14 @@ int runJobsLocally(const SweepPlan& plan, int jobs, std::ostream& out) {
             if (waitpid(running[i].pid, &status, WNOHANG) != running[i].pid) continue;
             const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
             if (!ok) ++failed;
-            report(running[i].k,
-                   ok ? std::string("done")
-                      : (WIFEXITED(status) ? "exit " + std::to_string(WEXITSTATUS(status))
-                                           : "killed by signal " +
-                                                 std::to_string(WTERMSIG(status))) +
-                            " (log: " +
-                            (plan.dir / "logs" / (std::to_string(running[i].k) + ".log"))
-                                .string() +
-                            ")");
+            report(
+                running[i].k,
+                ok ? std::string("done")
+                   : (WIFEXITED(status) ? "exit " + std::to_string(WEXITSTATUS(status))
+                                        : "killed by signal " + std::to_string(WTERMSIG(status))) +
+                         " (log: " +
+                         (plan.dir / "logs" / (std::to_string(running[i].k) + ".log")).string() +
+                         ")");
             running.erase(running.begin() + static_cast<std::ptrdiff_t>(i));
             reaped = true;
             break;

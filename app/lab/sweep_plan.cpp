@@ -7,9 +7,9 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
-#include <random>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <sstream>
 
 #include "exit_codes.h"
@@ -236,8 +236,8 @@ std::optional<SweepPlan> readPlan(const fs::path& path, std::ostream& err) {
     return plan;
 }
 
-int planSweep(const SweepOptions& options, const fs::path& dir, bool slurm,
-              const fs::path& binary, std::ostream& out, std::ostream& err) {
+int planSweep(const SweepOptions& options, const fs::path& dir, bool slurm, const fs::path& binary,
+              std::ostream& out, std::ostream& err) {
     if (options.float_binary) {
         err << "--plan: the float comparison (--float-binary) runs in one process only\n";
         return kExitBadInput;

@@ -27,10 +27,10 @@ struct PlannedRun {
 /// Everything a job needs, pinned when the sweep is planned, so that jobs run anywhere the
 /// same paths hold the same scene, assets and binary.
 struct SweepPlan {
-    std::string id;  ///< FNV-1a (hex) of the plan's content; in every result file
-    std::filesystem::path dir;    ///< the plan's directory (absolute; not stored, where it was read)
-    std::filesystem::path scene;  ///< absolute
-    std::string scene_hash;       ///< FNV-1a (hex) of the scene file's bytes when planned
+    std::string id;             ///< FNV-1a (hex) of the plan's content; in every result file
+    std::filesystem::path dir;  ///< the plan's directory (absolute; not stored, where it was read)
+    std::filesystem::path scene;   ///< absolute
+    std::string scene_hash;        ///< FNV-1a (hex) of the scene file's bytes when planned
     std::filesystem::path binary;  ///< absolute path of the cdlab the jobs run
     double duration = 0;           ///< simulated seconds per run
     int repeat = 1;

@@ -2,15 +2,17 @@
 // own result, --collect DIR merges them into the one-process sweep's outputs. The deterministic
 // columns must come out bit-identical whichever engine ran the jobs (one after another, -j,
 // GNU Parallel, the Slurm array script), and a missing, failed or foreign result must be named.
+#include "sweep_plan.h"
+
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <limits>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -19,7 +21,6 @@
 #include "cli_run.h"
 #include "engine/scene.h"
 #include "sweep_job.h"
-#include "sweep_plan.h"
 #include "sweep_report.h"
 
 namespace {
@@ -31,8 +32,9 @@ using cdlab_test::slurp;
 fs::path tempDir(const std::string& name) { return cdlab_test::tempDir("cdlab_plan_", name); }
 
 // 2 broad phases x 2 time steps (one tunnels, one catches the plate) and the reference.
-const std::string kVary = " --vary broadphase=sap,hgrid --vary world.time_step=0.05,0.005 "
-                          "--repeat 2";
+const std::string kVary =
+    " --vary broadphase=sap,hgrid --vary world.time_step=0.05,0.005 "
+    "--repeat 2";
 
 // One CSV line split into fields (RFC 4180 quotes).
 std::vector<std::string> csvFields(const std::string& line) {
@@ -90,9 +92,8 @@ fs::path sceneCopy(const fs::path& dir) {
 // The one-process sweep of `scene` into DIR/one, without report timings.
 fs::path oneProcessSweep(const fs::path& scene, const fs::path& work) {
     const fs::path out = work / "one";
-    const auto r = runCdlab("sweep " + scene.string() + kVary + " --no-report-timing --out " +
-                                out.string(),
-                            work);
+    const auto r = runCdlab(
+        "sweep " + scene.string() + kVary + " --no-report-timing --out " + out.string(), work);
     EXPECT_EQ(r.exit_code, 0) << r.err;
     return out;
 }
@@ -156,9 +157,10 @@ TEST(SweepPlan, GnuParallelRunsTheJobs) {
     const fs::path scene = sceneCopy(work);
     const fs::path one = oneProcessSweep(scene, work);
     const fs::path dir = plan(scene, work);
-    ASSERT_EQ(shell("parallel --will-cite --jobs 2 --halt never :::: " + (dir / "jobs.txt").string() +
-                    " > " + (work / "parallel.log").string() + " 2>&1"),
-              0)
+    ASSERT_EQ(
+        shell("parallel --will-cite --jobs 2 --halt never :::: " + (dir / "jobs.txt").string() +
+              " > " + (work / "parallel.log").string() + " 2>&1"),
+        0)
         << slurp(work / "parallel.log");
     expectSameAsOneProcess(dir, one, work);
     fs::remove_all(work);
@@ -169,15 +171,14 @@ TEST(SweepPlan, LocalJobsGiveTheOneProcessColumns) {
     const fs::path scene = sceneCopy(work);
     const fs::path one = oneProcessSweep(scene, work);
     const fs::path out = work / "j2";
-    const auto r = runCdlab("sweep " + scene.string() + kVary + " -j 2 --no-report-timing --out " +
-                                out.string(),
-                            work);
+    const auto r = runCdlab(
+        "sweep " + scene.string() + kVary + " -j 2 --no-report-timing --out " + out.string(), work);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(deterministicColumns(out / "results.csv"), deterministicColumns(one / "results.csv"));
     EXPECT_EQ(slurp(out / "report.md"), slurp(one / "report.md"));
     // With timings, the report names the clocks; every run recorded its CPU time.
-    const auto timed = runCdlab("sweep " + scene.string() + kVary + " -j 2 --out " + out.string(),
-                                work);
+    const auto timed =
+        runCdlab("sweep " + scene.string() + kVary + " -j 2 --out " + out.string(), work);
     ASSERT_EQ(timed.exit_code, 0) << timed.err;
     const std::string report = slurp(out / "report.md");
     EXPECT_NE(report.find("CLOCK_THREAD_CPUTIME_ID"), std::string::npos);
@@ -246,8 +247,7 @@ TEST(SweepPlan, MissingAndFailedJobsAreNamed) {
     EXPECT_EQ(r.exit_code, 1) << r.err;
     const std::string run3 = "broadphase=hgrid world.time_step=0.05";
     const std::string run4 = "broadphase=hgrid world.time_step=0.005";
-    EXPECT_NE(r.err.find("missing " + run3 + ": job 3 left no result"), std::string::npos)
-        << r.err;
+    EXPECT_NE(r.err.find("missing " + run3 + ": job 3 left no result"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("missing " + run4 + ": job 4 failed: "), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("is not the scene planned"), std::string::npos) << r.err;
     const std::string report = slurp(dir / "report.md");
@@ -267,8 +267,7 @@ TEST(SweepPlan, MissingAndFailedJobsAreNamed) {
     EXPECT_NE(no_ref.err.find("missing reference: job 0 left no result"), std::string::npos)
         << no_ref.err;
     EXPECT_FALSE(fs::exists(dir / "results.csv"));
-    EXPECT_NE(slurp(dir / "report.md").find("The reference run left no result"),
-              std::string::npos);
+    EXPECT_NE(slurp(dir / "report.md").find("The reference run left no result"), std::string::npos);
     fs::remove_all(work);
 }
 
@@ -294,9 +293,9 @@ TEST(SweepPlan, BadInputIsExitTwoWithAClearMessage) {
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("--run K is required"), std::string::npos) << r.err;
     for (const char* j : {"0", "-3"}) {
-        r = runCdlab("sweep " + scene.string() + kVary + " -j " + j + " --out " +
-                         (work / "j").string(),
-                     work);
+        r = runCdlab(
+            "sweep " + scene.string() + kVary + " -j " + j + " --out " + (work / "j").string(),
+            work);
         EXPECT_EQ(r.exit_code, 2) << j;
         EXPECT_NE(r.err.find("must be >= 1"), std::string::npos) << r.err;
     }
@@ -315,9 +314,9 @@ TEST(SweepPlan, BadInputIsExitTwoWithAClearMessage) {
 
     // A result of another plan of the same sweep (re-planned into another directory).
     const fs::path other = work / "other";
-    ASSERT_EQ(runCdlab("sweep " + scene.string() + kVary + " --plan " + other.string(), work)
-                  .exit_code,
-              0);
+    ASSERT_EQ(
+        runCdlab("sweep " + scene.string() + kVary + " --plan " + other.string(), work).exit_code,
+        0);
     ASSERT_EQ(shell(jobLines(other)[1] + " > /dev/null 2>&1"), 0);
     fs::copy_file(other / "results/1.json", dir / "results/1.json",
                   fs::copy_options::overwrite_existing);
