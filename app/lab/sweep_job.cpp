@@ -41,7 +41,10 @@ double numberFrom(const json& j) {
     if (s == "nan") return std::numeric_limits<double>::quiet_NaN();
     if (s == "inf") return std::numeric_limits<double>::infinity();
     if (s == "-inf") return -std::numeric_limits<double>::infinity();
-    throw std::runtime_error("'" + s + "' is not a number");
+    std::string message = "'";
+    message += s;
+    message += "' is not a number";
+    throw std::runtime_error(message);
 }
 
 using DoubleField = double SweepRun::*;
