@@ -46,7 +46,7 @@ struct SweepOptions {
     /// OUT/plan (sweep_plan.h), runs its jobs N at a time as child processes of `cdlab_binary`
     /// and collects them (sweep_collect.h). Not with float_binary.
     int jobs = 1;
-    /// The cdlab executable the jobs of a plan run (default: this process's, /proc/self/exe).
+    /// The cdlab executable the jobs run with jobs > 1 (the command sets its own, /proc/self/exe).
     std::filesystem::path cdlab_binary;
     /// The runs were timed while sharing the machine with each other (jobs run concurrently, or
     /// on different hosts): their wall-clock times are disturbed, so the reading ranks runs by

@@ -100,12 +100,12 @@ int runJobsLocally(const SweepPlan& plan, int jobs, std::ostream& out) {
 
 int runPlannedLocally(const SweepOptions& options, const SweepSetup& setup, std::ostream& out,
                       std::ostream& err) {
+    // No fallback to /proc/self/exe here: a library caller (a test) is not cdlab.
     std::error_code ec;
-    const fs::path binary = options.cdlab_binary.empty() ? fs::read_symlink("/proc/self/exe", ec)
-                                                         : options.cdlab_binary;
+    const fs::path& binary = options.cdlab_binary;
     if (binary.empty() || !fs::is_regular_file(binary, ec)) {
-        err << "-j " << options.jobs << ": cannot find the cdlab executable to run the jobs ("
-            << (binary.empty() ? "/proc/self/exe" : binary.string()) << ")\n";
+        err << "-j " << options.jobs << ": no cdlab executable to run the jobs"
+            << (binary.empty() ? "" : " (" + binary.string() + " is not a file)") << "\n";
         return kExitBadInput;
     }
     const SweepPlan plan = makePlan(options, setup, binary, setup.out_dir / "plan");

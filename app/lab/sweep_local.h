@@ -17,8 +17,8 @@ namespace app::sweep {
 int runJobsLocally(const SweepPlan& plan, int jobs, std::ostream& out);
 
 /// The one-process sweep's outputs through a plan: plans `setup` into OUT/plan, runs its jobs
-/// options.jobs at a time with options.cdlab_binary (default /proc/self/exe) and collects them
-/// into OUT. Exit codes as collectSweep's.
+/// options.jobs at a time with options.cdlab_binary (required: `cdlab sweep` passes its own
+/// executable) and collects them into OUT. Exit codes as collectSweep's.
 int runPlannedLocally(const SweepOptions& options, const SweepSetup& setup, std::ostream& out,
                       std::ostream& err);
 

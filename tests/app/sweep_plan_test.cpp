@@ -20,6 +20,7 @@
 
 #include "cli_run.h"
 #include "engine/scene.h"
+#include "sweep.h"
 #include "sweep_job.h"
 #include "sweep_report.h"
 
@@ -163,6 +164,16 @@ TEST(SweepPlan, GnuParallelRunsTheJobs) {
         0)
         << slurp(work / "parallel.log");
     expectSameAsOneProcess(dir, one, work);
+    // The across-hosts command of docs/distributed-sweeps.md, with this machine as its only host
+    // (":" in the login file: no ssh), two job slots.
+    fs::remove_all(dir / "results");
+    fs::create_directories(dir / "results");
+    std::ofstream(work / "hosts.txt") << "2/:\n";
+    ASSERT_EQ(shell("cd " + work.string() + " && parallel --will-cite --sshloginfile hosts.txt " +
+                    "--workdir . :::: " + (dir / "jobs.txt").string() + " > parallel.log 2>&1"),
+              0)
+        << slurp(work / "parallel.log");
+    expectSameAsOneProcess(dir, one, work);
     fs::remove_all(work);
 }
 
@@ -198,6 +209,28 @@ TEST(SweepPlan, LocalJobsGiveTheOneProcessColumns) {
         }
     }
     EXPECT_EQ(report.find("the reading ranks them by CPU time") != std::string::npos, overlapped);
+    fs::remove_all(work);
+}
+
+// runSweep called as a library with -j must be told which cdlab to run: its own executable is
+// not one (here it is this test binary, which would run every test again for each job).
+TEST(SweepPlan, ParallelRunsFromTheLibraryNeedTheCdlabBinary) {
+    const fs::path work = tempDir("library");
+    app::SweepOptions o;
+    o.scene = fs::path(CDLAB_SOURCE_DIR) / "tests/data/tunnel_small.yaml";
+    o.vary = {"broadphase=sap,hgrid"};
+    o.repeat = 1;
+    o.jobs = 2;
+    o.out_dir = work / "out";
+    std::ostringstream out, err;
+    EXPECT_EQ(app::runSweep(o, out, err), 2);
+    EXPECT_NE(err.str().find("no cdlab executable to run the jobs"), std::string::npos)
+        << err.str();
+    o.cdlab_binary = CDLAB_BINARY;
+    err.str("");
+    EXPECT_EQ(app::runSweep(o, out, err), 0) << err.str();
+    const std::string csv = slurp(o.out_dir / "results.csv");
+    EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3) << csv;  // header and two runs
     fs::remove_all(work);
 }
 
