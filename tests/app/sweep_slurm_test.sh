@@ -28,7 +28,8 @@ trap cleanup EXIT
 if ! munge -n 2> /dev/null | unmunge > /dev/null 2>&1; then
   mkdir -p /run/munge && chown munge:munge /run/munge
   [ -s /etc/munge/munge.key ] || { echo "sweep_slurm_test: no /etc/munge/munge.key" >&2; exit 2; }
-  runuser -u munge -- /usr/sbin/munged -F > "$work/munged.log" 2>&1 &
+  # setpriv execs munged as the munge user: the pid recorded is munged's own.
+  setpriv --reuid=munge --regid=munge --init-groups /usr/sbin/munged -F > "$work/munged.log" 2>&1 &
   pids+=($!)
   for _ in $(seq 50); do munge -n 2> /dev/null | unmunge > /dev/null 2>&1 && break; sleep 0.1; done
 fi
