@@ -138,7 +138,7 @@ Command addSweepCommand(CLI::App& cli) {
     cmd->add_flag("--keep-traces", f->sweep.keep_traces,
                   "keep DIR/traces/ (both builds' frames) after the float comparison");
     cmd->add_flag("--no-report-timing", f->no_timing,
-                  "leave wall-clock times out of report.md so it is bit-identical");
+                  "leave times (wall-clock and CPU) out of report.md so it is bit-identical");
     cmd->add_option("-j,--jobs", f->sweep.jobs,
                     "run N runs at a time, each a cdlab process of its own (a plan in OUT/plan, "
                     "collected into OUT); the reading then ranks by CPU time when runs overlapped")
