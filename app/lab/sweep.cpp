@@ -31,22 +31,22 @@
 #include "render/image.h"
 #include "run_scene.h"
 #include "sweep_measure.h"
+#include "sweep_plan.h"
+#include "sweep_local.h"
+#include "sweep_setup.h"
 #include "sweep_report.h"
 
 namespace app {
 
 namespace fs = std::filesystem;
 
-using sweep::Chart;
-using sweep::charts;
 using sweep::compareWithReference;
 using sweep::csvField;
-using sweep::csvTable;
 using sweep::FirstContacts;
 using sweep::fmt;
 using sweep::labelOf;
-using sweep::markdownReport;
 using sweep::measure;
+using sweep::shellQuote;
 
 namespace {
 
@@ -55,19 +55,6 @@ std::string trim(const std::string& s) {
     if (a == std::string::npos) return "";
     const std::size_t b = s.find_last_not_of(" \t");
     return s.substr(a, b - a + 1);
-}
-
-// Single-quoted for /bin/sh: every character literal, ' written as '\''.
-std::string shellQuote(const std::string& s) {
-    std::string q = "'";
-    for (char c : s) {
-        if (c == '\'') {
-            q += "'\\''";
-        } else {
-            q += c;
-        }
-    }
-    return q + "'";
 }
 
 // Runs one combination through this (double) build in-process and through the float build as a
@@ -149,85 +136,6 @@ bool parseVary(const std::string& text, std::string& key, std::vector<std::strin
 
 namespace {
 
-using Axes = std::vector<std::pair<std::string, std::vector<std::string>>>;
-
-// The axes of --vary and the overrides of --reference; an error message and false when one is
-// malformed or a key is given twice.
-bool parseSweepOptions(const SweepOptions& options, std::ostream& err, Axes& axes,
-                       std::vector<engine::SceneOverride>& reference_overrides) {
-    for (const std::string& v : options.vary) {
-        std::string key, error;
-        std::vector<std::string> values;
-        if (!parseVary(v, key, values, error)) {
-            err << "--vary " << error << "\n";
-            return false;
-        }
-        for (const auto& axis : axes) {
-            if (axis.first == key) {
-                err << "--vary " << key << ": given twice; list every value in one --vary (" << key
-                    << "=A,B,...)\n";
-                return false;
-            }
-        }
-        axes.emplace_back(key, values);
-    }
-    for (const std::string& v : options.reference) {
-        std::string key, error;
-        std::vector<std::string> values;
-        if (!parseVary(v, key, values, error) || values.size() != 1) {
-            err << "--reference " << (error.empty() ? "'" + v + "': expected KEY=VALUE" : error)
-                << "\n";
-            return false;
-        }
-        reference_overrides.push_back({key, values[0], "--reference"});
-    }
-    if (!(options.reference_refine >= 1) || !std::isfinite(options.reference_refine)) {
-        err << "--reference-refine: must be a finite number >= 1\n";
-        return false;
-    }
-    if (options.repeat < 1) {
-        err << "--repeat " << options.repeat
-            << ": must be >= 1 (each run is timed this many times; 3 gives a min..max spread)\n";
-        return false;
-    }
-    if (options.duration && !(*options.duration > 0 && std::isfinite(*options.duration))) {
-        err << "--duration: must be a finite number > 0\n";
-        return false;
-    }
-
-    return true;
-}
-
-// Every combination of the axes' values, in axis order (one empty combination without axes).
-std::vector<std::vector<engine::SceneOverride>> combinations(const Axes& axes) {
-    std::vector<std::vector<engine::SceneOverride>> combos{{}};
-    for (const auto& [key, values] : axes) {
-        std::vector<std::vector<engine::SceneOverride>> next;
-        for (const auto& c : combos) {
-            for (const std::string& v : values) {
-                next.push_back(c);
-                next.back().push_back({key, v, "--vary"});
-            }
-        }
-        combos = std::move(next);
-    }
-    return combos;
-}
-
-// One bar chart per column of charts() (timings only with report_timing), reference last.
-void writeCharts(const SweepOptions& options, const fs::path& out_dir,
-                 const std::vector<SweepRun>& runs, const SweepRun& reference) {
-    for (const Chart& c : charts()) {
-        if (c.timing && !options.report_timing) continue;
-        render::BarChart chart;
-        chart.title = c.title;
-        chart.log_scale = c.log_scale;
-        for (const SweepRun& r : runs) chart.bars.push_back({r.label, c.value(r), false});
-        chart.bars.push_back({"reference", c.value(reference), true});
-        render::writePng(out_dir / c.file, render::drawBarChart(chart));
-    }
-}
-
 // Every combination run again through the float build (--float-binary): float_vs_double.csv
 // and its chart, and the comparisons for the report.
 std::vector<FloatRun> compareFloatBuild(
@@ -271,12 +179,12 @@ std::vector<FloatRun> compareFloatBuild(
 // of one run's repeats. The first pass measures everything; later passes only time the steps
 // and must reproduce the first pass's deterministic columns. False (with a message) when one
 // does not: determinism is a guarantee of the engine.
-bool measureAll(const SweepOptions& options, const engine::Scene& reference_scene,
-                const std::vector<engine::Scene>& scenes,
-                const std::vector<std::vector<engine::SceneOverride>>& combos,
-                const std::vector<engine::SceneOverride>& reference_overrides, double duration,
-                std::ostream& out, std::ostream& err, SweepRun& reference,
-                std::vector<SweepRun>& runs) {
+bool measureAll(const SweepOptions& options, const sweep::SweepSetup& setup, std::ostream& out,
+                std::ostream& err, SweepRun& reference, std::vector<SweepRun>& runs) {
+    const engine::Scene& reference_scene = setup.reference_scene;
+    const std::vector<engine::Scene>& scenes = setup.scenes;
+    const std::vector<std::vector<engine::SceneOverride>>& combos = setup.combos;
+    const double duration = setup.duration;
     // repeats[0] is the reference, repeats[i + 1] scene i; each holds one SweepRun per pass.
     std::vector<std::vector<SweepRun>> repeats(scenes.size() + 1);
     FirstContacts reference_contacts;
@@ -312,7 +220,7 @@ bool measureAll(const SweepOptions& options, const engine::Scene& reference_scen
             << " runs timed again, deterministic columns identical\n";
     }
     reference = sweep::combineRepeats(repeats[0]);
-    reference.label = labelOf(reference_overrides);
+    reference.label = labelOf(setup.reference_overrides);
     for (std::size_t i = 0; i < scenes.size(); ++i) {
         SweepRun run = sweep::combineRepeats(repeats[i + 1]);
         run.overrides = combos[i];
@@ -326,10 +234,6 @@ bool measureAll(const SweepOptions& options, const engine::Scene& reference_scen
 }  // namespace
 
 int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) {
-    // The axes of the sweep.
-    Axes axes;
-    std::vector<engine::SceneOverride> reference_overrides;
-    if (!parseSweepOptions(options, err, axes, reference_overrides)) return kExitBadInput;
     if (options.float_binary) {
         std::error_code ec;
         if (!fs::is_regular_file(*options.float_binary, ec)) {
@@ -337,78 +241,32 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
                 << ": no such file (build one with cmake -DCDLAB_USE_FLOAT=ON)\n";
             return kExitBadInput;
         }
-    }
-    // Every combination is loaded (and so validated) before anything runs.
-    const std::vector<std::vector<engine::SceneOverride>> combos = combinations(axes);
-    engine::Scene base;
-    std::vector<engine::Scene> scenes;
-    try {
-        base = engine::loadScene(options.scene);
-        for (const std::string& note : base.notes) err << note << "\n";
-    } catch (const engine::SceneError& e) {
-        err << e.what() << "\n";
-        return kExitBadInput;
-    }
-    for (const auto& c : combos) {
-        try {
-            scenes.push_back(engine::loadScene(options.scene, c));
-        } catch (const engine::SceneError& e) {
-            err << "sweep run '" << labelOf(c) << "': " << e.what() << "\n";
+        if (options.jobs != 1) {
+            err << "-j " << options.jobs << ": the float comparison runs in one process; "
+                << "leave out -j or --float-binary\n";
             return kExitBadInput;
         }
     }
-    const double duration = options.duration ? *options.duration
-                                             : double(std::max(base.frames - 1, 1)) *
-                                                   base.steps_per_frame * base.world.time_step;
-    engine::Scene reference_scene;
-    try {
-        std::vector<engine::SceneOverride> ref = {
-            {"world.time_step", fmt(base.world.time_step / options.reference_refine, "%.17g")}};
-        ref.insert(ref.end(), reference_overrides.begin(), reference_overrides.end());
-        reference_scene = engine::loadScene(options.scene, ref);
-    } catch (const engine::SceneError& e) {
-        err << "sweep reference: " << e.what() << "\n";
+    if (options.jobs < 1) {
+        err << "-j " << options.jobs << ": must be >= 1 (runs at a time)\n";
         return kExitBadInput;
     }
-
-    // Steps per run, checked before anything runs: llround of a huge quotient is undefined, and
-    // a run of 1e20 s would never end.
-    constexpr double kMaxSweepSteps = 1e9;
-    std::vector<const engine::Scene*> all_runs{&reference_scene};
-    for (const engine::Scene& s : scenes) all_runs.push_back(&s);
-    for (const engine::Scene* s : all_runs) {
-        const double steps = duration / s->world.time_step;
-        if (!(steps <= kMaxSweepSteps)) {
-            err << "--duration " << fmt(duration) << ": " << fmt(steps) << " steps at time step "
-                << fmt(s->world.time_step) << " s, more than the limit of " << fmt(kMaxSweepSteps)
-                << "\n";
-            return kExitBadInput;
-        }
-    }
-
-    const fs::path out_dir =
-        options.out_dir.empty() ? fs::path("out") / ("sweep_" + base.name) : options.out_dir;
+    const std::optional<sweep::SweepSetup> setup = sweep::setUpSweep(options, err);
+    if (!setup) return kExitBadInput;
+    if (options.jobs > 1) return sweep::runPlannedLocally(options, *setup, out, err);
+    const fs::path& out_dir = setup->out_dir;
     try {
         prepareOutputDir(out_dir);
-        for (const char* f :
-             {"results.csv", "report.md", "float_vs_double.csv", "float_deviation.png"}) {
-            fs::remove(out_dir / f);
-        }
-        for (const Chart& c : charts()) fs::remove(out_dir / c.file);
+        sweep::removeSweepOutputs(out_dir);
 
         std::vector<SweepRun> runs;
         SweepRun reference;
-        if (!measureAll(options, reference_scene, scenes, combos, reference_overrides, duration,
-                        out, err, reference, runs)) {
-            return kExitFailure;
-        }
-        writeCharts(options, out_dir, runs, reference);
+        if (!measureAll(options, *setup, out, err, reference, runs)) return kExitFailure;
         const std::vector<FloatRun> floats =
-            options.float_binary ? compareFloatBuild(options, combos, out_dir, out)
+            options.float_binary ? compareFloatBuild(options, setup->combos, out_dir, out)
                                  : std::vector<FloatRun>{};
-        writeTextAtomically(out_dir / "results.csv", csvTable(runs));
-        writeTextAtomically(out_dir / "report.md",
-                            markdownReport(options, base, duration, runs, reference, floats));
+        sweep::writeSweepOutputs(options, setup->base, setup->duration, runs, reference, floats,
+                                 {}, out_dir);
         out << "wrote " << (out_dir / "report.md").string() << ", "
             << (out_dir / "results.csv").string() << " and charts\n";
     } catch (const std::exception& e) {

@@ -42,6 +42,25 @@ struct SweepOptions {
     /// accuracy; the others only step the world, and must end in the same state with the same
     /// counters.
     int repeat = 3;
+    /// Runs at a time: 1 runs every run in this process; N > 1 plans the sweep into
+    /// OUT/plan (sweep_plan.h), runs its jobs N at a time as child processes of `cdlab_binary`
+    /// and collects them (sweep_collect.h). Not with float_binary.
+    int jobs = 1;
+    /// The cdlab executable the jobs run with jobs > 1 (the command sets its own, /proc/self/exe).
+    std::filesystem::path cdlab_binary;
+    /// The runs were timed while sharing the machine with each other (jobs run concurrently, or
+    /// on different hosts): their wall-clock times are disturbed, so the reading ranks runs by
+    /// thread CPU time instead. Set by the collect step from the jobs' own records.
+    bool timed_concurrently = false;
+    /// The runs were the jobs of a plan, each timed in a process of its own (set by collect).
+    bool planned = false;
+};
+
+/// A run of a planned sweep that left no usable result: named on stderr and in report.md,
+/// never silently left out.
+struct SweepFailure {
+    std::string label;   ///< the run, as SweepRun::label ("reference" for the reference run)
+    std::string reason;  ///< why: no result file, or the job's own error
 };
 
 /// A wall-clock figure over the repeats of one run (ms): median and range.
@@ -55,7 +74,7 @@ struct Timed {
 enum class StepVsReference { Coarser, Same, Finer };
 
 /// What one run measured. Times are wall-clock (std::chrono::steady_clock, inside World::step)
-/// means per step (ms), summarised over the repeats; counts are means per step unless named
+/// means per step (ms), summarised over the repeats, except the cpu_ ones; counts are means per step unless named
 /// total.
 struct SweepRun {
     std::string label;  ///< "broadphase=hgrid world.time_step=0.01", or "reference"
@@ -65,6 +84,12 @@ struct SweepRun {
     int repeats = 1;  ///< times the run was timed
     Timed ms_integrate, ms_volumes, ms_broad, ms_narrow, ms_ccd, ms_response, ms_step;
     Timed ms_per_simulated_s;
+    /// Thread CPU time (CLOCK_THREAD_CPUTIME_ID) around World::step, ms per step and per
+    /// simulated second: what the run cost this thread, nearly undisturbed by other processes
+    /// sharing the cores (unlike the wall-clock columns above).
+    Timed cpu_ms_step, cpu_ms_per_simulated_s;
+    std::string host;         ///< the machine the run was timed on
+    bool concurrent = false;  ///< timed while another run of the sweep ran on the same host
     StepVsReference step_vs_reference = StepVsReference::Coarser;
     double flagged = 0;                ///< broad-phase pairs per step
     double confirmed = 0;              ///< narrow-phase confirmed pairs per step
@@ -123,9 +148,10 @@ TraceComparison compareTraces(const std::filesystem::path& a, const std::filesys
 bool parseVary(const std::string& text, std::string& key, std::vector<std::string>& values,
                std::string& error);
 
-/// Exit codes: 0 success, 1 output failure or a repeat that differs from the first in a
-/// deterministic column (pairs, tests, CCD stops, final state), 2 bad input (flags, a
-/// combination's scene error).
+/// Runs the sweep in this process, or with options.jobs > 1 as a plan whose jobs run that many
+/// at a time (sweep_local.h). Exit codes: 0 success, 1 output failure, a repeat that differs
+/// from the first in a deterministic column (pairs, tests, CCD stops, final state) or a job
+/// that left no result, 2 bad input (flags, a combination's scene error).
 int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err);
 
 }  // namespace app

@@ -3,6 +3,8 @@
 
 #include <malloc.h>
 #include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -66,6 +68,21 @@ bool resetPeakResident() {
     return bool(f);
 }
 
+// This thread's CPU time (s): POSIX CLOCK_THREAD_CPUTIME_ID. The engine steps on the calling
+// thread, so this is the step's cost, whatever else shares the cores.
+double threadCpuSeconds() {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+// This machine's name (gethostname), "" when it has none.
+std::string hostName() {
+    char name[256] = {};
+    if (gethostname(name, sizeof name - 1) != 0) return "";
+    return name;
+}
+
 }  // namespace
 
 std::string labelOf(const std::vector<engine::SceneOverride>& overrides) {
@@ -83,6 +100,7 @@ SweepRun measure(const engine::Scene& scene, double duration, FirstContacts* fir
     const double resident_kb = procStatusKb("VmRSS");
     engine::World world = engine::makeWorld(scene);
     run.time_step = scene.world.time_step;
+    run.host = hostName();
     run.steps = std::max<std::int64_t>(1, std::llround(duration / run.time_step));
 
     // Contacts the run saw: pairs confirmed at the end of a step, pairs the CCD stage stopped at
@@ -118,9 +136,12 @@ SweepRun measure(const engine::Scene& scene, double duration, FirstContacts* fir
     // bookkeeping below is outside every timed interval.
     double ms_integrate = 0, ms_volumes = 0, ms_broad = 0, ms_narrow = 0, ms_ccd = 0,
            ms_response = 0, ms_step = 0;
+    double cpu_s = 0;
     for (std::int64_t s = 0; s < run.steps; ++s) {
         const double step_start = double(world.time());
+        const double cpu_before = threadCpuSeconds();
         world.step();
+        cpu_s += threadCpuSeconds() - cpu_before;
         const engine::StepStats& st = world.lastStats();
         ms_integrate += 1e3 * st.integrate_s;
         ms_volumes += 1e3 * st.volumes_s;
@@ -165,6 +186,8 @@ SweepRun measure(const engine::Scene& scene, double duration, FirstContacts* fir
     run.ms_response = sample(ms_response);
     run.ms_step = sample(ms_step);
     run.ms_per_simulated_s = sample(ms_step / run.time_step);
+    run.cpu_ms_step = sample(1e3 * cpu_s / n);
+    run.cpu_ms_per_simulated_s = sample(1e3 * cpu_s / n / run.time_step);
     run.broad_false_positives = run.flagged - run.confirmed;
     run.state_hash = world.stateHash();
     if (first == nullptr) return run;
@@ -222,7 +245,8 @@ SweepRun combineRepeats(const std::vector<SweepRun>& repeats) {
     for (Timed SweepRun::*field :
          {&SweepRun::ms_integrate, &SweepRun::ms_volumes, &SweepRun::ms_broad, &SweepRun::ms_narrow,
           &SweepRun::ms_ccd, &SweepRun::ms_response, &SweepRun::ms_step,
-          &SweepRun::ms_per_simulated_s}) {
+          &SweepRun::ms_per_simulated_s, &SweepRun::cpu_ms_step,
+          &SweepRun::cpu_ms_per_simulated_s}) {
         std::vector<double> samples;
         for (const SweepRun& r : repeats) samples.push_back((r.*field).median);
         run.*field = summarize(samples);

@@ -109,7 +109,11 @@ std::string csvTable(const std::vector<SweepRun>& runs) {
            "narrow_tests,triangle_tests,mesh_bv_tests,toi_events,max_penetration_m,"
            "pairs_confirmed_total,missed_pairs,extra_pairs,"
            "max_first_contact_error_s,mean_first_contact_error_s,max_energy_drift,"
-           "max_angular_momentum_drift,memory_mib,state_hash\n";
+           "max_angular_momentum_drift,memory_mib,state_hash,cpu_clock";
+    for (const char* name : {"cpu_ms_step", "cpu_ms_per_simulated_s"}) {
+        csv << ',' << name << "_median," << name << "_min," << name << "_max";
+    }
+    csv << ",host,concurrent\n";
     for (const SweepRun& r : runs) {
         csv << csvField(r.label) << ',' << fmt(r.time_step, "%.17g") << ','
             << stepVsReferenceName(r.step_vs_reference) << ',' << r.steps << ',' << r.repeats
@@ -129,7 +133,12 @@ std::string csvTable(const std::vector<SweepRun>& runs) {
                          r.max_angular_momentum_drift}) {
             csv << ',' << fmt(v, "%.6g");
         }
-        csv << ',' << fmt(r.memory_mib, "%.4g") << ',' << r.state_hash << '\n';
+        csv << ',' << fmt(r.memory_mib, "%.4g") << ',' << r.state_hash << ",thread_cputime";
+        for (const Timed& t : {r.cpu_ms_step, r.cpu_ms_per_simulated_s}) {
+            csv << ',' << fmt(t.median, "%.6g") << ',' << fmt(t.min, "%.6g") << ','
+                << fmt(t.max, "%.6g");
+        }
+        csv << ',' << csvField(r.host) << ',' << (r.concurrent ? 1 : 0) << '\n';
     }
     return csv.str();
 }
@@ -198,14 +207,15 @@ std::string resultsTable(const SweepOptions& options, const std::vector<SweepRun
     std::ostringstream md;
     md << "\n| run | dt (s) | steps |";
     if (options.report_timing) {
-        md << " ms/step, median (min..max) | ms per sim. s, median (min..max) | memory (MiB) |";
+        md << " ms/step, median (min..max) | ms per sim. s, median (min..max) | CPU ms per sim. "
+              "s, median (min..max) | memory (MiB) |";
     }
     md << " flagged/step | confirmed/step | BP false pos./step | Nv/step | mesh Nv/step | Np/step "
           "| "
           "CCD stops | "
           "missed | extra | max TOI err (s) | max depth (m) | energy drift | abs L drift "
           "|\n|---|---|---|";
-    if (options.report_timing) md << "---|---|---|";
+    if (options.report_timing) md << "---|---|---|---|";
     md << "---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     auto row = [&](const SweepRun& r, bool is_reference) {
         md << "| " << r.label << " | " << fmt(r.time_step);
@@ -217,6 +227,7 @@ std::string resultsTable(const SweepOptions& options, const std::vector<SweepRun
         if (options.report_timing) {
             md << ' ' << timedCell(r.ms_step, r.repeats, "%.3f") << " | "
                << timedCell(r.ms_per_simulated_s, r.repeats, "%.3g") << " | "
+               << timedCell(r.cpu_ms_per_simulated_s, r.repeats, "%.3g") << " | "
                << fmt(r.memory_mib, "%.3g") << " |";
         }
         md << ' ' << fmt(r.flagged, "%.2f") << " | " << fmt(r.confirmed, "%.2f") << " | "
@@ -234,44 +245,61 @@ std::string resultsTable(const SweepOptions& options, const std::vector<SweepRun
     return md.str();
 }
 
-// "ms per simulated second" of a run for the reading: median (min..max).
-std::string costFigure(const SweepRun& r) {
-    return timedCell(r.ms_per_simulated_s, r.repeats, "%.3g");
+// The timed column the reading ranks runs by: wall-clock ms per simulated second, or thread
+// CPU ms per simulated second when the runs were timed concurrently (their wall-clock times
+// then measure the machine's load as much as the run).
+struct CostClock {
+    Timed SweepRun::*field;
+    const char* unit;  // "ms per simulated second", "CPU ms per simulated second"
+};
+
+CostClock costClock(const SweepOptions& options) {
+    if (options.timed_concurrently) {
+        return {&SweepRun::cpu_ms_per_simulated_s, "CPU ms per simulated second"};
+    }
+    return {&SweepRun::ms_per_simulated_s, "ms per simulated second"};
+}
+
+// The cost of a run for the reading: median (min..max).
+std::string costFigure(const SweepRun& r, const CostClock& clock) {
+    return timedCell(r.*clock.field, r.repeats, "%.3g");
 }
 
 // The reading's line on cost among `runs`: the cheapest is named only when its whole min..max
 // range lies below every other run's (rankLowest), otherwise the runs within its spread are
 // listed and no winner is named.
-std::string costReading(const std::string& what, const std::vector<const SweepRun*>& runs) {
+std::string costReading(const std::string& what, const std::vector<const SweepRun*>& runs,
+                        const CostClock& clock) {
     std::vector<Timed> cost;
-    for (const SweepRun* r : runs) cost.push_back(r->ms_per_simulated_s);
+    for (const SweepRun* r : runs) cost.push_back(r->*clock.field);
     const int repeats = runs.front()->repeats;
     const Ranking ranking = rankLowest(cost, repeats);
     const SweepRun& best = *runs[ranking.best];
     std::ostringstream md;
-    const std::string spread =
-        "ms per simulated second, median (min..max of " + std::to_string(repeats) + " repeats)";
+    const std::string spread = std::string(clock.unit) + ", median (min..max of " +
+                               std::to_string(repeats) + " repeats)";
     switch (ranking.state) {
         case Ranking::State::Empty:
             break;
         case Ranking::State::Only:
-            md << "- Only one of the " << what << ": **" << best.label << "** (" << costFigure(best)
-               << " ms per simulated second).\n";
+            md << "- Only one of the " << what << ": **" << best.label << "** ("
+               << costFigure(best, clock) << " " << clock.unit << ").\n";
             break;
         case Ranking::State::NoSpread:
             md << "- Cheapest of the " << what << ": none named, each was timed once "
                << "(--repeat 1), so there is no spread to compare the differences with.\n";
             break;
         case Ranking::State::Separated:
-            md << "- Cheapest of the " << what << ": **" << best.label << "** (" << costFigure(best)
-               << " " << spread << "); its slowest repeat beat every other run's fastest.\n";
+            md << "- Cheapest of the " << what << ": **" << best.label << "** ("
+               << costFigure(best, clock) << " " << spread
+               << "); its slowest repeat beat every other run's fastest.\n";
             break;
         case Ranking::State::WithinSpread: {
             md << "- Cheapest of the " << what << ": none named, the lowest costs are within "
                << "measurement spread of each other (" << spread << "): ";
             for (std::size_t k = 0; k < ranking.overlapping.size(); ++k) {
                 const SweepRun& r = *runs[ranking.overlapping[k]];
-                md << (k == 0 ? "" : ", ") << "**" << r.label << "** " << costFigure(r);
+                md << (k == 0 ? "" : ", ") << "**" << r.label << "** " << costFigure(r, clock);
             }
             md << ".\n";
             break;
@@ -332,7 +360,7 @@ std::string readingSection(const SweepOptions& options, const engine::Scene& bas
               "time: every choice here trades contacts for speed; see the missed, extra and "
               "first-contact columns.\n";
     } else if (options.report_timing) {
-        md << costReading(accurate_runs, accurate);
+        md << costReading(accurate_runs, accurate, costClock(options));
     } else {
         const SweepRun* fewest = *std::min_element(
             accurate.begin(), accurate.end(),
@@ -344,12 +372,13 @@ std::string readingSection(const SweepOptions& options, const engine::Scene& bas
     if (options.report_timing && runs.size() > 1) {
         std::vector<const SweepRun*> all;
         for (const SweepRun& r : runs) all.push_back(&r);
-        const SweepRun* lowest =
-            *std::min_element(all.begin(), all.end(), [](const SweepRun* a, const SweepRun* b) {
-                return a->ms_per_simulated_s.median < b->ms_per_simulated_s.median;
+        const CostClock clock = costClock(options);
+        const SweepRun* lowest = *std::min_element(
+            all.begin(), all.end(), [&clock](const SweepRun* a, const SweepRun* b) {
+                return (a->*clock.field).median < (b->*clock.field).median;
             });
         if (std::find(accurate.begin(), accurate.end(), lowest) == accurate.end()) {
-            md << costReading("runs, whatever their accuracy", all);
+            md << costReading("runs, whatever their accuracy", all, clock);
         }
     }
     const auto tightest = std::min_element(runs.begin(), runs.end(), [](auto& a, auto& b) {
@@ -420,11 +449,56 @@ std::string readingSection(const SweepOptions& options, const engine::Scene& bas
     return md.str();
 }
 
+// The report's note on the clocks: which clock each timed column reads, how the repeats were
+// taken, and which clock the reading ranks by.
+std::string timingNote(const SweepOptions& options, const std::vector<SweepRun>& runs,
+                       const SweepRun& reference) {
+    const int repeats = runs.empty() ? reference.repeats : runs.front().repeats;
+    std::ostringstream md;
+    md << "- Times are wall-clock (std::chrono::steady_clock inside World::step), this "
+          "machine, this build; they vary from run to run. Every run, the reference too, "
+          "was timed "
+       << repeats;
+    if (options.planned) {
+        md << (repeats == 1 ? " time" : " times, back to back")
+           << ", each run a job in a process of its own";
+    } else {
+        md << (repeats == 1 ? " time" : " times, the repeats interleaved across runs");
+    }
+    md << "; the table gives the median and the min..max range (results.csv: every stage). "
+          "The reading names a run cheapest only when its slowest repeat beat every other "
+          "run's fastest. Memory: the process's peak resident set during the first repeat "
+          "less its resident set at the start (Linux VmHWM, reset per run).\n";
+    md << "- CPU columns: the stepping thread's CPU time (CLOCK_THREAD_CPUTIME_ID around "
+          "World::step), which other processes sharing the cores disturb far less than the "
+          "wall clock.";
+    if (options.timed_concurrently) {
+        md << " The runs were timed concurrently (jobs overlapping on one host, or on several "
+              "hosts; results.csv: host, concurrent), so their wall-clock times include waiting "
+              "for shared cores: the reading ranks them by CPU time.";
+    }
+    md << "\n";
+    return md.str();
+}
+
+// The runs that left no result, each with its reason: the table and the reading leave them out.
+std::string failureSection(const std::vector<SweepFailure>& failures) {
+    if (failures.empty()) return "";
+    std::ostringstream md;
+    md << "\n## Missing or failed runs\n\n"
+       << failures.size() << (failures.size() == 1 ? " run" : " runs")
+       << " of the plan left no result; the table and the reading below leave "
+       << (failures.size() == 1 ? "it" : "them") << " out.\n\n";
+    for (const SweepFailure& f : failures) md << "- **" << f.label << "**: " << f.reason << "\n";
+    return md.str();
+}
+
 }  // namespace
 
 std::string markdownReport(const SweepOptions& options, const engine::Scene& base, double duration,
                            const std::vector<SweepRun>& runs, const SweepRun& reference,
-                           const std::vector<FloatRun>& floats) {
+                           const std::vector<FloatRun>& floats,
+                           const std::vector<SweepFailure>& failures) {
     std::ostringstream md;
     md << "# Sweep of `" << options.scene.filename().string() << "`\n\n";
     md << "- " << base.bodies.size() << " bodies, " << fmt(duration) << " s simulated per run, "
@@ -447,17 +521,8 @@ std::string markdownReport(const SweepOptions& options, const engine::Scene& bas
     md << "- Energy drift: max over steps of |E - E0| / (sum of |kinetic| + |potential| terms at "
           "t = 0); |L| drift: max over bodies and steps of the relative change of a body's "
           "angular momentum.\n";
-    if (options.report_timing) {
-        const int repeats = runs.empty() ? reference.repeats : runs.front().repeats;
-        md << "- Times are wall-clock (std::chrono::steady_clock inside World::step), this "
-              "machine, this build; they vary from run to run. Every run, the reference too, "
-              "was timed "
-           << repeats << (repeats == 1 ? " time" : " times, the repeats interleaved across runs")
-           << "; the table gives the median and the min..max range (results.csv: every stage). "
-              "The reading names a run cheapest only when its slowest repeat beat every other "
-              "run's fastest. Memory: the process's peak resident set during the first repeat "
-              "less its resident set at the start (Linux VmHWM, reset per run).\n";
-    }
+    if (options.report_timing) md << timingNote(options, runs, reference);
+    md << failureSection(failures);
     md << resultsTable(options, runs, reference);
     md << '\n';
     for (const Chart& c : charts()) {
@@ -470,6 +535,33 @@ std::string markdownReport(const SweepOptions& options, const engine::Scene& bas
     }
     md << readingSection(options, base, runs, reference, floats);
     return md.str();
+}
+
+void writeSweepOutputs(const SweepOptions& options, const engine::Scene& base, double duration,
+                       const std::vector<SweepRun>& runs, const SweepRun& reference,
+                       const std::vector<FloatRun>& floats,
+                       const std::vector<SweepFailure>& failures, const fs::path& out_dir) {
+    // One bar chart per column of charts() (timings only with report_timing), reference last.
+    for (const Chart& c : charts()) {
+        if (c.timing && !options.report_timing) continue;
+        render::BarChart chart;
+        chart.title = c.title;
+        chart.log_scale = c.log_scale;
+        for (const SweepRun& r : runs) chart.bars.push_back({r.label, c.value(r), false});
+        chart.bars.push_back({"reference", c.value(reference), true});
+        render::writePng(out_dir / c.file, render::drawBarChart(chart));
+    }
+    writeTextAtomically(out_dir / "results.csv", csvTable(runs));
+    writeTextAtomically(out_dir / "report.md", markdownReport(options, base, duration, runs,
+                                                              reference, floats, failures));
+}
+
+void removeSweepOutputs(const fs::path& out_dir) {
+    for (const char* f :
+         {"results.csv", "report.md", "float_vs_double.csv", "float_deviation.png"}) {
+        fs::remove(out_dir / f);
+    }
+    for (const Chart& c : charts()) fs::remove(out_dir / c.file);
 }
 
 }  // namespace sweep

@@ -2,6 +2,7 @@
 // float-versus-double section) and the comparison of two traces behind that section.
 #pragma once
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -51,9 +52,23 @@ struct Ranking {
 /// repeat beat every other run's fastest. A pure function of the numbers given.
 Ranking rankLowest(const std::vector<Timed>& values, int repeats);
 
-/// report.md: the table, the reading of it, the float comparison when there was one.
+/// report.md: the table, the reading of it, the float comparison when there was one, and a
+/// section naming every run of a plan that left no result (`failures`).
 std::string markdownReport(const SweepOptions& options, const engine::Scene& base,
                            double duration, const std::vector<SweepRun>& runs,
-                           const SweepRun& reference, const std::vector<FloatRun>& floats);
+                           const SweepRun& reference, const std::vector<FloatRun>& floats,
+                           const std::vector<SweepFailure>& failures = {});
+
+/// Writes the sweep's outputs into `out_dir` (which exists): the charts, results.csv and
+/// report.md, each file complete or absent. Throws on an output failure.
+void writeSweepOutputs(const SweepOptions& options, const engine::Scene& base, double duration,
+                       const std::vector<SweepRun>& runs, const SweepRun& reference,
+                       const std::vector<FloatRun>& floats,
+                       const std::vector<SweepFailure>& failures,
+                       const std::filesystem::path& out_dir);
+
+/// Removes the outputs an earlier sweep left in `out_dir` (results.csv, report.md, charts,
+/// float comparison), so none outlives a rerun that fails before writing its own.
+void removeSweepOutputs(const std::filesystem::path& out_dir);
 
 }  // namespace app::sweep
