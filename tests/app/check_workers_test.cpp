@@ -159,12 +159,12 @@ TEST(CheckCli, TimeoutStopsOnlyTheSlowScene) {
     std::string slow = slurp(work / "slow.yaml");
     slow.replace(slow.find("frames: 25, "), 12, "");
     write(work / "slow.yaml", slow);
-    const CliResult r = runCdlab("check --timeout 0.5 -j 2 " + (work / "slow.yaml").string() + " " +
+    const CliResult r = runCdlab("check --timeout 2 -j 2 " + (work / "slow.yaml").string() + " " +
                                      (work / "good.yaml").string(),
                                  work);
     EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
     EXPECT_NE(r.out.find("slow.yaml  run                                          FAIL    could "
-                         "not run: timed out after 0.5 s"),
+                         "not run: timed out after 2 s"),
               std::string::npos)
         << r.out;
     EXPECT_NE(r.out.find("good.yaml  pair a / b colliding at every frames 11..20  pass"),
@@ -173,9 +173,9 @@ TEST(CheckCli, TimeoutStopsOnlyTheSlowScene) {
     EXPECT_NE(r.out.find("2 scenes, 2 expectations, 1 failed"), std::string::npos) << r.out;
 
     // --timeout alone grades in a child too, one scene at a time.
-    const CliResult one = runCdlab("check --timeout 0.5 " + (work / "slow.yaml").string(), work);
+    const CliResult one = runCdlab("check --timeout 1 " + (work / "slow.yaml").string(), work);
     EXPECT_EQ(one.exit_code, 1);
-    EXPECT_NE(one.out.find("could not run: timed out after 0.5 s"), std::string::npos) << one.out;
+    EXPECT_NE(one.out.find("could not run: timed out after 1 s"), std::string::npos) << one.out;
     fs::remove_all(work);
 }
 
