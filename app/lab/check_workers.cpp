@@ -7,7 +7,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -100,6 +100,26 @@ fs::path logPath(const fs::path& work, std::size_t i) {
     return work / (std::to_string(i) + ".log");
 }
 
+// The child between fork and exec: only async-signal-safe calls. It dies with the parent
+// (PR_SET_PDEATHSIG survives exec; set before exec, so no window in which the parent could die
+// unnoticed), reads /dev/null, writes stdout and stderr to its log, and reports a failed exec's
+// errno through `report_fd`, which exec closes.
+[[noreturn]] void execWorker(char* const* argv, const char* log, pid_t parent, int report_fd) {
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) ::_exit(127);
+    int err = 0;
+    const int in = ::open("/dev/null", O_RDONLY);
+    const int out = ::open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (in < 0 || out < 0 || ::dup2(in, 0) < 0 || ::dup2(out, 1) < 0 || ::dup2(out, 2) < 0) {
+        err = errno;
+    } else {
+        ::execve(argv[0], argv, environ);
+        err = errno;
+    }
+    [[maybe_unused]] const ssize_t n = ::write(report_fd, &err, sizeof err);
+    ::_exit(127);
+}
+
 // Starts `cdlab check --worker-result ...` for scene `i`, its stdout and stderr into its log.
 // Returns -1 and sets `error` when it cannot be started.
 pid_t spawnWorker(const WorkerPlan& plan, std::size_t i, const fs::path& work, std::string& error) {
@@ -115,18 +135,33 @@ pid_t spawnWorker(const WorkerPlan& plan, std::size_t i, const fs::path& work, s
     std::vector<char*> argv;
     for (std::string& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
-
     const std::string log = logPath(work, i).string();
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&actions, 1, 2);
-    pid_t pid = -1;
-    const int rc = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    if (rc != 0) {
-        error = "cannot start " + plan.exe.string() + ": " + std::strerror(rc);
+
+    int pipe_fds[2];
+    if (::pipe2(pipe_fds, O_CLOEXEC) != 0) {
+        error = std::string("cannot start a grader: ") + std::strerror(errno);
+        return -1;
+    }
+    const pid_t parent = ::getpid();
+    const pid_t pid = ::fork();
+    const int fork_errno = errno;
+    if (pid == 0) execWorker(argv.data(), log.c_str(), parent, pipe_fds[1]);
+    ::close(pipe_fds[1]);
+    int child_errno = 0;
+    ssize_t n = 0;
+    if (pid > 0) {
+        do {
+            n = ::read(pipe_fds[0], &child_errno, sizeof child_errno);
+        } while (n < 0 && errno == EINTR);
+    }
+    ::close(pipe_fds[0]);
+    if (pid < 0 || n == ssize_t(sizeof child_errno)) {
+        if (pid > 0) {
+            while (::waitpid(pid, nullptr, 0) < 0 && errno == EINTR) {
+            }
+        }
+        error = "cannot start " + plan.exe.string() + ": " +
+                std::strerror(pid < 0 ? fork_errno : child_errno);
         return -1;
     }
     return pid;

@@ -27,11 +27,13 @@ struct WorkerPlan {
 /// Grades every scene of `plan` in child processes, at most `jobs` at once; one report per
 /// scene, in the order of `plan.scenes`. A child that dies, exits without a report or outlives
 /// the timeout (then it is killed) gives a NotRun report saying so; what it printed is kept in
-/// the report's `log`. Labels are the scene paths as given.
+/// the report's `log`. Labels are the scene paths as given. The children die with this process
+/// (PR_SET_PDEATHSIG), so a check killed from outside leaves none grading for nobody.
 std::vector<SceneReport> gradeInWorkers(const WorkerPlan& plan);
 
 /// The child's side: grades scene number `index` (gradeSceneFile) and writes its report to
 /// `result`. Returns the process exit code: 0 when the report was written, whatever the grade.
+/// (The parent set it up, before exec, to be killed when the parent dies.)
 int runCheckWorker(const std::filesystem::path& scene, std::size_t index, std::optional<int> frames,
                    const std::filesystem::path& dump_root, const std::filesystem::path& result);
 

@@ -8,7 +8,10 @@
 #include "check_workers.h"
 
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -176,6 +179,51 @@ TEST(CheckCli, TimeoutStopsOnlyTheSlowScene) {
     const CliResult one = runCdlab("check --timeout 1 " + (work / "slow.yaml").string(), work);
     EXPECT_EQ(one.exit_code, 1);
     EXPECT_NE(one.out.find("could not run: timed out after 1 s"), std::string::npos) << one.out;
+    fs::remove_all(work);
+}
+
+// Processes whose command line holds `needle` (a zombie's is empty).
+std::vector<pid_t> processesMentioning(const std::string& needle) {
+    std::vector<pid_t> pids;
+    for (const fs::directory_entry& e : fs::directory_iterator("/proc")) {
+        const std::string pid = e.path().filename().string();
+        if (pid.find_first_not_of("0123456789") != std::string::npos) continue;
+        std::string cmdline = slurp(e.path() / "cmdline");
+        std::replace(cmdline.begin(), cmdline.end(), '\0', ' ');
+        if (cmdline.find(needle) != std::string::npos) pids.push_back(std::stoi(pid));
+    }
+    return pids;
+}
+
+// A check killed from outside (a CI job's timeout) takes its children with it.
+TEST(CheckCli, ChildrenDieWithTheCheck) {
+    const fs::path work = tempDir("orphans");
+    const fs::path slow = work / "slow.yaml";
+    write(slow, scene("  min_bodies: 3\n", 1, ", steps_per_frame: 10"));
+    std::string text = slurp(slow);
+    text.replace(text.find("frames: 25"), 10, "frames: 1000000");
+    write(slow, text);
+    const std::string cmd = std::string(CDLAB_BINARY) + " check -j 2 " + slow.string() + " " +
+                            slow.string() + " > /dev/null 2>&1 & echo $! > " +
+                            (work / "pid").string();
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    const pid_t parent = std::stoi(slurp(work / "pid"));
+    // The parent and its two children name the scene (this folder is this test's own).
+    for (int i = 0; i < 500 && processesMentioning(slow.string()).size() < 3; ++i) {
+        ::usleep(10000);
+    }
+    EXPECT_EQ(processesMentioning("check -j 2 " + slow.string()).size(), 1u);
+    EXPECT_EQ(processesMentioning("-- " + slow.string()).size(), 2u);
+    // However soon after their start the parent dies: no window before exec.
+    ::kill(parent, SIGKILL);
+    std::vector<pid_t> left;
+    for (int i = 0; i < 500; ++i) {
+        left = processesMentioning(slow.string());
+        if (left.empty()) break;
+        ::usleep(10000);
+    }
+    EXPECT_TRUE(left.empty()) << "graders outlived their check";
+    for (const pid_t pid : left) ::kill(pid, SIGKILL);
     fs::remove_all(work);
 }
 
