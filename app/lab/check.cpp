@@ -71,6 +71,19 @@ bool loadAll(const std::vector<fs::path>& files, std::vector<engine::Scene>& sce
     return !bad;
 }
 
+// What the grading had to say on stderr, in command-line order: the loader's notes (unless
+// loadAll printed them already), the message of every scene that did not load, the children's
+// output.
+void printMessages(const std::vector<SceneReport>& reports, bool with_notes, std::ostream& err) {
+    for (const SceneReport& s : reports) {
+        if (with_notes) {
+            for (const std::string& note : s.notes) err << note << "\n";
+        }
+        if (s.outcome == SceneOutcome::NotLoaded) err << s.rows.front().reason << "\n";
+        err << s.log;
+    }
+}
+
 void printTable(const std::vector<SceneReport>& reports, std::ostream& out) {
     std::size_t scene_w = 5, what_w = 11, rows = 0, failed = 0, not_loaded = 0;
     for (const SceneReport& s : reports) {
@@ -208,7 +221,12 @@ int runCheck(const CheckOptions& options, std::ostream& out, std::ostream& err) 
     if (in_children) {
         WorkerPlan plan{options.worker_exe, options.scenes, options.frames,
                         dump_root,          jobs,           options.timeout};
-        reports = gradeInWorkers(plan);
+        try {
+            reports = gradeInWorkers(plan);
+        } catch (const render::RenderError& e) {
+            err << "check: " << e.what() << "\n";
+            return kExitFailure;
+        }
     } else {
         for (std::size_t i = 0; i < options.scenes.size(); ++i) {
             if (keep_going) {
@@ -221,22 +239,11 @@ int runCheck(const CheckOptions& options, std::ostream& out, std::ostream& err) 
     }
     if (remove_dumps) fs::remove_all(dump_root, ec);
 
-    // What went to stderr while grading, in command-line order (the notes were printed by
-    // loadAll when every scene was loaded first).
-    bool bad_input = false;
-    for (const SceneReport& s : reports) {
-        if (keep_going) {
-            for (const std::string& note : s.notes) err << note << "\n";
-        }
-        if (s.outcome == SceneOutcome::NotLoaded) {
-            bad_input = true;
-            err << s.rows.front().reason << "\n";
-        }
-        err << s.log;
-    }
+    printMessages(reports, /*with_notes=*/keep_going, err);
     printTable(reports, out);
-    bool failed = false;
+    bool failed = false, bad_input = false;
     for (const SceneReport& s : reports) {
+        bad_input = bad_input || s.outcome == SceneOutcome::NotLoaded;
         for (const CheckRow& r : s.rows) failed = failed || !r.pass;
     }
     if (options.junit &&

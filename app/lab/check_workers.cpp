@@ -270,11 +270,13 @@ int runCheckWorker(const fs::path& scene, std::size_t index, std::optional<int> 
 
 std::vector<SceneReport> gradeInWorkers(const WorkerPlan& plan) {
     std::vector<SceneReport> reports(plan.scenes.size());
-    const fs::path work =
-        fs::temp_directory_path() / ("cdlab_check_work_" + std::to_string(::getpid()));
     std::error_code ec;
+    const fs::path tmp = fs::temp_directory_path(ec);
+    if (ec) throw render::RenderError("no temporary folder for the graders: " + ec.message());
+    const fs::path work = tmp / ("cdlab_check_work_" + std::to_string(::getpid()));
     fs::remove_all(work, ec);
-    fs::create_directories(work);
+    fs::create_directories(work, ec);
+    if (ec) throw render::RenderError("cannot create " + work.string() + ": " + ec.message());
 
     std::vector<Child> running;
     std::size_t next = 0;

@@ -28,7 +28,8 @@ struct WorkerPlan {
 /// scene, in the order of `plan.scenes`. A child that dies, exits without a report or outlives
 /// the timeout (then it is killed) gives a NotRun report saying so; what it printed is kept in
 /// the report's `log`. Labels are the scene paths as given. The children die with this process
-/// (PR_SET_PDEATHSIG), so a check killed from outside leaves none grading for nobody.
+/// (PR_SET_PDEATHSIG), so a check killed from outside leaves none grading for nobody. Throws
+/// render::RenderError when the folder of the children's reports cannot be made.
 std::vector<SceneReport> gradeInWorkers(const WorkerPlan& plan);
 
 /// The child's side: grades scene number `index` (gradeSceneFile) and writes its report to
