@@ -113,6 +113,8 @@ fs::path logPath(const fs::path& work, std::size_t i) {
     if (in < 0 || out < 0 || ::dup2(in, 0) < 0 || ::dup2(out, 1) < 0 || ::dup2(out, 2) < 0) {
         err = errno;
     } else {
+        if (in > 2) ::close(in);
+        if (out > 2) ::close(out);
         ::execve(argv[0], argv, environ);
         err = errno;
     }
