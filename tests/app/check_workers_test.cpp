@@ -222,6 +222,10 @@ TEST(CheckCli, ChildrenDieWithTheCheck) {
     }
     EXPECT_TRUE(left.empty()) << "graders outlived their check";
     for (const pid_t pid : left) ::kill(pid, SIGKILL);
+    // What the killed check could not remove: its children's reports and its pause-dump folder.
+    const std::string id = std::to_string(parent);
+    fs::remove_all(fs::temp_directory_path() / ("cdlab_check_work_" + id));
+    fs::remove_all(fs::temp_directory_path() / ("cdlab_check_" + id));
     fs::remove_all(work);
 }
 
