@@ -1,26 +1,117 @@
 // app/lab/check.cpp -- `cdlab check`: runs each scene once and grades it with the checkers of
 // its `expect:` section (checkers.h), which all watch that single run: frame 0 is the initial
 // state, frame k is after k * steps_per_frame steps. Rows come out in a fixed order (the order of
-// makeCheckers, then file order), so two checks of the same scene print the same table.
+// makeCheckers, then file order), and scenes in command-line order whichever process graded them
+// and whenever it finished, so two checks of the same scenes print the same table.
 #include "check.h"
 
-#include <iostream>
-#include <string>
+#include <sched.h>
 #include <unistd.h>
-#include <vector>
 
 #include <algorithm>
+#include <chrono>
+#include <iostream>
 #include <memory>
 #include <ostream>
+#include <string>
+#include <thread>
+#include <vector>
 
+#include "check_workers.h"
 #include "checkers.h"
+#include "checkers_step.h"
 #include "exit_codes.h"
+#include "junit_report.h"
 #include "output_files.h"
 #include "render/image.h"
 
 namespace app {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The cores this process may run on (its affinity mask, as a container or taskset sets it).
+int availableCores() {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0) {
+        return CPU_COUNT(&set);
+    }
+    return std::max(1u, std::thread::hardware_concurrency());
+}
+
+// Bad flags, reported before anything runs; empty when the options are usable.
+std::string badOption(const CheckOptions& options) {
+    if (options.scenes.empty()) return "check: no scene given";
+    if (options.frames && *options.frames < 1) return "--frames: must be >= 1";
+    if (options.jobs < 0) return "--jobs: must be >= 0 (0: one per core)";
+    if (options.timeout && !(*options.timeout > 0)) return "--timeout: must be > 0 seconds";
+    return {};
+}
+
+// Loads every scene before any runs, printing the loader's notes and errors in command-line
+// order; false when any scene is bad.
+bool loadAll(const std::vector<fs::path>& files, std::vector<engine::Scene>& scenes,
+             std::ostream& err) {
+    bool bad = false;
+    for (const fs::path& file : files) {
+        try {
+            scenes.push_back(engine::loadScene(file));
+            for (const std::string& note : scenes.back().notes) err << note << "\n";
+        } catch (const engine::SceneError& e) {
+            err << e.what() << "\n";
+            bad = true;
+        }
+    }
+    return !bad;
+}
+
+// What the grading had to say on stderr, in command-line order: the loader's notes (unless
+// loadAll printed them already), the message of every scene that did not load, the children's
+// output.
+void printMessages(const std::vector<SceneReport>& reports, bool with_notes, std::ostream& err) {
+    for (const SceneReport& s : reports) {
+        if (with_notes) {
+            for (const std::string& note : s.notes) err << note << "\n";
+        }
+        if (s.outcome == SceneOutcome::NotLoaded) err << s.rows.front().reason << "\n";
+        err << s.log;
+    }
+}
+
+void printTable(const std::vector<SceneReport>& reports, std::ostream& out) {
+    std::size_t scene_w = 5, what_w = 11, rows = 0, failed = 0, not_loaded = 0;
+    for (const SceneReport& s : reports) {
+        scene_w = std::max(scene_w, s.label.size());
+        for (const CheckRow& r : s.rows) what_w = std::max(what_w, r.expectation.size());
+        not_loaded += s.outcome == SceneOutcome::NotLoaded ? 1 : 0;
+    }
+    auto pad = [](const std::string& s, std::size_t w) {
+        return s + std::string(w > s.size() ? w - s.size() : 0, ' ');
+    };
+    out << pad("scene", scene_w) << "  " << pad("expectation", what_w) << "  result  reason\n";
+    for (const SceneReport& s : reports) {
+        for (const CheckRow& r : s.rows) {
+            ++rows;
+            failed += r.pass ? 0 : 1;
+            out << pad(s.label, scene_w) << "  " << pad(r.expectation, what_w) << "  "
+                << (r.pass ? "pass" : "FAIL    " + r.reason) << "\n";
+        }
+    }
+    out << reports.size() << " scene" << (reports.size() == 1 ? "" : "s") << ", " << rows
+        << " expectations, " << failed << " failed";
+    if (not_loaded > 0) {
+        out << ", " << not_loaded << " scene" << (not_loaded == 1 ? "" : "s") << " not loaded";
+    }
+    out << "\n";
+}
+
+}  // namespace
 
 std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames, const fs::path& dump_dir) {
     std::vector<CheckRow> rows;
@@ -50,28 +141,71 @@ std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames, const f
     return rows;
 }
 
+SceneReport gradeScene(const engine::Scene& scene, std::size_t index, std::optional<int> frames,
+                       const fs::path& dump_root) {
+    SceneReport report;
+    report.notes = scene.notes;
+    const int run_frames = frames.value_or(scene.expect.frames.value_or(scene.frames));
+    const auto start = std::chrono::steady_clock::now();
+    try {
+        const fs::path dir = dump_root / (std::to_string(index) + "_" + scene.name);
+        if (!scene.expect.pause_dumps.empty()) {
+            std::error_code ec;
+            fs::create_directories(dir, ec);
+            if (ec) throw render::RenderError("cannot create " + dir.string());
+        }
+        report.rows = checkScene(scene, run_frames, dir);
+        report.outcome = SceneOutcome::Graded;
+    } catch (const std::exception& e) {
+        report.rows = {{"run", false, std::string("could not run: ") + e.what()}};
+        report.outcome = SceneOutcome::NotRun;
+    }
+    report.seconds = secondsSince(start);
+    return report;
+}
+
+SceneReport gradeSceneFile(const fs::path& file, std::size_t index, std::optional<int> frames,
+                           const fs::path& dump_root) {
+    std::optional<engine::Scene> scene;
+    try {
+        scene = engine::loadScene(file);
+    } catch (const engine::SceneError& e) {
+        SceneReport report;
+        report.label = file.string();
+        report.outcome = SceneOutcome::NotLoaded;
+        report.rows = {{"load", false, e.what()}};
+        return report;
+    }
+    SceneReport report = gradeScene(*scene, index, frames, dump_root);
+    report.label = file.string();
+    return report;
+}
+
 int runCheck(const CheckOptions& options, std::ostream& out, std::ostream& err) {
-    if (options.scenes.empty()) {
-        err << "check: no scene given\n";
+    if (const std::string bad = badOption(options); !bad.empty()) {
+        err << bad << "\n";
         return kExitBadInput;
     }
-    if (options.frames && *options.frames < 1) {
-        err << "--frames: must be >= 1\n";
-        return kExitBadInput;
-    }
-    // Every scene is loaded before any runs: bad input stops the whole check.
-    std::vector<engine::Scene> scenes;
-    bool bad = false;
-    for (const fs::path& file : options.scenes) {
+    const auto start = std::chrono::steady_clock::now();
+    const bool keep_going = options.keep_going || options.junit.has_value();
+    const int jobs = options.jobs == 0 ? availableCores() : options.jobs;
+    const bool in_children = jobs > 1 || options.timeout.has_value();
+    if (options.junit) {
+        // A report that cannot be written is found out before the grading, not after it.
         try {
-            scenes.push_back(engine::loadScene(file));
-            for (const std::string& note : scenes.back().notes) err << note << "\n";
-        } catch (const engine::SceneError& e) {
-            err << e.what() << "\n";
-            bad = true;
+            prepareOutputDir(fs::absolute(*options.junit).parent_path());
+        } catch (const render::RenderError& e) {
+            err << "--junit: " << e.what() << "\n";
+            return kExitFailure;
         }
     }
-    if (bad) return kExitBadInput;
+
+    // Without keep_going every scene is loaded before any runs: bad input stops the whole check.
+    std::vector<engine::Scene> scenes;
+    if (!keep_going) {
+        if (!loadAll(options.scenes, scenes, err)) return kExitBadInput;
+        if (in_children) scenes.clear();  // each child loads its own
+    }
 
     fs::path dump_root;
     bool remove_dumps = false;
@@ -83,48 +217,40 @@ int runCheck(const CheckOptions& options, std::ostream& out, std::ostream& err) 
         remove_dumps = true;
     }
 
-    struct Line {
-        std::string scene;
-        CheckRow row;
-    };
-    std::vector<Line> lines;
-    for (std::size_t i = 0; i < scenes.size(); ++i) {
-        const engine::Scene& scene = scenes[i];
-        const std::string label = options.scenes[i].string();
-        const int frames = options.frames.value_or(scene.expect.frames.value_or(scene.frames));
+    std::vector<SceneReport> reports;
+    if (in_children) {
+        WorkerPlan plan{options.worker_exe, options.scenes, options.frames,
+                        dump_root,          jobs,           options.timeout};
         try {
-            const fs::path dir = dump_root / (std::to_string(i) + "_" + scene.name);
-            if (!scene.expect.pause_dumps.empty()) {
-                fs::create_directories(dir, ec);
-                if (ec) throw render::RenderError("cannot create " + dir.string());
+            reports = gradeInWorkers(plan);
+        } catch (const render::RenderError& e) {
+            err << "check: " << e.what() << "\n";
+            return kExitFailure;
+        }
+    } else {
+        for (std::size_t i = 0; i < options.scenes.size(); ++i) {
+            if (keep_going) {
+                reports.push_back(gradeSceneFile(options.scenes[i], i, options.frames, dump_root));
+            } else {
+                reports.push_back(gradeScene(scenes[i], i, options.frames, dump_root));
+                reports.back().label = options.scenes[i].string();
             }
-            for (CheckRow& r : checkScene(scene, frames, dir)) {
-                lines.push_back({label, std::move(r)});
-            }
-        } catch (const std::exception& e) {
-            lines.push_back({label, {"run", false, std::string("could not run: ") + e.what()}});
         }
     }
     if (remove_dumps) fs::remove_all(dump_root, ec);
 
-    std::size_t scene_w = 5, what_w = 11;
-    for (const Line& l : lines) {
-        scene_w = std::max(scene_w, l.scene.size());
-        what_w = std::max(what_w, l.row.expectation.size());
+    printMessages(reports, /*with_notes=*/keep_going, err);
+    printTable(reports, out);
+    bool failed = false, bad_input = false;
+    for (const SceneReport& s : reports) {
+        bad_input = bad_input || s.outcome == SceneOutcome::NotLoaded;
+        for (const CheckRow& r : s.rows) failed = failed || !r.pass;
     }
-    auto pad = [](const std::string& s, std::size_t w) {
-        return s + std::string(w > s.size() ? w - s.size() : 0, ' ');
-    };
-    int failed = 0;
-    out << pad("scene", scene_w) << "  " << pad("expectation", what_w) << "  result  reason\n";
-    for (const Line& l : lines) {
-        failed += l.row.pass ? 0 : 1;
-        out << pad(l.scene, scene_w) << "  " << pad(l.row.expectation, what_w) << "  "
-            << (l.row.pass ? "pass" : "FAIL    " + l.row.reason) << "\n";
+    if (options.junit &&
+        !writeTextReporting(*options.junit, junitXml(reports, secondsSince(start)), err)) {
+        return bad_input ? kExitBadInput : kExitFailure;
     }
-    out << scenes.size() << " scene" << (scenes.size() == 1 ? "" : "s") << ", " << lines.size()
-        << " expectations, " << failed << " failed\n";
-    return failed == 0 ? kExitOk : kExitFailure;
+    return bad_input ? kExitBadInput : failed ? kExitFailure : kExitOk;
 }
 
 }  // namespace app
