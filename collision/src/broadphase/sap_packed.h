@@ -28,9 +28,12 @@ namespace collision {
 /// Coherence (as Bullet's DBVT and Box2D's tree fatten leaves): the swept boxes are fat, the exact
 /// box grown by kMargin times its recent largest step per frame, and the candidate pairs (fat
 /// boxes overlap) are kept between frames. A frame where few boxes left their fat box re-fattens
-/// and re-queries only those; when many did, margins are not paying and everything is swept
-/// again with exact boxes, margins tried again kRetryFrames later. A new proxy set (insert,
-/// remove) is swept with exact boxes: the one-shot path.
+/// only those and looks each up in the last full sweep's sorted bands (binary search on min x,
+/// O(log n + k) per band), which still hold every box not re-fattened since; the re-fattened
+/// ("stale") boxes are tested apart, four at a time. Once many have escaped since the last full
+/// sweep, every fat box is swept again (margins kept); when most escape in one frame, margins
+/// are not paying and everything is swept with exact boxes, margins tried again kRetryFrames
+/// later. A new proxy set (insert, remove) is swept with exact boxes: the one-shot path.
 class PackedSweepAndPrune : public BroadPhase {
 public:
     std::string_view name() const override { return "sap-packed"; }
@@ -48,9 +51,10 @@ private:
     static constexpr float kBandWidth = 3.0f;  ///< band width / median y extent
     static constexpr int kBigBands = 4;        ///< a box meeting more bands than this is big
     static constexpr std::size_t kPad = 4;     ///< NaN sentinels after each swept list
-    static constexpr float kMargin = 32.0f;     ///< fat margin / recent motion per frame
+    static constexpr float kMargin = 16.0f;     ///< fat margin / recent motion per frame
     static constexpr float kMotionDecay = 0.95f;
-    static constexpr std::size_t kQueryShare = 128;  ///< escaped boxes per full sweep's cost
+    static constexpr std::size_t kEscapeShare = 4;  ///< a full sweep when n / this escape at once
+    static constexpr std::size_t kStaleShare = 4;   ///< ... or n / this since the last full one
     static constexpr int kRetryFrames = 32;
 
     /// Float bounds of a sorted list of boxes, one array per bound (structure of arrays), so
@@ -77,6 +81,11 @@ private:
     template <typename Hit>
     static std::int64_t sweepRange(const Lanes& lanes, std::size_t begin, std::size_t end,
                                    Hit&& hit);
+    /// Tests `box` against lanes from place j on, four at a time, calling hit(place) for each
+    /// overlap; stops at the first group with a box past max x (stop_past_x) or a NaN.
+    template <typename Hit>
+    static std::int64_t queryRange(const Lanes& lanes, std::size_t j, const float (&box)[6],
+                                   bool stop_past_x, Hit&& hit);
     int bandOf(float y) const {
         const float t = (y - band_lo_) * band_scale_;
         // Compare before converting: a NaN or huge t must not reach the integer conversion.
@@ -93,6 +102,7 @@ private:
     bool insideFat(ProxyId id) const;
     void rebuild();
     void fullSweep(BroadPhaseCounters& counters);
+    void restale();
     void queryEscaped(BroadPhaseCounters& counters);
 
     ProxyTable table_;
@@ -105,6 +115,12 @@ private:
     std::vector<float> motion_;    ///< recent largest centre step per frame, by id
     std::vector<ProxyId> present_;
     std::vector<ProxyId> escaped_;
+    std::vector<char> stale_;          ///< by id: re-fattened since the last full sweep
+    std::vector<ProxyId> stale_ids_;   ///< the stale ids, sorted on fat min x
+    std::vector<ProxyId> merged_ids_;
+    Lanes stale_lanes_;                ///< their fat boxes in that order, then kPad NaN
+    double stale_reach_ = 0;           ///< the widest stale fat box in x
+    std::vector<double> band_reach_;   ///< per band: its widest box in x
     std::vector<char> escaped_flag_;
     std::vector<ProxyPair> candidates_;
     std::vector<ProxyPair> fresh_;
