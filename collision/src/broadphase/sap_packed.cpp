@@ -73,6 +73,12 @@ void PackedSweepAndPrune::move(ProxyId id, const ProxyVolumes& v) {
     }
     table_.move(id, v);
     ++moved_;
+    // Whether it left its fat box, tested here while the box is at hand (a proxy set changed
+    // since the last findPairs is rebuilt whole: nothing to note).
+    if (!dirty_ && !escaped_flag_[id] && !insideFat(id)) {
+        escaped_flag_[id] = 1;
+        escaped_.push_back(id);
+    }
 }
 
 void PackedSweepAndPrune::radixSortEntries() {
@@ -374,11 +380,12 @@ void PackedSweepAndPrune::rebuild() {
             continue;
         }
         present_.push_back(id);
-        // Margins first given to all boxes at once would run out at once: each box's first
-        // margin is a fraction of the full one, from 1/2 to 1 by a hash of its id, so the
-        // escapes spread over the frames that follow.
+        // Margins given to all boxes at once would run out at once, and again every lifetime
+        // after (boxes moving steadily escape after about kMargin frames): each box's first
+        // margin is a fraction of the full one, spread over (0, 1] by a hash of its id, so the
+        // escapes spread evenly over the frames of a lifetime.
         const std::uint32_t hash = static_cast<std::uint32_t>(id) * 0x9E3779B9u;
-        const float share = 0.5f + 0.5f * float(hash >> 8) * 0x1.0p-24f;
+        const float share = float((hash >> 8) + 1) * 0x1.0p-24f;
         fatten(id, margins_on_ ? share * kMargin * motion_[id] : 0.0f);
     }
     shift_ = radix::bitsFor(static_cast<std::uint64_t>(capacity) + 1);
@@ -566,22 +573,15 @@ void PackedSweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCou
         fullSweep(counters);
         dirty_ = false;
     } else {
-        escaped_.clear();
-        for (const ProxyId id : present_) {
-            if (!insideFat(id)) escaped_.push_back(id);
-        }
+        // escaped_ (flagged in escaped_flag_): the boxes that move() found outside their fat box.
         // Past this many escaped boxes, their sweep costs about as much as a full one.
         const std::size_t limit = present_.size() / kEscapeShare + 1;
         if (escaped_.empty()) {
         } else if (margins_on_ && escaped_.size() <= limit &&
                    stale_ids_.size() + escaped_.size() <= present_.size() / kStaleShare) {
-            for (const ProxyId e : escaped_) {
-                fatten(e, kMargin * motion_[e]);
-                escaped_flag_[e] = 1;
-            }
+            for (const ProxyId e : escaped_) fatten(e, kMargin * motion_[e]);
             restale();
             queryEscaped(counters);
-            for (const ProxyId e : escaped_) escaped_flag_[e] = 0;
         } else if (margins_on_ && escaped_.size() <= present_.size() / 2) {
             // Many escaped at once: re-fatten them and sweep every fat box. The others keep
             // theirs, so the escapes stay spread over frames.
@@ -600,6 +600,8 @@ void PackedSweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCou
             fullSweep(counters);
         }
     }
+    for (const ProxyId e : escaped_) escaped_flag_[e] = 0;
+    escaped_.clear();
 
     // The exact answer: every candidate (fat boxes overlap) tested on the double AABBs, as
     // Aabb::overlaps does. Candidates are sorted, so the pairs are.
