@@ -210,8 +210,7 @@ void PackedSweepAndPrune::fullSweep(BroadPhaseCounters& counters) {
 
 template <typename Hit>
 std::int64_t PackedSweepAndPrune::queryRange(const Lanes& lanes, std::size_t j,
-                                             const float (&box)[6], bool stop_past_x,
-                                             Hit&& hit) {
+                                             const float (&box)[6], bool stop_past_x, Hit&& hit) {
     // box: min x, max x, min y, max y, min z, max z. From place j (a multiple of nothing in
     // particular), four lanes at a time, to the first group holding a box past max x
     // (stop_past_x: the lanes are sorted on min x) or a NaN sentinel.
@@ -300,7 +299,7 @@ void PackedSweepAndPrune::queryEscaped(BroadPhaseCounters& counters) {
     const Lanes& lanes = one ? all_ : band_;
     for (const ProxyId e : escaped_) {
         const std::size_t k = static_cast<std::size_t>(e);
-        const float box[6] = {fat_.min_x[k], fat_.max_x[k],  fat_.min_y[k],
+        const float box[6] = {fat_.min_x[k],      fat_.max_x[k], fat_.min_y[k],
                               -fat_.neg_max_y[k], fat_.min_z[k], -fat_.neg_max_z[k]};
         const auto key = [&](ProxyId other) {
             keys_.push_back((static_cast<std::uint64_t>(e) << shift_) |
@@ -451,7 +450,8 @@ void PackedSweepAndPrune::dealBands() {
             band_.copy(k, all_, i);
             band_place_[k] = static_cast<std::uint32_t>(i);
             band_first_[k] = first_band_[i];
-            band_reach_[b] = std::max(band_reach_[b], double(all_.max_x[i]) - double(all_.min_x[i]));
+            band_reach_[b] =
+                std::max(band_reach_[b], double(all_.max_x[i]) - double(all_.min_x[i]));
         }
     }
     for (int b = 0; b < bands_; ++b) {
@@ -468,8 +468,8 @@ void PackedSweepAndPrune::dealBands() {
 /// box, the boxes after it whose min x is within its x range get the y/z test, four at a time;
 /// hit(i, j) sees the places of each pair whose float boxes overlap. Returns the tests made.
 template <typename Hit>
-std::int64_t PackedSweepAndPrune::sweepRange(const Lanes& lanes, std::size_t begin,
-                                             std::size_t end, Hit&& hit) {
+std::int64_t PackedSweepAndPrune::sweepRange(const Lanes& lanes, std::size_t begin, std::size_t end,
+                                             Hit&& hit) {
     const float* min_x = lanes.min_x.data();
     const float* max_x = lanes.max_x.data();
     const float* min_y = lanes.min_y.data();
@@ -516,21 +516,22 @@ std::int64_t PackedSweepAndPrune::sweepRange(const Lanes& lanes, std::size_t beg
 
 void PackedSweepAndPrune::sweepBands(BroadPhaseCounters& counters) {
     if (bands_ == 1) {
-        counters.volume_tests += sweepRange(all_, 0, entries_.size(), [this](std::size_t i,
-                                                                           std::size_t j) {
-            confirm(i, j);
-        });
+        counters.volume_tests += sweepRange(
+            all_, 0, entries_.size(), [this](std::size_t i, std::size_t j) { confirm(i, j); });
         return;
     }
     const std::uint32_t* place = band_place_.data();
     const int* first = band_first_.data();
     for (int b = 0; b < bands_; ++b) {
-        counters.volume_tests += sweepRange(
-            band_, band_start_[b], band_start_[b + 1] - kPad, [&](std::size_t i, std::size_t j) {
-                // Report the pair only in the band of the larger min y, max(first band of
-                // each), which both boxes meet: both start at or before b, so one starts in b.
-                if (first[i] == b || first[j] == b) confirm(place[i], place[j]);
-            });
+        counters.volume_tests += sweepRange(band_, band_start_[b], band_start_[b + 1] - kPad,
+                                            [&](std::size_t i, std::size_t j) {
+                                                // Report the pair only in the band of the larger
+                                                // min y, max(first band of each), which both boxes
+                                                // meet: both start at or before b, so one starts in
+                                                // b.
+                                                if (first[i] == b || first[j] == b)
+                                                    confirm(place[i], place[j]);
+                                            });
     }
 }
 
@@ -539,8 +540,8 @@ void PackedSweepAndPrune::sweepBig(BroadPhaseCounters& counters) {
     std::int64_t tests = 0;
     // A big box against every box after it in the sorted list (big or not)...
     for (const std::uint32_t g : big_) {
-        tests += sweepRange(all_, g, g + 1,
-                            [this](std::size_t i, std::size_t j) { confirm(i, j); });
+        tests +=
+            sweepRange(all_, g, g + 1, [this](std::size_t i, std::size_t j) { confirm(i, j); });
     }
     // ...and every other box against the big boxes after it.
     const std::size_t n = entries_.size();

@@ -51,7 +51,7 @@ private:
     static constexpr float kBandWidth = 3.0f;  ///< band width / median y extent
     static constexpr int kBigBands = 4;        ///< a box meeting more bands than this is big
     static constexpr std::size_t kPad = 4;     ///< NaN sentinels after each swept list
-    static constexpr float kMargin = 16.0f;     ///< fat margin / recent motion per frame
+    static constexpr float kMargin = 16.0f;    ///< fat margin / recent motion per frame
     static constexpr float kMotionDecay = 0.95f;
     static constexpr std::size_t kEscapeShare = 4;  ///< a full sweep when n / this escape at once
     static constexpr std::size_t kStaleShare = 4;   ///< ... or n / this since the last full one
@@ -112,22 +112,22 @@ private:
     // Fat boxes by id (absent ids NaN): the exact box grown by kMargin times the box's recent
     // motion per frame, rounded outward; candidates_ holds every pair whose fat boxes overlap.
     Lanes fat_;
-    std::vector<float> motion_;    ///< recent largest centre step per frame, by id
+    std::vector<float> motion_;  ///< recent largest centre step per frame, by id
     std::vector<ProxyId> present_;
     std::vector<ProxyId> escaped_;
-    std::vector<char> stale_;          ///< by id: re-fattened since the last full sweep
-    std::vector<ProxyId> stale_ids_;   ///< the stale ids, sorted on fat min x
+    std::vector<char> stale_;         ///< by id: re-fattened since the last full sweep
+    std::vector<ProxyId> stale_ids_;  ///< the stale ids, sorted on fat min x
     std::vector<ProxyId> merged_ids_;
-    Lanes stale_lanes_;                ///< their fat boxes in that order, then kPad NaN
-    double stale_reach_ = 0;           ///< the widest stale fat box in x
-    std::vector<double> band_reach_;   ///< per band: its widest box in x
+    Lanes stale_lanes_;               ///< their fat boxes in that order, then kPad NaN
+    double stale_reach_ = 0;          ///< the widest stale fat box in x
+    std::vector<double> band_reach_;  ///< per band: its widest box in x
     std::vector<char> escaped_flag_;
     std::vector<ProxyPair> candidates_;
     std::vector<ProxyPair> fresh_;
     std::vector<ProxyPair> merged_;
     bool margins_on_ = false;
     int retry_in_ = 1;
-    float lo_y_ = 0;              ///< lowest min y and highest max y (float)
+    float lo_y_ = 0;  ///< lowest min y and highest max y (float)
     float hi_y_ = 0;
     // Bands along y: band b covers [band_lo_ + b / band_scale_, ...); the last is open above.
     int bands_ = 1;
