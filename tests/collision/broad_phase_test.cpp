@@ -624,10 +624,10 @@ TEST(PackedSweepAndPrune, JitteringBoxesEqualBruteForceWhileFatBoxesAreReused) {
 
 // sap-packed's steady state under steady motion: boxes of sizes 1:100 (log-uniform) and a few
 // huge ones (spanning many y bands, swept apart as "big") drift 1-2 % of their size per frame,
-// so every frame some boxes leave their fat box. Those are looked up in the last full sweep's
+// so every frame some boxes leave their fat box. Those are looked up in the sorted
 // bands, and boxes re-fattened since (stale) in a list of their own, sorted on min x:
 //
-//      bands (as of the last full sweep)     stale (current fat boxes)
+//      bands (as last dealt)                 stale (current fat boxes)
 //      y3 |  [==]   [=]     [====]           [=]  [==]       [=]
 //      y2 |    [=]    [==] [=]                  ^ escaped this frame: looked up in both
 //      y1 | [====]  [=]  [=]

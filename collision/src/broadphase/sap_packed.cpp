@@ -5,8 +5,8 @@
 // rounded outward, so it contains the exact box, and two exact boxes that overlap have fat boxes
 // that overlap; the pairs are the candidates that pass the exact double test. Between frames a
 // pair whose two fat boxes did not change keeps its status, so only the boxes that left their
-// fat box are re-queried and their old candidates dropped. The bands of the last full sweep
-// (band_, big_) hold the fat boxes as they were then; a box re-fattened since is stale (stale_),
+// fat box are re-queried and their old candidates dropped. The bands (band_, big_) hold the fat
+// boxes as they were when last dealt; a box re-fattened since is stale (stale_),
 // its band entry ignored and its current fat box kept in stale_lanes_ instead.
 #include "broadphase/sap_packed.h"
 
@@ -194,7 +194,7 @@ bool PackedSweepAndPrune::insideFat(ProxyId id) const {
            double(fat_.min_z[k]) <= box.min.z() && box.max.z() <= -double(fat_.neg_max_z[k]);
 }
 
-void PackedSweepAndPrune::fullSweep(BroadPhaseCounters& counters) {
+void PackedSweepAndPrune::resnapshot(BroadPhaseCounters& counters) {
     for (const ProxyId id : stale_ids_) stale_[id] = 0;
     stale_ids_.clear();
     stale_lanes_.resize(kPad);
@@ -202,6 +202,10 @@ void PackedSweepAndPrune::fullSweep(BroadPhaseCounters& counters) {
     sortEntries(counters);
     pack();
     dealBands();
+}
+
+void PackedSweepAndPrune::fullSweep(BroadPhaseCounters& counters) {
+    resnapshot(counters);
     keys_.clear();
     sweepBands(counters);
     sweepBig(counters);
@@ -286,7 +290,7 @@ void PackedSweepAndPrune::restale() {
 }
 
 void PackedSweepAndPrune::queryEscaped(BroadPhaseCounters& counters) {
-    // The last full sweep's sorted bands still hold every box that has not been re-fattened
+    // The sorted bands, as last dealt, still hold every box that has not been re-fattened
     // since (not stale): an escaped box is looked up in the bands its y range meets, by binary
     // search on min x from its min x less the band's widest box; the stale boxes' current fat
     // boxes are kept apart (stale_lanes_, sorted on min x) and looked up the same way. A
@@ -578,11 +582,13 @@ void PackedSweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCou
         // Past this many escaped boxes, their sweep costs about as much as a full one.
         const std::size_t limit = present_.size() / kEscapeShare + 1;
         if (escaped_.empty()) {
-        } else if (margins_on_ && escaped_.size() <= limit &&
-                   stale_ids_.size() + escaped_.size() <= present_.size() / kStaleShare) {
+        } else if (margins_on_ && escaped_.size() <= limit) {
             for (const ProxyId e : escaped_) fatten(e, kMargin * motion_[e]);
             restale();
             queryEscaped(counters);
+            // The candidates are complete; once many boxes are stale, their list is long and
+            // the bands are sorted and dealt again from the current fat boxes (no sweep).
+            if (stale_ids_.size() > present_.size() / kStaleShare) resnapshot(counters);
         } else if (margins_on_ && escaped_.size() <= present_.size() / 2) {
             // Many escaped at once: re-fatten them and sweep every fat box. The others keep
             // theirs, so the escapes stay spread over frames.

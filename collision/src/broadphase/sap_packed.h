@@ -28,12 +28,13 @@ namespace collision {
 /// Coherence (as Bullet's DBVT and Box2D's tree fatten leaves): the swept boxes are fat, the exact
 /// box grown by kMargin times its recent largest step per frame, and the candidate pairs (fat
 /// boxes overlap) are kept between frames. A frame where few boxes left their fat box re-fattens
-/// only those and looks each up in the last full sweep's sorted bands (binary search on min x,
+/// only those and looks each up in the last sorted bands (binary search on min x,
 /// O(log n + k) per band), which still hold every box not re-fattened since; the re-fattened
-/// ("stale") boxes are tested apart, four at a time. Once many have escaped since the last full
-/// sweep, every fat box is swept again (margins kept); when most escape in one frame, margins
-/// are not paying and everything is swept with exact boxes, margins tried again kRetryFrames
-/// later. A new proxy set (insert, remove) is swept with exact boxes: the one-shot path.
+/// ("stale") boxes are looked up in a sorted list of their own. Once many are stale, the bands
+/// are sorted and dealt again (no sweep: the candidates are complete). When many escape in one
+/// frame every fat box is swept again (margins kept); when most do, margins are not paying and
+/// everything is swept with exact boxes, margins tried again kRetryFrames later. A new proxy set
+/// (insert, remove) is swept with exact boxes: the one-shot path.
 class PackedSweepAndPrune : public BroadPhase {
 public:
     std::string_view name() const override { return "sap-packed"; }
@@ -54,7 +55,7 @@ private:
     static constexpr float kMargin = 16.0f;    ///< fat margin / recent motion per frame
     static constexpr float kMotionDecay = 0.95f;
     static constexpr std::size_t kEscapeShare = 4;  ///< a full sweep when n / this escape at once
-    static constexpr std::size_t kStaleShare = 4;   ///< ... or n / this since the last full one
+    static constexpr std::size_t kStaleShare = 4;   ///< bands dealt again past n / this stale
     static constexpr int kRetryFrames = 32;
 
     /// Float bounds of a sorted list of boxes, one array per bound (structure of arrays), so
@@ -101,6 +102,8 @@ private:
     void fatten(ProxyId id, float margin);
     bool insideFat(ProxyId id) const;
     void rebuild();
+    /// Sorts, packs and deals the current fat boxes into bands; none stale after.
+    void resnapshot(BroadPhaseCounters& counters);
     void fullSweep(BroadPhaseCounters& counters);
     void restale();
     void queryEscaped(BroadPhaseCounters& counters);
@@ -115,7 +118,7 @@ private:
     std::vector<float> motion_;  ///< recent largest centre step per frame, by id
     std::vector<ProxyId> present_;
     std::vector<ProxyId> escaped_;
-    std::vector<char> stale_;         ///< by id: re-fattened since the last full sweep
+    std::vector<char> stale_;         ///< by id: re-fattened since the bands were dealt
     std::vector<ProxyId> stale_ids_;  ///< the stale ids, sorted on fat min x
     std::vector<ProxyId> merged_ids_;
     Lanes stale_lanes_;               ///< their fat boxes in that order, then kPad NaN
