@@ -5,7 +5,9 @@
 // rounded outward, so it contains the exact box, and two exact boxes that overlap have fat boxes
 // that overlap; the pairs are the candidates that pass the exact double test. Between frames a
 // pair whose two fat boxes did not change keeps its status, so only the boxes that left their
-// fat box are re-queried (against every fat box) and their old candidates dropped.
+// fat box are re-queried and their old candidates dropped. The bands (band_, big_) hold the fat
+// boxes as they were when last dealt; a box re-fattened since is stale (stale_),
+// its band entry ignored and its current fat box kept in stale_lanes_ instead.
 #include "broadphase/sap_packed.h"
 
 #include <algorithm>
@@ -71,6 +73,12 @@ void PackedSweepAndPrune::move(ProxyId id, const ProxyVolumes& v) {
     }
     table_.move(id, v);
     ++moved_;
+    // Whether it left its fat box, tested here while the box is at hand (a proxy set changed
+    // since the last findPairs is rebuilt whole: nothing to note).
+    if (!dirty_ && !escaped_flag_[id] && !insideFat(id)) {
+        escaped_flag_[id] = 1;
+        escaped_.push_back(id);
+    }
 }
 
 void PackedSweepAndPrune::radixSortEntries() {
@@ -186,63 +194,161 @@ bool PackedSweepAndPrune::insideFat(ProxyId id) const {
            double(fat_.min_z[k]) <= box.min.z() && box.max.z() <= -double(fat_.neg_max_z[k]);
 }
 
-void PackedSweepAndPrune::fullSweep(BroadPhaseCounters& counters) {
+void PackedSweepAndPrune::resnapshot(BroadPhaseCounters& counters) {
+    for (const ProxyId id : stale_ids_) stale_[id] = 0;
+    stale_ids_.clear();
+    stale_lanes_.resize(kPad);
+    stale_lanes_.pad(0);
     sortEntries(counters);
     pack();
     dealBands();
+}
+
+void PackedSweepAndPrune::fullSweep(BroadPhaseCounters& counters) {
+    resnapshot(counters);
     keys_.clear();
     sweepBands(counters);
     sweepBig(counters);
     radix::keysToSortedPairs(keys_, scratch_, shift_, candidates_, /*order_ids=*/true);
 }
 
-void PackedSweepAndPrune::queryEscaped(BroadPhaseCounters& counters) {
-    // Each escaped box against every fat box, four at a time (absent ids are NaN: never hit).
-    // A pair of two escaped boxes is taken from the lower id only.
-    fresh_.clear();
-    const std::size_t blocks = (static_cast<std::size_t>(table_.capacity()) + 3) / 4;
+template <typename Hit>
+std::int64_t PackedSweepAndPrune::queryRange(const Lanes& lanes, std::size_t j,
+                                             const float (&box)[6], bool stop_past_x, Hit&& hit) {
+    // box: min x, max x, min y, max y, min z, max z. From place j (a multiple of nothing in
+    // particular), four lanes at a time, to the first group holding a box past max x
+    // (stop_past_x: the lanes are sorted on min x) or a NaN sentinel.
     std::int64_t tests = 0;
+#if defined(__SSE2__)
+    const __m128 hi_x = _mm_set1_ps(box[1]);
+    const __m128 lo_x = _mm_set1_ps(box[0]);
+    const __m128 hi_y = _mm_set1_ps(box[3]);
+    const __m128 hi_z = _mm_set1_ps(box[5]);
+    const __m128 neg_lo_y = _mm_set1_ps(-box[2]);
+    const __m128 neg_lo_z = _mm_set1_ps(-box[4]);
+    for (;; j += 4) {
+        const __m128 min_x = _mm_loadu_ps(lanes.min_x.data() + j);
+        const __m128 in_x = _mm_cmple_ps(min_x, hi_x);
+        __m128 m = _mm_and_ps(in_x, _mm_cmple_ps(lo_x, _mm_loadu_ps(lanes.max_x.data() + j)));
+        m = _mm_and_ps(m, _mm_cmple_ps(_mm_loadu_ps(lanes.min_y.data() + j), hi_y));
+        m = _mm_and_ps(m, _mm_cmple_ps(_mm_loadu_ps(lanes.min_z.data() + j), hi_z));
+        m = _mm_and_ps(m, _mm_cmple_ps(_mm_loadu_ps(lanes.neg_max_y.data() + j), neg_lo_y));
+        m = _mm_and_ps(m, _mm_cmple_ps(_mm_loadu_ps(lanes.neg_max_z.data() + j), neg_lo_z));
+        tests += 4;
+        for (int bits = _mm_movemask_ps(m); bits != 0; bits &= bits - 1) {
+            hit(j + static_cast<std::size_t>(std::countr_zero(unsigned(bits))));
+        }
+        const int x_bits = _mm_movemask_ps(stop_past_x ? in_x : _mm_cmpord_ps(min_x, min_x));
+        if (x_bits != 0xF) break;
+    }
+#else
+    for (; stop_past_x ? lanes.min_x[j] <= box[1] : lanes.min_x[j] == lanes.min_x[j]; ++j) {
+        ++tests;
+        if (box[0] <= lanes.max_x[j] && lanes.min_x[j] <= box[1] && lanes.min_y[j] <= box[3] &&
+            lanes.min_z[j] <= box[5] && lanes.neg_max_y[j] <= -box[2] &&
+            lanes.neg_max_z[j] <= -box[4]) {
+            hit(j);
+        }
+    }
+#endif
+    return tests;
+}
+
+void PackedSweepAndPrune::restale() {
+    // The stale boxes that did not escape this frame keep their fat boxes, hence their order;
+    // this frame's escaped boxes, sorted, are merged in (ties by id: deterministic).
+    std::sort(escaped_.begin(), escaped_.end(), [this](ProxyId a, ProxyId b) {
+        const float ka = fat_.min_x[static_cast<std::size_t>(a)];
+        const float kb = fat_.min_x[static_cast<std::size_t>(b)];
+        return ka < kb || (ka == kb && a < b);
+    });
+    merged_ids_.clear();
+    std::size_t e = 0;
+    const auto before = [this](ProxyId a, ProxyId b) {
+        const float ka = fat_.min_x[static_cast<std::size_t>(a)];
+        const float kb = fat_.min_x[static_cast<std::size_t>(b)];
+        return ka < kb || (ka == kb && a < b);
+    };
+    for (const ProxyId id : stale_ids_) {
+        if (escaped_flag_[id]) continue;
+        while (e < escaped_.size() && before(escaped_[e], id)) merged_ids_.push_back(escaped_[e++]);
+        merged_ids_.push_back(id);
+    }
+    merged_ids_.insert(merged_ids_.end(), escaped_.begin() + static_cast<std::ptrdiff_t>(e),
+                       escaped_.end());
+    stale_ids_.swap(merged_ids_);
+    for (const ProxyId id : escaped_) stale_[id] = 1;
+    const std::size_t count = stale_ids_.size();
+    stale_lanes_.resize(count + kPad);
+    stale_reach_ = 0;
+    for (std::size_t i = 0; i < count; ++i) {
+        const std::size_t k = static_cast<std::size_t>(stale_ids_[i]);
+        stale_lanes_.copy(i, fat_, k);
+        stale_reach_ = std::max(stale_reach_, double(fat_.max_x[k]) - double(fat_.min_x[k]));
+    }
+    stale_lanes_.pad(count);
+}
+
+void PackedSweepAndPrune::queryEscaped(BroadPhaseCounters& counters) {
+    // The sorted bands, as last dealt, still hold every box that has not been re-fattened
+    // since (not stale): an escaped box is looked up in the bands its y range meets, by binary
+    // search on min x from its min x less the band's widest box; the stale boxes' current fat
+    // boxes are kept apart (stale_lanes_, sorted on min x) and looked up the same way. A
+    // pair of two escaped boxes is taken from the lower id only; a pair met in several bands
+    // only in the band of the larger min y (as in the full sweep).
+    keys_.clear();
+    std::int64_t tests = 0;
+    const std::size_t n = entries_.size();
+    const bool one = bands_ == 1;
+    const Lanes& lanes = one ? all_ : band_;
     for (const ProxyId e : escaped_) {
         const std::size_t k = static_cast<std::size_t>(e);
-#if defined(__SSE2__)
-        const __m128 lim_x = _mm_set1_ps(fat_.max_x[k]);
-        const __m128 lim_nx = _mm_set1_ps(-fat_.min_x[k]);
-        const __m128 lim_y = _mm_set1_ps(-fat_.neg_max_y[k]);
-        const __m128 lim_z = _mm_set1_ps(-fat_.neg_max_z[k]);
-        const __m128 lim_ny = _mm_set1_ps(-fat_.min_y[k]);
-        const __m128 lim_nz = _mm_set1_ps(-fat_.min_z[k]);
-        const __m128 sign = _mm_set1_ps(-0.0f);
-        for (std::size_t b = 0; b < blocks; ++b) {
-            const std::size_t j = 4 * b;
-            __m128 m = _mm_cmple_ps(_mm_loadu_ps(fat_.min_x.data() + j), lim_x);
-            m = _mm_and_ps(m, _mm_cmple_ps(_mm_xor_ps(_mm_loadu_ps(fat_.max_x.data() + j), sign),
-                                           lim_nx));
-            m = _mm_and_ps(m, _mm_cmple_ps(_mm_loadu_ps(fat_.min_y.data() + j), lim_y));
-            m = _mm_and_ps(m, _mm_cmple_ps(_mm_loadu_ps(fat_.min_z.data() + j), lim_z));
-            m = _mm_and_ps(m, _mm_cmple_ps(_mm_loadu_ps(fat_.neg_max_y.data() + j), lim_ny));
-            m = _mm_and_ps(m, _mm_cmple_ps(_mm_loadu_ps(fat_.neg_max_z.data() + j), lim_nz));
-            for (int bits = _mm_movemask_ps(m); bits != 0; bits &= bits - 1) {
-                const ProxyId other =
-                    static_cast<ProxyId>(j + static_cast<std::size_t>(std::countr_zero(unsigned(bits))));
-                if (other == e || (escaped_flag_[other] && other < e)) continue;
-                fresh_.push_back(e < other ? ProxyPair{e, other} : ProxyPair{other, e});
+        const float box[6] = {fat_.min_x[k],      fat_.max_x[k], fat_.min_y[k],
+                              -fat_.neg_max_y[k], fat_.min_z[k], -fat_.neg_max_z[k]};
+        const auto key = [&](ProxyId other) {
+            keys_.push_back((static_cast<std::uint64_t>(e) << shift_) |
+                            static_cast<std::uint64_t>(other));
+        };
+        const int fe = one ? 0 : bandOf(box[2]);
+        const int le = one ? 0 : bandOf(box[3]);
+        for (int b = fe; b <= le; ++b) {
+            const std::size_t begin = one ? 0 : band_start_[b];
+            const std::size_t end = one ? n : band_start_[b + 1] - kPad;
+            const float from = roundDown(double(box[0]) - band_reach_[b]);
+            const auto first = lanes.min_x.begin();
+            const std::size_t j = static_cast<std::size_t>(
+                std::lower_bound(first + static_cast<std::ptrdiff_t>(begin),
+                                 first + static_cast<std::ptrdiff_t>(end), from) -
+                first);
+            tests += queryRange(lanes, j, box, true, [&](std::size_t at) {
+                if (!one && b != std::max(fe, band_first_[at])) return;
+                const ProxyId other = ids_[one ? at : band_place_[at]];
+                if (!stale_[other]) key(other);
+            });
+        }
+        for (const std::uint32_t g : big_) {
+            ++tests;
+            const ProxyId other = ids_[g];
+            if (stale_[other]) continue;
+            if (all_.min_x[g] <= box[1] && all_.max_x[g] >= box[0] && all_.min_y[g] <= box[3] &&
+                all_.min_z[g] <= box[5] && -all_.neg_max_y[g] >= box[2] &&
+                -all_.neg_max_z[g] >= box[4]) {
+                key(other);
             }
         }
-#else
-        for (std::size_t j = 0; j < 4 * blocks; ++j) {
-            if (fat_.min_x[j] <= fat_.max_x[k] && fat_.min_x[k] <= fat_.max_x[j] &&
-                fat_.min_y[j] <= -fat_.neg_max_y[k] && fat_.min_z[j] <= -fat_.neg_max_z[k] &&
-                fat_.neg_max_y[j] <= -fat_.min_y[k] && fat_.neg_max_z[j] <= -fat_.min_z[k]) {
-                const ProxyId other = static_cast<ProxyId>(j);
-                if (other == e || (escaped_flag_[other] && other < e)) continue;
-                fresh_.push_back(e < other ? ProxyPair{e, other} : ProxyPair{other, e});
-            }
-        }
-#endif
-        tests += static_cast<std::int64_t>(4 * blocks);
+        const auto first = stale_lanes_.min_x.begin();
+        const std::size_t from = static_cast<std::size_t>(
+            std::lower_bound(first, first + static_cast<std::ptrdiff_t>(stale_ids_.size()),
+                             roundDown(double(box[0]) - stale_reach_)) -
+            first);
+        tests += queryRange(stale_lanes_, from, box, true, [&](std::size_t at) {
+            const ProxyId other = stale_ids_[at];
+            if (other == e || (escaped_flag_[other] && other < e)) return;
+            key(other);
+        });
     }
     counters.volume_tests += tests;
-    std::sort(fresh_.begin(), fresh_.end());
+    radix::keysToSortedPairs(keys_, scratch_, shift_, fresh_, /*order_ids=*/true);
     // The kept candidates (no escaped member) and the fresh ones, both sorted, merged.
     merged_.clear();
     std::size_t f = 0;
@@ -265,6 +371,8 @@ void PackedSweepAndPrune::rebuild() {
             fat_.neg_max_z[k] = std::numeric_limits<float>::quiet_NaN();
     }
     escaped_flag_.assign(capacity, 0);
+    stale_.assign(capacity, 0);
+    stale_ids_.clear();
     motion_.resize(capacity, 0);
     present_.clear();
     for (ProxyId id = 0; id < table_.capacity(); ++id) {
@@ -275,7 +383,13 @@ void PackedSweepAndPrune::rebuild() {
             continue;
         }
         present_.push_back(id);
-        fatten(id, margins_on_ ? kMargin * motion_[id] : 0.0f);
+        // Margins given to all boxes at once would run out at once, and again every lifetime
+        // after (boxes moving steadily escape after about kMargin frames): each box's first
+        // margin is a fraction of the full one, spread over (0, 1] by a hash of its id, so the
+        // escapes spread evenly over the frames of a lifetime.
+        const std::uint32_t hash = static_cast<std::uint32_t>(id) * 0x9E3779B9u;
+        const float share = float((hash >> 8) + 1) * 0x1.0p-24f;
+        fatten(id, margins_on_ ? share * kMargin * motion_[id] : 0.0f);
     }
     shift_ = radix::bitsFor(static_cast<std::uint64_t>(capacity) + 1);
 }
@@ -299,7 +413,14 @@ void PackedSweepAndPrune::dealBands() {
         const std::size_t most = std::min<std::size_t>(kMaxBands, n / kMinPerBand);
         bands_ = static_cast<int>(std::clamp<float>(std::ceil(span / width), 1, float(most)));
     }
-    if (bands_ == 1) return;
+    if (bands_ == 1) {
+        double reach = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            reach = std::max(reach, double(all_.max_x[i]) - double(all_.min_x[i]));
+        }
+        band_reach_.assign(1, reach);
+        return;
+    }
     band_lo_ = lo_y_;
     band_scale_ = float(bands_) / span;
 
@@ -324,6 +445,7 @@ void PackedSweepAndPrune::dealBands() {
     band_place_.resize(total);
     band_first_.resize(total);
     fill_.assign(band_start_.begin(), band_start_.end() - 1);
+    band_reach_.assign(static_cast<std::size_t>(bands_), 0.0);
     // Dealt in sorted order, so every band is sorted on min x.
     for (std::size_t i = 0; i < n; ++i) {
         if (first_band_[i] < 0) continue;
@@ -332,6 +454,8 @@ void PackedSweepAndPrune::dealBands() {
             band_.copy(k, all_, i);
             band_place_[k] = static_cast<std::uint32_t>(i);
             band_first_[k] = first_band_[i];
+            band_reach_[b] =
+                std::max(band_reach_[b], double(all_.max_x[i]) - double(all_.min_x[i]));
         }
     }
     for (int b = 0; b < bands_; ++b) {
@@ -348,8 +472,8 @@ void PackedSweepAndPrune::dealBands() {
 /// box, the boxes after it whose min x is within its x range get the y/z test, four at a time;
 /// hit(i, j) sees the places of each pair whose float boxes overlap. Returns the tests made.
 template <typename Hit>
-std::int64_t PackedSweepAndPrune::sweepRange(const Lanes& lanes, std::size_t begin,
-                                             std::size_t end, Hit&& hit) {
+std::int64_t PackedSweepAndPrune::sweepRange(const Lanes& lanes, std::size_t begin, std::size_t end,
+                                             Hit&& hit) {
     const float* min_x = lanes.min_x.data();
     const float* max_x = lanes.max_x.data();
     const float* min_y = lanes.min_y.data();
@@ -396,21 +520,22 @@ std::int64_t PackedSweepAndPrune::sweepRange(const Lanes& lanes, std::size_t beg
 
 void PackedSweepAndPrune::sweepBands(BroadPhaseCounters& counters) {
     if (bands_ == 1) {
-        counters.volume_tests += sweepRange(all_, 0, entries_.size(), [this](std::size_t i,
-                                                                           std::size_t j) {
-            confirm(i, j);
-        });
+        counters.volume_tests += sweepRange(
+            all_, 0, entries_.size(), [this](std::size_t i, std::size_t j) { confirm(i, j); });
         return;
     }
     const std::uint32_t* place = band_place_.data();
     const int* first = band_first_.data();
     for (int b = 0; b < bands_; ++b) {
-        counters.volume_tests += sweepRange(
-            band_, band_start_[b], band_start_[b + 1] - kPad, [&](std::size_t i, std::size_t j) {
-                // Report the pair only in the band of the larger min y, max(first band of
-                // each), which both boxes meet: both start at or before b, so one starts in b.
-                if (first[i] == b || first[j] == b) confirm(place[i], place[j]);
-            });
+        counters.volume_tests += sweepRange(band_, band_start_[b], band_start_[b + 1] - kPad,
+                                            [&](std::size_t i, std::size_t j) {
+                                                // Report the pair only in the band of the larger
+                                                // min y, max(first band of each), which both boxes
+                                                // meet: both start at or before b, so one starts in
+                                                // b.
+                                                if (first[i] == b || first[j] == b)
+                                                    confirm(place[i], place[j]);
+                                            });
     }
 }
 
@@ -419,8 +544,8 @@ void PackedSweepAndPrune::sweepBig(BroadPhaseCounters& counters) {
     std::int64_t tests = 0;
     // A big box against every box after it in the sorted list (big or not)...
     for (const std::uint32_t g : big_) {
-        tests += sweepRange(all_, g, g + 1,
-                            [this](std::size_t i, std::size_t j) { confirm(i, j); });
+        tests +=
+            sweepRange(all_, g, g + 1, [this](std::size_t i, std::size_t j) { confirm(i, j); });
     }
     // ...and every other box against the big boxes after it.
     const std::size_t n = entries_.size();
@@ -453,22 +578,24 @@ void PackedSweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCou
         fullSweep(counters);
         dirty_ = false;
     } else {
-        escaped_.clear();
-        for (const ProxyId id : present_) {
-            if (!insideFat(id)) escaped_.push_back(id);
-        }
-        // A query scans every fat box; a full sweep costs about kQueryShare of them per box.
-        const std::size_t limit = present_.size() / kQueryShare + 1;
+        // escaped_ (flagged in escaped_flag_): the boxes that move() found outside their fat box.
+        // Past this many escaped boxes, their sweep costs about as much as a full one.
+        const std::size_t limit = present_.size() / kEscapeShare + 1;
         if (escaped_.empty()) {
         } else if (margins_on_ && escaped_.size() <= limit) {
-            for (const ProxyId e : escaped_) {
-                fatten(e, kMargin * motion_[e]);
-                escaped_flag_[e] = 1;
-            }
+            for (const ProxyId e : escaped_) fatten(e, kMargin * motion_[e]);
+            restale();
             queryEscaped(counters);
-            for (const ProxyId e : escaped_) escaped_flag_[e] = 0;
+            // The candidates are complete; once many boxes are stale, their list is long and
+            // the bands are sorted and dealt again from the current fat boxes (no sweep).
+            if (stale_ids_.size() > present_.size() / kStaleShare) resnapshot(counters);
+        } else if (margins_on_ && escaped_.size() <= present_.size() / 2) {
+            // Many escaped at once: re-fatten them and sweep every fat box. The others keep
+            // theirs, so the escapes stay spread over frames.
+            for (const ProxyId e : escaped_) fatten(e, kMargin * motion_[e]);
+            fullSweep(counters);
         } else {
-            // Too many left their fat boxes: margins do not pay here (or not yet). Sweep
+            // Most left their fat boxes: margins do not pay here (or not yet). Sweep
             // everything, now and then trying margins again.
             if (margins_on_) {
                 margins_on_ = false;
@@ -480,6 +607,9 @@ void PackedSweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCou
             fullSweep(counters);
         }
     }
+    for (const ProxyId e : escaped_) escaped_flag_[e] = 0;
+    escaped_.clear();
+
     // The exact answer: every candidate (fat boxes overlap) tested on the double AABBs, as
     // Aabb::overlaps does. Candidates are sorted, so the pairs are.
     // Branch-free: every candidate is written, and the count advances only for an overlap

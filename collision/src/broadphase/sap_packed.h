@@ -28,9 +28,13 @@ namespace collision {
 /// Coherence (as Bullet's DBVT and Box2D's tree fatten leaves): the swept boxes are fat, the exact
 /// box grown by kMargin times its recent largest step per frame, and the candidate pairs (fat
 /// boxes overlap) are kept between frames. A frame where few boxes left their fat box re-fattens
-/// and re-queries only those; when many did, margins are not paying and everything is swept
-/// again with exact boxes, margins tried again kRetryFrames later. A new proxy set (insert,
-/// remove) is swept with exact boxes: the one-shot path.
+/// only those and looks each up in the last sorted bands (binary search on min x,
+/// O(log n + k) per band), which still hold every box not re-fattened since; the re-fattened
+/// ("stale") boxes are looked up in a sorted list of their own. Once many are stale, the bands
+/// are sorted and dealt again (no sweep: the candidates are complete). When many escape in one
+/// frame every fat box is swept again (margins kept); when most do, margins are not paying and
+/// everything is swept with exact boxes, margins tried again kRetryFrames later. A new proxy set
+/// (insert, remove) is swept with exact boxes: the one-shot path.
 class PackedSweepAndPrune : public BroadPhase {
 public:
     std::string_view name() const override { return "sap-packed"; }
@@ -48,9 +52,10 @@ private:
     static constexpr float kBandWidth = 3.0f;  ///< band width / median y extent
     static constexpr int kBigBands = 4;        ///< a box meeting more bands than this is big
     static constexpr std::size_t kPad = 4;     ///< NaN sentinels after each swept list
-    static constexpr float kMargin = 32.0f;     ///< fat margin / recent motion per frame
+    static constexpr float kMargin = 16.0f;    ///< fat margin / recent motion per frame
     static constexpr float kMotionDecay = 0.95f;
-    static constexpr std::size_t kQueryShare = 128;  ///< escaped boxes per full sweep's cost
+    static constexpr std::size_t kEscapeShare = 4;  ///< a full sweep when n / this escape at once
+    static constexpr std::size_t kStaleShare = 4;   ///< bands dealt again past n / this stale
     static constexpr int kRetryFrames = 32;
 
     /// Float bounds of a sorted list of boxes, one array per bound (structure of arrays), so
@@ -77,6 +82,11 @@ private:
     template <typename Hit>
     static std::int64_t sweepRange(const Lanes& lanes, std::size_t begin, std::size_t end,
                                    Hit&& hit);
+    /// Tests `box` against lanes from place j on, four at a time, calling hit(place) for each
+    /// overlap; stops at the first group with a box past max x (stop_past_x) or a NaN.
+    template <typename Hit>
+    static std::int64_t queryRange(const Lanes& lanes, std::size_t j, const float (&box)[6],
+                                   bool stop_past_x, Hit&& hit);
     int bandOf(float y) const {
         const float t = (y - band_lo_) * band_scale_;
         // Compare before converting: a NaN or huge t must not reach the integer conversion.
@@ -92,7 +102,10 @@ private:
     void fatten(ProxyId id, float margin);
     bool insideFat(ProxyId id) const;
     void rebuild();
+    /// Sorts, packs and deals the current fat boxes into bands; none stale after.
+    void resnapshot(BroadPhaseCounters& counters);
     void fullSweep(BroadPhaseCounters& counters);
+    void restale();
     void queryEscaped(BroadPhaseCounters& counters);
 
     ProxyTable table_;
@@ -102,16 +115,22 @@ private:
     // Fat boxes by id (absent ids NaN): the exact box grown by kMargin times the box's recent
     // motion per frame, rounded outward; candidates_ holds every pair whose fat boxes overlap.
     Lanes fat_;
-    std::vector<float> motion_;    ///< recent largest centre step per frame, by id
+    std::vector<float> motion_;  ///< recent largest centre step per frame, by id
     std::vector<ProxyId> present_;
     std::vector<ProxyId> escaped_;
+    std::vector<char> stale_;         ///< by id: re-fattened since the bands were dealt
+    std::vector<ProxyId> stale_ids_;  ///< the stale ids, sorted on fat min x
+    std::vector<ProxyId> merged_ids_;
+    Lanes stale_lanes_;               ///< their fat boxes in that order, then kPad NaN
+    double stale_reach_ = 0;          ///< the widest stale fat box in x
+    std::vector<double> band_reach_;  ///< per band: its widest box in x
     std::vector<char> escaped_flag_;
     std::vector<ProxyPair> candidates_;
     std::vector<ProxyPair> fresh_;
     std::vector<ProxyPair> merged_;
     bool margins_on_ = false;
     int retry_in_ = 1;
-    float lo_y_ = 0;              ///< lowest min y and highest max y (float)
+    float lo_y_ = 0;  ///< lowest min y and highest max y (float)
     float hi_y_ = 0;
     // Bands along y: band b covers [band_lo_ + b / band_scale_, ...); the last is open above.
     int bands_ = 1;
