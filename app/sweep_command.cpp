@@ -22,7 +22,8 @@ Command addSweepCommand(CLI::App& cli) {
     CLI::App* cmd = cli.add_subcommand(
         "sweep",
         "run one scene under every combination of choices; measure cost and accuracy "
-        "against a fine reference run; write results.csv, report.md and charts");
+        "against a fine reference run; write results.csv, report.md, charts and report.html "
+        "(a page that opens from disk: the charts and a sortable table)");
     cmd->add_option("scene", f->sweep.scene, "scene file (YAML)")->required();
     cmd->add_option("--vary", f->sweep.vary,
                     "KEY=V1,V2,... (repeatable): a dotted scene key and its values, e.g. "

@@ -30,6 +30,7 @@
 #include "render/chart.h"
 #include "render/image.h"
 #include "run_scene.h"
+#include "sweep_html.h"
 #include "sweep_measure.h"
 #include "sweep_report.h"
 
@@ -391,7 +392,8 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
     try {
         prepareOutputDir(out_dir);
         for (const char* f :
-             {"results.csv", "report.md", "float_vs_double.csv", "float_deviation.png"}) {
+             {"results.csv", "report.md", "report.html", "float_vs_double.csv",
+              "float_deviation.png"}) {
             fs::remove(out_dir / f);
         }
         for (const Chart& c : charts()) fs::remove(out_dir / c.file);
@@ -409,7 +411,9 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
         writeTextAtomically(out_dir / "results.csv", csvTable(runs));
         writeTextAtomically(out_dir / "report.md",
                             markdownReport(options, base, duration, runs, reference, floats));
+        writeSweepHtml(out_dir / "report.html", options, runs, reference, floats, {});
         out << "wrote " << (out_dir / "report.md").string() << ", "
+            << (out_dir / "report.html").string() << ", "
             << (out_dir / "results.csv").string() << " and charts\n";
     } catch (const std::exception& e) {
         err << "error: " << e.what() << "\n";

@@ -44,6 +44,13 @@ struct SweepOptions {
     int repeat = 3;
 };
 
+/// A run of a planned sweep that left no usable result: named on stderr and in report.md,
+/// never silently left out.
+struct SweepFailure {
+    std::string label;   ///< the run, as SweepRun::label ("reference" for the reference run)
+    std::string reason;  ///< why: no result file, or the job's own error
+};
+
 /// A wall-clock figure over the repeats of one run (ms): median and range.
 struct Timed {
     double median = 0;
