@@ -142,9 +142,9 @@ std::string sweepPageHtml(const SweepOptions& options, const std::vector<SweepRu
     std::string out = html::pageStart("cdlab sweep: " + scene);
     out +=
         "<header>\n<h1>Sweep of " + html::escape(scene) + "</h1>\n<p class=\"meta\">" +
-        std::to_string(runs.size()) + " runs and the reference (" +
-        html::escape(reference.label.empty() ? "the scene at a finer time step" : reference.label) +
-        ") &middot; <a href=\"report.md\">report.md</a> (the reading) &middot; "
+        std::to_string(runs.size()) +
+        " runs, each measured against the reference run (the last bar of each chart) "
+        "&middot; <a href=\"report.md\">report.md</a> (the reading) &middot; "
         "<a href=\"results.csv\">results.csv</a></p>\n</header>\n<main>\n";
     out += failureBanner(failures, runs.size());
     out += "<section id=\"charts\">\n<h2>Charts</h2>\n</section>\n";

@@ -1,14 +1,19 @@
 // tests/app/browser.h -- headless Chromium for the tests of cdlab's HTML pages: load a page from
 // disk, let its scripts run, and take the DOM they left or a screenshot; pick attributes out of
-// the serialised DOM.
+// the serialised DOM; count a colour in part of a screenshot.
 #pragma once
 
+#include <algorithm>
+#include <array>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <regex>
+#include <sstream>
 #include <string>
 
 #include "cli_run.h"
+#include "render/image.h"
 
 namespace cdlab_test {
 
@@ -68,6 +73,24 @@ inline int countOf(const std::string& text, const std::string& needle) {
     for (std::size_t at = text.find(needle); at != std::string::npos;
          at = text.find(needle, at + needle.size())) {
         ++n;
+    }
+    return n;
+}
+
+/// Pixels of a screenshot within 40 per channel of `rgb` inside `rect`, "x,y,width,height" in
+/// page pixels (a page's data-rect attribute).
+inline int pixelsInRect(const render::Image& image, const std::string& rect,
+                        std::array<int, 3> rgb) {
+    int x0 = 0, y0 = 0, w = 0, h = 0;
+    char sep = 0;
+    std::stringstream(rect) >> x0 >> sep >> y0 >> sep >> w >> sep >> h;
+    int n = 0;
+    for (int y = std::max(y0, 0); y < std::min(y0 + h, image.height); ++y) {
+        for (int x = std::max(x0, 0); x < std::min(x0 + w, image.width); ++x) {
+            const std::uint8_t* p = image.pixel(x, y);
+            n += std::abs(p[0] - rgb[0]) <= 40 && std::abs(p[1] - rgb[1]) <= 40 &&
+                 std::abs(p[2] - rgb[2]) <= 40;
+        }
     }
     return n;
 }

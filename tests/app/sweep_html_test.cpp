@@ -40,22 +40,6 @@ int dataLines(const fs::path& file) {
     return n;
 }
 
-// Pixels within 40 per channel of `rgb` inside the rectangle "x,y,width,height".
-int pixelsInRect(const render::Image& image, const std::string& rect, std::array<int, 3> rgb) {
-    int x0 = 0, y0 = 0, w = 0, h = 0;
-    char sep;
-    std::stringstream(rect) >> x0 >> sep >> y0 >> sep >> w >> sep >> h;
-    int n = 0;
-    for (int y = std::max(y0, 0); y < std::min(y0 + h, image.height); ++y) {
-        for (int x = std::max(x0, 0); x < std::min(x0 + w, image.width); ++x) {
-            const std::uint8_t* p = image.pixel(x, y);
-            n += std::abs(p[0] - rgb[0]) <= 40 && std::abs(p[1] - rgb[1]) <= 40 &&
-                 std::abs(p[2] - rgb[2]) <= 40;
-        }
-    }
-    return n;
-}
-
 }  // namespace
 
 // Three time steps over the same 0.1 s: 2, 10 and 50 steps. Sorted by steps, descending, the

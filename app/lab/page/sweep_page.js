@@ -15,6 +15,19 @@
                            a.right - a.left, a.bottom - a.top].map(Math.round).join(',');
   }
 
+  // Axis numbers: three significant digits, exponents outside 1e-3..1e5.
+  function tick(value) {
+    const v = Number(value);
+    if (v === 0) return '0';
+    const a = Math.abs(v);
+    return a >= 1e-3 && a < 1e5 ? String(Number(v.toPrecision(3))) : v.toExponential(1);
+  }
+  // A log axis labels its powers of ten only.
+  function decade(value) {
+    const e = Math.log10(Number(value));
+    return Math.abs(e - Math.round(e)) < 1e-9 ? '1e' + Math.round(e) : '';
+  }
+
   function barChart(spec, index) {
     const box = document.createElement('div');
     box.className = 'bar-box';
@@ -39,7 +52,9 @@
       options: {
         indexAxis: 'y', animation: false, responsive: true, maintainAspectRatio: false,
         scales: { x: { type: spec.log_scale ? 'logarithmic' : 'linear',
-                       beginAtZero: !spec.log_scale } },
+                       beginAtZero: !spec.log_scale,
+                       ticks: { maxRotation: 0, callback: spec.log_scale ? decade : tick } },
+                  y: { ticks: { autoSkip: false } } },
         plugins: { legend: { display: false },
                    title: { display: true, text: spec.title + ' (' + spec.file + ')' } }
       }
