@@ -25,15 +25,15 @@
 #include "collision/broadphase/broad_phase.h"
 #include "engine/scene.h"
 #include "exit_codes.h"
+#include "html_page.h"
 #include "output_files.h"
 #include "pause_dump.h"
-#include "html_page.h"
-#include "run_html.h"
 #include "render/frame_writer.h"
 #include "render/image.h"
 #include "render/output_file.h"
 #include "render/renderer.h"
 #include "render/volume_states.h"
+#include "run_html.h"
 
 namespace app {
 
