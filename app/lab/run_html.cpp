@@ -61,8 +61,14 @@ nlohmann::ordered_json pageData(const RunPage& page) {
     data["timeline"] = timelineJson(page.frames);
     nlohmann::ordered_json pauses = nlohmann::ordered_json::array();
     for (const RunPagePause& p : page.pauses) {
+        nlohmann::ordered_json rects = nlohmann::ordered_json::array();
+        for (const std::optional<render::ScreenRect>& r : p.body_rects) {
+            rects.push_back(r ? nlohmann::ordered_json{r->x0, r->y0, r->x1, r->y1}
+                              : nlohmann::ordered_json());
+        }
         pauses.push_back({{"frame", p.frame},
                           {"picture", "pause_" + std::to_string(p.frame) + ".png"},
+                          {"rects", std::move(rects)},
                           {"dump", nlohmann::ordered_json::parse(p.dump_json)}});
     }
     data["pauses"] = std::move(pauses);

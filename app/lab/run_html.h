@@ -4,8 +4,11 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "render/renderer.h"
 
 namespace app {
 
@@ -25,6 +28,9 @@ struct RunPageFrame {
 struct RunPagePause {
     int frame = 0;
     std::string dump_json;  ///< pause_FRAME.json's text
+    /// Where each body's AABB shows in the picture (render::screenRect), by body id; nothing
+    /// for a body off the picture or reaching behind the camera.
+    std::vector<std::optional<render::ScreenRect>> body_rects;
 };
 
 /// What index.html shows of a finished run.

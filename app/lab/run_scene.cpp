@@ -3,10 +3,7 @@
 // and renamed, and summary.json, written last, marks a finished run.
 #include "run_scene.h"
 
-#include <memory>
-#include <string>
 #include <unistd.h>
-#include <vector>
 
 #include <algorithm>
 #include <chrono>
@@ -15,11 +12,15 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <memory>
 #include <new>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <sstream>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "broadphase_check.h"
 #include "collision/broadphase/broad_phase.h"
@@ -188,6 +189,17 @@ RunPageFrame pageFrame(int frame, const engine::World& world, const FrameStats& 
     row.response_ms = 1e3 * f.response_s;
     row.step_ms = 1e3 * f.total_s;
     return row;
+}
+
+// Where each body's AABB shows in the run's pictures (index.html outlines a body there).
+std::vector<std::optional<render::ScreenRect>> bodyRects(const engine::World& world,
+                                                         const engine::Scene& scene) {
+    std::vector<std::optional<render::ScreenRect>> rects;
+    for (const collision::ProxyVolumes& v : world.volumes()) {
+        rects.push_back(render::screenRect(scene.camera, scene.output.width, scene.output.height,
+                                           v.aabb.min, v.aabb.max));
+    }
+    return rects;
 }
 
 std::string frameName(int frame) {
@@ -430,7 +442,9 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
                 writer.submit(std::move(pause_image), out_dir / (stem + ".png"), hold_frames);
                 std::string dump = pauseDumpJson(world, frame);
                 writeTextAtomically(out_dir / (stem + ".json"), dump);
-                if (options.html) page.pauses.push_back({frame, std::move(dump)});
+                if (options.html) {
+                    page.pauses.push_back({frame, std::move(dump), bodyRects(world, scene)});
+                }
             }
             progress.update(frame + 1);
         }

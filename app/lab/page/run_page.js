@@ -218,15 +218,35 @@
     heading.appendChild(jump);
     article.appendChild(heading);
     const grid = text('div', undefined, 'pause-grid');
+    // The picture with an outline over the body shown (its AABB's place in the picture).
+    const picture = text('div', undefined, 'picture');
     const img = document.createElement('img');
     img.src = pause.picture;
     img.alt = 'pause picture of frame ' + pause.frame;
     img.addEventListener('error', function () {
-      img.replaceWith(text('p', 'no picture: cannot load ' + pause.picture, 'missing'));
+      picture.replaceWith(text('p', 'no picture: cannot load ' + pause.picture, 'missing'));
     });
-    grid.appendChild(img);
+    picture.appendChild(img);
+    const outlines = [];
+    const outline = function (ids) {
+      outlines.forEach(function (o) { o.remove(); });
+      outlines.length = 0;
+      ids.forEach(function (id) {
+        const r = pause.rects[id];
+        if (!r) return;
+        const o = text('div', undefined, 'outline');
+        o.style.left = (100 * r[0] / data.width) + '%';
+        o.style.top = (100 * r[1] / data.height) + '%';
+        o.style.width = (100 * (r[2] - r[0]) / data.width) + '%';
+        o.style.height = (100 * (r[3] - r[1]) / data.height) + '%';
+        picture.appendChild(o);
+        outlines.push(o);
+      });
+    };
+    grid.appendChild(picture);
     const side = text('div', undefined, 'pause-side');
-    const detail = text('div', 'Hover over or click a body to see its volumes and state.', 'detail');
+    const detail = text('div', 'Hover over or click a body (in the list or in the picture) to ' +
+                        'see its volumes and state.', 'detail');
     const table = document.createElement('table');
     table.className = 'bodies';
     const head = table.createTHead().insertRow();
@@ -239,7 +259,36 @@
       body.querySelectorAll('tr.highlight').forEach(function (r) { r.classList.remove('highlight'); });
       row.classList.add('highlight');
       detail.replaceChildren(bodyDetail(b));
+      outline([b.id]);
     };
+    // The body under the pointer: the smallest outline holding it (nearer bodies tend to be
+    // larger, so the smallest is the most specific guess).
+    const bodyAt = function (event) {
+      const box = img.getBoundingClientRect();
+      const x = (event.clientX - box.left) * data.width / box.width;
+      const y = (event.clientY - box.top) * data.height / box.height;
+      let best = -1, area = Infinity;
+      pause.rects.forEach(function (r, id) {
+        if (!r || x < r[0] || x > r[2] || y < r[1] || y > r[3]) return;
+        const a = (r[2] - r[0]) * (r[3] - r[1]);
+        if (a < area) { area = a; best = id; }
+      });
+      return best;
+    };
+    picture.addEventListener('mousemove', function (event) {
+      const id = bodyAt(event);
+      if (id >= 0) show(body.rows[id], dump.bodies[id]);
+    });
+    picture.addEventListener('click', function (event) {
+      const id = bodyAt(event);
+      if (id < 0) return;
+      pinned = { row: body.rows[id], body: dump.bodies[id] };
+      show(pinned.row, pinned.body);
+      pinned.row.scrollIntoView({ block: 'nearest' });
+    });
+    picture.addEventListener('mouseleave', function () {
+      if (pinned) show(pinned.row, pinned.body);
+    });
     dump.bodies.forEach(function (b) {
       const row = body.insertRow();
       row.className = 'body state-' + b.state;
@@ -248,7 +297,12 @@
        b.volume_states.obb].forEach(function (c) { row.appendChild(text('td', String(c))); });
       row.addEventListener('mouseenter', function () { show(row, b); });
       row.addEventListener('mouseleave', function () {
-        if (pinned) show(pinned.row, pinned.body); else row.classList.remove('highlight');
+        if (pinned) {
+          show(pinned.row, pinned.body);
+        } else {
+          row.classList.remove('highlight');
+          outline([]);
+        }
       });
       row.addEventListener('click', function () { pinned = { row: row, body: b }; show(row, b); });
     });
@@ -259,6 +313,7 @@
         if (row) row.classList.add('highlight');
       });
       detail.replaceChildren(bodyDetail(dump.bodies[pair[0]]), bodyDetail(dump.bodies[pair[1]]));
+      outline(pair);
     };
     side.appendChild(pairList('confirmed pairs', dump.colliding_pairs, select));
     side.appendChild(pairList('flagged pairs', dump.flagged_pairs, select));
