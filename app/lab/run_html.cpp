@@ -84,6 +84,11 @@ std::string playerHtml(const RunPage& page) {
         out +=
             "<p class=\"missing\" id=\"no-video\">no video: " + html::escape(page.no_video_reason) +
             "</p>\n";
+        // The frames instead, one at a time: the timeline's cursor picks which.
+        if (page.frames_written && !page.frames.empty()) {
+            out +=
+                "<img id=\"frame-view\" alt=\"the frame at the cursor\" src=\"frame_00000.png\">\n";
+        }
     } else if (gif) {
         // A GIF plays as a picture, without controls: no cursor to follow.
         out += "<img id=\"video-picture\" alt=\"the run's video\" src=\"" +
@@ -114,8 +119,11 @@ std::string runPageHtml(const RunPage& page) {
     out +=
         "<section id=\"timeline\">\n<h2>Timeline</h2>\n"
         "<p class=\"hint\">Per frame: pairs the broad phase flagged and the narrow phase "
-        "confirmed, and the wall-clock time of each stage. The blue line follows the video; "
-        "click a chart to move the video there.</p>\n"
+        "confirmed, and the wall-clock time of each stage. ";
+    out += page.video.empty()
+               ? "The blue line marks the frame shown; click a chart to pick another.</p>\n"
+               : "The blue line follows the video; click a chart to move the video there.</p>\n";
+    out +=
         "<div class=\"chart-box\"><canvas id=\"pairs-chart\"></canvas></div>\n"
         "<div class=\"chart-box\"><canvas id=\"stages-chart\"></canvas></div>\n</section>\n";
     out += "<section id=\"pauses\">\n<h2>Pause pictures</h2>\n";

@@ -150,7 +150,8 @@ TEST(RunHtml, PageShowsVideoTimelineAndPauseBodies) {
     fs::remove_all(work);
 }
 
-// Without a video the page says why in place of the player; a later run into the same folder
+// Without a video the page says why in place of the player and shows the frames' PNGs
+// instead (the timeline's cursor picks which); a later run into the same folder
 // that fails (its encoder dies) leaves no index.html behind, not even the earlier one.
 TEST(RunHtml, NoVideoIsSaidAndAFailedRunLeavesNoPage) {
     const fs::path work = tempDir("cdlab_html_", "failed");
@@ -163,6 +164,9 @@ TEST(RunHtml, NoVideoIsSaidAndAFailedRunLeavesNoPage) {
     EXPECT_NE(html.find("id=\"no-video\">no video: the run was made with --no-video</p>"),
               std::string::npos);
     EXPECT_EQ(html.find("<video"), std::string::npos);
+    EXPECT_NE(html.find("<img id=\"frame-view\" alt=\"the frame at the cursor\" "
+                        "src=\"frame_00000.png\">"),
+              std::string::npos);
 
     const fs::path bin = work / "bin";
     fs::create_directories(bin);

@@ -32,10 +32,15 @@
     return { frame: lo, held: vf > start[lo] };
   }
 
+  // Without a video, the frames' PNGs beside the page (when the run wrote them) follow the cursor.
+  let frameView = document.getElementById('frame-view');
+  function frameFile(f) { return 'frame_' + String(f).padStart(5, '0') + '.png'; }
+
   function showFrame(frame, held) {
     if (frame === state.frame && held === state.held) return;
     state.frame = frame;
     state.held = held;
+    if (frameView) frameView.src = frameFile(frame);
     const i = Math.max(0, Math.min(frameCount - 1, frame));
     readout.textContent = 'frame ' + frame + ' of ' + (frameCount - 1) + ' \u00b7 t = ' +
         Number(timeline.time[i]).toPrecision(4) + ' s \u00b7 ' + timeline.flagged[i] +
@@ -45,7 +50,7 @@
 
   function seekTo(frame) {
     const f = Math.max(0, Math.min(frameCount - 1, Math.round(frame)));
-    if (video && !video.error) video.currentTime = (start[f] + 0.5) / fps;
+    if (video && !video.error && !video.hidden) video.currentTime = (start[f] + 0.5) / fps;
     showFrame(f, false);
   }
 
@@ -145,6 +150,13 @@
     message.textContent = 'no video: ' + reason;
     message.hidden = false;
     if (video) video.hidden = true;
+    if (!frameView && data.frames_written && frameCount > 0) {
+      frameView = document.createElement('img');
+      frameView.id = 'frame-view';
+      frameView.alt = 'the frame at the cursor';
+      frameView.src = frameFile(Math.max(0, state.frame));
+      message.after(frameView);
+    }
   }
 
   if (video) {
