@@ -32,6 +32,37 @@ std::vector<std::string> runLabels(const std::string& dom) {
     return labels;
 }
 
+// The cells of every run row of the results table, in the DOM's order.
+std::vector<std::vector<std::string>> runRows(const std::string& dom) {
+    const std::regex row("<tr class=\"run\">(.*?)</tr>");
+    const std::regex cell("<td[^>]*>([^<]*)</td>");
+    std::vector<std::vector<std::string>> rows;
+    for (auto r = std::sregex_iterator(dom.begin(), dom.end(), row); r != std::sregex_iterator();
+         ++r) {
+        const std::string cells = (*r)[1].str();
+        rows.emplace_back();
+        for (auto c = std::sregex_iterator(cells.begin(), cells.end(), cell);
+             c != std::sregex_iterator(); ++c) {
+            rows.back().push_back((*c)[1].str());
+        }
+    }
+    return rows;
+}
+
+// The data rows of a CSV file without quoted fields, split at commas.
+std::vector<std::vector<std::string>> csvRows(const fs::path& file) {
+    std::istringstream lines(slurp(file));
+    std::vector<std::vector<std::string>> rows;
+    std::string line;
+    std::getline(lines, line);
+    while (std::getline(lines, line)) {
+        std::istringstream fields(line);
+        rows.emplace_back();
+        for (std::string f; std::getline(fields, f, ',');) rows.back().push_back(f);
+    }
+    return rows;
+}
+
 // Lines of a file but the first (a CSV's data rows).
 int dataLines(const fs::path& file) {
     std::istringstream lines(slurp(file));
@@ -65,6 +96,10 @@ TEST(SweepHtml, TableHoldsTheCsvRowsSortsNumbersAndChartsAreDrawn) {
               (std::vector<std::string>{"world.time_step=0.002", "world.time_step=0.01",
                                         "world.time_step=0.05"}));
     EXPECT_NE(dom.find("aria-sort=\"descending\">steps</th>"), std::string::npos);
+    // Cell for cell the CSV's rows, in the sorted order (the CSV has them as --vary gave them).
+    const std::vector<std::vector<std::string>> csv = csvRows(o.out_dir / "results.csv");
+    ASSERT_EQ(csv.size(), 3u);
+    EXPECT_EQ(runRows(dom), (std::vector<std::vector<std::string>>{csv[2], csv[1], csv[0]}));
     EXPECT_EQ(dom.find("id=\"failures\""), std::string::npos);
     for (int chart = 0; chart < 5; ++chart) {
         EXPECT_EQ(attribute(startTag(dom, "chart-" + std::to_string(chart)), "data-rendered"), "1")
