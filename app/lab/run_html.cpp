@@ -121,8 +121,10 @@ std::string runPageHtml(const RunPage& page) {
         "<p class=\"hint\">Per frame: pairs the broad phase flagged and the narrow phase "
         "confirmed, and the wall-clock time of each stage. ";
     out += page.video.empty()
-               ? "The blue line marks the frame shown; click a chart to pick another.</p>\n"
-               : "The blue line follows the video; click a chart to move the video there.</p>\n";
+               ? "The blue line marks the frame shown; click a chart to pick another, or step "
+                 "with the arrow keys.</p>\n"
+               : "The blue line follows the video; click a chart to move the video there, or "
+                 "step with the arrow keys.</p>\n";
     out +=
         "<div class=\"chart-box\"><canvas id=\"pairs-chart\"></canvas></div>\n"
         "<div class=\"chart-box\"><canvas id=\"stages-chart\"></canvas></div>\n</section>\n";

@@ -177,6 +177,15 @@
   }
   state.frame = -1;
   showFrame(0, false);
+  // Left and right arrows step one frame (the video's own keys when it has the focus).
+  document.addEventListener('keydown', function (event) {
+    if (event.target === video || event.altKey || event.ctrlKey || event.metaKey) return;
+    if (event.key === 'ArrowLeft' || event.key === 'ArrowRight') {
+      if (video) video.pause();
+      seekTo(state.frame + (event.key === 'ArrowRight' ? 1 : -1));
+      event.preventDefault();
+    }
+  });
 
   function text(tag, content, cls) {
     const e = document.createElement(tag);
