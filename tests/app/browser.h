@@ -8,7 +8,6 @@
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
-#include <regex>
 #include <sstream>
 #include <string>
 
@@ -62,9 +61,11 @@ inline std::string startTag(const std::string& dom, const std::string& id) {
 
 /// The value of attribute `name` in a start tag ("" when absent).
 inline std::string attribute(const std::string& tag, const std::string& name) {
-    const std::regex re("\\s" + name + "=\"([^\"]*)\"");
-    std::smatch m;
-    return std::regex_search(tag, m, re) ? m[1].str() : "";
+    const std::string key = " " + name + "=\"";
+    const std::size_t at = tag.find(key);
+    if (at == std::string::npos) return "";
+    const std::size_t begin = at + key.size();
+    return tag.substr(begin, tag.find('"', begin) - begin);
 }
 
 /// Occurrences of `needle` in `text`.
