@@ -56,6 +56,12 @@ Command addRunCommand(CLI::App& cli) {
                   "verify every step's pairs against the brute-force reference; stop with a "
                   "report (exit 3) at the first mismatch");
     cmd->add_option("--stats", f->stats, "write per-frame counters and stage times to FILE.csv");
+    cmd->add_flag("--html", f->run.html,
+                  "write <out>/index.html, a page that opens from disk without a network: the "
+                  "video, a timeline of flagged and confirmed pairs and of each stage's time per "
+                  "frame with a cursor that follows the video (click to seek), and each "
+                  "--pause-at picture with its bodies and pairs (hover or click a body for its "
+                  "volumes and state)");
     cmd->add_flag("--quiet", f->quiet, "no progress bar");
     cmd->add_flag("--timing", f->run.timing,
                   "print where the time went: wall time and fps, and milliseconds per frame for "

@@ -99,7 +99,8 @@ Command addSweepCommand(CLI::App& cli) {
     CLI::App* cmd = cli.add_subcommand(
         "sweep",
         "run one scene under every combination of choices; measure cost and accuracy "
-        "against a fine reference run; write results.csv, report.md and charts. Runs in "
+        "against a fine reference run; write results.csv, report.md, charts and report.html "
+        "(a page that opens from disk: the charts and a sortable table). Runs in "
         "this process, -j N processes at a time, or as independent jobs for GNU Parallel or a "
         "Slurm array (--plan DIR, then --collect DIR)");
     cmd->add_option("scene", f->sweep.scene, "scene file (YAML); not with --job or --collect");

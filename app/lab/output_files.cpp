@@ -63,7 +63,7 @@ bool isRunOutput(const std::string& name) {
     if ((strip("pause_", ".png", middle) || strip("pause_", ".json", middle)) && allDigits(middle)) {
         return true;
     }
-    if (name == "summary.json") return true;
+    if (name == "summary.json" || name == "index.html") return true;
     return name.find(".partial") != std::string::npos;
 }
 

@@ -23,7 +23,7 @@ void prepareOutputDir(const std::filesystem::path& dir);
 
 /// Removes what an earlier run left in `dir`, so a rerun with fewer frames never shows the old
 /// ones beside the new summary: cdlab's own outputs only (frame_NNNNN.png, pause_N.png and .json,
-/// summary.json, and *.partial files of a killed run), and only regular files. Other files stay.
+/// summary.json, index.html, and *.partial files of a killed run), and only regular files. Other files stay.
 /// Throws render::RenderError when one cannot be removed.
 void clearPreviousRun(const std::filesystem::path& dir);
 

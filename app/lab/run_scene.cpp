@@ -3,10 +3,7 @@
 // and renamed, and summary.json, written last, marks a finished run.
 #include "run_scene.h"
 
-#include <memory>
-#include <string>
 #include <unistd.h>
-#include <vector>
 
 #include <algorithm>
 #include <chrono>
@@ -15,16 +12,21 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <memory>
 #include <new>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <sstream>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "broadphase_check.h"
 #include "collision/broadphase/broad_phase.h"
 #include "engine/scene.h"
 #include "exit_codes.h"
+#include "html_page.h"
 #include "output_files.h"
 #include "pause_dump.h"
 #include "render/frame_writer.h"
@@ -32,6 +34,7 @@
 #include "render/output_file.h"
 #include "render/renderer.h"
 #include "render/volume_states.h"
+#include "run_html.h"
 
 namespace app {
 
@@ -171,6 +174,34 @@ std::string timingLine(int frames, double wall_s, const StageTimes& st,
     return line;
 }
 
+// The timeline's row of one frame (index.html), the same figures as statsRow().
+RunPageFrame pageFrame(int frame, const engine::World& world, const FrameStats& f) {
+    RunPageFrame row;
+    row.frame = frame;
+    row.time = double(world.time());
+    row.flagged = static_cast<std::int64_t>(world.flaggedPairs().size());
+    row.colliding = static_cast<std::int64_t>(world.collidingPairs().size());
+    row.integrate_ms = 1e3 * f.integrate_s;
+    row.volumes_ms = 1e3 * f.volumes_s;
+    row.broadphase_ms = 1e3 * f.broad_s;
+    row.narrowphase_ms = 1e3 * f.narrow_s;
+    row.ccd_ms = 1e3 * f.ccd_s;
+    row.response_ms = 1e3 * f.response_s;
+    row.step_ms = 1e3 * f.total_s;
+    return row;
+}
+
+// Where each body's AABB shows in the run's pictures (index.html outlines a body there).
+std::vector<std::optional<render::ScreenRect>> bodyRects(const engine::World& world,
+                                                         const engine::Scene& scene) {
+    std::vector<std::optional<render::ScreenRect>> rects;
+    for (const collision::ProxyVolumes& v : world.volumes()) {
+        rects.push_back(render::screenRect(scene.camera, scene.output.width, scene.output.height,
+                                           v.aabb.min, v.aabb.max));
+    }
+    return rects;
+}
+
 std::string frameName(int frame) {
     char name[32];
     std::snprintf(name, sizeof name, "frame_%05d.png", frame);
@@ -270,6 +301,40 @@ std::string summaryJson(const RunOptions& options, const engine::Scene& scene,
     return summary.dump(1) + "\n";
 }
 
+// What index.html says of the run before its frames: the scene and the picture format.
+RunPage runPage(const RunOptions& options, const engine::Scene& scene, const engine::World& world,
+                long hold_frames) {
+    RunPage page;
+    page.scene = options.scene.string();
+    page.scene_name = scene.name;
+    page.broad_phase = scene.world.broad_phase;
+    page.bodies = world.bodies().size();
+    page.width = scene.output.width;
+    page.height = scene.output.height;
+    page.fps = scene.output.fps;
+    page.hold_frames = hold_frames;
+    page.frames_written = !options.no_frames;
+    return page;
+}
+
+// Writes out_dir/index.html once the video is complete: the video referred to relative to the
+// page, or the reason there is none.
+void writeRunPage(RunPage page, const fs::path& out_dir, bool want_video,
+                  const fs::path& video_path) {
+    std::error_code ec;
+    if (!want_video) {
+        page.no_video_reason = "the run was made with --no-video";
+    } else if (!fs::is_regular_file(video_path, ec)) {
+        page.no_video_reason = video_path.string() + " was not found when this page was written";
+    } else {
+        const fs::path dir = fs::absolute(out_dir, ec);
+        fs::path relative = fs::absolute(video_path, ec).lexically_relative(dir);
+        if (relative.empty()) relative = fs::absolute(video_path, ec);
+        page.video = html::urlPath(relative.generic_string());
+    }
+    writeTextAtomically(out_dir / "index.html", runPageHtml(page));
+}
+
 }  // namespace
 
 int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
@@ -321,6 +386,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         std::string trace_text;
         ProgressBar progress(options.progress && ::isatty(STDERR_FILENO), scene.frames);
         RunTotals totals;
+        RunPage page = runPage(options, scene, world, hold_frames);
         for (int frame = 0; frame < scene.frames; ++frame) {
             FrameStats frame_stats;
             auto checkStep = [&](int step) -> bool {
@@ -354,6 +420,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
             }
             if (options.stats_csv) stats_text += statsRow(frame, world, frame_stats);
             if (options.trace) trace_text += traceLine(frame, world);
+            if (options.html) page.frames.push_back(pageFrame(frame, world, frame_stats));
             totals.flagged += static_cast<std::int64_t>(world.flaggedPairs().size());
             totals.colliding += static_cast<std::int64_t>(world.collidingPairs().size());
             frame_options.hud_text =
@@ -373,7 +440,11 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
                 auto pause_image = std::make_shared<const render::Image>(
                     renderer.render(world, scene.camera, pause_options));
                 writer.submit(std::move(pause_image), out_dir / (stem + ".png"), hold_frames);
-                writeTextAtomically(out_dir / (stem + ".json"), pauseDumpJson(world, frame));
+                std::string dump = pauseDumpJson(world, frame);
+                writeTextAtomically(out_dir / (stem + ".json"), dump);
+                if (options.html) {
+                    page.pauses.push_back({frame, std::move(dump), bodyRects(world, scene)});
+                }
             }
             progress.update(frame + 1);
         }
@@ -383,6 +454,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         }
         if (options.stats_csv) writeTextAtomically(*options.stats_csv, stats_text);
         if (options.trace) writeTextAtomically(*options.trace, trace_text);
+        if (options.html) writeRunPage(std::move(page), out_dir, want_video, video_path);
 
         writeTextAtomically(out_dir / "summary.json",
                             summaryJson(options, scene, world, totals, want_video, video_path));
@@ -390,6 +462,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         out << "wrote " << (options.no_frames ? 0 : scene.frames) << " frames to "
             << out_dir.string();
         if (want_video) out << " and " << video_path.string();
+        if (options.html) out << ", the page " << (out_dir / "index.html").string();
         out << " (" << world.bodies().size() << " bodies, " << world.stepCount() << " steps, "
             << scene.world.broad_phase << (options.check_broad_phase ? ", every step checked" : "")
             << ")\n";

@@ -37,6 +37,9 @@ struct RunOptions {
     /// One JSON line per frame: time, every body's position and orientation, confirmed pairs
     /// (`cdlab sweep --float-binary` compares a float build's trace with the double one's).
     std::optional<std::filesystem::path> trace;
+    /// Write index.html beside the frames (run_html.h): the video, the timeline of pairs and
+    /// stage times with a cursor following the video, the pause pictures with their bodies.
+    bool html = false;
 };
 
 /// Exit codes: 0 success, 1 output or runtime failure, 2 bad input (scene, flags),

@@ -268,6 +268,7 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
         sweep::writeSweepOutputs(options, setup->base, setup->duration, runs, reference, floats,
                                  {}, out_dir);
         out << "wrote " << (out_dir / "report.md").string() << ", "
+            << (out_dir / "report.html").string() << ", "
             << (out_dir / "results.csv").string() << " and charts\n";
     } catch (const std::exception& e) {
         err << "error: " << e.what() << "\n";

@@ -150,7 +150,7 @@ int collectSweep(const CollectOptions& options, std::ostream& out, std::ostream&
         << (collected->timed_concurrently ? " (timed concurrently: the reading ranks by CPU time)"
                                           : "")
         << "; wrote " << (out_dir / "report.md").string()
-        << (collected->reference ? ", results.csv and charts" : "") << "\n";
+        << (collected->reference ? ", report.html, results.csv and charts" : "") << "\n";
     for (const SweepFailure& f : collected->failures) {
         err << "sweep --collect: missing " << f.label << ": " << f.reason << "\n";
     }

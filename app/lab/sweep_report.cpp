@@ -23,6 +23,7 @@
 #include "render/chart.h"
 #include "render/image.h"
 #include "run_scene.h"
+#include "sweep_html.h"
 
 namespace app {
 
@@ -554,11 +555,13 @@ void writeSweepOutputs(const SweepOptions& options, const engine::Scene& base, d
     writeTextAtomically(out_dir / "results.csv", csvTable(runs));
     writeTextAtomically(out_dir / "report.md", markdownReport(options, base, duration, runs,
                                                               reference, floats, failures));
+    writeSweepHtml(out_dir / "report.html", options, runs, reference, floats, failures);
 }
 
 void removeSweepOutputs(const fs::path& out_dir) {
     for (const char* f :
-         {"results.csv", "report.md", "float_vs_double.csv", "float_deviation.png"}) {
+         {"results.csv", "report.md", "report.html", "float_vs_double.csv",
+          "float_deviation.png"}) {
         fs::remove(out_dir / f);
     }
     for (const Chart& c : charts()) fs::remove(out_dir / c.file);

@@ -59,16 +59,16 @@ std::string markdownReport(const SweepOptions& options, const engine::Scene& bas
                            const SweepRun& reference, const std::vector<FloatRun>& floats,
                            const std::vector<SweepFailure>& failures = {});
 
-/// Writes the sweep's outputs into `out_dir` (which exists): the charts, results.csv and
-/// report.md, each file complete or absent. Throws on an output failure.
+/// Writes the sweep's outputs into `out_dir` (which exists): the charts, results.csv,
+/// report.md and report.html (sweep_html.h), each file complete or absent. Throws on an output failure.
 void writeSweepOutputs(const SweepOptions& options, const engine::Scene& base, double duration,
                        const std::vector<SweepRun>& runs, const SweepRun& reference,
                        const std::vector<FloatRun>& floats,
                        const std::vector<SweepFailure>& failures,
                        const std::filesystem::path& out_dir);
 
-/// Removes the outputs an earlier sweep left in `out_dir` (results.csv, report.md, charts,
-/// float comparison), so none outlives a rerun that fails before writing its own.
+/// Removes the outputs an earlier sweep left in `out_dir` (results.csv, report.md,
+/// report.html, charts, float comparison), so none outlives a rerun that fails before writing its own.
 void removeSweepOutputs(const std::filesystem::path& out_dir);
 
 }  // namespace app::sweep

@@ -292,6 +292,13 @@ TEST(SweepPlan, MissingAndFailedJobsAreNamed) {
     EXPECT_NE(csv.find("broadphase=sap world.time_step=0.05,"), std::string::npos);
     EXPECT_EQ(csv.find(run3 + ","), std::string::npos);
     EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3);
+    // The page carries the failures too: the banner, and a row marked failed for each.
+    const std::string page = slurp(dir / "report.html");
+    EXPECT_NE(page.find("id=\"failures\""), std::string::npos);
+    EXPECT_NE(page.find("<tr class=\"failed\" data-failed=\"1\"><td>" + run3 + "</td>"),
+              std::string::npos);
+    EXPECT_NE(page.find("<tr class=\"failed\" data-failed=\"1\"><td>" + run4 + "</td>"),
+              std::string::npos);
 
     // Without the reference nothing can be compared: report.md says so, no table.
     fs::remove(dir / "results/0.json");
@@ -300,6 +307,7 @@ TEST(SweepPlan, MissingAndFailedJobsAreNamed) {
     EXPECT_NE(no_ref.err.find("missing reference: job 0 left no result"), std::string::npos)
         << no_ref.err;
     EXPECT_FALSE(fs::exists(dir / "results.csv"));
+    EXPECT_FALSE(fs::exists(dir / "report.html"));
     EXPECT_NE(slurp(dir / "report.md").find("The reference run left no result"), std::string::npos);
     fs::remove_all(work);
 }

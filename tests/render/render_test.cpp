@@ -775,3 +775,43 @@ TEST(Renderer, TimeOfImpactPoseIsDrawnInBlue) {
     ASSERT_FALSE(world.toiEvents().empty());
     EXPECT_GT(countBlue(renderer.render(world, scene.camera, options)), 50);
 }
+
+// screenRect() is where render() draws: a turned box's AABB wireframe (the only thing drawn)
+// fills exactly the rectangle screenRect() gives for that AABB, to within the line's width.
+TEST(Renderer, ScreenRectIsWhereTheAabbIsDrawn) {
+    engine::World world(engine::WorldSettings{});
+    world.addBody(
+        makeShapeBody("box", collision::Shape::box(Vec3(1.2, 0.5, 0.7)), Vec3(1.5, -0.8, 1),
+                      Quat(Eigen::AngleAxis<Real>(Real(0.6), Vec3(1, 2, 3).normalized()))));
+    world.detect();
+    engine::CameraSettings camera = headOnCamera();
+    camera.position = Vec3(2, 3, 9);
+    render::FrameOptions options = plainOptions();
+    options.draw.bodies = false;
+    options.draw.sphere = false;
+    options.draw.aabb = true;
+    render::Renderer renderer(kWidth, kHeight);
+    const render::Image image = renderer.render(world, camera, options);
+    const Rgb green = toRgb(render::stateColor(engine::BodyState::Apart));
+    int x0 = kWidth, y0 = kHeight, x1 = -1, y1 = -1;
+    for (int y = 0; y < kHeight; ++y) {
+        for (int x = 0; x < kWidth; ++x) {
+            if (!close(pixelAt(image, x, y), green, 60)) continue;
+            x0 = std::min(x0, x);
+            y0 = std::min(y0, y);
+            x1 = std::max(x1, x + 1);
+            y1 = std::max(y1, y + 1);
+        }
+    }
+    ASSERT_GE(x1, 0) << "nothing drawn";
+    const collision::Aabb& box = world.volumes()[0].aabb;
+    const std::optional<render::ScreenRect> rect =
+        render::screenRect(camera, kWidth, kHeight, box.min, box.max);
+    ASSERT_TRUE(rect.has_value());
+    EXPECT_NEAR(rect->x0, x0, 1.5);
+    EXPECT_NEAR(rect->y0, y0, 1.5);
+    EXPECT_NEAR(rect->x1, x1, 1.5);
+    EXPECT_NEAR(rect->y1, y1, 1.5);
+    // Behind the camera: no rectangle.
+    EXPECT_FALSE(render::screenRect(camera, kWidth, kHeight, Vec3(0, 0, 20), Vec3(1, 1, 21)));
+}

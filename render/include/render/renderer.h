@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "collision/bvh/bvh_level.h"
@@ -33,6 +34,19 @@ inline constexpr collision::Color kContactColor{1.0f, 0.0f, 1.0f, 1.0f};
 /// Colour of a hierarchy node drawn with draw.bvh_depth: the state colours, Overlapping as
 /// flagged (yellow) and Confirmed as colliding (red).
 collision::Color nodeColor(collision::BvhNodeState state);
+
+/// A rectangle of a picture in pixels: x to the right and y down from the top-left corner.
+struct ScreenRect {
+    double x0 = 0, y0 = 0;  ///< top-left
+    double x1 = 0, y1 = 0;  ///< bottom-right
+};
+
+/// Where the world-frame box [min, max] shows in a width x height picture that render() takes
+/// with `camera` (gluLookAt and gluPerspective): the bounding rectangle of its eight corners'
+/// images, clipped to the picture. Nothing when a corner lies at or behind the eye's plane, or
+/// when the rectangle misses the picture.
+std::optional<ScreenRect> screenRect(const engine::CameraSettings& camera, int width, int height,
+                                     const collision::Vec3& min, const collision::Vec3& max);
 
 /// What one frame shows. With draw.hud and any volume (or hierarchy level) drawn, a colour legend
 /// (apart / flagged / colliding) goes bottom-left.
