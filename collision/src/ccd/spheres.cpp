@@ -3,14 +3,23 @@
 // where the pair sits in the world: a 1e6 offset changes it by rounding of the inputs only.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "collision/ccd/ccd.h"
 #include "collision/geometry/shape.h"
 
 namespace collision {
 
-CcdOutput timeOfImpactSpheres(const Vec3& c0a, const Vec3& c1a, Real ra, const Vec3& c0b,
-                              const Vec3& c1b, Real rb) {
+namespace {
+
+// The closed form below. `round_early`: the discriminant's factors are rounded outwards (reach
+// up, miss down, by kOutward) so the computed sqrt(D') is never below the one of the relative
+// quantities, q never too small and c / q never late. Near grazing (D' ~ 0) the plain form's
+// rounding of D' moves t by ~sqrt(eps) of the step in either direction; this moves it earlier.
+constexpr Real kOutward = Real(8) * std::numeric_limits<Real>::epsilon();
+
+CcdOutput sphereRoot(const Vec3& c0a, const Vec3& c1a, Real ra, const Vec3& c0b, const Vec3& c1b,
+                     Real rb, bool round_early) {
     CcdOutput out;
     out.state = CcdState::Failed;
     if (!c0a.allFinite() || !c1a.allFinite() || !c0b.allFinite() || !c1b.allFinite() ||
@@ -70,8 +79,8 @@ CcdOutput timeOfImpactSpheres(const Vec3& c0a, const Vec3& c1a, Real ra, const V
     // difference ~R^2 |dv|^2, which lost (|d0| / R)^2 of precision (measured: t off by 2e-12 at
     // 1e6 sizes of motion per step; this form is exact to rounding there, and exactly 0 for
     // head-on motion where the cross product vanishes). Grazing (== 0) counts as a Hit.
-    const Real reach = std::sqrt(a) * radius;
-    const Real miss = d0.cross(dv).norm();
+    const Real reach = std::sqrt(a) * radius * (round_early ? 1 + kOutward : 1);
+    const Real miss = d0.cross(dv).norm() * (round_early ? 1 - kOutward : 1);
     const Real disc = (reach - miss) * (reach + miss);
     if (disc < 0) {
         out.state = CcdState::Separated;
@@ -92,6 +101,13 @@ CcdOutput timeOfImpactSpheres(const Vec3& c0a, const Vec3& c1a, Real ra, const V
     out.t = out.t_upper = t;
     out.normal = contactNormal(t);
     return out;
+}
+
+}  // namespace
+
+CcdOutput timeOfImpactSpheres(const Vec3& c0a, const Vec3& c1a, Real ra, const Vec3& c0b,
+                              const Vec3& c1b, Real rb) {
+    return sphereRoot(c0a, c1a, ra, c0b, c1b, rb, false);
 }
 
 // The engine's entry for a sphere pair: the sweeps' centres move linearly whatever the
@@ -129,7 +145,7 @@ ToiOutput timeOfImpactSphereSweeps(const ToiInput& input) {
         out.normal = contact.normal;
         return out;
     }
-    const CcdOutput gap = timeOfImpactSpheres(c0a, c1a, ra + input.target_gap, c0b, c1b, rb);
+    const CcdOutput gap = sphereRoot(c0a, c1a, ra + input.target_gap, c0b, c1b, rb, true);
     if (gap.state == CcdState::Failed) return out;
     if (gap.state == CcdState::Overlapped) {
         // Within the target gap at t = 0: a Hit at 0 with the present gap (the engine asks
@@ -143,8 +159,9 @@ ToiOutput timeOfImpactSphereSweeps(const ToiInput& input) {
         out.t = input.t_max;
         return out;
     }
-    // Bias the rounding earlier: c / q is within a few ulps of the true root of the rounded
-    // relative quantities; stepping back kSphereToiSlack of the step keeps t before contact.
+    // Bias the rounding earlier: with the discriminant rounded outwards, c / q is at most a few
+    // ulps of t past the root of the rounded relative quantities; stepping back
+    // kSphereToiSlack of the step keeps t before contact.
     const Real t = std::max(Real(0), gap.t - kSphereToiSlack);
     if (t > input.t_max) {
         out.state = CcdState::Separated;
