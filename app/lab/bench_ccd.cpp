@@ -281,8 +281,8 @@ void printTable(const std::vector<Row>& rows, std::ostream& out) {
     out << std::left << std::setw(mw) << "method" << std::setw(29) << "set" << std::setw(12)
         << "kind" << std::right << std::setw(8) << "queries" << std::setw(6) << "FN" << std::setw(6)
         << "FP" << std::setw(7) << "failed" << std::setw(8) << "inexact" << std::setw(11)
-        << "mean_us" << std::setw(11) << "median_us" << std::setw(11) << "p99_us"
-        << std::setw(11) << "max_us"
+        << "mean_us" << std::setw(11) << "median_us" << std::setw(11) << "p99_us" << std::setw(11)
+        << "max_us"
         << "\n";
     for (const Row& r : rows) {
         out << std::left << std::setw(mw) << r.method << std::setw(29) << r.set << std::setw(12)
@@ -311,8 +311,7 @@ nlohmann::json printRatios(const std::vector<Row>& rows, std::ostream& out) {
                 << std::setprecision(3) << " median " << median << "x  p99 " << p99 << "x  max "
                 << max << "x\n"
                 << std::setprecision(6);
-            ratios.push_back(
-                {{"kind", ours.kind}, {"median", median}, {"p99", p99}, {"max", max}});
+            ratios.push_back({{"kind", ours.kind}, {"median", median}, {"p99", p99}, {"max", max}});
         }
     }
     return ratios;
@@ -350,6 +349,39 @@ SceneRow runScene(const engine::Scene& scene, engine::CcdMethod method) {
     row.step_us = 1e6 * step_s / scene.frames;
     row.ccd_us = 1e6 * ccd_s / scene.frames;
     row.toi_queries = queries / scene.frames;
+    return row;
+}
+
+// Sphere-sphere pairs of the continuous stage, advancement against the exact root.
+struct SphereRow {
+    std::string spheres;          ///< world.ccd_spheres
+    double first_toi_s = -1;      ///< simulated time of the first time of impact acted on
+    double ccd_us = 0;            ///< mean CCD stage time per frame, microseconds
+    std::int64_t queries = 0;     ///< time-of-impact calls over the run
+    std::int64_t iterations = 0;  ///< their iterations (distance queries or roots)
+};
+
+SphereRow runSpheres(const engine::Scene& scene, engine::CcdSpheres spheres) {
+    engine::Scene copy = scene;
+    copy.world.ccd = engine::CcdMethod::ConservativeAdvancement;
+    copy.world.ccd_spheres = spheres;
+    engine::World world = engine::makeWorld(copy);
+    SphereRow row;
+    row.spheres = std::string(engine::ccdSpheresName(spheres));
+    double ccd_s = 0;
+    for (int f = 0; f < scene.frames; ++f) {
+        for (int k = 0; k < scene.steps_per_frame; ++k) {
+            const double t0 = world.time();
+            world.step();
+            ccd_s += world.lastStats().ccd_s;
+            row.queries += world.lastStats().toi_queries;
+            row.iterations += world.lastStats().toi_iterations;
+            if (row.first_toi_s < 0 && !world.toiEvents().empty()) {
+                row.first_toi_s = t0 + world.toiEvents()[0].t * copy.world.time_step;
+            }
+        }
+    }
+    row.ccd_us = 1e6 * ccd_s / std::max(1, scene.frames);
     return row;
 }
 
@@ -488,6 +520,39 @@ int runBenchCcd(const BenchCcdOptions& options, std::ostream& out, std::ostream&
         }
     }
 
+    // Sphere pairs (scenes/ccd_spheres.yaml when present): the exact root against advancement.
+    std::vector<SphereRow> sphere_rows;
+    if (options.scenes) {
+        const fs::path dir =
+            options.scenes_explicit ? options.scenes_dir : defaultDataPath(options.scenes_dir);
+        if (fs::is_regular_file(dir / "ccd_spheres.yaml")) {
+            engine::Scene scene;
+            try {
+                scene = engine::loadScene(dir / "ccd_spheres.yaml");
+            } catch (const engine::SceneError& e) {
+                err << e.what() << "\n";
+                return 2;
+            }
+            for (const engine::CcdSpheres m :
+                 {engine::CcdSpheres::Advancement, engine::CcdSpheres::Exact}) {
+                sphere_rows.push_back(runSpheres(scene, m));
+            }
+            out << "\nsphere pairs (ccd_spheres.yaml)\n"
+                << std::left << std::setw(13) << "ccd_spheres" << std::right << std::setw(22)
+                << "first_toi_s" << std::setw(9) << "queries" << std::setw(12) << "iterations"
+                << std::setw(12) << "iter/query" << std::setw(13) << "ccd_us/frame"
+                << "\n";
+            for (const SphereRow& r : sphere_rows) {
+                out << std::left << std::setw(13) << r.spheres << std::right << std::setw(22)
+                    << std::setprecision(17) << r.first_toi_s << std::setw(9) << r.queries
+                    << std::setw(12) << r.iterations << std::fixed << std::setprecision(2)
+                    << std::setw(12)
+                    << (r.queries > 0 ? static_cast<double>(r.iterations) / r.queries : 0.0)
+                    << std::setw(13) << r.ccd_us << std::defaultfloat << "\n";
+            }
+        }
+    }
+
     if (options.json) {
         nlohmann::json doc;
         doc["benchmark"] = "ccd";
@@ -504,6 +569,14 @@ int runBenchCcd(const BenchCcdOptions& options, std::ostream& out, std::ostream&
                                                    {"ccd_us_per_frame", r.ccd_us},
                                                    {"toi_queries_per_frame", r.toi_queries},
                                                    {"toi_events", r.toi_events}});
+        }
+        doc["sphere_pairs"] = nlohmann::json::array();
+        for (const SphereRow& r : sphere_rows) {
+            doc["sphere_pairs"].push_back(nlohmann::json{{"ccd_spheres", r.spheres},
+                                                         {"first_toi_s", r.first_toi_s},
+                                                         {"toi_queries", r.queries},
+                                                         {"toi_iterations", r.iterations},
+                                                         {"ccd_us_per_frame", r.ccd_us}});
         }
         if (!writeTextReporting(*options.json, doc.dump(2) + "\n", err)) return 1;
     }

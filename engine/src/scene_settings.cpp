@@ -25,10 +25,11 @@ namespace engine::scene_parsing {
 
 void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
     const std::string path = "world";
-    const std::vector<Entry> es = entries(
-        n, path,
-        {"bounds", "gravity", "time_step", "steps_per_frame", "frames", "mesh_bvh", "integrator",
-         "ccd", "ccd_tolerance", "ccd_target_gap", "response", "restitution", "friction"});
+    const std::vector<Entry> es =
+        entries(n, path,
+                {"bounds", "gravity", "time_step", "steps_per_frame", "frames", "mesh_bvh",
+                 "integrator", "ccd", "ccd_spheres", "ccd_tolerance", "ccd_target_gap", "response",
+                 "restitution", "friction"});
     {
         const Entry& b = require(es, "bounds", n, path);
         const std::string bp = childPath(path, "bounds");
@@ -103,6 +104,12 @@ void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
                 fail(e.value, p,
                      "unknown ccd method '" + name + "' (expected one of: " + ccdMethodNames() +
                          ")");
+            }
+        } else if (e.key == "ccd_spheres") {
+            const std::string name = readString(e.value, p);
+            if (!findCcdSpheres(name, scene.world.ccd_spheres)) {
+                fail(e.value, p,
+                     "unknown ccd_spheres '" + name + "' (expected one of: advancement, exact)");
             }
         } else if (e.key == "ccd_tolerance") {
             // Fractions of the pair's smaller bounding radius (WorldSettings). 0 would ask the

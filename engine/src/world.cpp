@@ -105,6 +105,22 @@ bool findCcdMethod(std::string_view name, CcdMethod& out) {
     return false;
 }
 
+std::string_view ccdSpheresName(CcdSpheres method) {
+    return method == CcdSpheres::Exact ? "exact" : "advancement";
+}
+
+bool findCcdSpheres(std::string_view name, CcdSpheres& out) {
+    if (name == "advancement") {
+        out = CcdSpheres::Advancement;
+        return true;
+    }
+    if (name == "exact") {
+        out = CcdSpheres::Exact;
+        return true;
+    }
+    return false;
+}
+
 std::string ccdMethodNames() {
     std::string out;
     for (const CcdEntry& e : kCcdMethods) {

@@ -34,8 +34,8 @@ Vec3 rotationBetween(const Quat& q0, const Quat& q1) {
 
 }  // namespace
 
-// The continuous stage (ccd: conservative_advancement). After integration every body has a
-// sweep from its pose at the start of the step to its integrated pose: linear in position;
+// The continuous stage (ccd: conservative_advancement; sphere pairs by the exact quadratic
+// root with ccd_spheres: exact). After integration every body has a sweep from its pose at the start of the step to its integrated pose: linear in position;
 // for semi-implicit Euler the integrator's rotation as a world turn about L and a body-frame
 // spin (exact for symmetric bodies, so a pose stopped mid-step keeps the energy), for the
 // other integrators the constant-axis chord from start to end.
@@ -115,6 +115,7 @@ void World::findSweptPairs() {
 void World::queryTimesOfImpact() {
     toi_events_.clear();
     stats_.toi_queries = 0;
+    stats_.toi_iterations = 0;
     for (const collision::ProxyPair& pair : ccd_pairs_) {
         const Body& a = bodies_[pair.a];
         const Body& b = bodies_[pair.b];
@@ -138,7 +139,13 @@ void World::queryTimesOfImpact() {
             a.shape.bvh != nullptr ? collision::treeOf<collision::Obb>(*a.shape.bvh) : nullptr;
         const collision::Bvh<collision::Obb>* tree_b =
             b.shape.bvh != nullptr ? collision::treeOf<collision::Obb>(*b.shape.bvh) : nullptr;
+        // Two spheres with ccd_spheres: exact: the closed-form root of |d0 + t dv| = ra + rb +
+        // gap, exact for the sweeps' linear motion of the centres (collision/ccd/ccd.h).
+        const bool exact_spheres = settings_.ccd_spheres == CcdSpheres::Exact &&
+                                   a.shape.type == collision::ShapeType::Sphere &&
+                                   b.shape.type == collision::ShapeType::Sphere;
         auto query = [&]() {
+            if (exact_spheres) return collision::timeOfImpactSphereSweeps(in);
             if (tree_a == nullptr || tree_b == nullptr) return collision::timeOfImpact(in);
             collision::MeshToiInput mi;
             static_cast<collision::ToiQuery&>(mi) = in;
@@ -148,6 +155,7 @@ void World::queryTimesOfImpact() {
         };
         collision::ToiOutput out = query();
         ++stats_.toi_queries;
+        stats_.toi_iterations += out.iterations;
         if (out.state == collision::CcdState::Hit && out.t == 0 && out.distance > 0) {
             // Already within the target gap (typically: stopped here by the previous step).
             // Ask again for half the present gap, so a separating pair is free to go and an
@@ -156,6 +164,7 @@ void World::queryTimesOfImpact() {
             in.tolerance = out.distance / 4;
             out = query();
             ++stats_.toi_queries;
+            stats_.toi_iterations += out.iterations;
         }
         if (out.state != collision::CcdState::Hit && out.state != collision::CcdState::Failed) {
             continue;

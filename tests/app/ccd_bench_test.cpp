@@ -92,6 +92,18 @@ TEST(CcdBench, UnitTestSetTableAndJsonWithNoFalseNegatives) {
             EXPECT_GT(row["toi_events"].get<int>(), 0) << row.dump();
         }
     }
+    // Sphere pairs of scenes/ccd_spheres.yaml: the exact root needs one iteration per query
+    // and stops no later than the advancement (both at the target gap, to rounding).
+    ASSERT_TRUE(doc.contains("sphere_pairs"));
+    ASSERT_EQ(doc["sphere_pairs"].size(), 2u);
+    const nlohmann::json& advance = doc["sphere_pairs"][0];
+    const nlohmann::json& exact = doc["sphere_pairs"][1];
+    EXPECT_EQ(advance["ccd_spheres"], "advancement");
+    EXPECT_EQ(exact["ccd_spheres"], "exact");
+    EXPECT_EQ(exact["toi_iterations"].get<int>(), exact["toi_queries"].get<int>());
+    EXPECT_GT(advance["toi_iterations"].get<int>(), advance["toi_queries"].get<int>());
+    EXPECT_GT(exact["first_toi_s"].get<double>(), 0.0);
+    EXPECT_NEAR(exact["first_toi_s"].get<double>(), advance["first_toi_s"].get<double>(), 1e-12);
     EXPECT_NE(r.out.find("ccd_us/frame"), std::string::npos);
     // Measured: the naive cubic misses 5 of the unit-test edge-edge contacts.
     EXPECT_GT(naive_false_negatives, 0);

@@ -265,6 +265,55 @@ TEST(CcdPolicy, RunsAreBitIdentical) {
     EXPECT_NE(on.stateHash(), off.stateHash());
 }
 
+// Sphere pairs with world.ccd_spheres: exact take the closed-form root: scenes/ccd_spheres.yaml
+// (two 5 cm bullets head-on at 600 m/s each, first contact at (60 - 0.1) / 1200 s) never lets
+// the bullets pass each other, stops them within the target gap of the analytic contact, never
+// after it,
+// with one iteration per query (the advancement lands on the same root here, pure translation,
+// after more distance queries).
+TEST(CcdPolicy, ExactSphereRootStopsHeadOnBulletsAtTheAnalyticContact) {
+    const Real contact_s = 59.9 / 1200;
+    struct Run {
+        Real first_toi_s = -1;
+        std::int64_t queries = 0;
+        std::int64_t iterations = 0;
+    };
+    auto run = [&](CcdSpheres method) {
+        Scene scene = loadScene(kScenes / "ccd_spheres.yaml");
+        scene.world.ccd_spheres = method;
+        World world = makeWorld(scene);
+        Run r;
+        for (int i = 0; i < 60; ++i) {
+            const Real t0 = world.time();
+            world.step();
+            const Body& left = world.bodies()[0];
+            const Body& right = world.bodies()[1];
+            EXPECT_LT(left.position.x() + 0.05, right.position.x() - 0.05) << "step " << i;
+            r.queries += world.lastStats().toi_queries;
+            r.iterations += world.lastStats().toi_iterations;
+            for (const ToiEvent& e : world.toiEvents()) {
+                if (r.first_toi_s < 0 && e.a == 0 && e.b == 1) {
+                    r.first_toi_s = t0 + e.t * scene.world.time_step;
+                }
+            }
+        }
+        return r;
+    };
+    const Run exact = run(CcdSpheres::Exact);
+    const Run advance = run(CcdSpheres::Advancement);
+    ASSERT_GT(exact.first_toi_s, 0);
+    ASSERT_GT(advance.first_toi_s, 0);
+    EXPECT_LE(exact.first_toi_s, contact_s);
+    // The target gap, 1e-3 of 5 cm at 1200 m/s of closing: 4.2e-8 s early.
+    EXPECT_NEAR(exact.first_toi_s, contact_s - 0.05e-3 / 1200, 1e-12);
+    // Pure translation head-on: the advancement's first step lands on the same root (to
+    // rounding); it needs more than one distance query to know it.
+    EXPECT_NEAR(advance.first_toi_s, exact.first_toi_s, 1e-12);
+    EXPECT_EQ(exact.iterations, exact.queries);
+    EXPECT_GT(advance.iterations, advance.queries)
+        << advance.iterations << " " << advance.queries << " " << exact.queries;
+}
+
 TEST(CcdPolicy, SceneErrors) {
     const std::string head = "world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n";
     try {
@@ -284,6 +333,14 @@ TEST(CcdPolicy, SceneErrors) {
     } catch (const SceneError& e) {
         EXPECT_EQ(std::string(e.what()),
                   "t.yaml:8:5: bodies[0].velocity: a static body does not move");
+    }
+    try {
+        parseScene(head + "  ccd_spheres: analytic\n", "t.yaml", ".");
+        FAIL() << "accepted an unknown ccd_spheres";
+    } catch (const SceneError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  "t.yaml:3:16: world.ccd_spheres: unknown ccd_spheres 'analytic' (expected one "
+                  "of: advancement, exact)");
     }
 }
 

@@ -46,6 +46,15 @@ bool findCcdMethod(std::string_view name, CcdMethod& out);
 /// "off, conservative_advancement", for error messages.
 std::string ccdMethodNames();
 
+/// Time of impact of a sphere-sphere pair in the continuous stage (world.ccd_spheres).
+enum class CcdSpheres : std::uint8_t {
+    Advancement,  ///< collision::timeOfImpact like every other pair (iterative, tolerance)
+    Exact,        ///< collision::timeOfImpactSphereSweeps: the closed-form root, one iteration
+};
+std::string_view ccdSpheresName(CcdSpheres method);  ///< "advancement", "exact"
+/// By scene name; false when the name is unknown.
+bool findCcdSpheres(std::string_view name, CcdSpheres& out);
+
 /// Contact response of the step (world.response in scene files).
 enum class Response : std::uint8_t {
     /// No contact solver: discrete contacts are detected only, so overlapping bodies pass
@@ -105,6 +114,9 @@ struct WorldSettings {
     /// dimensionless: a fraction of the smaller bounding radius of the two bodies, so the next
     /// step starts separated. Scene key `world.ccd_target_gap`, in [0, 1].
     Real ccd_target_gap = Real(1e-3);
+    /// Sphere-sphere pairs of the continuous stage: advancement (default, as every pair) or
+    /// the exact quadratic root. Scene key `world.ccd_spheres`.
+    CcdSpheres ccd_spheres = CcdSpheres::Advancement;
     Response response = Response::None;
     /// Default of bodies that do not set theirs (scene files), and with response: impulse the
     /// material of the bounds' faces, which then act as static walls.
@@ -131,6 +143,7 @@ struct StepStats {
     std::int64_t bv_tests = 0;        ///< mesh-hierarchy node tests of the narrow phase
     std::int64_t toi_queries = 0;     ///< timeOfImpact calls in the continuous stage
     std::int64_t toi_events = 0;      ///< pairs stopped at their time of impact
+    std::int64_t toi_iterations = 0;  ///< iterations (distance queries / roots) of those calls
     std::int64_t contact_points = 0;  ///< manifold points the contact solver handled
 };
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 
 #include "collision/math.h"
 
@@ -183,6 +184,22 @@ struct ToiOutput {
 /// GJK per iteration; pure translation converges in 1-2 iterations, fast rotation near
 /// grazing contact may need many: capped by max_iterations -> Failed with a safe t.
 ToiOutput timeOfImpact(const ToiInput& input);
+
+/// Exact time of impact of two spheres (input.a, input.b both ShapeType::Sphere, centred at
+/// their local origins) under the sweeps' motion: a sphere's geometry ignores its rotation and
+/// its centre moves linearly (Sweep::at), so the gap is |d0 + t dv| - ra - rb exactly and
+/// timeOfImpactSpheres solves |d0 + t dv| = ra + rb + target_gap in closed form (one
+/// quadratic, iterations = 1). Guarantee: exact up to the rounding of the relative quantities,
+/// and never after the first contact: the root is moved earlier by a few ulps of the step
+/// (kSphereToiSlack), which covers the quadratic's own rounding, and any target_gap > 0 keeps
+/// the pair that far apart. tolerance/relative_tolerance are not needed and ignored.
+/// Failure mode: only on non-finite input or non-sphere shapes -> Failed at t = 0 (safe).
+/// Already within target_gap at t = 0 but not overlapping -> Hit at t = 0 with the present gap
+/// in `distance` (as timeOfImpact reports it); overlapping -> Overlapped.
+ToiOutput timeOfImpactSphereSweeps(const ToiInput& input);
+
+/// The amount (fraction of the step) by which timeOfImpactSphereSweeps moves its root earlier.
+inline constexpr Real kSphereToiSlack = Real(64) * std::numeric_limits<Real>::epsilon();
 
 // ---- Continuous OBB test with interval arithmetic (ccd/obb.cpp). ----
 
