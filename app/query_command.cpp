@@ -149,8 +149,8 @@ void writeQueryTable(std::ostream& out, const std::filesystem::path (&paths)[2],
             << (r.colliding ? "colliding" : "apart") << std::setw(8) << r.pairs.size()
             << std::setw(10) << r.first.bv_tests << std::setw(10) << r.first.triangle_tests
             << std::setw(10) << r.all.bv_tests << std::setw(10) << r.all.triangle_tests
-            << std::setprecision(2) << std::setw(11) << r.build_ms << std::setw(11)
-            << r.first_us << std::setw(11) << r.all_us << std::setprecision(1) << std::setw(8)
+            << std::setprecision(2) << std::setw(11) << r.build_ms << std::setw(11) << r.first_us
+            << std::setw(11) << r.all_us << std::setprecision(1) << std::setw(8)
             << r.unit.bv_test_ns << std::setw(8) << r.unit.triangle_test_ns << std::setw(8)
             << r.refit.refit_node_ns << (r.unit.triangles_from_queries ? "" : "*") << "\n";
     }
@@ -224,18 +224,19 @@ int runSelfQuery(const std::vector<std::string_view>& names, const std::filesyst
             << " triangles; pairs sharing a vertex index are adjacent and not counted)\n";
         out << std::left << std::setw(8) << "bv" << std::right << std::setw(8) << "pairs"
             << std::setw(10) << "Nv" << std::setw(10) << "Np" << std::setw(11) << "build ms"
-            << std::setw(11) << "self us" << std::setw(8) << "Cu ns" << "\n"
+            << std::setw(11) << "self us" << std::setw(8) << "Cu ns"
+            << "\n"
             << std::fixed;
         for (const SelfRow& r : rows) {
-            out << std::left << std::setw(8) << r.bv << std::right << std::setw(8)
-                << r.pairs.size() << std::setw(10) << r.stats.bv_tests << std::setw(10)
-                << r.stats.triangle_tests << std::setprecision(2) << std::setw(11) << r.build_ms
-                << std::setw(11) << r.query_us << std::setprecision(1) << std::setw(8)
-                << r.refit.refit_node_ns << "\n";
+            out << std::left << std::setw(8) << r.bv << std::right << std::setw(8) << r.pairs.size()
+                << std::setw(10) << r.stats.bv_tests << std::setw(10) << r.stats.triangle_tests
+                << std::setprecision(2) << std::setw(11) << r.build_ms << std::setw(11)
+                << r.query_us << std::setprecision(1) << std::setw(8) << r.refit.refit_node_ns
+                << "\n";
         }
         out << std::left << std::setw(8) << "brute" << std::right << std::setw(8) << brute.size()
-            << std::setw(10) << 0 << std::setw(10) << brute_stats.triangle_tests
-            << std::setw(11) << "-" << std::setprecision(2) << std::setw(11) << brute_us << "\n";
+            << std::setw(10) << 0 << std::setw(10) << brute_stats.triangle_tests << std::setw(11)
+            << "-" << std::setprecision(2) << std::setw(11) << brute_us << "\n";
         out << "(Nv: BV tests, Np: triangle tests; brute: every non-adjacent pair after a box "
                "reject;\n Cu: ns per node of a refit of the tree)\n";
     }

@@ -263,8 +263,8 @@ public:
     void report(const CheckRun& run, std::vector<CheckRow>& rows) const override {
         for (std::size_t k = 0; k < expect_.size(); ++k) {
             const engine::SelfCollisionExpectation& s = expect_[k];
-            std::string what = s.name + " self-intersecting triangle pairs at " +
-                               frameText(s.frames) + ":";
+            std::string what =
+                s.name + " self-intersecting triangle pairs at " + frameText(s.frames) + ":";
             if (s.min_pairs) what += " >= " + std::to_string(*s.min_pairs);
             if (s.max_pairs) what += " <= " + std::to_string(*s.max_pairs);
             CheckRow r{what, failures_[k].empty(), failures_[k]};

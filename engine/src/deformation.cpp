@@ -36,8 +36,8 @@ Vec3 deformPoint(const Deformation& d, const Vec3& rest, Real t) {
             if (k == 0) return rest;
             const Real phi = k * x;
             const Real half = std::sin(phi / 2);
-            return Vec3(std::sin(phi) / k - y * std::sin(phi), 2 * half * half / k + y * std::cos(phi),
-                        z);
+            return Vec3(std::sin(phi) / k - y * std::sin(phi),
+                        2 * half * half / k + y * std::cos(phi), z);
         }
         case DeformKind::Twist: {
             const Real angle = d.amount * swell(d.frequency, t) * x;
@@ -46,8 +46,7 @@ Vec3 deformPoint(const Deformation& d, const Vec3& rest, Real t) {
             return Vec3(x, c * y - s * z, s * y + c * z);
         }
         case DeformKind::Wave: {
-            const Real phase =
-                2 * std::numbers::pi_v<Real> * (x / d.wavelength - d.frequency * t);
+            const Real phase = 2 * std::numbers::pi_v<Real> * (x / d.wavelength - d.frequency * t);
             return Vec3(x, y + d.amount * std::sin(phase), z);
         }
     }

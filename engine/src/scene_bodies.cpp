@@ -452,7 +452,8 @@ Mat3 SceneParser::readInertia(const YAML::Node& n, const std::string& path) cons
 }
 
 Deformation SceneParser::readDeformation(const YAML::Node& n, const std::string& path) const {
-    if (!n.IsMap()) fail(n, path, "expected a mapping with keys: kind, amount, frequency, wavelength");
+    if (!n.IsMap())
+        fail(n, path, "expected a mapping with keys: kind, amount, frequency, wavelength");
     const std::vector<Entry> es = entries(n, path, {"kind", "amount", "frequency", "wavelength"});
     Deformation d;
     const Entry& kind = require(es, "kind", n, path);
@@ -476,7 +477,8 @@ Deformation SceneParser::readDeformation(const YAML::Node& n, const std::string&
         fail(frequency.value, childPath(path, "frequency"), "must be in (0, 1000] (Hz)");
     }
     if (const Entry* w = find(es, "wavelength")) {
-        if (d.kind != DeformKind::Wave) fail(w->key_node, childPath(path, "wavelength"), "applies to kind: wave only");
+        if (d.kind != DeformKind::Wave)
+            fail(w->key_node, childPath(path, "wavelength"), "applies to kind: wave only");
         d.wavelength = readReal(w->value, childPath(path, "wavelength"));
         if (!(d.wavelength > 0) || !std::isfinite(d.wavelength)) {
             fail(w->value, childPath(path, "wavelength"), "must be > 0 (m)");

@@ -176,8 +176,7 @@ void ExpectReader::selfCollision(const Entry& e, const std::string& p, Expectati
             p_.fail(body.value, childPath(ip, "body"),
                     "'" + s.name + "' does not have 'self_collision: true'");
         }
-        s.frames =
-            readFrames(p_.require(se, "frames", list[i], ip).value, childPath(ip, "frames"));
+        s.frames = readFrames(p_.require(se, "frames", list[i], ip).value, childPath(ip, "frames"));
         if (const Entry* m = p_.find(se, "min_pairs")) {
             s.min_pairs = readCount(m->value, childPath(ip, "min_pairs"));
         }

@@ -65,8 +65,8 @@ TriangleMesh triangleSoup(std::uint64_t seed, int triangles, int pool) {
     TriangleMesh mesh;
     for (int i = 0; i < pool; ++i) mesh.vertices.push_back(rng.vec(0, 1));
     for (int t = 0; t < triangles; ++t) {
-        mesh.triangles.push_back({rng.integer(0, pool - 1), rng.integer(0, pool - 1),
-                                  rng.integer(0, pool - 1)});
+        mesh.triangles.push_back(
+            {rng.integer(0, pool - 1), rng.integer(0, pool - 1), rng.integer(0, pool - 1)});
     }
     for (int t = 0; t < 4; ++t) {
         const Vec3 a = rng.vec(0, 1);
@@ -102,7 +102,8 @@ std::vector<Case> adversarialMeshes() {
     std::vector<Case> all;
     for (const Case& c : base) {
         all.push_back(c);
-        all.push_back({c.name + ", translated by 1e6", transformed(c.mesh, 1, Vec3(1e6, -1e6, 1e6))});
+        all.push_back(
+            {c.name + ", translated by 1e6", transformed(c.mesh, 1, Vec3(1e6, -1e6, 1e6))});
         all.push_back({c.name + ", scaled by 1e-4", transformed(c.mesh, 1e-4, Vec3::Zero())});
         all.push_back({c.name + ", scaled by 1e4", transformed(c.mesh, 1e4, Vec3::Zero())});
     }
@@ -147,8 +148,9 @@ TYPED_TEST(BvhSelf, AdversarialMeshesMatchBruteForce) {
         const std::vector<TrianglePair>& brute = bruteAnswers()[k];
         EXPECT_EQ(collision::intersectSelf(Bvh<TypeParam>(c.mesh)), brute) << c.name;
         // Leaves of several triangles hold adjacent ones together: still excluded.
-        EXPECT_EQ(collision::intersectSelf(Bvh<TypeParam>(c.mesh, BvhBuildOptions{BvhSplit::Mean, 3})),
-                  brute)
+        EXPECT_EQ(
+            collision::intersectSelf(Bvh<TypeParam>(c.mesh, BvhBuildOptions{BvhSplit::Mean, 3})),
+            brute)
             << c.name;
         non_empty += !brute.empty();
     }

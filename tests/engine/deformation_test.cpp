@@ -2,6 +2,8 @@
 // (bend, twist, wave), the world moving the vertices and refitting the body's hierarchy every
 // step (self pairs equal to the brute force on the deformed mesh, volumes containing it), the
 // rebuild rule, and the scene keys' errors.
+#include "engine/deformation.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,7 +13,6 @@
 #include <vector>
 
 #include "collision/bvh/bvh.h"
-#include "engine/deformation.h"
 #include "engine/scene.h"
 #include "engine/world.h"
 
@@ -50,9 +51,7 @@ TEST(Deformation, ClosedForms) {
     EXPECT_NEAR(deformPoint(wave, Vec3(0.5, 1, 0), 0.5).y(), 1.0, 1e-12);
 }
 
-Scene deformScene() {
-    return loadScene(fs::path(CDLAB_SOURCE_DIR) / "scenes/deform_self.yaml");
-}
+Scene deformScene() { return loadScene(fs::path(CDLAB_SOURCE_DIR) / "scenes/deform_self.yaml"); }
 
 TEST(Deformation, WorldRefitsAndSelfPairsFollowTheDeformedMesh) {
     const Scene scene = deformScene();
@@ -132,11 +131,13 @@ TEST(Deformation, SceneKeysRejectBadValues) {
     const std::string head =
         "world: {bounds: {min: [-5, -5, -5], max: [5, 5, 5]}}\n"
         "bodies:\n";
-    EXPECT_SCENE_ERROR(head + "  - {shape: sphere, radius: 1, position: [0, 0, 0], deform: "
-                              "{kind: bend, amount: 1, frequency: 1}}\n",
+    EXPECT_SCENE_ERROR(head +
+                           "  - {shape: sphere, radius: 1, position: [0, 0, 0], deform: "
+                           "{kind: bend, amount: 1, frequency: 1}}\n",
                        "3:53: bodies[0].deform: ", "applies to mesh bodies only");
-    const std::string mesh = "  - {shape: mesh, file: ../assets/wavy_strip.obj, position: [0, 0, "
-                             "0], deform: ";
+    const std::string mesh =
+        "  - {shape: mesh, file: ../assets/wavy_strip.obj, position: [0, 0, "
+        "0], deform: ";
     EXPECT_SCENE_ERROR(head + mesh + "{kind: melt, amount: 1, frequency: 1}}\n",
                        "3:87: bodies[0].deform.kind: ", "unknown deformation 'melt'");
     EXPECT_SCENE_ERROR(head + mesh + "{kind: bend, amount: 1, frequency: 0}}\n",

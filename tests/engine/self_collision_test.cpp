@@ -64,15 +64,15 @@ TEST(SelfCollision, SceneKeysRejectMisuse) {
         "bodies:\n";                                                          // 2
     const std::string sphere =
         "  - {name: s, shape: sphere, radius: 1, position: [0, 0, 0], self_collision: true}\n";
-    EXPECT_SCENE_ERROR(world + sphere, "3:78: bodies[0].self_collision: ",
-                       "applies to mesh bodies only");
+    EXPECT_SCENE_ERROR(world + sphere,
+                       "3:78: bodies[0].self_collision: ", "applies to mesh bodies only");
     const std::string ring =
         "  - {name: r, shape: mesh, file: ../assets/torus.obj, position: [0, 0, 0]}\n"  // 3
         "expect:\n"                                                                     // 4
         "  self_collision:\n";                                                          // 5
-    EXPECT_SCENE_ERROR(world + ring + "    - {body: r, frames: [0, 9], max_pairs: 0}\n",
-                       "6:14: expect.self_collision[0].body: ",
-                       "does not have 'self_collision: true'");
+    EXPECT_SCENE_ERROR(
+        world + ring + "    - {body: r, frames: [0, 9], max_pairs: 0}\n",
+        "6:14: expect.self_collision[0].body: ", "does not have 'self_collision: true'");
     const std::string self_ring =
         "  - {name: r, shape: mesh, file: ../assets/torus.obj, position: [0, 0, 0], "
         "self_collision: true}\n"
@@ -80,10 +80,12 @@ TEST(SelfCollision, SceneKeysRejectMisuse) {
         "  self_collision:\n";
     EXPECT_SCENE_ERROR(world + self_ring + "    - {body: r, frames: [0, 9]}\n",
                        "6:7: expect.self_collision[0]: ", "needs 'min_pairs' or 'max_pairs'");
-    EXPECT_SCENE_ERROR(world + self_ring + "    - {body: r, frames: 1, min_pairs: 3, max_pairs: 2}\n",
-                       "6:53: expect.self_collision[0].max_pairs: ", "must be >= 'min_pairs'");
-    const Scene ok = parseScene(world + self_ring + "    - {body: r, frames: [0, 9], min_pairs: 0}\n",
-                                "test.yaml", fs::path(CDLAB_SOURCE_DIR) / "scenes");
+    EXPECT_SCENE_ERROR(
+        world + self_ring + "    - {body: r, frames: 1, min_pairs: 3, max_pairs: 2}\n",
+        "6:53: expect.self_collision[0].max_pairs: ", "must be >= 'min_pairs'");
+    const Scene ok =
+        parseScene(world + self_ring + "    - {body: r, frames: [0, 9], min_pairs: 0}\n",
+                   "test.yaml", fs::path(CDLAB_SOURCE_DIR) / "scenes");
     ASSERT_EQ(ok.expect.self_collision.size(), 1u);
     EXPECT_TRUE(ok.bodies[0].self_collision);
     EXPECT_EQ(ok.expect.self_collision[0].min_pairs, 0);
