@@ -38,6 +38,7 @@ struct Row {
     double first_us = 0;  // per query
     double all_us = 0;    // per query
     BvhUnitCosts unit;    // Cv, Cp: measured after the timed queries
+    RefitUnitCost refit;  // Cu on mesh A
 };
 
 // Mean time per call of `fn`, repeated until ~20 ms have passed (at most 1000 calls).
@@ -118,6 +119,8 @@ void writeQueryJson(std::ostream& out, const std::filesystem::path (&paths)[2],
               {"bv_tests_timed", r.unit.bv_tests_timed},
               {"triangle_tests_timed", r.unit.triangle_tests_timed},
               {"triangle_tests_from_query", r.unit.triangles_from_queries},
+              {"refit_node_ns", r.refit.refit_node_ns},
+              {"refit_nodes_timed", r.refit.nodes_timed},
               // F = Nv Cv + Np Cp for the all-pairs query, beside its measured time_us.
               {"all_pairs_model_us",
                1e-3 * (static_cast<double>(r.all.bv_tests) * r.unit.bv_test_ns +
@@ -138,7 +141,7 @@ void writeQueryTable(std::ostream& out, const std::filesystem::path (&paths)[2],
         << std::setw(8) << "pairs" << std::setw(10) << "first Nv" << std::setw(10) << "first Np"
         << std::setw(10) << "all Nv" << std::setw(10) << "all Np" << std::setw(11) << "build ms"
         << std::setw(11) << "first us" << std::setw(11) << "all us" << std::setw(8) << "Cv ns"
-        << std::setw(8) << "Cp ns"
+        << std::setw(8) << "Cp ns" << std::setw(8) << "Cu ns"
         << "\n";
     out << std::fixed;
     for (const Row& r : rows) {
@@ -146,17 +149,102 @@ void writeQueryTable(std::ostream& out, const std::filesystem::path (&paths)[2],
             << (r.colliding ? "colliding" : "apart") << std::setw(8) << r.pairs.size()
             << std::setw(10) << r.first.bv_tests << std::setw(10) << r.first.triangle_tests
             << std::setw(10) << r.all.bv_tests << std::setw(10) << r.all.triangle_tests
-            << std::setprecision(2) << std::setw(11) << r.build_ms << std::setw(11)
-            << r.first_us << std::setw(11) << r.all_us << std::setprecision(1) << std::setw(8)
-            << r.unit.bv_test_ns << std::setw(8) << r.unit.triangle_test_ns
-            << (r.unit.triangles_from_queries ? "" : "*") << "\n";
+            << std::setprecision(2) << std::setw(11) << r.build_ms << std::setw(11) << r.first_us
+            << std::setw(11) << r.all_us << std::setprecision(1) << std::setw(8)
+            << r.unit.bv_test_ns << std::setw(8) << r.unit.triangle_test_ns << std::setw(8)
+            << r.refit.refit_node_ns << (r.unit.triangles_from_queries ? "" : "*") << "\n";
     }
     out << "(Nv: BV tests, Np: triangle tests; build: both trees; Cv, Cp: ns per BV test and\n"
-           " per triangle test, timed by replaying the all-pairs query's own tests";
+           " per triangle test, timed by replaying the all-pairs query's own tests; Cu: ns per\n"
+           " node of a refit of A's tree";
     bool random_cp = false;
     for (const Row& r : rows) random_cp = random_cp || !r.unit.triangles_from_queries;
     if (random_cp) out << ";\n * the query tested no triangles: Cp on random triangle pairs";
     out << ")\n";
+}
+
+// Self-collision of one mesh: every requested tree against itself beside the brute-force loop.
+int runSelfQuery(const std::vector<std::string_view>& names, const std::filesystem::path& path,
+                 const collision::TriangleMesh& mesh, bool json, std::ostream& out,
+                 std::ostream& err) {
+    struct SelfRow {
+        std::string_view bv;
+        std::vector<collision::TrianglePair> pairs;
+        collision::BvhQueryStats stats;
+        double build_ms = 0;
+        double query_us = 0;
+        RefitUnitCost refit;
+    };
+    collision::BvhQueryStats brute_stats;
+    const std::vector<collision::TrianglePair> brute =
+        collision::intersectSelfBruteForce(mesh, &brute_stats);
+    const double brute_us =
+        1e6 * timePerCall([&] { (void)collision::intersectSelfBruteForce(mesh); });
+    std::vector<SelfRow> rows;
+    bool agree = true;
+    for (const std::string_view name : names) {
+        SelfRow row;
+        row.bv = name;
+        const auto b0 = Clock::now();
+        const std::unique_ptr<collision::MeshBvh> tree = collision::buildMeshBvh(name, mesh);
+        row.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - b0).count();
+        row.pairs = tree->intersectSelf(&row.stats);
+        row.query_us = 1e6 * timePerCall([&] { (void)tree->intersectSelf(); });
+        row.refit = measureRefitUnitCost(name, mesh);
+        agree = agree && row.pairs == brute;
+        rows.push_back(std::move(row));
+    }
+    if (json) {
+        nlohmann::json j;
+        j["mesh"] = {{"path", path.string()}, {"triangles", mesh.triangles.size()}};
+        j["agrees_with_brute_force"] = agree;
+        nlohmann::json pairs = nlohmann::json::array();
+        for (const collision::TrianglePair& p : brute) pairs.push_back({p.a, p.b});
+        j["brute_force"] = {{"self_pair_count", brute.size()},
+                            {"self_pairs", std::move(pairs)},
+                            {"triangle_tests", brute_stats.triangle_tests},
+                            {"time_us", brute_us}};
+        nlohmann::json results = nlohmann::json::array();
+        for (const SelfRow& r : rows) {
+            nlohmann::json rp = nlohmann::json::array();
+            for (const collision::TrianglePair& p : r.pairs) rp.push_back({p.a, p.b});
+            results.push_back({{"bv", std::string(r.bv)},
+                               {"self_pair_count", r.pairs.size()},
+                               {"self_pairs", std::move(rp)},
+                               {"bv_tests", r.stats.bv_tests},
+                               {"triangle_tests", r.stats.triangle_tests},
+                               {"build_ms", r.build_ms},
+                               {"time_us", r.query_us},
+                               {"refit_node_ns", r.refit.refit_node_ns}});
+        }
+        j["results"] = results;
+        out << j.dump(2) << "\n";
+    } else {
+        out << "self-collision of " << path.string() << " (" << mesh.triangles.size()
+            << " triangles; pairs sharing a vertex index are adjacent and not counted)\n";
+        out << std::left << std::setw(8) << "bv" << std::right << std::setw(8) << "pairs"
+            << std::setw(10) << "Nv" << std::setw(10) << "Np" << std::setw(11) << "build ms"
+            << std::setw(11) << "self us" << std::setw(8) << "Cu ns"
+            << "\n"
+            << std::fixed;
+        for (const SelfRow& r : rows) {
+            out << std::left << std::setw(8) << r.bv << std::right << std::setw(8) << r.pairs.size()
+                << std::setw(10) << r.stats.bv_tests << std::setw(10) << r.stats.triangle_tests
+                << std::setprecision(2) << std::setw(11) << r.build_ms << std::setw(11)
+                << r.query_us << std::setprecision(1) << std::setw(8) << r.refit.refit_node_ns
+                << "\n";
+        }
+        out << std::left << std::setw(8) << "brute" << std::right << std::setw(8) << brute.size()
+            << std::setw(10) << 0 << std::setw(10) << brute_stats.triangle_tests << std::setw(11)
+            << "-" << std::setprecision(2) << std::setw(11) << brute_us << "\n";
+        out << "(Nv: BV tests, Np: triangle tests; brute: every non-adjacent pair after a box "
+               "reject;\n Cu: ns per node of a refit of the tree)\n";
+    }
+    if (!agree) {
+        err << "error: a tree's self pairs differ from the brute force's (a BVH bug)\n";
+        return 1;
+    }
+    return 0;
 }
 
 }  // namespace
@@ -224,6 +312,26 @@ int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err) 
             return 2;
         }
     }
+    if (options.self) {
+        if (!options.mesh_b.empty() || !options.pose_b.empty()) {
+            err << "--self: takes one mesh and no --pose-b\n";
+            return 2;
+        }
+        engine::MeshImportOutput imported = engine::importMesh(options.mesh_a, 1.0);
+        if (!imported.ok) {
+            err << options.mesh_a.string() << ": " << imported.error << "\n";
+            return 2;
+        }
+        if (imported.report.changed()) {
+            err << "warning: " << options.mesh_a.string() << ": "
+                << engine::describeImportChanges(imported.report) << "\n";
+        }
+        return runSelfQuery(names, options.mesh_a, imported.mesh, options.json, out, err);
+    }
+    if (options.mesh_b.empty()) {
+        err << "mesh_b: required (or --self for one mesh against itself)\n";
+        return 2;
+    }
     collision::TriangleMesh meshes[2];
     engine::MeshImportReport reports[2];
     const std::filesystem::path paths[2] = {options.mesh_a, options.mesh_b};
@@ -256,6 +364,7 @@ int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err) 
         row.all_us = 1e6 * timePerCall([&] { (void)a->intersect(*b, pose_b); });
         // Cv and Cp: the all-pairs query's own tests replayed in batches, outside its timing.
         row.unit = measureBvhUnitCosts(*a, *b, std::span<const collision::Pose>(&pose_b, 1));
+        row.refit = measureRefitUnitCost(name, meshes[0]);
         rows.push_back(std::move(row));
     }
     bool agree = true;
@@ -282,11 +391,15 @@ Command addQueryCommand(CLI::App& cli) {
         "mesh against mesh through every BVH volume type: answer, triangle pairs, "
         "BV and triangle tests, build and query time side by side");
     cmd->add_option("mesh_a", query->mesh_a, "mesh A (any format assimp reads)")->required();
-    cmd->add_option("mesh_b", query->mesh_b, "mesh B")->required();
+    cmd->add_option("mesh_b", query->mesh_b, "mesh B (omitted with --self)");
     cmd->add_option("--bv", query->bv, "volume type or all")->capture_default_str();
     cmd->add_option("--pose-b", query->pose_b,
                     "B's pose in A's frame: x,y,z,qw,qx,qy,qz (default identity)");
     cmd->add_flag("--json", query->json, "machine-readable output");
+    cmd->add_flag("--self", query->self,
+                  "self-collision of mesh A: its intersecting non-adjacent triangle pairs "
+                  "through each tree against itself and the brute-force loop (exit 1 if they "
+                  "differ)");
     return {cmd, [query]() { return runQuery(*query, std::cout, std::cerr); }};
 }
 

@@ -18,6 +18,7 @@ struct QueryOptions {
     std::string bv = "all";  ///< a BVH volume name (collision::bvhVolumeNames()) or "all"
     std::string pose_b;      ///< "x,y,z,qw,qx,qy,qz" (B's frame in A's); empty: identity
     bool json = false;       ///< machine-readable output on `out`
+    bool self = false;       ///< self-collision of mesh_a alone (mesh_b must be empty)
 };
 
 /// Parses "x,y,z,qw,qx,qy,qz" into a pose (quaternion normalised). Returns nothing and sets
@@ -25,7 +26,9 @@ struct QueryOptions {
 std::optional<collision::Pose> parsePose(std::string_view text, std::string* error);
 
 /// Exit codes: 0 success, 1 the volume types disagree on the pair list (a bug: reported),
-/// 2 bad input (flag, unreadable or empty mesh).
+/// 2 bad input (flag, unreadable or empty mesh). With `self`: the non-adjacent intersecting
+/// triangle pairs of mesh_a through every requested tree against itself and through the
+/// brute-force loop; exit 1 when a tree's pairs differ from the brute force's.
 int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err);
 
 }  // namespace app

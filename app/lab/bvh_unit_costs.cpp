@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -102,6 +103,26 @@ BvhUnitCosts measureBvhUnitCosts(const collision::MeshBvh& a, const collision::M
     costs.bv_test_ns = 1e9 * bv_seconds / static_cast<double>(costs.bv_tests_timed);
     costs.triangle_test_ns = 1e9 * tri_seconds / static_cast<double>(costs.triangle_tests_timed);
     return costs;
+}
+
+RefitUnitCost measureRefitUnitCost(std::string_view volume, const collision::TriangleMesh& mesh,
+                                   std::int64_t node_target) {
+    RefitUnitCost cost;
+    const std::unique_ptr<collision::MeshBvh> tree = collision::buildMeshBvh(volume, mesh);
+    if (!tree || tree->nodeCount() == 0) return cost;
+    const std::int64_t nodes = tree->nodeCount();
+    const std::int64_t repeats = std::max<std::int64_t>(1, (node_target + nodes - 1) / nodes);
+    std::int64_t refitted = 0;
+    const double seconds = fastestOfThree(
+        [&] {
+            std::int64_t n = 0;
+            for (std::int64_t r = 0; r < repeats; ++r) n += tree->refit(mesh);
+            return n;
+        },
+        &refitted);
+    cost.nodes_timed = refitted;
+    cost.refit_node_ns = refitted > 0 ? 1e9 * seconds / static_cast<double>(refitted) : 0;
+    return cost;
 }
 
 }  // namespace app

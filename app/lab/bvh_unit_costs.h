@@ -1,10 +1,12 @@
 // app/lab/bvh_unit_costs.h -- measured unit costs of the BVH cost model F = Nv Cv + Np Cp: the time
 // of one node-volume test (Cv) and one triangle test (Cp), from replaying the tests the
-// all-pairs query really makes at the given poses. Used by `cdlab query` and `bench narrowphase`.
+// all-pairs query really makes at the given poses; and Cu, the time per node of a refit (the
+// Nu Cu term of a deforming mesh). Used by `cdlab query` and `bench narrowphase`.
 #pragma once
 
 #include <cstdint>
 #include <span>
+#include <string_view>
 
 #include "collision/bvh/bvh.h"
 #include "collision/bvh/bvh_replay.h"
@@ -34,5 +36,18 @@ BvhUnitCosts measureBvhUnitCosts(const collision::MeshBvh& a, const collision::M
                                  std::span<const collision::Pose> poses,
                                  std::int64_t bv_target = 200000,
                                  std::int64_t triangle_target = 100000);
+
+/// Cu of one volume type on one mesh.
+struct RefitUnitCost {
+    double refit_node_ns = 0;        ///< Cu: ns per node refitted (MeshBvh::refit / its Nu)
+    std::int64_t nodes_timed = 0;    ///< nodes in the timed batch (one repetition)
+};
+
+/// Builds the `volume` tree of `mesh` and times refits of it to the same vertices (the same work
+/// as a refit to a deformed copy: every node's volume refitted to its triangles' corners),
+/// repeated until a batch holds at least `node_target` nodes, fastest of 3. A refit node's cost
+/// grows with its subtree (a node is fitted to all its corners): Cu is per node on this mesh.
+RefitUnitCost measureRefitUnitCost(std::string_view volume, const collision::TriangleMesh& mesh,
+                                   std::int64_t node_target = 200000);
 
 }  // namespace app

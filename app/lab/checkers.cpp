@@ -245,6 +245,42 @@ private:
     std::vector<RestTracker> rests_;
 };
 
+// ---- a mesh body's own intersecting triangle pairs over a range of frames ----
+class SelfCollisionChecker final : public Checker {
+public:
+    explicit SelfCollisionChecker(const std::vector<engine::SelfCollisionExpectation>& expect)
+        : expect_(expect), failures_(expect.size()) {}
+    void observeFrame(CheckRun& run, int frame) override {
+        for (std::size_t k = 0; k < expect_.size(); ++k) {
+            const engine::SelfCollisionExpectation& s = expect_[k];
+            if (frame < s.frames.first || frame > s.frames.last || !failures_[k].empty()) continue;
+            const auto n = static_cast<int>(run.world.selfPairs(s.body).size());
+            if ((s.min_pairs && n < *s.min_pairs) || (s.max_pairs && n > *s.max_pairs)) {
+                failures_[k] = std::to_string(n) + " pairs at frame " + std::to_string(frame);
+            }
+        }
+    }
+    void report(const CheckRun& run, std::vector<CheckRow>& rows) const override {
+        for (std::size_t k = 0; k < expect_.size(); ++k) {
+            const engine::SelfCollisionExpectation& s = expect_[k];
+            std::string what =
+                s.name + " self-intersecting triangle pairs at " + frameText(s.frames) + ":";
+            if (s.min_pairs) what += " >= " + std::to_string(*s.min_pairs);
+            if (s.max_pairs) what += " <= " + std::to_string(*s.max_pairs);
+            CheckRow r{what, failures_[k].empty(), failures_[k]};
+            if (s.frames.last >= run.frames) {
+                r.pass = false;
+                r.reason = "the run has only " + std::to_string(run.frames) + " frames";
+            }
+            rows.push_back(r);
+        }
+    }
+
+private:
+    const std::vector<engine::SelfCollisionExpectation>& expect_;
+    std::vector<std::string> failures_;  // the first frame outside the bounds, per expectation
+};
+
 // ---- pause dumps: written at their frames as `cdlab run --pause-at` writes them, then read
 // back ----
 class PauseDumpChecker final : public Checker {
@@ -423,6 +459,9 @@ std::vector<std::unique_ptr<Checker>> makeCheckers(const engine::Scene& scene,
     }
     if (!ex.toi.empty()) out.push_back(makeToiChecker(ex.toi));
     if (!ex.rest.empty()) out.push_back(std::make_unique<RestChecker>(ex.rest));
+    if (!ex.self_collision.empty()) {
+        out.push_back(std::make_unique<SelfCollisionChecker>(ex.self_collision));
+    }
     if (!ex.pause_dumps.empty()) {
         out.push_back(std::make_unique<PauseDumpChecker>(ex.pause_dumps));
     }

@@ -68,6 +68,9 @@ struct FrameStats {
     std::int64_t narrow_tests = 0;
     std::int64_t triangle_tests = 0;
     std::int64_t bv_tests = 0;
+    std::int64_t refit_nodes = 0;
+    std::int64_t rebuilds = 0;
+    double refit_s = 0;
     double integrate_s = 0, volumes_s = 0, broad_s = 0, narrow_s = 0, ccd_s = 0, response_s = 0,
            total_s = 0;
 
@@ -79,6 +82,9 @@ struct FrameStats {
         narrow_tests += s.narrow_tests;
         triangle_tests += s.triangle_tests;
         bv_tests += s.bv_tests;
+        refit_nodes += s.refit_nodes;
+        rebuilds += s.rebuilds;
+        refit_s += s.refit_s;
         integrate_s += s.integrate_s;
         volumes_s += s.volumes_s;
         broad_s += s.broad_phase_s;
@@ -92,19 +98,31 @@ struct FrameStats {
 constexpr const char* kStatsHeader =
     "frame,time,broadphase,bodies,flagged,colliding,volume_tests,volumes_updated,swaps,"
     "narrow_tests,triangle_tests,bv_tests,integrate_ms,volumes_ms,broadphase_ms,narrowphase_ms,"
-    "ccd_ms,response_ms,step_ms\n";
+    "ccd_ms,response_ms,step_ms,self_pairs,refit_nodes,refit_ms,refit_node_ns,rebuilds\n";
+
+// Intersecting triangle pairs within self_collision mesh bodies at the current state.
+std::int64_t selfPairCount(const engine::World& world) {
+    std::int64_t n = 0;
+    for (std::size_t i = 0; i < world.bodies().size(); ++i) {
+        n += static_cast<std::int64_t>(world.selfPairs(static_cast<engine::BodyId>(i)).size());
+    }
+    return n;
+}
 
 std::string statsRow(int frame, const engine::World& world, const FrameStats& f) {
     char line[512];
     std::snprintf(line, sizeof line,
                   "%d,%.9g,%s,%zu,%zu,%zu,%lld,%lld,%lld,%lld,%lld,%lld,%.6f,%.6f,%.6f,%.6f,%.6f,"
-                  "%.6f,%.6f\n",
+                  "%.6f,%.6f,%lld,%lld,%.6f,%.3f,%lld\n",
                   frame, double(world.time()), std::string(world.broadPhase().name()).c_str(),
                   world.bodies().size(), world.flaggedPairs().size(), world.collidingPairs().size(),
                   (long long)f.broad.volume_tests, (long long)f.broad.volumes_updated,
                   (long long)f.broad.swaps, (long long)f.narrow_tests, (long long)f.triangle_tests,
                   (long long)f.bv_tests, 1e3 * f.integrate_s, 1e3 * f.volumes_s, 1e3 * f.broad_s,
-                  1e3 * f.narrow_s, 1e3 * f.ccd_s, 1e3 * f.response_s, 1e3 * f.total_s);
+                  1e3 * f.narrow_s, 1e3 * f.ccd_s, 1e3 * f.response_s, 1e3 * f.total_s,
+                  (long long)selfPairCount(world), (long long)f.refit_nodes, 1e3 * f.refit_s,
+                  f.refit_nodes > 0 ? 1e9 * f.refit_s / double(f.refit_nodes) : 0.0,
+                  (long long)f.rebuilds);
     return line;
 }
 
@@ -278,6 +296,7 @@ void prepareOutputs(const RunOptions& options, const fs::path& out_dir, bool wan
 struct RunTotals {
     std::int64_t flagged = 0;    ///< flagged pairs summed over frames
     std::int64_t colliding = 0;  ///< colliding pairs summed over frames
+    std::int64_t self_pairs = 0;  ///< self-intersecting triangle pairs summed over frames
     double step_seconds = 0;
 };
 
@@ -294,6 +313,7 @@ std::string summaryJson(const RunOptions& options, const engine::Scene& scene,
     summary["state_hash"] = world.stateHash();
     summary["flagged_pair_frames"] = totals.flagged;
     summary["colliding_pair_frames"] = totals.colliding;
+    summary["self_pair_frames"] = totals.self_pairs;
     summary["mean_step_ms"] =
         world.stepCount() > 0 ? 1e3 * totals.step_seconds / double(world.stepCount()) : 0.0;
     summary["video"] = want_video ? video_path.string() : "";
@@ -423,6 +443,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
             if (options.html) page.frames.push_back(pageFrame(frame, world, frame_stats));
             totals.flagged += static_cast<std::int64_t>(world.flaggedPairs().size());
             totals.colliding += static_cast<std::int64_t>(world.collidingPairs().size());
+            totals.self_pairs += selfPairCount(world);
             frame_options.hud_text =
                 scene.draw.hud ? render::hudLine(world, frame, options.hud_timing) : "";
             if (!options.no_frames || want_video) {

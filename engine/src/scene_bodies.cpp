@@ -451,6 +451,42 @@ Mat3 SceneParser::readInertia(const YAML::Node& n, const std::string& path) cons
     return inertia;
 }
 
+Deformation SceneParser::readDeformation(const YAML::Node& n, const std::string& path) const {
+    if (!n.IsMap())
+        fail(n, path, "expected a mapping with keys: kind, amount, frequency, wavelength");
+    const std::vector<Entry> es = entries(n, path, {"kind", "amount", "frequency", "wavelength"});
+    Deformation d;
+    const Entry& kind = require(es, "kind", n, path);
+    const std::string k = readString(kind.value, childPath(path, "kind"));
+    if (k == "bend") {
+        d.kind = DeformKind::Bend;
+    } else if (k == "twist") {
+        d.kind = DeformKind::Twist;
+    } else if (k == "wave") {
+        d.kind = DeformKind::Wave;
+    } else {
+        fail(kind.value, childPath(path, "kind"),
+             "unknown deformation '" + k + "' (expected one of: bend, twist, wave)");
+    }
+    const Entry& amount = require(es, "amount", n, path);
+    d.amount = readReal(amount.value, childPath(path, "amount"));
+    if (!std::isfinite(d.amount)) fail(amount.value, childPath(path, "amount"), "must be finite");
+    const Entry& frequency = require(es, "frequency", n, path);
+    d.frequency = readReal(frequency.value, childPath(path, "frequency"));
+    if (!(d.frequency > 0 && d.frequency <= 1e3)) {
+        fail(frequency.value, childPath(path, "frequency"), "must be in (0, 1000] (Hz)");
+    }
+    if (const Entry* w = find(es, "wavelength")) {
+        if (d.kind != DeformKind::Wave)
+            fail(w->key_node, childPath(path, "wavelength"), "applies to kind: wave only");
+        d.wavelength = readReal(w->value, childPath(path, "wavelength"));
+        if (!(d.wavelength > 0) || !std::isfinite(d.wavelength)) {
+            fail(w->value, childPath(path, "wavelength"), "must be > 0 (m)");
+        }
+    }
+    return d;
+}
+
 std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
                                          const Scene& scene) {
     const std::string path = indexPath("bodies", index);
@@ -469,6 +505,18 @@ std::vector<Body> SceneParser::parseBody(const YAML::Node& n, std::size_t index,
     Body body = makeBody(std::move(values.name), std::move(shape), props);
     body.restitution = values.restitution;
     body.friction = values.friction;
+    if (const Entry* self = find(es, "self_collision")) {
+        const std::string p = childPath(path, "self_collision");
+        body.self_collision = readBool(self->value, p);
+        if (body.self_collision && type != ShapeType::Mesh) {
+            fail(self->value, p, "applies to mesh bodies only (shape: mesh)");
+        }
+    }
+    if (const Entry* deform = find(es, "deform")) {
+        const std::string p = childPath(path, "deform");
+        if (type != ShapeType::Mesh) fail(deform->key_node, p, "applies to mesh bodies only");
+        body.deform = readDeformation(deform->value, p);
+    }
     auto place = [&props, is_static = values.is_static](Body& b, const Vec3& p, const Quat& q,
                                                           const Vec3& v, const Vec3& w) {
         b.position = p;

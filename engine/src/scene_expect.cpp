@@ -89,6 +89,8 @@ public:
     /// `tunnelling` and `toi`: pairs of bodies, with what passes through or the time of impact.
     void tunnellingOrToi(const Entry& e, const std::string& p, Expectations& ex) const;
     void rest(const Entry& e, const std::string& p, Expectations& ex) const;
+    void selfCollision(const Entry& e, const std::string& p, Expectations& ex,
+                       const Scene& scene) const;
     void broadPhases(const Entry& e, const std::string& p, Expectations& ex) const;
     void pauseDumps(const Entry& e, const std::string& p, Expectations& ex) const;
     void pairs(const Entry& e, const std::string& p, Expectations& ex) const;
@@ -157,6 +159,39 @@ void ExpectReader::rest(const Entry& e, const std::string& p, Expectations& ex) 
             }
             ex.rest.push_back(std::move(r));
         }
+}
+
+void ExpectReader::selfCollision(const Entry& e, const std::string& p, Expectations& ex,
+                                 const Scene& scene) const {
+    const std::vector<YAML::Node> list = readList(e.value, p);
+    for (std::size_t i = 0; i < list.size(); ++i) {
+        const std::string ip = indexPath(p, i);
+        const std::vector<Entry> se =
+            p_.entries(list[i], ip, {"body", "frames", "min_pairs", "max_pairs"});
+        const Entry& body = p_.require(se, "body", list[i], ip);
+        SelfCollisionExpectation s;
+        s.body = readBody(body.value, childPath(ip, "body"));
+        s.name = body.value.Scalar();
+        if (!scene.bodies[static_cast<std::size_t>(s.body)].self_collision) {
+            p_.fail(body.value, childPath(ip, "body"),
+                    "'" + s.name + "' does not have 'self_collision: true'");
+        }
+        s.frames = readFrames(p_.require(se, "frames", list[i], ip).value, childPath(ip, "frames"));
+        if (const Entry* m = p_.find(se, "min_pairs")) {
+            s.min_pairs = readCount(m->value, childPath(ip, "min_pairs"));
+        }
+        if (const Entry* m = p_.find(se, "max_pairs")) {
+            s.max_pairs = readCount(m->value, childPath(ip, "max_pairs"));
+        }
+        if (!s.min_pairs && !s.max_pairs) {
+            p_.fail(list[i], ip, "needs 'min_pairs' or 'max_pairs' (or both)");
+        }
+        if (s.min_pairs && s.max_pairs && *s.max_pairs < *s.min_pairs) {
+            p_.fail(p_.find(se, "max_pairs")->value, childPath(ip, "max_pairs"),
+                    "must be >= 'min_pairs'");
+        }
+        ex.self_collision.push_back(std::move(s));
+    }
 }
 
 void ExpectReader::broadPhases(const Entry& e, const std::string& p, Expectations& ex) const {
@@ -274,14 +309,15 @@ void SceneParser::parseExpect(const Entry& entry, Scene& scene) const {
     ex.present = true;
     const std::string kinds =
         "min_bodies, min_moving_rotating, broadphases, energy_drift_max, energy_rise_max, "
-        "pause_dumps, pairs, colors, tunnelling, toi, rest";
+        "pause_dumps, pairs, colors, tunnelling, toi, rest, self_collision";
     if (n.IsNull() || (n.IsMap() && n.size() == 0)) {
         fail(entry.key_node, path, "states no expectation (give at least one of: " + kinds + ")");
     }
     const std::vector<Entry> es =
         entries(n, path,
                 {"frames", "min_bodies", "min_moving_rotating", "broadphases", "energy_drift_max",
-                 "energy_rise_max", "pause_dumps", "pairs", "colors", "tunnelling", "toi", "rest"});
+                 "energy_rise_max", "pause_dumps", "pairs", "colors", "tunnelling", "toi", "rest",
+                 "self_collision"});
     // The run length first: every frame below must lie inside it.
     if (const Entry* f = find(es, "frames")) {
         const int v = readInt(f->value, childPath(path, "frames"));
@@ -308,6 +344,8 @@ void SceneParser::parseExpect(const Entry& entry, Scene& scene) const {
             reader.tunnellingOrToi(e, p, ex);
         } else if (e.key == "rest") {
             reader.rest(e, p, ex);
+        } else if (e.key == "self_collision") {
+            reader.selfCollision(e, p, ex, scene);
         } else if (e.key == "broadphases") {
             reader.broadPhases(e, p, ex);
         } else if (e.key == "pause_dumps") {
@@ -322,7 +360,8 @@ void SceneParser::parseExpect(const Entry& entry, Scene& scene) const {
     const bool states_something =
         ex.min_bodies || ex.min_moving_rotating || !ex.broad_phases.empty() ||
         ex.energy_drift_max || ex.energy_rise_max || !ex.pause_dumps.empty() || !ex.pairs.empty() ||
-        !ex.colors.empty() || !ex.tunnelling.empty() || !ex.toi.empty() || !ex.rest.empty();
+        !ex.colors.empty() || !ex.tunnelling.empty() || !ex.toi.empty() || !ex.rest.empty() ||
+        !ex.self_collision.empty();
     if (!states_something) {
         fail(entry.key_node, path, "states no expectation (give at least one of: " + kinds + ")");
     }

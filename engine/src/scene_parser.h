@@ -44,7 +44,7 @@ inline constexpr std::string_view kBodyKeys[] = {
     "name",  "shape",    "radius",           "half_height", "half_extents", "file",
     "scale", "position", "orientation_wxyz", "euler_deg",   "velocity",     "angular_velocity",
     "mass",  "density",  "repeat",           "static",      "restitution",  "friction",
-    "inertia"};
+    "inertia", "self_collision", "deform"};
 
 inline constexpr std::string_view kRepeatKeys[] = {
     "count", "seed", "region", "speed", "spin", "random_orientation", "separated"};
@@ -195,6 +195,7 @@ private:
     void parseDraw(const YAML::Node& n, Scene& scene) const;
     /// One body, or the `repeat.count` bodies a `repeat` entry generates.
     std::vector<Body> parseBody(const YAML::Node& n, std::size_t index, const Scene& scene);
+    Deformation readDeformation(const YAML::Node& n, const std::string& path) const;
     ShapeType bodyShape(const std::vector<Entry>& es, const YAML::Node& n, const std::string& path,
                         std::string& shape_name, std::vector<std::string_view>& shape_keys) const;
     BodyValues readBodyValues(const std::vector<Entry>& es, const YAML::Node& n,

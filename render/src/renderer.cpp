@@ -164,7 +164,8 @@ struct Renderer::Impl {
     void drawVolumes(const engine::World& world, const CameraFrame& cam,
                      const FrameOptions& options, GlDebugDraw& debug);
     /// Draws the triangle buffer and empties it.
-    void drawTriangles();
+    void drawTriangles(const collision::Color& color = kBodyColor);
+    void drawSelfPairs(const engine::World& world, const CameraFrame& cam);
     void drawLines(const LineBuffer& lines, float width_px);
     void readPixels(Image& image);
     void drawOverlays(Image& image, const FrameOptions& options) const;
@@ -304,6 +305,33 @@ void Renderer::Impl::drawBodies(const engine::World& world, const CameraFrame& c
         }
     }
     drawTriangles();
+    drawSelfPairs(world, cam);
+}
+
+// The triangles of each self_collision mesh body that cross another of its triangles, drawn
+// again in the colliding colour over the body's own (the same vertices give the same depths,
+// and GL_LEQUAL lets the second draw win).
+void Renderer::Impl::drawSelfPairs(const engine::World& world, const CameraFrame& cam) {
+    std::vector<std::array<std::int32_t, 3>> hit;
+    for (std::size_t i = 0; i < world.bodies().size(); ++i) {
+        const std::span<const collision::TrianglePair> pairs =
+            world.selfPairs(static_cast<engine::BodyId>(i));
+        const engine::Body& body = world.bodies()[i];
+        if (pairs.empty() || !body.shape.mesh) continue;
+        std::vector<std::int32_t> ids;
+        for (const collision::TrianglePair& p : pairs) {
+            ids.push_back(p.a);
+            ids.push_back(p.b);
+        }
+        std::sort(ids.begin(), ids.end());
+        ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+        hit.clear();
+        for (const std::int32_t t : ids) {
+            hit.push_back(body.shape.mesh->triangles[static_cast<std::size_t>(t)]);
+        }
+        tessellateTriangles(body.shape.mesh->vertices, hit, body.pose(), cam, triangles);
+    }
+    drawTriangles(stateColor(engine::BodyState::Colliding));
 }
 
 void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& cam,
@@ -424,7 +452,7 @@ void Renderer::Impl::drawVolumes(const engine::World& world, const CameraFrame& 
     }
 }
 
-void Renderer::Impl::drawTriangles() {
+void Renderer::Impl::drawTriangles(const collision::Color& color) {
     if (triangles.count() == 0) return;
     struct Clear {
         TriangleBuffer& buffer;
@@ -440,7 +468,7 @@ void Renderer::Impl::drawTriangles() {
     const GLfloat specular[4] = {0.30f, 0.30f, 0.30f, 1.0f};
     glMaterialfv(GL_FRONT_AND_BACK, GL_SPECULAR, specular);
     glMaterialf(GL_FRONT_AND_BACK, GL_SHININESS, 40.0f);
-    glColor4f(kBodyColor.r, kBodyColor.g, kBodyColor.b, 1.0f);
+    glColor4f(color.r, color.g, color.b, 1.0f);
     // Pushed back a little so wireframes lying on the surface (a sphere's bounding sphere, a
     // box's OBB) win the depth test instead of z-fighting; the slope term covers the rim.
     glEnable(GL_POLYGON_OFFSET_FILL);
@@ -630,6 +658,11 @@ std::string hudLine(const engine::World& world, int frame, bool include_timing) 
         static_cast<long long>(st.broad.volumes_updated), static_cast<long long>(st.narrow_tests),
         static_cast<long long>(st.triangle_tests));
     std::string line(buffer, std::size_t(std::clamp(n, 0, int(sizeof buffer) - 1)));
+    // Only in scenes that have them: self-collision and deforming mesh bodies.
+    bool self = false;
+    for (const engine::Body& b : world.bodies()) self = self || b.self_collision;
+    if (self) line += "  self pairs " + std::to_string(st.self_pairs);
+    if (st.refit_nodes > 0) line += "  refit nodes " + std::to_string(st.refit_nodes);
     if (include_timing) {
         n = std::snprintf(
             buffer, sizeof buffer, "\nstep %.3f ms  volumes %.3f  broad %.3f  narrow %.3f ms",

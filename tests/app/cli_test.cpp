@@ -439,7 +439,8 @@ const std::vector<std::string> kStatsColumns = {
     "frame",          "time",         "broadphase",      "bodies",     "flagged",
     "colliding",      "volume_tests", "volumes_updated", "swaps",      "narrow_tests",
     "triangle_tests", "bv_tests",     "integrate_ms",    "volumes_ms", "broadphase_ms",
-    "narrowphase_ms", "ccd_ms",       "response_ms",     "step_ms"};
+    "narrowphase_ms", "ccd_ms",       "response_ms",     "step_ms",    "self_pairs",
+    "refit_nodes",    "refit_ms",     "refit_node_ns",   "rebuilds"};
 
 TEST(Cli, StatsCsvHasOneRowPerFrameAndCheckBroadphasePasses) {
     const fs::path work = tempDir("stats");

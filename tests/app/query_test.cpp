@@ -151,6 +151,50 @@ TEST(Query, ImportChangesAreReportedOnStderrAndInJson) {
     fs::remove_all(dir);
 }
 
+TEST(Query, SelfListsTheBruteForcePairsForEveryVolumeType) {
+    // The figure-eight ribbon passes through itself once, at the origin, between vertices.
+    const QueryResult r = runQueryCli("assets/figure_eight_ribbon.obj --self --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_TRUE(j["agrees_with_brute_force"].get<bool>());
+    const engine::MeshImportOutput ribbon =
+        engine::importMesh(fs::path(CDLAB_SOURCE_DIR) / "assets/figure_eight_ribbon.obj", 1.0);
+    ASSERT_TRUE(ribbon.ok) << ribbon.error;
+    const std::vector<collision::TrianglePair> brute =
+        collision::intersectSelfBruteForce(ribbon.mesh);
+    ASSERT_FALSE(brute.empty());
+    nlohmann::json expected = nlohmann::json::array();
+    for (const collision::TrianglePair& p : brute) expected.push_back({p.a, p.b});
+    EXPECT_EQ(j["brute_force"]["self_pairs"], expected);
+    ASSERT_EQ(j["results"].size(), 9u);
+    for (const auto& row : j["results"]) {
+        EXPECT_EQ(row["self_pairs"], expected) << row["bv"];
+        EXPECT_GT(row["bv_tests"].get<std::int64_t>(), 0) << row["bv"];
+    }
+    // The table names the count per volume type; a closed torus has no self pairs.
+    const QueryResult t = runQueryCli("assets/torus.obj --self --bv obb");
+    ASSERT_EQ(t.exit_code, 0) << t.err;
+    EXPECT_NE(t.out.find("self-collision of assets/torus.obj"), std::string::npos) << t.out;
+    std::istringstream table(t.out);
+    std::string line;
+    bool obb_row = false;
+    while (std::getline(table, line)) {
+        std::istringstream cells(line);
+        std::string bv;
+        std::string pairs;
+        cells >> bv >> pairs;
+        if (bv != "obb") continue;
+        obb_row = true;
+        EXPECT_EQ(pairs, "0") << line;
+    }
+    EXPECT_TRUE(obb_row) << t.out;
+    // One mesh only; and without --self the second mesh is required.
+    EXPECT_EQ(runQueryCli("assets/torus.obj assets/torus.obj --self").exit_code, 2);
+    const QueryResult missing = runQueryCli("assets/torus.obj");
+    EXPECT_EQ(missing.exit_code, 2);
+    EXPECT_NE(missing.err.find("mesh_b"), std::string::npos) << missing.err;
+}
+
 TEST(Query, ParsePose) {
     std::string error;
     const auto pose = app::parsePose("1, 2, 3, 2, 0, 0, 0", &error);

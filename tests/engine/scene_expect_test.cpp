@@ -54,7 +54,7 @@ TEST(SceneExpect, EmptyExpectationsAreAnError) {
     const std::string what =
         "states no expectation (give at least one of: min_bodies, "
         "min_moving_rotating, broadphases, energy_drift_max, "
-        "energy_rise_max, pause_dumps, pairs, colors, tunnelling, toi, rest)";
+        "energy_rise_max, pause_dumps, pairs, colors, tunnelling, toi, rest, self_collision)";
     EXPECT_SCENE_ERROR(kScene, "7:1: expect: ", what);
     EXPECT_SCENE_ERROR(kScene.substr(0, kScene.size() - 1) + " {}\n", "7:1: expect: ", what);
     EXPECT_SCENE_ERROR(kScene.substr(0, kScene.size() - 1) + " ~\n", "7:1: expect: ", what);

@@ -4,11 +4,13 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "collision/geometry/shape.h"
 #include "collision/math.h"
 #include "collision/volumes/bounding_volumes.h"
+#include "engine/deformation.h"
 
 namespace engine {
 
@@ -43,6 +45,12 @@ struct Body {
     Real friction = Real(0.5);     ///< Coulomb coefficient >= 0; a pair uses sqrt(mu_a mu_b)
     /// Infinite mass: inv_mass = 0, inverse inertia 0, zero momenta; never moves (setStatic).
     bool is_static = false;
+    /// Mesh bodies only: every step the world lists the body's own intersecting triangle pairs
+    /// (World::selfPairs). Scene key `self_collision`.
+    bool self_collision = false;
+    /// Mesh bodies only: prescribed shape change; the world moves the vertices and refits the
+    /// body's own hierarchy every step (World::step). Scene key `deform`.
+    std::optional<Deformation> deform;
 
     Vec3 position = Vec3::Zero();       ///< m, centre of mass, world
     Quat orientation = Quat::Identity();

@@ -111,6 +111,17 @@ struct RestExpectation {
     std::optional<Real> max_speed;         ///< m/s, of the centre of mass
 };
 
+/// `expect.self_collision[i]`: on every frame of a range, the number of the body's own
+/// intersecting triangle pairs (World::selfPairs; the body must have `self_collision: true`)
+/// is at least `min_pairs` and at most `max_pairs` (`max_pairs: 0`: none).
+struct SelfCollisionExpectation {
+    BodyId body = 0;
+    std::string name;
+    FrameRange frames;
+    std::optional<int> min_pairs;
+    std::optional<int> max_pairs;
+};
+
 /// The optional top-level `expect:` section: outcomes `cdlab check` verifies. Frames are
 /// validated against `frames` (or the scene's frame count); body names must exist (unique).
 struct Expectations {
@@ -127,6 +138,7 @@ struct Expectations {
     std::vector<TunnelExpectation> tunnelling;
     std::vector<ToiExpectation> toi;
     std::vector<RestExpectation> rest;
+    std::vector<SelfCollisionExpectation> self_collision;
 };
 
 struct Scene {

@@ -126,6 +126,10 @@ struct WorldSettings {
     /// A step that flags more candidate pairs stops the run (SimulationError). Not a scene key:
     /// scenes get kMaxCandidatePairs; tests lower it.
     std::size_t max_candidate_pairs = kMaxCandidatePairs;
+    /// A deforming mesh body's hierarchy is rebuilt instead of refitted when its quality ratio
+    /// (sum of node volumes / root volume, MeshBvh::volumeRatio) exceeds this multiple of the
+    /// ratio at its last build. Not a scene key.
+    Real rebuild_ratio = Real(1.5);
 };
 
 /// Wall-clock time per stage of the last step, in seconds, and the broad phase's counters.
@@ -145,6 +149,14 @@ struct StepStats {
     std::int64_t toi_events = 0;      ///< pairs stopped at their time of impact
     std::int64_t toi_iterations = 0;  ///< iterations (distance queries / roots) of those calls
     std::int64_t contact_points = 0;  ///< manifold points the contact solver handled
+    /// Intersecting non-adjacent triangle pairs within self_collision mesh bodies (their
+    /// traversals' node and triangle tests are in bv_tests and triangle_tests).
+    std::int64_t self_pairs = 0;
+    /// Deforming mesh bodies: hierarchy nodes refitted (the cost model's Nu), the time of moving
+    /// their vertices and refitting (and rebuilding) their hierarchies, and the rebuilds.
+    std::int64_t refit_nodes = 0;
+    double refit_s = 0;
+    std::int64_t rebuilds = 0;
 };
 
 class ContactSolver;
@@ -205,6 +217,10 @@ public:
     const StepStats& lastStats() const { return stats_; }
     /// Times of impact acted on in the last step, sorted by (t, a, b); empty when ccd is off.
     std::span<const ToiEvent> toiEvents() const { return toi_events_; }
+    /// Body `id`'s own intersecting triangle pairs at the current state (mesh triangle indices,
+    /// a < b, sorted; triangles sharing a vertex index excluded); empty unless the body is a mesh
+    /// with self_collision. Asserts a valid id.
+    std::span<const collision::TrianglePair> selfPairs(BodyId id) const;
     Real time() const { return time_; }
     std::int64_t stepCount() const { return step_count_; }
 
@@ -249,6 +265,7 @@ private:
     void applyImpactImpulses();
     void findResponsePairs(Real margin_fraction);
     void runCollisionPipeline();
+    void findSelfPairs();  // self_collision mesh bodies: self_pairs_ and stats_
     /// Derives the contact details of the colliding pairs of two convex shapes and/or of the
     /// pairs with a mesh, each group at most once per state.
     void computeDetails(bool convex_pairs, bool mesh_pairs) const;
@@ -275,6 +292,18 @@ private:
     std::vector<BodyId> sweep_order_;
     std::vector<collision::ProxyPair> ccd_pairs_;
     std::vector<ToiEvent> toi_events_;
+    std::vector<std::vector<collision::TrianglePair>> self_pairs_;  ///< per body
+    /// A deforming mesh body's own geometry: rest vertices, the current mesh and hierarchy (the
+    /// body's shape points at them), and the hierarchy's volume ratio at its last build.
+    struct DeformingMesh {
+        BodyId body = 0;
+        std::vector<Vec3> rest;
+        std::shared_ptr<collision::TriangleMesh> mesh;
+        std::shared_ptr<collision::MeshBvh> bvh;
+        Real built_ratio = 0;
+    };
+    std::vector<DeformingMesh> deforming_;
+    void deformBody(DeformingMesh& d);  // vertices at time_, refit or rebuild, hull, bounds
     std::unique_ptr<ContactSolver> solver_;  ///< only with response: impulse
     std::vector<collision::Aabb> grown_;
     std::vector<collision::ProxyPair> response_pairs_;
