@@ -8,6 +8,7 @@
 
 #include "command.h"
 #include "exit_codes.h"
+#include "render/occlusion_oracle.h"
 
 namespace {
 
@@ -46,6 +47,8 @@ int runCli(int argc, char** argv) {
 // Whatever escapes a command ends the run with a message and exit 1, never an abort: running out
 // of memory (a scene past what this machine holds) is reported as such.
 int main(int argc, char** argv) {
+    // The composition root hands render's occlusion queries to the `cullide` broad phase.
+    render::installOcclusionQueryOracle();
     try {
         return runCli(argc, argv);
     } catch (const std::bad_alloc&) {

@@ -2,6 +2,8 @@
 // list of every benchmark method by name.
 #include "bench_method.h"
 
+#include "collision/broadphase/visibility_oracle.h"
+
 namespace app {
 
 namespace {
@@ -36,10 +38,12 @@ std::vector<BenchMethodEntry> makeMethods() {
     std::vector<BenchMethodEntry> methods;
     for (const collision::BroadPhaseEntry& entry : collision::broadPhaseRegistry()) {
         if (entry.volume != "aabb") continue;
+        // cullide only where a rendering context was installed (cdlab, not the bare bench).
+        if (entry.needs_render_context && !collision::hasVisibilityOracleFactory()) continue;
         BenchMethodEntry m;
         m.name = std::string(entry.name);
         m.description = std::string(entry.description);
-        m.default_set = true;
+        m.default_set = !entry.needs_render_context;
         m.threads = entry.threads;
         const collision::BroadPhaseEntry* e = &entry;
         m.create = [e]() -> std::unique_ptr<BenchMethod> {

@@ -1,6 +1,8 @@
 // Differential tests: every broad phase in the registry reports exactly its brute-force
 // reference's pair set on every frame of random and adversarial coherent-motion scenes,
-// including touching and zero-size boxes and proxies leaving and re-entering.
+// including touching and zero-size boxes and proxies leaving and re-entering. collision_tests
+// runs them on every broad phase that needs no rendering context; cullide_tests compiles this
+// same file, installs render's occlusion-query oracle and runs them on those that do.
 #include "collision/broadphase/broad_phase.h"
 
 #include <gtest/gtest.h>
@@ -10,12 +12,23 @@
 #include <set>
 
 #include "broadphase/hgrid.h"
+#include "collision/broadphase/visibility_oracle.h"
 #include "test_random.h"
 
 namespace collision {
 namespace {
 
 using cdlab_test::Rng;
+
+// The registry rows this binary tests: with a visibility oracle installed (cullide_tests) the
+// ones that need it, else (collision_tests, which cannot render) all the others.
+std::vector<BroadPhaseEntry> testedBroadPhases() {
+    std::vector<BroadPhaseEntry> out;
+    for (const BroadPhaseEntry& e : broadPhaseRegistry()) {
+        if (e.needs_render_context == hasVisibilityOracleFactory()) out.push_back(e);
+    }
+    return out;
+}
 
 // A moving box whose three volumes are consistent: exact AABB, circumsphere, the box as OBB.
 struct MovingBox {
@@ -177,7 +190,7 @@ void expectEqualsReference(const BroadPhaseEntry& entry, Layout layout, int n, i
 class BroadPhaseDifferential : public ::testing::TestWithParam<Layout> {};
 
 TEST_P(BroadPhaseDifferential, EveryBroadPhaseEqualsItsReferenceOnEveryFrame) {
-    for (const BroadPhaseEntry& entry : broadPhaseRegistry()) {
+    for (const BroadPhaseEntry& entry : testedBroadPhases()) {
         expectEqualsReference(entry, GetParam(), 120, 150, 42);
     }
 }
@@ -200,7 +213,7 @@ INSTANTIATE_TEST_SUITE_P(Layouts, BroadPhaseDifferential,
 // float(min x) ties for most of them, then coherent motion again.
 TEST(BroadPhaseDifferential, FixedMembershipThroughJumpsTiesAndFloatTies) {
     constexpr int kBoxes = 400;
-    for (const BroadPhaseEntry& entry : broadPhaseRegistry()) {
+    for (const BroadPhaseEntry& entry : testedBroadPhases()) {
         SCOPED_TRACE(std::string(entry.name));
         const BroadPhaseEntry* ref_entry = findBroadPhase(entry.reference);
         ASSERT_NE(ref_entry, nullptr);
@@ -446,7 +459,7 @@ std::vector<ProxyPair> pairsOf(const BroadPhaseEntry& entry,
 
 TEST(BroadPhaseDifferential, HugeAndTinyExtentsEqualTheReference) {
     const std::vector<ProxyVolumes> volumes = extremeBoxes(false);
-    for (const BroadPhaseEntry& entry : broadPhaseRegistry()) {
+    for (const BroadPhaseEntry& entry : testedBroadPhases()) {
         SCOPED_TRACE(std::string(entry.name));
         const std::vector<ProxyPair> ref = pairsOf(*findBroadPhase(entry.reference), volumes);
         EXPECT_EQ(pairsOf(entry, volumes), ref);
@@ -517,7 +530,7 @@ TEST(BroadPhaseDifferential, FloatRoundingEdgesEqualTheReference) {
     const std::vector<ProxyPair> ref = pairsOf(*findBroadPhase("brute"), volumes);
     // Per axis 6 touching neighbours and 5 apart ones; 19 overlapping neighbours near 1e7.
     ASSERT_EQ(ref.size(), 3u * 6 + 19);
-    for (const BroadPhaseEntry& entry : broadPhaseRegistry()) {
+    for (const BroadPhaseEntry& entry : testedBroadPhases()) {
         if (entry.volume != "aabb") continue;
         SCOPED_TRACE(std::string(entry.name));
         EXPECT_EQ(pairsOf(entry, volumes), ref);
@@ -529,10 +542,27 @@ TEST(BroadPhaseRegistry, NamesAreUniqueAndReferencesExist) {
     for (const BroadPhaseEntry& e : broadPhaseRegistry()) {
         EXPECT_TRUE(names.insert(e.name).second) << e.name;
         EXPECT_NE(findBroadPhase(e.reference), nullptr) << e.name;
-        EXPECT_EQ(e.create()->name(), e.name);
     }
+    for (const BroadPhaseEntry& e : testedBroadPhases()) EXPECT_EQ(e.create()->name(), e.name);
     EXPECT_EQ(findBroadPhase("no-such"), nullptr);
     EXPECT_NE(broadPhaseNames().find("sap"), std::string::npos);
+}
+
+// Without a rendering context (this binary links no renderer) `cullide` is not made: the error
+// says what it needs, so a scene asking for it fails with that message.
+TEST(BroadPhaseRegistry, CullideWithoutARenderingContextSaysWhatItNeeds) {
+    if (hasVisibilityOracleFactory()) GTEST_SKIP() << "an oracle is installed here";
+    const BroadPhaseEntry* entry = findBroadPhase("cullide");
+    ASSERT_NE(entry, nullptr);
+    EXPECT_TRUE(entry->needs_render_context);
+    try {
+        entry->create();
+        ADD_FAILURE() << "created without an oracle";
+    } catch (const BroadPhaseUnavailable& e) {
+        EXPECT_NE(std::string(e.what()).find("needs the render module's OSMesa context"),
+                  std::string::npos)
+            << e.what();
+    }
 }
 
 // PairOrder::Found skips the sort: the same pairs as brute force, each (a, b) with a < b, no

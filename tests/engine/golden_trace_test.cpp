@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "collision/broadphase/broad_phase.h"
 #include "engine/scene.h"
 #include "engine/world.h"
 
@@ -59,7 +60,14 @@ struct Trace {
 };
 
 Trace runScene(const fs::path& file) {
-    const engine::Scene scene = engine::loadScene(file);
+    engine::Scene scene = engine::loadScene(file);
+    // A broad phase that renders (cullide) cannot be made here; its reference reports the same
+    // pairs by contract (checked in cullide_tests and by the scene's expect: broadphases), so the
+    // trace is the one the scene runs.
+    const collision::BroadPhaseEntry* entry = collision::findBroadPhase(scene.world.broad_phase);
+    if (entry != nullptr && entry->needs_render_context) {
+        scene.world.broad_phase = std::string(entry->reference);
+    }
     engine::World world = engine::makeWorld(scene);
     Trace t;
     t.frames = scene.expect.frames.value_or(scene.frames);

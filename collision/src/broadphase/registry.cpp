@@ -3,6 +3,7 @@
 #include "collision/broadphase/broad_phase.h"
 
 #include "broadphase/brute.h"
+#include "broadphase/cullide.h"
 #include "broadphase/grid.h"
 #include "broadphase/hgrid.h"
 #include "broadphase/obb.h"
@@ -54,6 +55,10 @@ const BroadPhaseEntry kRegistry[] = {
      []() -> std::unique_ptr<BroadPhase> { return std::make_unique<DynamicAabbTree>(); }},
     {"octree", "loose octree (k = 2)", "aabb", "brute",
      []() -> std::unique_ptr<BroadPhase> { return std::make_unique<LooseOctree>(); }},
+    {"cullide",
+     "CULLIDE: AABBs fully visible in an occlusion-query pass are pruned, exact AABB pairs among "
+     "the rest (needs render's OSMesa context)",
+     "aabb", "brute", createCullide, 1, true},
     {"obb", "OBB separating-axis test after a sweep over the OBBs' AABBs", "obb", "obb-brute",
      []() -> std::unique_ptr<BroadPhase> { return std::make_unique<ObbBroadPhase>(); }},
     {"obb-brute", "all pairs of OBBs, separating-axis test (reference)", "obb", "obb-brute",

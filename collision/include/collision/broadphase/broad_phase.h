@@ -73,6 +73,9 @@ struct BroadPhaseEntry {
     std::string_view reference;  ///< name of the brute-force broad phase it must equal
     std::unique_ptr<BroadPhase> (*create)();
     int threads = 1;  ///< threads it runs on (timing it by thread CPU time needs 1)
+    /// Needs a rendering context (a VisibilityOracle factory, see visibility_oracle.h): create()
+    /// throws BroadPhaseUnavailable without one.
+    bool needs_render_context = false;
 };
 
 std::span<const BroadPhaseEntry> broadPhaseRegistry();
