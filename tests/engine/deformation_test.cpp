@@ -15,6 +15,7 @@
 #include "collision/bvh/bvh.h"
 #include "engine/scene.h"
 #include "engine/world.h"
+#include "scene_error.h"
 
 namespace engine {
 namespace {
@@ -110,22 +111,6 @@ TEST(Deformation, RebuildRuleChangesTheTreeNotTheAnswer) {
     EXPECT_EQ(rebuilds_a, 80);
     EXPECT_EQ(rebuilds_b, 0);
 }
-
-std::string errorOf(const std::string& text) {
-    try {
-        parseScene(text, "test.yaml", fs::path(CDLAB_SOURCE_DIR) / "scenes");
-    } catch (const SceneError& e) {
-        return e.what();
-    }
-    return "";
-}
-
-#define EXPECT_SCENE_ERROR(text, prefix, fragment)                                  \
-    do {                                                                            \
-        const std::string err_ = errorOf(text);                                     \
-        EXPECT_EQ(err_.rfind(std::string("test.yaml:") + (prefix), 0), 0u) << err_; \
-        EXPECT_NE(err_.find(fragment), std::string::npos) << err_;                  \
-    } while (false)
 
 TEST(Deformation, SceneKeysRejectBadValues) {
     const std::string head =

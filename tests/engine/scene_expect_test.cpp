@@ -8,25 +8,10 @@
 
 #include "engine/mesh_import.h"
 #include "engine/scene.h"
+#include "scene_error.h"
 
 namespace engine {
 namespace {
-
-std::string errorOf(const std::string& text) {
-    try {
-        parseScene(text, "test.yaml", std::filesystem::path(CDLAB_SOURCE_DIR) / "scenes");
-    } catch (const SceneError& e) {
-        return e.what();
-    }
-    return "";
-}
-
-#define EXPECT_SCENE_ERROR(text, prefix, fragment)                                  \
-    do {                                                                            \
-        const std::string err_ = errorOf(text);                                     \
-        EXPECT_EQ(err_.rfind(std::string("test.yaml:") + (prefix), 0), 0u) << err_; \
-        EXPECT_NE(err_.find(fragment), std::string::npos) << err_;                  \
-    } while (false)
 
 // Three bodies, 10 frames; tests append an `expect:` section from line 8 on.
 const std::string kScene =
@@ -39,9 +24,10 @@ const std::string kScene =
     "expect:\n";                                                          // 7
 
 TEST(SceneExpect, AbsentMeansNotPresent) {
-    const Scene s = parseScene("world: {bounds: {min: [-1, -1, -1], max: [1, 1, 1]}}\nbodies:\n"
-                               "  - {shape: sphere, radius: 0.25, position: [0.5, 0.5, 0.5]}\n",
-                               "x.yaml", ".");
+    const Scene s = parseScene(
+        "world: {bounds: {min: [-1, -1, -1], max: [1, 1, 1]}}\nbodies:\n"
+        "  - {shape: sphere, radius: 0.25, position: [0.5, 0.5, 0.5]}\n",
+        "x.yaml", ".");
     EXPECT_FALSE(s.expect.present);
     const Scene one = parseScene(kScene + "  min_bodies: 1\n", "x.yaml", ".");
     EXPECT_TRUE(one.expect.present);
@@ -70,7 +56,8 @@ TEST(SceneExpect, EmptyExpectationsAreAnError) {
             "empty list: states no expectation");
     }
     // One colour list may be empty when the other is not.
-    EXPECT_EQ(errorOf(kScene + "  colors:\n    - {frame: 1, present: [red], absent: []}\n"), "");
+    EXPECT_EQ(sceneErrorOf(kScene + "  colors:\n    - {frame: 1, present: [red], absent: []}\n"),
+              "");
 }
 
 TEST(SceneExpect, ParsesEveryKey) {

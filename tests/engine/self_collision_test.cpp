@@ -10,27 +10,12 @@
 #include "collision/bvh/bvh.h"
 #include "engine/scene.h"
 #include "engine/world.h"
+#include "scene_error.h"
 
 namespace engine {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string errorOf(const std::string& text) {
-    try {
-        parseScene(text, "test.yaml", fs::path(CDLAB_SOURCE_DIR) / "scenes");
-    } catch (const SceneError& e) {
-        return e.what();
-    }
-    return "";
-}
-
-#define EXPECT_SCENE_ERROR(text, prefix, fragment)                                  \
-    do {                                                                            \
-        const std::string err_ = errorOf(text);                                     \
-        EXPECT_EQ(err_.rfind(std::string("test.yaml:") + (prefix), 0), 0u) << err_; \
-        EXPECT_NE(err_.find(fragment), std::string::npos) << err_;                  \
-    } while (false)
 
 TEST(SelfCollision, ShippedSceneListsTheBruteForcePairsEveryStep) {
     const Scene scene = loadScene(fs::path(CDLAB_SOURCE_DIR) / "scenes/self_collision.yaml");
