@@ -463,7 +463,9 @@ void Renderer::Impl::drawKdops(const engine::World& world, const FrameOptions& o
         own_tests = true;
         const std::vector<collision::WorldKdop> kdops = worldKdops(world, engine::kDrawnKdops[i]);
         const std::vector<engine::BodyState> states = kdopOverlaps(world, kdops).states;
-        for (std::size_t b = 0; b < kdops.size(); ++b) debug.drawKdop(kdops[b], stateColor(states[b]));
+        for (std::size_t b = 0; b < kdops.size(); ++b) {
+            debug.drawKdop(kdops[b], stateColor(states[b]));
+        }
     }
 }
 

@@ -77,7 +77,8 @@ TEST(KdopVolume, RandomShapesGiveTightPolytopesAtEveryScaleAndOffset) {
                 Shape s = base;
                 if (trial % 4 == 0) s = Shape::sphere(base.radius * scale);
                 if (trial % 4 == 1) s = Shape::box(base.half_extents * scale);
-                if (trial % 4 == 2) s = Shape::capsule(base.radius * scale, base.half_height * scale);
+                if (trial % 4 == 2)
+                    s = Shape::capsule(base.radius * scale, base.half_height * scale);
                 if (trial % 4 == 3 && scale != 1) continue;  // hulls at scale 1 only
                 for (const int k : kKs) {
                     const WorldKdop d = collision::computeWorldKdop(s, moved, k);

@@ -375,12 +375,12 @@ TEST(SceneErrors, OutOfRangeValues) {
 }
 
 TEST(SceneDraw, VolumesAcceptKdopsBesideTheBodyVolumes) {
-    const Scene s = parse(kHeader + "draw: {volumes: [kdop26, aabb, kdop6]}\n");
+    const Scene s = parse(kValid + "draw: {volumes: [kdop26, aabb, kdop6]}\n");
     EXPECT_TRUE(s.draw.volumes_given);
     EXPECT_FALSE(s.draw.sphere);
     EXPECT_TRUE(s.draw.aabb);
     EXPECT_EQ(s.draw.kdop, (std::array<bool, 4>{true, false, false, true}));
-    EXPECT_EQ(parse(kHeader).draw.kdop, (std::array<bool, 4>{}));
+    EXPECT_EQ(parse(kValid).draw.kdop, (std::array<bool, 4>{}));
 }
 
 TEST(SceneErrors, DrawBvhDepthAndContactsAreValidated) {

@@ -18,8 +18,8 @@ namespace {
 using Face = std::vector<Vec3>;
 
 /// The 13 directions: axes, cube diagonals, face diagonals (the mesh BVH's order).
-constexpr int kDirections[13][3] = {{1, 0, 0},  {0, 1, 0},  {0, 0, 1},  {1, 1, 1},  {1, 1, -1},
-                                    {1, -1, 1}, {-1, 1, 1}, {1, 1, 0},  {1, 0, 1},  {0, 1, 1},
+constexpr int kDirections[13][3] = {{1, 0, 0},  {0, 1, 0},  {0, 0, 1}, {1, 1, 1}, {1, 1, -1},
+                                    {1, -1, 1}, {-1, 1, 1}, {1, 1, 0}, {1, 0, 1}, {0, 1, 1},
                                     {1, -1, 0}, {1, 0, -1}, {0, 1, -1}};
 
 /// Index of the first point within `tol` (max-norm) of p in `points`, appending p if none.
@@ -121,8 +121,8 @@ WorldKdop computeWorldKdop(const Shape& shape, const Pose& pose, int k) {
 Real kdopPolytopeTolerance(const WorldKdop& kdop) {
     Real scale = 0;
     for (int i = 0; i < 3; ++i) {
-        scale = std::max({scale, std::abs(kdop.min[std::size_t(i)]),
-                          std::abs(kdop.max[std::size_t(i)])});
+        scale = std::max(
+            {scale, std::abs(kdop.min[std::size_t(i)]), std::abs(kdop.max[std::size_t(i)])});
     }
     return 256 * kEpsilon * scale;
 }
