@@ -219,6 +219,18 @@ void SceneParser::parseCamera(const YAML::Node& n, Scene& scene) const {
     }
 }
 
+namespace {
+
+/// Index into DrawSettings::kdop of a volume name "kdopK", or -1.
+int kdopIndex(const std::string& name) {
+    for (std::size_t i = 0; i < engine::kDrawnKdops.size(); ++i) {
+        if (name == "kdop" + std::to_string(engine::kDrawnKdops[i])) return int(i);
+    }
+    return -1;
+}
+
+}  // namespace
+
 void SceneParser::parseDraw(const YAML::Node& n, Scene& scene) const {
     const std::string path = "draw";
     DrawSettings& d = scene.draw;
@@ -236,8 +248,10 @@ void SceneParser::parseDraw(const YAML::Node& n, Scene& scene) const {
             if (d.bvh_depth < -1) fail(e.value, p, "must be >= 0, or -1 for off");
         }
         if (e.key == "volumes") {
-            if (!e.value.IsSequence()) fail(e.value, p, "expected a list of: sphere, aabb, obb");
+            const std::string kinds = "sphere, aabb, obb, kdop6, kdop14, kdop18, kdop26";
+            if (!e.value.IsSequence()) fail(e.value, p, "expected a list of: " + kinds);
             d.sphere = d.aabb = d.obb = false;
+            d.kdop = {};
             d.volumes_given = true;
             for (std::size_t i = 0; i < e.value.size(); ++i) {
                 const std::string ip = indexPath(p, i);
@@ -248,9 +262,15 @@ void SceneParser::parseDraw(const YAML::Node& n, Scene& scene) const {
                     d.aabb = true;
                 } else if (v == "obb") {
                     d.obb = true;
+                } else if (const int k = kdopIndex(v); k >= 0) {
+                    d.kdop[std::size_t(k)] = true;
                 } else {
-                    fail(e.value[i], ip,
-                         "unknown volume '" + v + "' (expected one of: sphere, aabb, obb)");
+                    std::string what = "unknown volume '";
+                    what += v;
+                    what += "' (expected one of: ";
+                    what += kinds;
+                    what += ")";
+                    fail(e.value[i], ip, what);
                 }
             }
         }

@@ -163,6 +163,7 @@ struct Renderer::Impl {
     /// The bounding-volume wireframes, each kind in the colours of its own overlap test.
     void drawVolumes(const engine::World& world, const CameraFrame& cam,
                      const FrameOptions& options, GlDebugDraw& debug);
+    void drawKdops(const engine::World& world, const FrameOptions& options, GlDebugDraw& debug);
     /// Draws the triangle buffer and empties it.
     void drawTriangles(const collision::Color& color = kBodyColor);
     void drawSelfPairs(const engine::World& world, const CameraFrame& cam);
@@ -450,6 +451,22 @@ void Renderer::Impl::drawVolumes(const engine::World& world, const CameraFrame& 
             debug.drawObb(v.obb, colorOf(VolumeKind::Obb));
         }
     }
+    drawKdops(world, options, debug);
+}
+
+void Renderer::Impl::drawKdops(const engine::World& world, const FrameOptions& options,
+                               GlDebugDraw& debug) {
+    // Each k-DOP in the colours of its own slab test against the other bodies' k-DOPs of the
+    // same k; drawn as the polytope its slabs bound (Klosowski et al. 1998).
+    for (std::size_t i = 0; i < engine::kDrawnKdops.size(); ++i) {
+        if (!options.draw.kdop[i]) continue;
+        own_tests = true;
+        const std::vector<collision::WorldKdop> kdops = worldKdops(world, engine::kDrawnKdops[i]);
+        const std::vector<engine::BodyState> states = kdopOverlaps(world, kdops).states;
+        for (std::size_t b = 0; b < kdops.size(); ++b) {
+            debug.drawKdop(kdops[b], stateColor(states[b]));
+        }
+    }
 }
 
 void Renderer::Impl::drawTriangles(const collision::Color& color) {
@@ -568,7 +585,9 @@ void Renderer::Impl::drawOverlays(Image& image, const FrameOptions& options) con
     }
     if (!options.draw.hud) return;
     // Legends: the state colours bottom-left, what the structure's colours show top-right.
-    const bool any_volume = options.draw.sphere || options.draw.aabb || options.draw.obb;
+    const bool any_volume = options.draw.sphere || options.draw.aabb || options.draw.obb ||
+                            std::find(options.draw.kdop.begin(), options.draw.kdop.end(), true) !=
+                                options.draw.kdop.end();
     if (any_volume || options.draw.bvh_depth >= 0) {
         const Color apart = stateColor(engine::BodyState::Apart);
         const Color flagged = stateColor(engine::BodyState::Flagged);

@@ -46,6 +46,58 @@ engine::DrawSettings drawSettingsFor(const engine::DrawSettings& draw, const eng
     out.sphere = kind == VolumeKind::Sphere;
     out.aabb = kind == VolumeKind::Aabb;
     out.obb = kind == VolumeKind::Obb;
+    out.kdop = {};
+    return out;
+}
+
+namespace {
+
+/// Flagged for every body in a pair, then Colliding for those in a confirmed pair among them.
+std::vector<engine::BodyState> statesOf(const engine::World& world, std::size_t n,
+                                        const std::vector<collision::ProxyPair>& pairs) {
+    std::vector<engine::BodyState> states(n, engine::BodyState::Apart);
+    for (const collision::ProxyPair& p : pairs) {
+        states[std::size_t(p.a)] = engine::BodyState::Flagged;
+        states[std::size_t(p.b)] = engine::BodyState::Flagged;
+    }
+    for (const collision::ProxyPair& p : world.collidingPairs()) {
+        if (!std::binary_search(pairs.begin(), pairs.end(), p)) continue;
+        states[std::size_t(p.a)] = engine::BodyState::Colliding;
+        states[std::size_t(p.b)] = engine::BodyState::Colliding;
+    }
+    return states;
+}
+
+}  // namespace
+
+std::vector<collision::WorldKdop> worldKdops(const engine::World& world, int k) {
+    std::vector<collision::WorldKdop> out;
+    out.reserve(world.bodies().size());
+    for (const engine::Body& b : world.bodies()) {
+        out.push_back(collision::computeWorldKdop(b.shape, b.pose(), k));
+    }
+    return out;
+}
+
+VolumeOverlaps kdopOverlaps(const engine::World& world,
+                            const std::vector<collision::WorldKdop>& kdops) {
+    VolumeOverlaps out;
+    std::vector<std::size_t> order(kdops.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        return kdops[a].min[0] < kdops[b].min[0] || (kdops[a].min[0] == kdops[b].min[0] && a < b);
+    });
+    for (std::size_t i = 0; i < order.size(); ++i) {
+        const collision::WorldKdop& a = kdops[order[i]];
+        for (std::size_t j = i + 1; j < order.size() && kdops[order[j]].min[0] <= a.max[0]; ++j) {
+            if (!a.overlaps(kdops[order[j]])) continue;
+            const auto lo = collision::ProxyId(std::min(order[i], order[j]));
+            const auto hi = collision::ProxyId(std::max(order[i], order[j]));
+            out.pairs.push_back({lo, hi});
+        }
+    }
+    std::sort(out.pairs.begin(), out.pairs.end());
+    out.states = statesOf(world, kdops.size(), out.pairs);
     return out;
 }
 
@@ -66,16 +118,7 @@ VolumeOverlaps volumeOverlaps(const engine::World& world, VolumeKind kind) {
     collision::BroadPhaseCounters counters;
     finder->findPairs(out.pairs, counters);
 
-    out.states.assign(volumes.size(), engine::BodyState::Apart);
-    for (const collision::ProxyPair& p : out.pairs) {
-        out.states[std::size_t(p.a)] = engine::BodyState::Flagged;
-        out.states[std::size_t(p.b)] = engine::BodyState::Flagged;
-    }
-    for (const collision::ProxyPair& p : world.collidingPairs()) {
-        if (!std::binary_search(out.pairs.begin(), out.pairs.end(), p)) continue;
-        out.states[std::size_t(p.a)] = engine::BodyState::Colliding;
-        out.states[std::size_t(p.b)] = engine::BodyState::Colliding;
-    }
+    out.states = statesOf(world, volumes.size(), out.pairs);
     return out;
 }
 

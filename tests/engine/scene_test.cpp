@@ -368,7 +368,19 @@ TEST(SceneErrors, OutOfRangeValues) {
     EXPECT_SCENE_ERROR(kHeader + "camera: {up: [0, 0, 0]}\n",
                        "4:14: camera.up: ", "up must not be zero");
     EXPECT_SCENE_ERROR(kHeader + "draw: {volumes: [sphere, kdop]}\n", "4:26: draw.volumes[1]: ",
-                       "unknown volume 'kdop' (expected one of: sphere, aabb, obb)");
+                       "unknown volume 'kdop' (expected one of: sphere, aabb, obb, kdop6, "
+                       "kdop14, kdop18, kdop26)");
+    EXPECT_SCENE_ERROR(kHeader + "draw: {volumes: [kdop7]}\n", "4:18: draw.volumes[0]: ",
+                       "unknown volume 'kdop7'");
+}
+
+TEST(SceneDraw, VolumesAcceptKdopsBesideTheBodyVolumes) {
+    const Scene s = parse(kValid + "draw: {volumes: [kdop26, aabb, kdop6]}\n");
+    EXPECT_TRUE(s.draw.volumes_given);
+    EXPECT_FALSE(s.draw.sphere);
+    EXPECT_TRUE(s.draw.aabb);
+    EXPECT_EQ(s.draw.kdop, (std::array<bool, 4>{true, false, false, true}));
+    EXPECT_EQ(parse(kValid).draw.kdop, (std::array<bool, 4>{}));
 }
 
 TEST(SceneErrors, DrawBvhDepthAndContactsAreValidated) {

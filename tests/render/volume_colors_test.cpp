@@ -240,3 +240,51 @@ TEST(VolumeOverlaps, EqualBruteForceForEveryKindUnderEveryBroadPhase) {
         }
     }
 }
+
+namespace {
+
+// The diagonal pair again: D and E's 6-DOPs (their AABBs) overlap; the face-diagonal slab
+// (1, 1, 0) of the 18- and 26-DOPs separates them (D's reaches -0.67, E's starts at -0.53).
+TEST(KdopOverlaps, TighterKdopsLeaveTheDiagonalPairApart) {
+    const engine::World world = makeDiagonalPairWorld("sap");
+    using engine::BodyState;
+    const std::vector<BodyState> boxes = {BodyState::Flagged, BodyState::Flagged, BodyState::Apart};
+    const std::vector<BodyState> apart(3, BodyState::Apart);
+    EXPECT_EQ(render::kdopOverlaps(world, render::worldKdops(world, 6)).states, boxes);
+    EXPECT_EQ(render::kdopOverlaps(world, render::worldKdops(world, 14)).states, boxes);
+    EXPECT_EQ(render::kdopOverlaps(world, render::worldKdops(world, 18)).states, apart);
+    EXPECT_EQ(render::kdopOverlaps(world, render::worldKdops(world, 26)).states, apart);
+}
+
+TEST(KdopOverlaps, SweepFindsExactlyTheBruteForcePairs) {
+    engine::WorldSettings settings;
+    settings.bounds = collision::Aabb{Vec3::Constant(-20), Vec3::Constant(20)};
+    engine::World world(settings);
+    std::uint64_t seed = 12345;
+    auto next = [&seed] {
+        seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+        return Real(seed >> 11) / Real(1ull << 53);
+    };
+    for (int i = 0; i < 60; ++i) {
+        const Vec3 at(8 * next() - 4, 8 * next() - 4, 8 * next() - 4);
+        std::string name = "s";
+        name += std::to_string(i);
+        world.addBody(sphereBody(name, 0.3 + 0.4 * next(), at));
+    }
+    world.detect();
+    for (const int k : {6, 14, 18, 26}) {
+        const std::vector<collision::WorldKdop> kdops = render::worldKdops(world, k);
+        std::vector<collision::ProxyPair> brute;
+        for (std::size_t a = 0; a < kdops.size(); ++a) {
+            for (std::size_t b = a + 1; b < kdops.size(); ++b) {
+                if (kdops[a].overlaps(kdops[b])) {
+                    brute.push_back({collision::ProxyId(a), collision::ProxyId(b)});
+                }
+            }
+        }
+        EXPECT_EQ(render::kdopOverlaps(world, kdops).pairs, brute) << "k=" << k;
+        EXPECT_FALSE(brute.empty()) << "k=" << k;
+    }
+}
+
+}  // namespace

@@ -6,6 +6,7 @@
 
 #include "collision/math.h"
 #include "collision/volumes/bounding_volumes.h"
+#include "collision/volumes/kdop_volume.h"
 
 namespace collision {
 
@@ -41,6 +42,8 @@ public:
     virtual void drawLine(const Vec3& a, const Vec3& b, const Color& color) = 0;
     virtual void drawAabb(const Aabb& box, const Color& color);
     virtual void drawObb(const Obb& box, const Color& color);
+    /// The edges of the k-DOP's polytope (kdopPolytope).
+    virtual void drawKdop(const WorldKdop& kdop, const Color& color);
     /// A wire sphere (three great circles).
     virtual void drawSphere(const BoundingSphere& sphere, const Color& color);
     /// One line of the picture's legend: what the lines of `color` show. Entries are listed in

@@ -26,6 +26,13 @@ void DebugDraw::drawObb(const Obb& box, const Color& color) {
     }
 }
 
+void DebugDraw::drawKdop(const WorldKdop& kdop, const Color& color) {
+    const KdopPolytope p = kdopPolytope(kdop);
+    for (const auto& [a, b] : p.edges) {
+        drawLine(p.vertices[std::size_t(a)], p.vertices[std::size_t(b)], color);
+    }
+}
+
 void DebugDraw::drawSphere(const BoundingSphere& sphere, const Color& color) {
     constexpr int kSegments = 48;
     const Real step = Real(2) * std::numbers::pi_v<Real> / kSegments;

@@ -2,6 +2,7 @@
 // Every error names the place: "scene.yaml:12:7: bodies[3].radius: must be > 0".
 #pragma once
 
+#include <array>
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
@@ -26,13 +27,19 @@ struct OutputSettings {
     int fps = 30;
 };
 
+/// The k of each entry of DrawSettings::kdop.
+inline constexpr std::array<int, 4> kDrawnKdops{6, 14, 18, 26};
+
 /// What the renderer draws. Volume flags select which bounding volumes get wireframes.
 struct DrawSettings {
     bool bodies = true;
     bool sphere = true;
     bool aabb = false;
     bool obb = false;
-    /// The scene chose sphere/aabb/obb with `draw.volumes`. Otherwise `cdlab run` draws the
+    /// k-DOPs drawn as their polytopes, for k = kDrawnKdops[i] (`kdop6`, `kdop14`, `kdop18`,
+    /// `kdop26` in `draw.volumes`).
+    std::array<bool, 4> kdop{};
+    /// The scene chose its volumes with `draw.volumes`. Otherwise `cdlab run` draws the
     /// volume its broad phase tests (render::drawSettingsFor) instead of the defaults above.
     bool volumes_given = false;
     bool bounds = true;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "collision/broadphase/broad_phase.h"
+#include "collision/volumes/kdop_volume.h"
 #include "engine/scene.h"
 #include "engine/world.h"
 
@@ -46,5 +47,14 @@ struct VolumeOverlaps {
 /// sorting broad phase for that volume (sap, sphere, obb: exact tests, each checked against its
 /// brute-force reference), O(n log n + pairs).
 VolumeOverlaps volumeOverlaps(const engine::World& world, VolumeKind kind);
+
+/// Per body, its world k-DOP of `k` (6, 14, 18, 26) at its current pose (exact support of
+/// its shape along every slab direction, collision::computeWorldKdop).
+std::vector<collision::WorldKdop> worldKdops(const engine::World& world, int k);
+
+/// The overlaps of the bodies' k-DOPs (collision::WorldKdop::overlaps; touching counts), states
+/// as for volumeOverlaps: sorted on the first slab and swept, O(n log n + pairs on that axis).
+VolumeOverlaps kdopOverlaps(const engine::World& world,
+                            const std::vector<collision::WorldKdop>& kdops);
 
 }  // namespace render
