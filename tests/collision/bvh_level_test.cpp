@@ -20,6 +20,7 @@
 #include "narrowphase/gjk.h"
 #include "test_meshes.h"
 #include "volumes/bvh_volumes.h"
+#include "bvh_typed_tests.h"
 
 namespace {
 
@@ -148,22 +149,9 @@ Counts count(const std::vector<BvhNodeState>& states) {
     return c;
 }
 
-template <class T>
-struct TupleToTypes;
-template <class... Ts>
-struct TupleToTypes<std::tuple<Ts...>> {
-    using type = ::testing::Types<Ts...>;
-};
-struct VolumeName {
-    template <class BV>
-    static std::string GetName(int) {
-        return std::string(collision::BvName<BV>::value);
-    }
-};
-
 template <class BV>
 class BvhLevelTyped : public ::testing::Test {};
-TYPED_TEST_SUITE(BvhLevelTyped, TupleToTypes<collision::BvhVolumeTypes>::type, VolumeName);
+TYPED_TEST_SUITE(BvhLevelTyped, BvhVolumeTestTypes, BvhVolumeTestName);
 
 // The states of both tori's nodes at depths 3 and 5 equal the brute force, node by node, and the
 // case has nodes of every colour (so the comparison can fail on each of them).

@@ -11,6 +11,7 @@
 
 #include "collision/bvh/bvh.h"
 #include "test_random.h"
+#include "bvh_typed_tests.h"
 
 namespace {
 
@@ -124,22 +125,9 @@ const std::vector<std::vector<TrianglePair>>& bruteAnswers() {
     return answers;
 }
 
-template <class T>
-struct TupleToTypes;
-template <class... Ts>
-struct TupleToTypes<std::tuple<Ts...>> {
-    using type = ::testing::Types<Ts...>;
-};
-struct VolumeName {
-    template <class BV>
-    static std::string GetName(int) {
-        return std::string(BvName<BV>::value);
-    }
-};
-
 template <class BV>
 class BvhSelf : public ::testing::Test {};
-TYPED_TEST_SUITE(BvhSelf, TupleToTypes<BvhVolumeTypes>::type, VolumeName);
+TYPED_TEST_SUITE(BvhSelf, BvhVolumeTestTypes, BvhVolumeTestName);
 
 TYPED_TEST(BvhSelf, AdversarialMeshesMatchBruteForce) {
     int non_empty = 0;

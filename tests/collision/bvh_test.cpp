@@ -18,6 +18,7 @@
 #include "test_meshes.h"
 #include "test_random.h"
 #include "test_scale.h"
+#include "bvh_typed_tests.h"
 
 namespace {
 
@@ -132,22 +133,9 @@ const std::vector<TrianglePair>& bruteAnswer(std::size_t pose) {
     return it->second;
 }
 
-template <class T>
-struct TupleToTypes;
-template <class... Ts>
-struct TupleToTypes<std::tuple<Ts...>> {
-    using type = ::testing::Types<Ts...>;
-};
-struct VolumeName {
-    template <class BV>
-    static std::string GetName(int) {
-        return std::string(BvName<BV>::value);
-    }
-};
-
 template <class BV>
 class BvhTyped : public ::testing::Test {};
-TYPED_TEST_SUITE(BvhTyped, TupleToTypes<BvhVolumeTypes>::type, VolumeName);
+TYPED_TEST_SUITE(BvhTyped, BvhVolumeTestTypes, BvhVolumeTestName);
 
 TYPED_TEST(BvhTyped, EveryFittedVolumeContainsItsTriangles) {
     for (const BvhSplit split : {BvhSplit::Median, BvhSplit::Mean}) {
