@@ -97,9 +97,9 @@ struct WorldSettings {
     /// m. With response: none bodies reflect off it (velocity flipped, elastic); with response:
     /// impulse its faces are static walls for the contact solver (restitution, friction).
     collision::Aabb bounds{Vec3::Constant(-10), Vec3::Constant(10)};
-    Vec3 gravity = Vec3::Zero();                                      ///< m/s^2
-    Real time_step = Real(1) / 60;                                    ///< s, > 0
-    std::string broad_phase = "sap";                                  ///< registry name
+    Vec3 gravity = Vec3::Zero();      ///< m/s^2
+    Real time_step = Real(1) / 60;    ///< s, > 0
+    std::string broad_phase = "sap";  ///< registry name
     /// Node volume of mesh bodies' hierarchies (collision::bvhVolumeNames()); scene key
     /// `world.mesh_bvh`. Read when mesh bodies are built (scene loading), not by the World.
     std::string mesh_bvh{collision::kDefaultMeshBvh};
@@ -303,7 +303,8 @@ private:
         Real built_ratio = 0;
     };
     std::vector<DeformingMesh> deforming_;
-    void deformBody(DeformingMesh& d);  // vertices at time_, refit or rebuild, hull, bounds
+    void addDeforming(BodyId id);            // addBody of a deforming mesh body: its own geometry
+    void deformBody(DeformingMesh& d);       // vertices at time_, refit or rebuild, hull, bounds
     std::unique_ptr<ContactSolver> solver_;  ///< only with response: impulse
     std::vector<collision::Aabb> grown_;
     std::vector<collision::ProxyPair> response_pairs_;
