@@ -1,6 +1,7 @@
 // app/lab/html_page.cpp -- see html_page.h.
 #include "html_page.h"
 
+#include "markup_entity.h"
 #include "page_assets.h"
 
 namespace app::html {
@@ -9,24 +10,11 @@ std::string escape(std::string_view text) {
     std::string out;
     out.reserve(text.size());
     for (const char c : text) {
-        switch (c) {
-            case '&':
-                out += "&amp;";
-                break;
-            case '<':
-                out += "&lt;";
-                break;
-            case '>':
-                out += "&gt;";
-                break;
-            case '"':
-                out += "&quot;";
-                break;
-            case '\'':
-                out += "&#39;";
-                break;
-            default:
-                out += c;
+        const std::string_view entity = markupEntity(c, "&#39;");
+        if (entity.empty()) {
+            out += c;
+        } else {
+            out += entity;
         }
     }
     return out;

@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <sstream>
 
+#include "markup_entity.h"
+
 namespace app {
 
 namespace {
@@ -114,22 +116,13 @@ std::string xmlEscape(std::string_view text, bool attribute) {
             i += n;
             continue;
         }
+        if (const std::string_view entity = markupEntity(static_cast<char>(b), "&apos;");
+            !entity.empty()) {
+            out += entity;
+            ++i;
+            continue;
+        }
         switch (b) {
-            case '&':
-                out += "&amp;";
-                break;
-            case '<':
-                out += "&lt;";
-                break;
-            case '>':
-                out += "&gt;";
-                break;
-            case '"':
-                out += "&quot;";
-                break;
-            case '\'':
-                out += "&apos;";
-                break;
             case '\t':
                 out += attribute ? "&#9;" : "\t";
                 break;
