@@ -17,6 +17,7 @@
 
 #include "exit_codes.h"
 #include "output_files.h"
+#include "sweep_measure.h"
 #include "sweep_report.h"
 
 namespace app::sweep {
@@ -47,24 +48,9 @@ double numberFrom(const json& j) {
     throw std::runtime_error(message);
 }
 
-using DoubleField = double SweepRun::*;
 using TimedField = Timed SweepRun::*;
 using CountField = std::int64_t SweepRun::*;
 
-const std::pair<const char*, DoubleField> kDoubles[] = {
-    {"time_step", &SweepRun::time_step},
-    {"flagged", &SweepRun::flagged},
-    {"confirmed", &SweepRun::confirmed},
-    {"broad_false_positives", &SweepRun::broad_false_positives},
-    {"bv_tests", &SweepRun::bv_tests},
-    {"narrow_tests", &SweepRun::narrow_tests},
-    {"triangle_tests", &SweepRun::triangle_tests},
-    {"mesh_bv_tests", &SweepRun::mesh_bv_tests},
-    {"max_penetration", &SweepRun::max_penetration},
-    {"max_energy_drift", &SweepRun::max_energy_drift},
-    {"max_angular_momentum_drift", &SweepRun::max_angular_momentum_drift},
-    {"memory_mib", &SweepRun::memory_mib},
-};
 const std::pair<const char*, TimedField> kTimed[] = {
     {"ms_integrate", &SweepRun::ms_integrate},
     {"ms_volumes", &SweepRun::ms_volumes},
@@ -85,7 +71,7 @@ const std::pair<const char*, CountField> kCounts[] = {
 
 json runJson(const SweepRun& r) {
     json j;
-    for (const auto& [name, field] : kDoubles) j[name] = number(r.*field);
+    for (const DoubleColumn& c : doubleColumns()) j[c.name] = number(r.*c.field);
     for (const auto& [name, field] : kTimed) {
         const Timed& t = r.*field;
         j[name] = {{"median", number(t.median)}, {"min", number(t.min)}, {"max", number(t.max)}};
@@ -99,7 +85,7 @@ json runJson(const SweepRun& r) {
 
 SweepRun runFrom(const json& j) {
     SweepRun r;
-    for (const auto& [name, field] : kDoubles) r.*field = numberFrom(j.at(name));
+    for (const DoubleColumn& c : doubleColumns()) r.*c.field = numberFrom(j.at(c.name));
     for (const auto& [name, field] : kTimed) {
         const json& t = j.at(name);
         r.*field = {numberFrom(t.at("median")), numberFrom(t.at("min")), numberFrom(t.at("max"))};

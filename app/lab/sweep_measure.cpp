@@ -199,26 +199,35 @@ SweepRun measure(const engine::Scene& scene, double duration, FirstContacts* fir
     return run;
 }
 
+std::span<const DoubleColumn> doubleColumns() {
+    static constexpr DoubleColumn kColumns[] = {
+        {"time_step", &SweepRun::time_step, false},
+        {"flagged", &SweepRun::flagged, true},
+        {"confirmed", &SweepRun::confirmed, true},
+        {"broad_false_positives", &SweepRun::broad_false_positives, true},
+        {"bv_tests", &SweepRun::bv_tests, true},
+        {"narrow_tests", &SweepRun::narrow_tests, true},
+        {"triangle_tests", &SweepRun::triangle_tests, true},
+        {"mesh_bv_tests", &SweepRun::mesh_bv_tests, true},
+        {"max_penetration", &SweepRun::max_penetration, false},
+        {"max_energy_drift", &SweepRun::max_energy_drift, false},
+        {"max_angular_momentum_drift", &SweepRun::max_angular_momentum_drift, false},
+        {"memory_mib", &SweepRun::memory_mib, false},
+    };
+    return kColumns;
+}
+
 std::string deterministicDifference(const SweepRun& first, const SweepRun& repeat) {
     // Exact comparison: the same scene and build must give bit-identical counts and states.
-    const std::pair<const char*, double SweepRun::*> means[] = {
-        {"flagged", &SweepRun::flagged},
-        {"confirmed", &SweepRun::confirmed},
-        {"broad_false_positives", &SweepRun::broad_false_positives},
-        {"bv_tests", &SweepRun::bv_tests},
-        {"narrow_tests", &SweepRun::narrow_tests},
-        {"triangle_tests", &SweepRun::triangle_tests},
-        {"mesh_bv_tests", &SweepRun::mesh_bv_tests},
-    };
     std::string d;
     if (first.steps != repeat.steps) {
         d = "steps: " + std::to_string(first.steps) + " vs " + std::to_string(repeat.steps);
     }
-    for (const auto& [name, field] : means) {
+    for (const DoubleColumn& c : doubleColumns()) {
         if (!d.empty()) break;
-        if (first.*field != repeat.*field) {
-            d = name;
-            d += ": " + fmt(first.*field, "%.17g") + " vs " + fmt(repeat.*field, "%.17g");
+        if (c.per_step && first.*c.field != repeat.*c.field) {
+            d = c.name;
+            d += ": " + fmt(first.*c.field, "%.17g") + " vs " + fmt(repeat.*c.field, "%.17g");
         }
     }
     if (d.empty() && first.toi_events != repeat.toi_events) {

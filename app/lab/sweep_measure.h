@@ -1,9 +1,10 @@
-// app/lab/sweep_measure.h -- one run of `cdlab sweep`: the scene simulated for the sweep's interval,
-// its stage times, counters, accuracy measures and memory, and its comparison with the
+// app/lab/sweep_measure.h -- one run of `cdlab sweep`: the scene simulated for the sweep's
+// interval, its stage times, counters, accuracy measures and memory, and its comparison with the
 // reference run pair by pair through first-contact times.
 #pragma once
 
 #include <map>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -27,6 +28,16 @@ std::string labelOf(const std::vector<engine::SceneOverride>& overrides);
 /// step's end, stopped by CCD, or pushed by the solver); without, the world is only stepped (a
 /// timing repeat: the untimed bookkeeping is skipped).
 SweepRun measure(const engine::Scene& scene, double duration, FirstContacts* first);
+
+/// A double-valued column of SweepRun, by its name in results and job files. `per_step`: one of
+/// the per-step pair and test counters, which deterministicDifference compares between repeats.
+struct DoubleColumn {
+    const char* name;
+    double SweepRun::*field;
+    bool per_step;
+};
+/// Every double-valued column of SweepRun (the timed and integer ones are separate fields).
+std::span<const DoubleColumn> doubleColumns();
 
 /// The first deterministic column in which `repeat` (a timing repeat of `first`) differs:
 /// "column: value in first vs value in repeat"; empty when they agree. Compared: steps, the
