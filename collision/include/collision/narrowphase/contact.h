@@ -63,7 +63,7 @@ struct ContactOutput {
     std::int32_t iterations = 0;  ///< GJK + EPA iterations, when they ran
 };
 
-/// Conventions of the implementation (collision/src/contact.cpp), added after the agreement:
+/// Conventions of the implementation (collision/src/narrowphase/contact.cpp):
 /// - Box edge k*4 + s_i + 2*s_j is the edge parallel to axis k whose other two coordinates (axes
 ///   i < j) are +half_extents where s = 1 and -half_extents where s = 0.
 /// - point_b - point_a = signed_distance * normal up to rounding (~1e-9 of the size), in every
