@@ -128,7 +128,7 @@ struct WorldSettings {
     std::size_t max_candidate_pairs = kMaxCandidatePairs;
     /// A deforming mesh body's hierarchy is rebuilt instead of refitted when its quality ratio
     /// (sum of node volumes / root volume, MeshBvh::volumeRatio) exceeds this multiple of the
-    /// ratio at its last build. Not a scene key.
+    /// ratio at its last build. Scene key `world.rebuild_ratio` (> 1).
     Real rebuild_ratio = Real(1.5);
 };
 
