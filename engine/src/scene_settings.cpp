@@ -286,3 +286,18 @@ void SceneParser::parseDraw(const YAML::Node& n, Scene& scene) const {
 }
 
 }  // namespace engine::scene_parsing
+
+namespace engine {
+
+bool drawOnlyVolume(DrawSettings& draw, std::string_view name) {
+    const int k = scene_parsing::kdopIndex(std::string(name));
+    if (name != "sphere" && name != "aabb" && name != "obb" && k < 0) return false;
+    draw.sphere = name == "sphere";
+    draw.aabb = name == "aabb";
+    draw.obb = name == "obb";
+    draw.kdop = {};
+    if (k >= 0) draw.kdop[std::size_t(k)] = true;
+    return true;
+}
+
+}  // namespace engine
