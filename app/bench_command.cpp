@@ -50,8 +50,9 @@ Command addBenchBroadphaseCommand(CLI::App& bench) {
                     "stop a method after this many seconds of frame time (0: no limit)")
         ->capture_default_str();
     cmd->add_option("--clock", o.clock,
-                    "thread: thread CPU time per frame (methods on several threads left out); "
-                    "wall: elapsed time, every method")
+                    "thread: thread CPU time per frame (methods on several threads left out; "
+                    "cullide, which renders on llvmpipe's threads, by process CPU time); wall: "
+                    "elapsed time, every method")
         ->check(CLI::IsMember({"thread", "wall"}))
         ->capture_default_str();
     cmd->add_flag("--in-process", f->in_process,

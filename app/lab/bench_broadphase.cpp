@@ -59,9 +59,17 @@ int oneShotRepetitions(const BenchOptions& options) {
     return std::min(options.frames, kMaxOneShotRepetitions);
 }
 
-/// The clock frames are timed by: --clock thread or wall.
-clockid_t frameClock(const BenchOptions& options) {
-    return options.clock == "wall" ? CLOCK_MONOTONIC : CLOCK_THREAD_CPUTIME_ID;
+/// The clock a method's frames are timed by: --clock wall, else the thread's CPU time, or the
+/// process's for a method that puts work on threads it does not own (BenchMethodEntry).
+clockid_t frameClock(const BenchOptions& options, const BenchMethodEntry& entry) {
+    if (options.clock == "wall") return CLOCK_MONOTONIC;
+    return entry.foreign_threads ? CLOCK_PROCESS_CPUTIME_ID : CLOCK_THREAD_CPUTIME_ID;
+}
+
+/// frameClock's name: "wall", "thread" or "process".
+std::string clockName(const BenchOptions& options, const BenchMethodEntry& entry) {
+    if (options.clock == "wall") return "wall";
+    return entry.foreign_threads ? "process" : "thread";
 }
 
 /// A "Vm...:" field of /proc/self/status in kB, or -1.
@@ -105,6 +113,7 @@ struct RunResult {
     int budget_hit = 0;
     std::int64_t pairs_last = 0;
     std::int64_t raw_pairs_last = -1;
+    std::int64_t potentially_colliding_last = -1;
     int mismatched_frames = 0;
     int first_mismatch_frame = -1;
     std::int64_t expected_pairs = 0;
@@ -145,7 +154,7 @@ RunResult measure(const BenchMethodEntry& entry, const MovingBoxes& initial,
     const bool peak_reset = options.isolate && resetPeakRss();
     const long rss_before = peak_reset ? statusKb("VmRSS:") : statusKb("VmHWM:");
 
-    const clockid_t clock = frameClock(options);
+    const clockid_t clock = frameClock(options, entry);
     const double t0 = clockSeconds(clock);
     std::unique_ptr<BenchMethod> method = entry.create();
     method->insertAll(boxes, volumes);
@@ -171,6 +180,7 @@ RunResult measure(const BenchMethodEntry& entry, const MovingBoxes& initial,
         }
     }
     r.raw_pairs_last = method->rawPairs();
+    r.potentially_colliding_last = method->potentiallyColliding();
     const long rss_after = statusKb("VmHWM:");
     method.reset();
 
@@ -197,7 +207,7 @@ RunResult measureOneShot(const BenchMethodEntry& entry, const MovingBoxes& boxes
     boxes.volumes(volumes);
     const int repetitions = oneShotRepetitions(options);
     std::vector<double> times;
-    const clockid_t clock = frameClock(options);
+    const clockid_t clock = frameClock(options, entry);
     double total = 0;
     for (int rep = 0; rep < repetitions; ++rep) {
         const double start = clockSeconds(clock);
@@ -210,6 +220,7 @@ RunResult measureOneShot(const BenchMethodEntry& entry, const MovingBoxes& boxes
         const PairSummary got = method->summary(boxes);
         r.pairs_last = got.pairs;
         r.raw_pairs_last = method->rawPairs();
+        r.potentially_colliding_last = method->potentiallyColliding();
         if (!(got == reference[0]) && r.mismatched_frames++ == 0) {
             r.first_mismatch_frame = 0;
             r.expected_pairs = reference[0].pairs;
@@ -315,6 +326,7 @@ struct Row {
     int configs = 0;     ///< configurations the tuned peer was chosen from
     bool skipped = false;
     std::string skip_reason;
+    std::string clock;  ///< clockName() of the method's frames
     RunResult result;
     double ratio = std::numeric_limits<double>::quiet_NaN();
 };
@@ -383,6 +395,7 @@ nlohmann::json rowJson(const Row& row) {
         j["skipped"] = row.skip_reason;
         return j;
     }
+    j["clock"] = row.clock;
     if (r.failed) {
         j["failed"] = std::string(r.note);
         return j;
@@ -394,6 +407,9 @@ nlohmann::json rowJson(const Row& row) {
     j["ms_per_frame_last100_median"] = number(r.last_median_ms);
     j["pairs"] = r.pairs_last;
     if (r.raw_pairs_last >= 0) j["raw_pairs"] = r.raw_pairs_last;
+    if (r.potentially_colliding_last >= 0) {
+        j["potentially_colliding"] = r.potentially_colliding_last;
+    }
     j["ratio_to_best_peer"] = number(row.ratio);
     j["peak_mb"] = number(r.peak_mb);
     j["frames"] = r.frames_run;
@@ -544,6 +560,16 @@ void reportWorkload(std::ostream& out, std::vector<Row>& rows, const BenchOption
                 << " pairs in the last frame (exact: " << r.pairs_last
                 << "; filtered untimed)\n";
         }
+        if (r.potentially_colliding_last >= 0) {
+            out << "  " << row.method << ": potentially colliding set held "
+                << r.potentially_colliding_last << " of " << row.n
+                << " boxes in the last frame (pairs: " << r.pairs_last << ")\n";
+        }
+        if (row.clock == "process") {
+            out << "  " << row.method
+                << ": timed by the process's CPU time (every thread's: it renders on llvmpipe's "
+                   "threads, which the thread's CPU clock misses)\n";
+        }
     }
     out.flush();
 }
@@ -599,6 +625,7 @@ Row runMethod(const BenchMethodEntry& m, const TableRun& run, const BenchOptions
     row.workload = tableName(run.workload, run.one_shot);
     row.n = n;
     row.peer = m.peer;
+    row.clock = clockName(options, m);
     if (m.threads > 1 && options.clock == "thread") {
         row.skipped = true;
         row.skip_reason = "runs on " + std::to_string(m.threads) +
@@ -727,7 +754,11 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
 
     out << "cdlab bench broadphase: " << options.frames << " frames per method; time = "
         << (options.clock == "wall" ? "elapsed (wall-clock) time" : "thread CPU time")
-        << " of (move all proxies + find pairs) per frame, ms.\n"
+        << " of (move all proxies + find pairs) per frame, ms"
+        << (options.clock == "wall"
+                ? ""
+                : " (a method rendering on llvmpipe's threads: process CPU time)")
+        << ".\n"
         << "insert_ms = create + insert all + first find pairs; first100/last100 = median of the "
            "first/last "
         << kEdgeFrames << " frames; vs_peer = median / best peer's median;\n"

@@ -27,6 +27,9 @@ public:
     }
     void findPairs() override { broad_phase_->findPairs(pairs_, counters_); }
     PairSummary summary(const MovingBoxes& /*boxes*/) override { return summarizePairs(pairs_); }
+    std::int64_t potentiallyColliding() const override {
+        return broad_phase_->potentiallyCollidingSize();
+    }
 
 private:
     std::unique_ptr<collision::BroadPhase> broad_phase_;
@@ -45,6 +48,7 @@ std::vector<BenchMethodEntry> makeMethods() {
         m.description = std::string(entry.description);
         m.default_set = !entry.needs_render_context;
         m.threads = entry.threads;
+        m.foreign_threads = entry.needs_render_context;
         const collision::BroadPhaseEntry* e = &entry;
         m.create = [e]() -> std::unique_ptr<BenchMethod> {
             return std::make_unique<CdlabMethod>(*e);

@@ -33,6 +33,9 @@ public:
     /// Pairs the method itself holds before exact filtering (its pair cache), or -1 when it
     /// reports exact pairs.
     virtual std::int64_t rawPairs() const { return -1; }
+    /// Boxes the method kept in a potentially colliding set at the last findPairs() (cullide's
+    /// visibility pruning), or -1 when it keeps none.
+    virtual std::int64_t potentiallyColliding() const { return -1; }
 };
 
 struct BenchMethodEntry {
@@ -46,6 +49,10 @@ struct BenchMethodEntry {
     /// Threads the method runs on. Thread CPU time (the default clock) would count only the
     /// calling thread's share of a method on more than one, so those run with --clock wall only.
     int threads = 1;
+    /// The method also puts work on threads it does not own (cullide: llvmpipe rasterises on
+    /// threads of its own). The thread's CPU clock would miss that work, so under --clock
+    /// thread such a method is timed by the process's CPU time (every thread's) instead.
+    bool foreign_threads = false;
     /// Peer configurations swept for the best: the peer (e.g. "bullet-dbvt") this entry is one
     /// configuration of, and the configuration ("m0.1:deferred"). Empty family: not swept.
     std::string family;

@@ -297,7 +297,8 @@ public:
             const std::string stem = "pause_" + std::to_string(frame);
             render::writePng(run.dump_dir / (stem + ".png"),
                              run.renderer().render(run.world, run.scene.camera, options));
-            writeTextAtomically(run.dump_dir / (stem + ".json"), pauseDumpJson(run.world, frame));
+            writeTextAtomically(run.dump_dir / (stem + ".json"),
+                                pauseDumpJson(run.world, frame, options.draw));
         }
     }
     void report(const CheckRun& run, std::vector<CheckRow>& rows) const override {
@@ -380,6 +381,7 @@ public:
             render::FrameOptions options;
             options.draw = render::drawSettingsFor(run.scene.draw, run.world);  // as cdlab run
             options.draw.hud = false;
+            if (!expect_[k].volume.empty()) engine::drawOnlyVolume(options.draw, expect_[k].volume);
             counts_[k] =
                 countStateColors(run.renderer().render(run.world, run.scene.camera, options));
         }
@@ -399,7 +401,13 @@ public:
                     what += colorName(s);
                 }
             }
-            CheckRow r{"colours " + what + " at frame " + std::to_string(c.frame), true, ""};
+            std::string name = "colours " + what + " at frame " + std::to_string(c.frame);
+            if (!c.volume.empty()) {
+                name += " (";
+                name += c.volume;
+                name += " only)";
+            }
+            CheckRow r{name, true, ""};
             if (c.frame >= run.frames) {
                 r.pass = false;
                 r.reason = "the run has only " + std::to_string(run.frames) + " frames";

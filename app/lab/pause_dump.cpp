@@ -3,7 +3,9 @@
 
 #include <array>
 #include <nlohmann/json.hpp>
+#include <string>
 #include <string_view>
+#include <vector>
 
 #include "render/volume_states.h"
 
@@ -32,7 +34,7 @@ std::string_view volumeStateName(engine::BodyState state) {
 
 }  // namespace
 
-std::string pauseDumpJson(const engine::World& world, int frame) {
+std::string pauseDumpJson(const engine::World& world, int frame, const engine::DrawSettings& draw) {
     nlohmann::ordered_json doc;
     doc["frame"] = frame;
     doc["time"] = world.time();
@@ -43,6 +45,21 @@ std::string pauseDumpJson(const engine::World& world, int frame) {
     std::array<render::VolumeOverlaps, 3> overlaps;
     for (const render::VolumeKind kind : render::kVolumeKinds) {
         overlaps[int(kind)] = render::volumeOverlaps(world, kind);
+    }
+    // Each k-DOP drawn, by the slab test that colours it.
+    struct KdopKind {
+        int k = 6;
+        std::string name;
+        std::vector<collision::WorldKdop> kdops;
+        render::VolumeOverlaps overlaps;
+    };
+    std::vector<KdopKind> kdop_kinds;
+    for (std::size_t i = 0; i < engine::kDrawnKdops.size(); ++i) {
+        if (!draw.kdop[i]) continue;
+        const int k = engine::kDrawnKdops[i];
+        KdopKind kind{k, "kdop" + std::to_string(k), render::worldKdops(world, k), {}};
+        kind.overlaps = render::kdopOverlaps(world, kind.kdops);
+        kdop_kinds.push_back(std::move(kind));
     }
     nlohmann::ordered_json bodies = nlohmann::ordered_json::array();
     const auto all = world.bodies();
@@ -74,7 +91,28 @@ std::string pauseDumpJson(const engine::World& world, int frame) {
             volume_states[std::string(render::volumeKindName(kind))] = std::string(
                 volumeStateName(i < states.size() ? states[i] : engine::BodyState::Apart));
         }
+        for (const KdopKind& kind : kdop_kinds) {
+            const collision::WorldKdop& kdop = kind.kdops[i];
+            const auto slabs = static_cast<std::ptrdiff_t>(kdop.k / 2);
+            bodies.back()[kind.name] = {
+                {"k", kdop.k},
+                {"min", std::vector<collision::Real>(kdop.min.begin(), kdop.min.begin() + slabs)},
+                {"max", std::vector<collision::Real>(kdop.max.begin(), kdop.max.begin() + slabs)},
+            };
+            volume_states[kind.name] = std::string(volumeStateName(kind.overlaps.states[i]));
+        }
         bodies.back()["volume_states"] = std::move(volume_states);
+    }
+    if (!kdop_kinds.empty()) {
+        nlohmann::ordered_json directions = nlohmann::ordered_json::object();
+        for (const KdopKind& kind : kdop_kinds) {
+            nlohmann::ordered_json list = nlohmann::ordered_json::array();
+            for (int s = 0; s < kind.k / 2; ++s) {
+                list.push_back(vec(collision::kdopSlabDirection(kind.k, s)));
+            }
+            directions[kind.name] = std::move(list);
+        }
+        doc["kdop_slab_directions"] = std::move(directions);
     }
     doc["bodies"] = std::move(bodies);
     doc["flagged_pairs"] = pairs(world.flaggedPairs());
@@ -83,6 +121,7 @@ std::string pauseDumpJson(const engine::World& world, int frame) {
     for (const render::VolumeKind kind : render::kVolumeKinds) {
         overlapping[std::string(render::volumeKindName(kind))] = pairs(overlaps[int(kind)].pairs);
     }
+    for (const KdopKind& kind : kdop_kinds) overlapping[kind.name] = pairs(kind.overlaps.pairs);
     doc["overlapping_pairs"] = std::move(overlapping);
     return doc.dump(1) + "\n";
 }

@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "engine/scene.h"
 #include "engine/world.h"
 
 namespace app {
@@ -11,7 +12,10 @@ namespace app {
 /// ("broadphase_volume"), bodies (pose, sphere, AABB, OBB, state, and "volume_states": each
 /// volume's state by its own overlap test, "apart" / "overlapping" / "colliding", as the pause
 /// picture colours it), flagged and colliding pairs, and "overlapping_pairs" per volume kind
-/// (all pair lists sorted, i < j). Numbers are printed to round-trip.
-std::string pauseDumpJson(const engine::World& world, int frame);
+/// (all pair lists sorted, i < j). For every k-DOP `draw` draws (draw.kdop), each body also has
+/// "kdopK": {"k", "min", "max"} (its k / 2 slab intervals, slab i along
+/// "kdop_slab_directions"["kdopK"][i], unnormalised), and "kdopK" joins "volume_states" and
+/// "overlapping_pairs". Numbers are printed to round-trip.
+std::string pauseDumpJson(const engine::World& world, int frame, const engine::DrawSettings& draw);
 
 }  // namespace app

@@ -461,7 +461,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
                 auto pause_image = std::make_shared<const render::Image>(
                     renderer.render(world, scene.camera, pause_options));
                 writer.submit(std::move(pause_image), out_dir / (stem + ".png"), hold_frames);
-                std::string dump = pauseDumpJson(world, frame);
+                std::string dump = pauseDumpJson(world, frame, pause_options.draw);
                 writeTextAtomically(out_dir / (stem + ".json"), dump);
                 if (options.html) {
                     page.pauses.push_back({frame, std::move(dump), bodyRects(world, scene)});

@@ -3,6 +3,7 @@
 // axis), as closed forms of (rest position, time).
 #include "engine/deformation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -51,6 +52,33 @@ Vec3 deformPoint(const Deformation& d, const Vec3& rest, Real t) {
         }
     }
     return rest;
+}
+
+Real deformSpeedBound(const Deformation& d, std::span<const Vec3> rest) {
+    constexpr Real kPi = std::numbers::pi_v<Real>;
+    // Bend and twist vary with the strength k = amount s(t), s = sin^2(pi f t), whose rate
+    // |ds/dt| = pi f |sin(2 pi f t)| is at most pi f.
+    const Real strength_rate = kPi * d.frequency * std::abs(d.amount);
+    Real bound = 0;
+    for (const Vec3& v : rest) {
+        const Real x = std::abs(v.x());
+        switch (d.kind) {
+            case DeformKind::Bend:
+                // p(k) = c(k) + y n(k), c(k) = integral over [0, x] of (cos ku, sin ku) du and
+                // n(k) = (-sin kx, cos kx): |dc/dk| <= x^2 / 2 and |dn/dk| = |x|.
+                bound = std::max(bound, strength_rate * (x * x / 2 + x * std::abs(v.y())));
+                break;
+            case DeformKind::Twist:
+                // A point at distance rho from the x axis turns by k x: speed rho |x| dk/dt.
+                bound = std::max(bound, strength_rate * x * std::hypot(v.y(), v.z()));
+                break;
+            case DeformKind::Wave:
+                // d/dt amount sin(2 pi (x / wavelength - f t)) = -2 pi f amount cos(...).
+                bound = 2 * kPi * d.frequency * std::abs(d.amount);
+                break;
+        }
+    }
+    return bound;
 }
 
 std::string_view deformKindName(DeformKind kind) {

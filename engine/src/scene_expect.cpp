@@ -264,7 +264,7 @@ void ExpectReader::colors(const Entry& e, const std::string& p, Expectations& ex
         for (std::size_t i = 0; i < list.size(); ++i) {
             const std::string ip = indexPath(p, i);
             const std::vector<Entry> ce =
-                p_.entries(list[i], ip, {"frame", "present", "absent", "min_pixels"});
+                p_.entries(list[i], ip, {"frame", "present", "absent", "min_pixels", "volume"});
             ColorExpectation color;
             color.line = list[i].Mark().line + 1;
             color.column = list[i].Mark().column + 1;
@@ -281,6 +281,17 @@ void ExpectReader::colors(const Entry& e, const std::string& p, Expectations& ex
                 } else if (c.key == "min_pixels") {
                     color.min_pixels = p_.readInt(c.value, cp);
                     if (color.min_pixels < 1) p_.fail(c.value, cp, "must be >= 1");
+                } else if (c.key == "volume") {
+                    color.volume = p_.readString(c.value, cp);
+                    DrawSettings probe;
+                    if (!drawOnlyVolume(probe, color.volume)) {
+                        std::string what = "unknown volume '";
+                        what += color.volume;
+                        what +=
+                            "' (expected one of: sphere, aabb, obb, kdop6, kdop14, kdop18, "
+                            "kdop26)";
+                        p_.fail(c.value, cp, what);
+                    }
                 }
             }
             for (const BodyState st : color.present) {

@@ -29,7 +29,7 @@ void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
         entries(n, path,
                 {"bounds", "gravity", "time_step", "steps_per_frame", "frames", "mesh_bvh",
                  "integrator", "ccd", "ccd_spheres", "ccd_tolerance", "ccd_target_gap", "response",
-                 "restitution", "friction"});
+                 "restitution", "friction", "rebuild_ratio"});
     {
         const Entry& b = require(es, "bounds", n, path);
         const std::string bp = childPath(path, "bounds");
@@ -125,6 +125,14 @@ void SceneParser::parseWorld(const YAML::Node& n, Scene& scene) const {
                 fail(e.value, p, "must be in [0, 1] (fraction of the smaller bounding radius)");
             }
             scene.world.ccd_target_gap = v;
+        } else if (e.key == "rebuild_ratio") {
+            // Multiple of a deforming mesh's volume ratio at its last build (WorldSettings); at
+            // or below 1 a tree would be rebuilt on every step that loosens it at all.
+            const Real v = readReal(e.value, p);
+            if (!(v > 1)) {
+                fail(e.value, p, "must be > 1 (multiple of the volume ratio at the last build)");
+            }
+            scene.world.rebuild_ratio = v;
         } else if (e.key == "integrator") {
             const std::string name = readString(e.value, p);
             if (!findIntegrator(name, scene.world.integrator)) {
@@ -278,3 +286,18 @@ void SceneParser::parseDraw(const YAML::Node& n, Scene& scene) const {
 }
 
 }  // namespace engine::scene_parsing
+
+namespace engine {
+
+bool drawOnlyVolume(DrawSettings& draw, std::string_view name) {
+    const int k = scene_parsing::kdopIndex(std::string(name));
+    if (name != "sphere" && name != "aabb" && name != "obb" && k < 0) return false;
+    draw.sphere = name == "sphere";
+    draw.aabb = name == "aabb";
+    draw.obb = name == "obb";
+    draw.kdop = {};
+    if (k >= 0) draw.kdop[std::size_t(k)] = true;
+    return true;
+}
+
+}  // namespace engine

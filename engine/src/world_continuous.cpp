@@ -50,6 +50,11 @@ Vec3 rotationBetween(const Quat& q0, const Quat& q1) {
 //    dropped), then each event that is the earliest for one of its moving bodies gets an
 //    impulse (restitution kCcdRestitution with response none, else the pair's;
 //    frictionless) at the witness midpoint, in (t, a, b) order.
+// Deforming mesh bodies: the stage sweeps the shape of the step's start (the world deforms
+// after it) and each query bounds how far the surface moves from it over the step
+// (deformSpeedBound x time step, ToiQuery::deform_speed_a/_b; the swept bounds grow by as much),
+// so no pair overlaps at any time before its stop, deforming surface included. The deformation
+// is prescribed and goes on after a stop; the discrete pipeline sees what it presses into.
 // Limitation: one round. A body stopped early is not re-tested against the bodies whose
 // sweeps it no longer blocks, and a third body's sweep is not re-tested against the stopped
 // pose (the discrete pipeline still sees any overlap that results).
@@ -83,10 +88,19 @@ void World::buildSweeps() {
         s.box.min = step_start_[i].position.cwiseMin(b.position) - Vec3::Constant(s.radius);
         s.box.max = step_start_[i].position.cwiseMax(b.position) + Vec3::Constant(s.radius);
         s.clamp_t = 1;
+        s.deform_speed = 0;
         s.moving =
             !b.is_static && (s.sweep.translation.squaredNorm() > 0 ||
                              s.sweep.rotation.squaredNorm() > 0 || s.sweep.spin.squaredNorm() > 0);
         sweep_order_.push_back(static_cast<BodyId>(i));
+    }
+    // A deforming body's surface also moves in its own frame, up to deform_speed over the step:
+    // its swept bounds grow by that much.
+    for (const DeformingMesh& d : deforming_) {
+        SweptBody& s = swept_[static_cast<std::size_t>(d.body)];
+        s.deform_speed = d.speed_bound * settings_.time_step;
+        s.box.min -= Vec3::Constant(s.deform_speed);
+        s.box.max += Vec3::Constant(s.deform_speed);
     }
     std::sort(sweep_order_.begin(), sweep_order_.end(), [this](BodyId x, BodyId y) {
         const Real ax = swept_[x].box.min.x(), ay = swept_[y].box.min.x();
@@ -132,13 +146,21 @@ void World::queryTimesOfImpact() {
             settings_.ccd_target_gap * std::min(swept_[pair.a].radius, swept_[pair.b].radius);
         in.relative_tolerance = settings_.ccd_tolerance;
         in.max_iterations = kCcdMaxIterations;
+        // A deforming body's shape is its shape at the start of the step (deformed after this
+        // stage); the query bounds how far its surface moves from it in the step.
+        in.deform_speed_a = swept_[pair.a].deform_speed;
+        in.deform_speed_b = swept_[pair.b].deform_speed;
         // Two meshes with OBB trees: their surfaces, triangle pair by triangle pair under the
         // continuous OBB test's culling (a ring may pass around a rod). Any other pair: the
-        // convex shapes, a mesh standing for its convex hull (conservative: may stop early).
+        // convex shapes, a mesh standing for its convex hull (conservative: may stop early); so
+        // is a deforming mesh, whose tree's culling assumes a rigid shape.
+        const bool rigid = in.deform_speed_a == 0 && in.deform_speed_b == 0;
         const collision::Bvh<collision::Obb>* tree_a =
-            a.shape.bvh != nullptr ? collision::treeOf<collision::Obb>(*a.shape.bvh) : nullptr;
+            rigid && a.shape.bvh != nullptr ? collision::treeOf<collision::Obb>(*a.shape.bvh)
+                                            : nullptr;
         const collision::Bvh<collision::Obb>* tree_b =
-            b.shape.bvh != nullptr ? collision::treeOf<collision::Obb>(*b.shape.bvh) : nullptr;
+            rigid && b.shape.bvh != nullptr ? collision::treeOf<collision::Obb>(*b.shape.bvh)
+                                            : nullptr;
         // Two spheres with ccd_spheres: exact: the closed-form root of |d0 + t dv| = ra + rb +
         // gap, exact for the sweeps' linear motion of the centres (collision/ccd/ccd.h).
         const bool exact_spheres = settings_.ccd_spheres == CcdSpheres::Exact &&

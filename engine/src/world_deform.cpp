@@ -58,6 +58,7 @@ void World::addDeforming(BodyId id) {
     d.rest = d.mesh->vertices;
     d.bvh = collision::buildMeshBvh(added.shape.bvh->volumeName(), *d.mesh);
     d.built_ratio = volumeRatio(*d.bvh);
+    d.speed_bound = deformSpeedBound(*added.deform, d.rest);
     deforming_.push_back(std::move(d));
     deformBody(deforming_.back());
 }

@@ -595,6 +595,11 @@ void Renderer::Impl::drawOverlays(Image& image, const FrameOptions& options) con
         std::vector<LegendRow> rows;
         if (any_volume && own_tests) {
             rows.push_back({{std::nullopt, "each volume coloured by its own overlap test"}});
+            std::string drawn;
+            for (const std::string& name : drawnVolumeNames(options.draw)) {
+                drawn += (drawn.empty() ? "drawn: " : ", ") + name;
+            }
+            rows.push_back({{std::nullopt, drawn}});
             rows.push_back({{apart, "apart"},
                             {flagged, "overlaps a volume of its kind"},
                             {colliding, "colliding"}});

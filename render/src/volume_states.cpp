@@ -50,6 +50,17 @@ engine::DrawSettings drawSettingsFor(const engine::DrawSettings& draw, const eng
     return out;
 }
 
+std::vector<std::string> drawnVolumeNames(const engine::DrawSettings& draw) {
+    std::vector<std::string> out;
+    if (draw.sphere) out.emplace_back("sphere");
+    if (draw.aabb) out.emplace_back("AABB");
+    if (draw.obb) out.emplace_back("OBB");
+    for (std::size_t i = 0; i < engine::kDrawnKdops.size(); ++i) {
+        if (draw.kdop[i]) out.push_back(std::to_string(engine::kDrawnKdops[i]) + "-DOP");
+    }
+    return out;
+}
+
 namespace {
 
 /// Flagged for every body in a pair, then Colliding for those in a confirmed pair among them.

@@ -230,6 +230,91 @@ TEST(BroadphaseBench, WallClockRunsTheTwoThreadMethodWithTheSamePairs) {
     fs::remove_all(work);
 }
 
+// Boxes of the workload after `frames` steps that overlap at least one other box (closed
+// intervals, like bruteForcePairs): each must be in a potentially colliding set.
+std::int64_t boxesInSomePair(app::WorkloadKind kind, int n, std::uint64_t seed, int frames) {
+    app::MovingBoxes boxes(kind, n, seed);
+    for (int f = 0; f < frames; ++f) boxes.step();
+    std::vector<char> paired(static_cast<std::size_t>(n), 0);
+    for (int a = 0; a < n; ++a) {
+        for (int b = a + 1; b < n; ++b) {
+            const collision::Aabb& ba = boxes.aabb(a);
+            const collision::Aabb& bb = boxes.aabb(b);
+            bool overlap = true;
+            for (int k = 0; k < 3; ++k) {
+                overlap = overlap && ba.min[k] <= bb.max[k] && bb.min[k] <= ba.max[k];
+            }
+            if (!overlap) continue;
+            paired[static_cast<std::size_t>(a)] = 1;
+            paired[static_cast<std::size_t>(b)] = 1;
+        }
+    }
+    return std::count(paired.begin(), paired.end(), 1);
+}
+
+// cullide renders on llvmpipe's threads, which the thread's CPU clock does not see: under the
+// default clock it is timed by the process's CPU time, and the table and JSON say so. Beside its
+// pairs it reports the size of its potentially colliding set in the last frame, which holds every
+// box that overlaps another and no more boxes than there are.
+TEST(BroadphaseBench, CullideReportsItsPotentiallyCollidingSetAndItsClock) {
+    const fs::path work = tempDir("cullide");
+    const fs::path json = work / "cullide.json";
+    const int n = 400;
+    const int frames = 3;
+    const std::uint64_t seed = 1;
+    const Result r =
+        runCdlab("bench broadphase --sizes " + std::to_string(n) + " --frames " +
+                     std::to_string(frames) + " --methods cullide,sap --workload uniform --seed " +
+                     std::to_string(seed) + " --json " + json.string(),
+                 work);
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    const nlohmann::json doc = nlohmann::json::parse(slurp(json));
+    ASSERT_EQ(doc["rows"].size(), 2u) << doc.dump();
+    const nlohmann::json& cullide = doc["rows"][0];
+    const nlohmann::json& sap = doc["rows"][1];
+    ASSERT_EQ(cullide["method"], "cullide");
+    ASSERT_FALSE(cullide.contains("skipped")) << cullide.dump();
+    EXPECT_EQ(cullide["mismatched_frames"], 0);
+    EXPECT_EQ(cullide["clock"], "process");
+    EXPECT_EQ(sap["clock"], "thread");
+    EXPECT_FALSE(sap.contains("potentially_colliding")) << sap.dump();
+    ASSERT_TRUE(cullide.contains("potentially_colliding")) << cullide.dump();
+    const std::int64_t pcs = cullide["potentially_colliding"].get<std::int64_t>();
+    const std::int64_t paired = boxesInSomePair(app::WorkloadKind::Uniform, n, seed, frames);
+    EXPECT_GT(paired, 0);
+    EXPECT_GE(pcs, paired);
+    EXPECT_LE(pcs, n);
+
+    bool clock_noted = false;
+    bool pcs_noted = false;
+    std::istringstream lines(r.out);
+    for (std::string line; std::getline(lines, line);) {
+        if (line.find("cullide: timed by the process's CPU time") != std::string::npos) {
+            clock_noted = true;
+        }
+        const std::string pcs_text = "cullide: potentially colliding set held " +
+                                     std::to_string(pcs) + " of " + std::to_string(n) + " boxes";
+        if (line.find(pcs_text) != std::string::npos) {
+            pcs_noted = true;
+            EXPECT_NE(line.find("(pairs: " + cullide["pairs"].dump() + ")"), std::string::npos)
+                << line;
+        }
+    }
+    EXPECT_TRUE(clock_noted) << r.out;
+    EXPECT_TRUE(pcs_noted) << r.out;
+
+    // Under --clock wall every method is timed by elapsed time, cullide too.
+    const Result wall = runCdlab(
+        "bench broadphase --sizes 200 --frames 2 --methods cullide "
+        "--workload uniform --clock wall --json " +
+            json.string(),
+        work);
+    ASSERT_EQ(wall.exit_code, 0) << wall.out << wall.err;
+    EXPECT_EQ(nlohmann::json::parse(slurp(json))["rows"][0]["clock"], "wall");
+    EXPECT_EQ(wall.out.find("timed by the process's CPU time"), std::string::npos) << wall.out;
+    fs::remove_all(work);
+}
+
 // Tuned peers: every configuration of each peer's grid runs (a "sweep" row each), and the peer
 // row of the table is the configuration whose sweep median was the lowest of its peer's.
 TEST(BroadphaseBench, TunedPeersRunTheirWholeGridAndReportTheFastestConfiguration) {

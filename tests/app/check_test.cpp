@@ -229,6 +229,37 @@ TEST(Check, ShortRunsAndMissingSectionsFail) {
     fs::remove_all(dir);
 }
 
+// `volume:` counts the colours of one volume alone. Two spheres on the diagonal (1, 1, 0): their
+// 6-DOPs (boxes) overlap, their 26-DOPs are apart on the (1, 1, 0) slab, so the 6-DOP frame has
+// yellow and the 26-DOP frame none, though the scene draws both; a wrong expectation fails.
+TEST(Check, ColoursOfOneVolumeAlone) {
+    const fs::path dir = tempDir("volume");
+    const std::string diagonal =
+        "world: {bounds: {min: [-4, -4, -4], max: [4, 4, 4]}, time_step: 0.1, frames: 2}\n"
+        "output: {width: 160, height: 120, fps: 10}\n"
+        "camera: {position: [0, 0, 9], look_at: [0, 0, 0]}\n"
+        "draw: {volumes: [kdop6, kdop26], bodies: false, bounds: false, hud: false}\n"
+        "bodies:\n"
+        "  - {name: d, shape: sphere, radius: 0.8, position: [-0.6, -0.6, 0]}\n"
+        "  - {name: e, shape: sphere, radius: 0.8, position: [0.6, 0.6, 0]}\n"
+        "expect:\n"
+        "  colors:\n"
+        "    - {frame: 0, present: [green, yellow]}\n"
+        "    - {frame: 0, volume: kdop6, present: [yellow], absent: [green]}\n"
+        "    - {frame: 0, volume: kdop26, present: [green], absent: [yellow]}\n"
+        "    - {frame: 1, volume: kdop26, present: [yellow]}\n";
+    const std::vector<CheckRow> rows = checkScene(parse(diagonal), 2, dir);
+    ASSERT_EQ(rows.size(), 4u);
+    EXPECT_TRUE(rows[0].pass) << rows[0].expectation << ": " << rows[0].reason;
+    EXPECT_EQ(rows[1].expectation, "colours yellow, no green at frame 0 (kdop6 only)");
+    EXPECT_TRUE(rows[1].pass) << rows[1].reason;
+    EXPECT_EQ(rows[2].expectation, "colours green, no yellow at frame 0 (kdop26 only)");
+    EXPECT_TRUE(rows[2].pass) << rows[2].reason;
+    EXPECT_FALSE(rows[3].pass);
+    EXPECT_EQ(rows[3].reason.rfind("yellow: 0 pixels, need 20", 0), 0u) << rows[3].reason;
+    fs::remove_all(dir);
+}
+
 TEST(Check, SameSceneSameRows) {
     const fs::path dir = tempDir("det");
     const engine::Scene scene = parse(kTwoSpheres +

@@ -90,6 +90,7 @@ TEST(PausePicture, EachVolumeTakesItsOwnTestsStateInPictureAndDump) {
     EXPECT_EQ(dump["overlapping_pairs"]["sphere"], nlohmann::json::array());
     EXPECT_EQ(dump["overlapping_pairs"]["aabb"], nlohmann::json::array({{0, 1}}));
     EXPECT_EQ(dump["overlapping_pairs"]["obb"], nlohmann::json::array({{0, 1}}));
+    EXPECT_FALSE(dump.contains("kdop_slab_directions"));  // no k-DOP drawn, none dumped
 
     // The camera looks straight at D: its sphere's outline at 45 degrees lies clear of its
     // box's edges (render/volume_colors_test.cpp), green; the box corner is yellow.
@@ -107,6 +108,63 @@ TEST(PausePicture, EachVolumeTakesItsOwnTestsStateInPictureAndDump) {
     // The frames of the run (no draw.volumes, broad phase sap) draw the AABBs, yellow.
     const render::Image frame = render::readPng(out / "frame_00001.png");
     EXPECT_TRUE(colorNear(frame, corner, kYellow));
+    fs::remove_all(work);
+}
+
+// k-DOPs drawn (draw.volumes) are dumped too, each by its own slab test: D and E sit on the
+// diagonal (1, 1, 0), so their 6-DOPs (boxes) and 14-DOPs (axes and cube diagonals) overlap
+// while the 26-DOPs' (1, 1, 0) slab separates them. Each slab interval is a sphere's
+// [d.c - r |d|, d.c + r |d|] along the dumped direction d; k-DOPs not drawn are not dumped.
+TEST(PausePicture, DrawnKdopsAreDumpedWithTheirSlabsAndStates) {
+    const fs::path work = tempDir("kdop");
+    std::string text = sceneText(-1.2, -0.6, kDiagonalBodies);
+    const std::string draw = "draw: {hud: false, bounds: false, bodies: false}";
+    ASSERT_NE(text.find(draw), std::string::npos);
+    text.replace(text.find(draw), draw.size(),
+                 "draw: {hud: false, bounds: false, bodies: false, volumes: [kdop6, kdop14, "
+                 "kdop26]}");
+    const fs::path scene = writeScene(work, "kdops.yaml", text);
+    const fs::path out = work / "out";
+    const CliResult r =
+        runCdlab("run " + scene.string() + " --no-video --pause-at 0 --out " + out.string(), work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json dump = nlohmann::json::parse(slurp(out / "pause_0.json"));
+
+    const Vec3 centres[3] = {Vec3(-1.2, -0.6, 0), Vec3(0, 0.6, 0), Vec3(2.8, 0, 0)};
+    for (const int k : {6, 14, 26}) {
+        const std::string name = "kdop" + std::to_string(k);
+        SCOPED_TRACE(name);
+        const nlohmann::json& directions = dump["kdop_slab_directions"][name];
+        ASSERT_EQ(directions.size(), std::size_t(k / 2));
+        for (std::size_t b = 0; b < 3; ++b) {
+            const nlohmann::json& kdop = dump["bodies"][b][name];
+            EXPECT_EQ(kdop["k"], k);
+            ASSERT_EQ(kdop["min"].size(), std::size_t(k / 2));
+            ASSERT_EQ(kdop["max"].size(), std::size_t(k / 2));
+            for (std::size_t i = 0; i < directions.size(); ++i) {
+                const Vec3 d(directions[i][0].get<double>(), directions[i][1].get<double>(),
+                             directions[i][2].get<double>());
+                EXPECT_NEAR(kdop["min"][i].get<double>(), d.dot(centres[b]) - 0.8 * d.norm(),
+                            1e-12);
+                EXPECT_NEAR(kdop["max"][i].get<double>(), d.dot(centres[b]) + 0.8 * d.norm(),
+                            1e-12);
+            }
+        }
+        EXPECT_EQ(dump["bodies"][2]["volume_states"][name], "apart");
+    }
+    const nlohmann::json& d = dump["bodies"][0];
+    EXPECT_EQ(d["volume_states"]["kdop6"], "overlapping");
+    EXPECT_EQ(d["volume_states"]["kdop14"], "overlapping");
+    EXPECT_EQ(d["volume_states"]["kdop26"], "apart");
+    EXPECT_EQ(dump["overlapping_pairs"]["kdop6"], nlohmann::json::array({{0, 1}}));
+    EXPECT_EQ(dump["overlapping_pairs"]["kdop14"], nlohmann::json::array({{0, 1}}));
+    EXPECT_EQ(dump["overlapping_pairs"]["kdop26"], nlohmann::json::array());
+    EXPECT_FALSE(d.contains("kdop18"));
+    EXPECT_FALSE(d["volume_states"].contains("kdop18"));
+    EXPECT_FALSE(dump["overlapping_pairs"].contains("kdop18"));
+    // The volumes every pause dump has are still there.
+    EXPECT_EQ(d["volume_states"]["aabb"], "overlapping");
+    EXPECT_EQ(d["volume_states"]["sphere"], "apart");
     fs::remove_all(work);
 }
 

@@ -180,6 +180,39 @@ TEST(RunHtml, NoVideoIsSaidAndAFailedRunLeavesNoPage) {
     fs::remove_all(work);
 }
 
+// A scene drawing k-DOPs: the page's pause table has a column per k-DOP drawn, named like the
+// legend ("6-DOP", "26-DOP"), holding each body's state of that k-DOP from the pause dump.
+TEST(RunHtml, PauseTableListsTheKdopsDrawn) {
+    ASSERT_FALSE(chromiumBinary().empty()) << kNoChromium;
+    const fs::path work = tempDir("cdlab_html_", "kdop");
+    std::string text = kSceneText;
+    const std::string bodies = "bodies:\n";
+    text.insert(text.find(bodies), "draw: {volumes: [kdop6, kdop26]}\n");
+    const fs::path scene = work / "kdops.yaml";
+    std::ofstream(scene) << text;
+    const fs::path out = work / "out";
+    const CliResult r = runCdlab("run " + scene.string() +
+                                     " --html --no-video --frames 2 --pause-at 1 --quiet --out " +
+                                     out.string(),
+                                 work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json pause = nlohmann::json::parse(slurp(out / "pause_1.json"));
+    const std::string dom = runChromium(out / "index.html", "", "--dump-dom", work);
+    ASSERT_NE(dom.find("<body data-rendered=\"1\""), std::string::npos)
+        << "the page's script did not finish: " << slurp(work / "chromium.log");
+    EXPECT_NE(dom.find("<th>OBB</th><th>6-DOP</th><th>26-DOP</th></tr>"), std::string::npos);
+    EXPECT_EQ(dom.find("<th>14-DOP</th>"), std::string::npos);
+    // Each body's row ends with its 6-DOP and 26-DOP states.
+    for (const nlohmann::json& b : pause["bodies"]) {
+        const std::string cells = "<td>" + b["volume_states"]["obb"].get<std::string>() +
+                                  "</td><td>" + b["volume_states"]["kdop6"].get<std::string>() +
+                                  "</td><td>" + b["volume_states"]["kdop26"].get<std::string>() +
+                                  "</td></tr>";
+        EXPECT_NE(dom.find(cells), std::string::npos) << cells;
+    }
+    fs::remove_all(work);
+}
+
 // Names are data: escaped in the page's text, and unable to end the JSON element, whose text
 // still parses to the same strings.
 TEST(HtmlPage, EscapesTextAndEmbedsJsonThatCannotCloseItsElement) {

@@ -280,6 +280,41 @@ TEST(ConservativeAdvancement, NeverLaterThanSampledFirstContactOnRandomPairs) {
     EXPECT_EQ(failed, 0);
 }
 
+// A deforming shape: its surface may move deform_speed (m per step) towards the other shape on
+// top of the rigid motion, so the gap of 0.5 m between a plate closing at 0.3 m a step and a
+// sphere closes by t = 0.5 / (0.3 + 0.7) at the earliest. The advancement must stop by then,
+// and it cannot unless it both bounds the rate (one advance of 0.5 / 1) and takes the surface's
+// displacement so far off the gap it measures on the t = 0 shapes (a second advance would pass
+// the bound). Bad deform speeds fail.
+//
+//   plate |-> 0.3/step, surface up to 0.7/step   <- 0.5 m ->   ( sphere )
+TEST(ConservativeAdvancement, DeformSpeedBoundsTheMovingSurface) {
+    const Shape plate = Shape::box(Vec3(0.05, 1, 1));
+    const Shape sphere = Shape::sphere(0.25);
+    ToiInput in = makeInput(plate, linear(Vec3(-0.8, 0, 0), Vec3(0.3, 0, 0)), sphere,
+                            linear(Vec3::Zero(), Vec3::Zero()));
+    in.tolerance = 1e-9;
+    const ToiOutput rigid = timeOfImpact(in);
+    ASSERT_EQ(rigid.state, CcdState::Separated);  // 0.3 of the 0.5 m gap in the step
+    for (const bool on_a : {true, false}) {
+        ToiInput d = in;
+        (on_a ? d.deform_speed_a : d.deform_speed_b) = 0.7;
+        const ToiOutput out = timeOfImpact(d);
+        ASSERT_EQ(out.state, CcdState::Hit) << on_a;
+        EXPECT_LE(out.t, 0.5 / (0.3 + 0.7)) << on_a;
+        EXPECT_GE(out.t, 0.5 / (0.3 + 0.7) - 1e-6) << on_a;
+        // A slower deformation never closes the gap in the step.
+        (on_a ? d.deform_speed_a : d.deform_speed_b) = 0.15;
+        EXPECT_EQ(timeOfImpact(d).state, CcdState::Separated) << on_a;
+    }
+    for (const Real bad :
+         {-0.1, std::numeric_limits<Real>::quiet_NaN(), std::numeric_limits<Real>::infinity()}) {
+        ToiInput d = in;
+        d.deform_speed_b = bad;
+        EXPECT_EQ(timeOfImpact(d).state, CcdState::Failed) << bad;
+    }
+}
+
 TEST(ConservativeAdvancement, OverlapCapAndBadInput) {
     const Shape s = Shape::sphere(0.5);
     ToiInput in = makeInput(s, linear(Vec3::Zero(), Vec3(1, 0, 0)), s,

@@ -5,10 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <memory>
 
 #include "collision/geometry/convex_hull.h"
 #include "collision/geometry/shape.h"
+#include "test_meshes.h"
 #include "test_random.h"
 
 namespace {
@@ -89,6 +91,39 @@ TEST(KdopVolume, RandomShapesGiveTightPolytopesAtEveryScaleAndOffset) {
         }
     }
     EXPECT_GT(checked, 300);
+}
+
+// A mesh body (a turned torus far from the origin): its k-DOP holds every vertex of the mesh in
+// every slab, each slab's two planes touch a mesh vertex (the support of a mesh is its hull's,
+// whose vertices are mesh vertices), and the polytope drawn from it is tight.
+TEST(KdopVolume, MeshBodyHoldsEveryVertexAndTouchesEverySlabPlane) {
+    auto mesh = std::make_shared<const collision::TriangleMesh>(
+        cdlab_test::makeTorusMesh(1.5, 0.4, 24, 12));
+    collision::ConvexHullOutput hull = collision::computeConvexHull(mesh->vertices);
+    ASSERT_TRUE(hull.ok) << hull.error;
+    const Shape torus = Shape::triangleMesh(
+        mesh, std::make_shared<const collision::ConvexPolytope>(std::move(hull.hull)));
+    cdlab_test::Rng rng(17);
+    const Pose pose{Vec3(250, -40, 7), rng.rotation()};
+    for (const int k : kKs) {
+        const WorldKdop d = collision::computeWorldKdop(torus, pose, k);
+        const Real tol = collision::kdopPolytopeTolerance(d);
+        for (int i = 0; i < k / 2; ++i) {
+            const Vec3 n = collision::kdopSlabDirection(k, i);
+            Real lo = std::numeric_limits<Real>::infinity();
+            Real hi = -lo;
+            for (const Vec3& v : mesh->vertices) {
+                const Real s = n.dot(pose.apply(v));
+                lo = std::min(lo, s);
+                hi = std::max(hi, s);
+            }
+            EXPECT_GE(lo, d.min[std::size_t(i)] - tol) << "k=" << k << " slab " << i;
+            EXPECT_LE(hi, d.max[std::size_t(i)] + tol) << "k=" << k << " slab " << i;
+            EXPECT_NEAR(lo, d.min[std::size_t(i)], tol) << "k=" << k << " slab " << i;
+            EXPECT_NEAR(hi, d.max[std::size_t(i)], tol) << "k=" << k << " slab " << i;
+        }
+        expectTightPolytope(d, collision::kdopPolytope(d));
+    }
 }
 
 TEST(KdopVolume, SixDopIsTheEightBoxCorners) {

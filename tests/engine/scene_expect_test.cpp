@@ -102,6 +102,22 @@ TEST(SceneExpect, ParsesEveryKey) {
               (std::vector<BodyState>{BodyState::Colliding, BodyState::Apart}));
     EXPECT_EQ(e.colors[0].absent, (std::vector<BodyState>{BodyState::Flagged}));
     EXPECT_EQ(e.colors[0].min_pixels, 5);
+    EXPECT_EQ(e.colors[0].volume, "");
+    const Scene one = parseScene(kScene +
+                                     "  colors:\n    - {frame: 1, volume: kdop14, "
+                                     "absent: [red]}\n",
+                                 "x.yaml", ".");
+    ASSERT_EQ(one.expect.colors.size(), 1u);
+    EXPECT_EQ(one.expect.colors[0].volume, "kdop14");
+}
+
+TEST(SceneExpectErrors, ColourVolumeIsADrawableVolume) {
+    EXPECT_SCENE_ERROR(kScene + "  colors:\n    - {frame: 1, volume: kdop8, present: [red]}\n",
+                       "9:26: expect.colors[0].volume: ",
+                       "unknown volume 'kdop8' (expected one of: sphere, aabb, obb, kdop6, "
+                       "kdop14, kdop18, kdop26)");
+    EXPECT_SCENE_ERROR(kScene + "  colors:\n    - {frame: 1, volume: [aabb], present: [red]}\n",
+                       "9:26: expect.colors[0].volume: ", "expected a string");
 }
 
 TEST(SceneExpectErrors, UnknownKeysAtEveryLevel) {

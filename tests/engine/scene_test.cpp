@@ -487,6 +487,27 @@ TEST(SceneErrors, CcdToleranceAndTargetGapAreValidated) {
                        "3:19: world.ccd_target_gap: ", "expected a number");
 }
 
+TEST(Scene, RebuildRatioReachesTheWorld) {
+    EXPECT_EQ(parse(kValid).world.rebuild_ratio, Real(1.5));
+    const Scene s = parse(
+        "world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  rebuild_ratio: 2.25\nbodies:\n"
+        "  - {shape: sphere, radius: 0.25, position: [0.5, 0.5, 0.5]}\n");
+    EXPECT_EQ(s.world.rebuild_ratio, Real(2.25));
+    EXPECT_EQ(makeWorld(s).settings().rebuild_ratio, Real(2.25));
+}
+
+TEST(SceneErrors, RebuildRatioIsValidated) {
+    const std::string head = "world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n";
+    EXPECT_SCENE_ERROR(head + "  rebuild_ratio: 1\n", "3:18: world.rebuild_ratio: ",
+                       "must be > 1 (multiple of the volume ratio at the last build)");
+    EXPECT_SCENE_ERROR(head + "  rebuild_ratio: 0.5\n",
+                       "3:18: world.rebuild_ratio: ", "must be > 1");
+    EXPECT_SCENE_ERROR(head + "  rebuild_ratio: .inf\n",
+                       "3:18: world.rebuild_ratio: ", "must be finite");
+    EXPECT_SCENE_ERROR(head + "  rebuild_ratio: often\n",
+                       "3:18: world.rebuild_ratio: ", "expected a number, got 'often'");
+}
+
 TEST(SceneErrors, UnknownMeshBvh) {
     EXPECT_SCENE_ERROR("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  mesh_bvh: kdop7\n",
                        "3:13: world.mesh_bvh: ",

@@ -288,3 +288,65 @@ TEST(KdopOverlaps, SweepFindsExactlyTheBruteForcePairs) {
 }
 
 }  // namespace
+
+// The 14-DOP is drawn as its polytope, not as the box of its three axis slabs: F's 14-DOP (a
+// cube of side 1.6 with each corner cut by a cube-diagonal slab) has an edge across the front
+// face's top right corner, from (0.8, -0.21, 0.8) to (-0.21, 0.8, 0.8) about F's centre. A point
+// 0.3 along it (clear of the box's far edges in perspective) is green with kdop14 drawn, and
+// nothing is drawn there with kdop6 (the box).
+TEST(KdopDrawing, FourteenDopCornerCutsAreDrawn) {
+    const engine::World world = makeDiagonalPairWorld("sap");
+    render::Renderer renderer(kWidth, kHeight);
+    const engine::CameraSettings cam = headOnCamera();
+    const Real cut = Real(0.8) * std::sqrt(Real(3)) - Real(1.6);  // -0.21
+    const Vec3 on_edge = Vec3(2.8, 0, 0) + 0.7 * Vec3(0.8, cut, 0.8) + 0.3 * Vec3(cut, 0.8, 0.8);
+    const PixelPos px = project(cam, kWidth, kHeight, on_edge);
+    render::FrameOptions options = volumesOnly(false, false, false);
+    options.draw.kdop[1] = true;  // kdop14
+    ASSERT_EQ(engine::kDrawnKdops[1], 14);
+    EXPECT_TRUE(colorNear(renderer.render(world, cam, options), px, kGreen, 1))
+        << px.x << "," << px.y;
+    options.draw.kdop = {};
+    options.draw.kdop[0] = true;  // kdop6: the box, no line there
+    EXPECT_FALSE(colorNear(renderer.render(world, cam, options), px, kGreen, 1))
+        << px.x << "," << px.y;
+}
+
+// The legend names every volume drawn, each k-DOP by its k.
+TEST(KdopDrawing, LegendNamesEachKDrawn) {
+    engine::DrawSettings draw;
+    draw.sphere = true;
+    draw.aabb = false;
+    draw.obb = false;
+    draw.kdop = {true, true, false, true};
+    EXPECT_EQ(render::drawnVolumeNames(draw),
+              (std::vector<std::string>{"sphere", "6-DOP", "14-DOP", "26-DOP"}));
+    draw.sphere = false;
+    draw.obb = true;
+    draw.kdop = {false, false, true, false};
+    EXPECT_EQ(render::drawnVolumeNames(draw), (std::vector<std::string>{"OBB", "18-DOP"}));
+
+    // In the frame: the legend block (bottom left, clear of the bodies' volumes) is there with
+    // the HUD, and its text differs between a frame drawing the 14-DOPs and one drawing the
+    // 26-DOPs.
+    const engine::World world = makeDiagonalPairWorld("sap");
+    render::Renderer renderer(640, 480);
+    render::FrameOptions options = volumesOnly(false, false, false);
+    options.draw.hud = true;
+    options.draw.kdop = {false, true, false, false};
+    const render::Image fourteen = renderer.render(world, headOnCamera(), options);
+    options.draw.kdop = {false, false, false, true};
+    const render::Image twenty_six = renderer.render(world, headOnCamera(), options);
+    options.draw.hud = false;
+    const render::Image no_legend = renderer.render(world, headOnCamera(), options);
+    int legend = 0;
+    int text = 0;
+    for (int y = 480 - 48; y < 480; ++y) {
+        for (int x = 0; x < 320; ++x) {
+            legend += pixelAt(twenty_six, x, y) != pixelAt(no_legend, x, y);
+            text += pixelAt(fourteen, x, y) != pixelAt(twenty_six, x, y);
+        }
+    }
+    EXPECT_GT(legend, 500);
+    EXPECT_GT(text, 10);
+}

@@ -195,8 +195,13 @@
   }
   function vec(a) { return '(' + a.map(function (x) { return Number(x).toPrecision(4); }).join(', ') + ')'; }
 
+  // The k-DOPs a pause dump holds ("kdop6", "kdop14", ...: those the scene draws), and how a
+  // legend names one ("14-DOP").
+  function kdopNames(dump) { return Object.keys(dump.kdop_slab_directions || {}); }
+  function kdopLabel(name) { return name.slice(4) + '-DOP'; }
+
   // Every field of a body: pose, motion, each volume and its state.
-  function bodyDetail(body) {
+  function bodyDetail(body, kdops) {
     const rows = [
       ['body', body.id + ' ' + (body.name || '') + ' (' + body.shape + ')'],
       ['state', body.state],
@@ -212,6 +217,14 @@
           vec(body.obb.half_extents) + ', axes ' + body.obb.axes.map(vec).join(' ') + ' \u2014 ' +
           body.volume_states.obb]
     ];
+    kdops.forEach(function (name) {
+      const kdop = body[name];
+      const slabs = kdop.min.map(function (lo, i) {
+        return '[' + Number(lo).toPrecision(4) + ', ' + Number(kdop.max[i]).toPrecision(4) + ']';
+      });
+      rows.push([kdopLabel(name), 'slabs ' + slabs.join(' ') + ' \u2014 ' +
+          body.volume_states[name]]);
+    });
     const dl = document.createElement('dl');
     rows.forEach(function (r) { dl.appendChild(text('dt', r[0])); dl.appendChild(text('dd', r[1])); });
     return dl;
@@ -271,7 +284,9 @@
     const table = document.createElement('table');
     table.className = 'bodies';
     const head = table.createTHead().insertRow();
-    ['id', 'name', 'shape', 'state', 'sphere', 'AABB', 'OBB'].forEach(function (h) {
+    const kdops = kdopNames(dump);
+    const columns = ['id', 'name', 'shape', 'state', 'sphere', 'AABB', 'OBB'];
+    columns.concat(kdops.map(kdopLabel)).forEach(function (h) {
       head.appendChild(text('th', h));
     });
     const body = table.createTBody();
@@ -279,7 +294,7 @@
     const show = function (row, b) {
       body.querySelectorAll('tr.highlight').forEach(function (r) { r.classList.remove('highlight'); });
       row.classList.add('highlight');
-      detail.replaceChildren(bodyDetail(b));
+      detail.replaceChildren(bodyDetail(b, kdops));
       outline([b.id]);
     };
     // The body under the pointer: the smallest outline holding it (nearer bodies tend to be
@@ -314,8 +329,10 @@
       const row = body.insertRow();
       row.className = 'body state-' + b.state;
       row.dataset.body = String(b.id);
-      [b.id, b.name, b.shape, b.state, b.volume_states.sphere, b.volume_states.aabb,
-       b.volume_states.obb].forEach(function (c) { row.appendChild(text('td', String(c))); });
+      const cells = [b.id, b.name, b.shape, b.state, b.volume_states.sphere, b.volume_states.aabb,
+                     b.volume_states.obb];
+      kdops.forEach(function (name) { cells.push(b.volume_states[name]); });
+      cells.forEach(function (c) { row.appendChild(text('td', String(c))); });
       row.addEventListener('mouseenter', function () { show(row, b); });
       row.addEventListener('mouseleave', function () {
         if (pinned) {

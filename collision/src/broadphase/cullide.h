@@ -22,6 +22,9 @@ public:
 
     /// Proxies left in the potentially colliding set by the last findPairs, ascending.
     const std::vector<ProxyId>& potentiallyColliding() const { return pcs_; }
+    std::int64_t potentiallyCollidingSize() const override {
+        return static_cast<std::int64_t>(pcs_.size());
+    }
 
 private:
     void pruneAlong(int axis, std::vector<char>& pruned);

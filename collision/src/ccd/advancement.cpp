@@ -143,7 +143,9 @@ ToiOutput timeOfImpact(const ToiInput& input) {
         !finiteSweep(input.sweep_b) || !std::isfinite(input.t_max) ||
         !std::isfinite(input.target_gap) || !std::isfinite(input.tolerance) ||
         !std::isfinite(input.relative_tolerance) || input.target_gap < 0 || input.tolerance < 0 ||
-        input.relative_tolerance < 0) {
+        input.relative_tolerance < 0 || !(input.deform_speed_a >= 0) ||
+        !(input.deform_speed_b >= 0) || !std::isfinite(input.deform_speed_a) ||
+        !std::isfinite(input.deform_speed_b)) {
         return out;
     }
     const Shape& a = *input.a;
@@ -158,6 +160,14 @@ ToiOutput timeOfImpact(const ToiInput& input) {
     const Real t_max = std::clamp(input.t_max, Real(0), Real(1));
     const Vec3 rel_translation = input.sweep_a.translation - input.sweep_b.translation;
     const Real spin_speed = spinSpeed(a, input.sweep_a.spin) + spinSpeed(b, input.sweep_b.spin);
+    // Deforming shapes: a point displaced by d <= deform_speed * t from its place on the given
+    // shape moves at most deform_speed faster, plus |rotation| d and |spin| d (d <= deform_speed
+    // over the step) from the body's turning; the gap is measured on the given shapes, less the
+    // displacement so far.
+    const Real deform_speed = input.deform_speed_a + input.deform_speed_b;
+    const Real deform_rate =
+        input.deform_speed_a * (1 + input.sweep_a.rotation.norm() + input.sweep_a.spin.norm()) +
+        input.deform_speed_b * (1 + input.sweep_b.rotation.norm() + input.sweep_b.spin.norm());
 
     Vec3 last_normal = Vec3::Zero();
     Real t = 0;
@@ -195,7 +205,7 @@ ToiOutput timeOfImpact(const ToiInput& input) {
             }
         }
         last_normal = n;
-        const Real gap = gapAlong(a, pa, b, pb, n);
+        const Real gap = gapAlong(a, pa, b, pb, n) - deform_speed * t;
         out.t = t;
         out.distance = std::max(gap, Real(0));
         out.normal = n;
@@ -230,7 +240,7 @@ ToiOutput timeOfImpact(const ToiInput& input) {
         // along n, the speed of the farthest point of each body across n by the world rotation,
         // and the fastest point speed of the body-frame spins (in any direction).
         const Real mu = rel_translation.dot(n) + input.sweep_a.rotation.cross(n).norm() * ra +
-                        input.sweep_b.rotation.cross(n).norm() * rb + spin_speed;
+                        input.sweep_b.rotation.cross(n).norm() * rb + spin_speed + deform_rate;
         if (!(mu > 0)) {
             out.state = CcdState::Separated;  // the gap along n never shrinks
             out.t = t_max;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string_view>
 
 #include "collision/math.h"
@@ -32,6 +33,13 @@ struct Deformation {
 
 /// Where the point at `rest` (body frame, m) is at time `t` (s).
 collision::Vec3 deformPoint(const Deformation& d, const collision::Vec3& rest, collision::Real t);
+
+/// A bound (m/s) on the speed of every point of the deformed mesh at every time: the largest
+/// over the rest vertices `rest` of a closed-form bound on |d/dt deformPoint(d, v, t)|. Points of
+/// its triangles and of its convex hull are convex combinations of vertices, so they move no
+/// faster. Wave: 2 pi |amount| f. Twist: pi f |amount| |x| sqrt(y^2 + z^2). Bend:
+/// pi f |amount| (x^2 / 2 + |x y|) (deformation.cpp).
+collision::Real deformSpeedBound(const Deformation& d, std::span<const collision::Vec3> rest);
 
 /// "bend", "twist", "wave".
 std::string_view deformKindName(DeformKind kind);

@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "engine/body.h"
@@ -29,6 +30,11 @@ struct OutputSettings {
 
 /// The k of each entry of DrawSettings::kdop.
 inline constexpr std::array<int, 4> kDrawnKdops{6, 14, 18, 26};
+
+struct DrawSettings;
+/// Draws exactly the volume named as in `draw.volumes` (sphere, aabb, obb, kdop6, kdop14, kdop18,
+/// kdop26), every other volume flag cleared. False, `draw` unchanged, for any other name.
+bool drawOnlyVolume(DrawSettings& draw, std::string_view name);
 
 /// What the renderer draws. Volume flags select which bounding volumes get wireframes.
 struct DrawSettings {
@@ -78,6 +84,10 @@ struct ColorExpectation {
     std::vector<BodyState> present;  ///< each needs at least min_pixels pixels of its colour
     std::vector<BodyState> absent;   ///< each must have fewer than min_pixels pixels
     int min_pixels = 20;
+    /// "": the frame draws the volumes the scene draws; else only this one (a name of
+    /// `draw.volumes`: sphere, aabb, obb, kdop6, kdop14, kdop18, kdop26), so the colours are
+    /// that volume's own test alone.
+    std::string volume;
     int line = 0;
     int column = 0;
 };

@@ -128,7 +128,7 @@ struct WorldSettings {
     std::size_t max_candidate_pairs = kMaxCandidatePairs;
     /// A deforming mesh body's hierarchy is rebuilt instead of refitted when its quality ratio
     /// (sum of node volumes / root volume, MeshBvh::volumeRatio) exceeds this multiple of the
-    /// ratio at its last build. Not a scene key.
+    /// ratio at its last build. Scene key `world.rebuild_ratio` (> 1).
     Real rebuild_ratio = Real(1.5);
 };
 
@@ -282,6 +282,7 @@ private:
         collision::Sweep sweep;
         collision::Aabb box;  ///< swept bounds over the step
         Real radius = 0;      ///< bounding radius about the centre of mass
+        Real deform_speed = 0;  ///< m per step: deformation's bound on any point's speed
         Real clamp_t = 1;     ///< earliest accepted time of impact
         bool moving = false;
     };
@@ -301,6 +302,7 @@ private:
         std::shared_ptr<collision::TriangleMesh> mesh;
         std::shared_ptr<collision::MeshBvh> bvh;
         Real built_ratio = 0;
+        Real speed_bound = 0;  ///< m/s, deformSpeedBound of the rest vertices
     };
     std::vector<DeformingMesh> deforming_;
     void addDeforming(BodyId id);            // addBody of a deforming mesh body: its own geometry

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -30,6 +31,10 @@ std::optional<VolumeKind> broadPhaseVolume(const engine::World& world);
 /// exactly the volume the world's broad phase tests drawn: bounding spheres for `sphere`, OBBs
 /// for `obb`, AABBs for every AABB-based broad phase.
 engine::DrawSettings drawSettingsFor(const engine::DrawSettings& draw, const engine::World& world);
+
+/// The volumes `draw` draws, as a legend names them: "sphere", "AABB", "OBB", then "6-DOP",
+/// "14-DOP", "18-DOP", "26-DOP" for each k-DOP drawn, in that order.
+std::vector<std::string> drawnVolumeNames(const engine::DrawSettings& draw);
 
 /// One kind of volume over all bodies, each judged by that kind's own overlap test.
 struct VolumeOverlaps {

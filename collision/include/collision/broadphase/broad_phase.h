@@ -61,6 +61,9 @@ public:
     /// `bounds` is the box the picture frames (the world bounds): what has no place in space of
     /// its own (SAP's intervals on each axis) is laid out along its edges. Default: nothing.
     virtual void draw(DebugDraw& /*draw*/, const Aabb& /*bounds*/) const {}
+    /// Proxies the last findPairs kept in a potentially colliding set before pairing them
+    /// (CULLIDE's visibility pruning), or -1 for a method that keeps no such set.
+    virtual std::int64_t potentiallyCollidingSize() const { return -1; }
     /// Checks internal invariants; returns an empty string when they hold, else what is broken.
     virtual std::string validate() const { return {}; }
 };

@@ -145,6 +145,13 @@ struct ToiQuery {
     /// translation (then Failed at the iteration cap).
     Real relative_tolerance = kToiRelativeTolerance;
     int max_iterations = 64;  ///< cap on distance queries (per triangle pair for meshes)
+    /// m per unit t, >= 0: a bound on how fast any point of shape A (B) moves relative to its
+    /// body frame (a deforming body; 0 for a rigid one). The shapes given are those at t = 0;
+    /// at t every point of the moving shape lies within deform_speed * t of its point on the
+    /// given one. Honoured by timeOfImpact; timeOfImpactMeshes and the sphere entries assume
+    /// rigid shapes.
+    Real deform_speed_a = 0;
+    Real deform_speed_b = 0;
 };
 
 /// Input of timeOfImpact.
@@ -179,7 +186,10 @@ struct ToiOutput {
 /// mu = (dA - dB).n + |rotA x n| rA + |rotB x n| rB + |spinA| sA + |spinB| sB per unit t
 /// (r = bounding radius about the local origin, s = largest distance from the spin axis), so
 /// t advances by (gap - target_gap) / mu, which never passes the first time
-/// the gap reaches target_gap. Guarantee: conservative (never later than first contact), up to
+/// the gap reaches target_gap. A deforming shape (deform_speed D > 0) adds
+/// D (1 + |rot| + |spin|) to mu and its displacement D t is taken off the gap measured on the
+/// t = 0 shape, so the bound holds for the moving surface too. Guarantee: conservative (never
+/// later than first contact), up to
 /// floating-point rounding of the gap (relative, positions are subtracted first). Cost: one
 /// GJK per iteration; pure translation converges in 1-2 iterations, fast rotation near
 /// grazing contact may need many: capped by max_iterations -> Failed with a safe t.
