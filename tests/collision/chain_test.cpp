@@ -1,13 +1,15 @@
 // tests/collision/chain_test.cpp -- articulated chains (collision/ccd/chain.h): joint
 // trajectories against their closed forms and against dense sampling (range and maxRate never
-// inside / below what at() does), and forward kinematics against hand-computed poses (planar
-// 2-link arm, prismatic slide, fixed joint, a branch).
+// inside / below what at() does), forward kinematics against hand-computed poses (planar
+// 2-link arm, prismatic slide, fixed joint, a branch), and the per-link motion bounds against
+// finite differences of forward kinematics on random chains.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
 #include "collision/ccd/chain.h"
+#include "test_chains.h"
 #include "test_random.h"
 
 namespace collision {
@@ -290,6 +292,90 @@ TEST(ChainKinematics, TwoChildrenOfOneLinkFollowTheirParent) {
     expectPoseNear(frames[2], Vec3(0, -1, 10.5), r0);
     // Link 3 sits 2 along link 1's z, which the turn about y maps to link 0's x = world y.
     expectPoseNear(frames[3], Vec3(0, 3, 10), r1);
+}
+
+
+// Random chains (1..8 links, mixed joints and trajectories, scales 1e-3..1e3, the base at the
+// world origin or 1e6 from it): points of each link within link_radius of its frame origin
+// (on that sphere, where the bound is tightest) never move faster than linkSpeedBound over
+// the interval (finite differences over 1/256 of it), nor farther from their place at the
+// interval's middle than the bound allows; linkSweptBounds holds the link's sphere throughout.
+TEST(ChainBounds, SpeedAndSweptBoundsHoldOnRandomChains) {
+    cdlab_test::Rng rng(2007);
+    constexpr int kSteps = 256;
+    int tight = 0;  // links whose sampled speed came within 2x of the bound
+    int links_checked = 0;
+    std::vector<Pose> frames;
+    for (int trial = 0; trial < 300; ++trial) {
+        const Real scale = std::pow(Real(10), rng.uniform(-3, 3));
+        const Real base = trial % 2 == 0 ? Real(1e6) : Real(0);
+        const Chain chain = cdlab_test::randomChain(rng, rng.integer(1, 8), scale, base,
+                                                    rng.uniform(0.1, 30));
+        const Real t0 = rng.uniform(-1, 2);
+        const Real t1 = t0 + std::pow(Real(10), rng.uniform(-3, 0));
+        for (int link = 0; link < int(chain.joints.size()); ++link) {
+            const Real bound = linkSpeedBound(chain, link, t0, t1);
+            const Aabb box = linkSweptBounds(chain, link, t0, t1);
+            const Real radius = chain.link_radius[static_cast<std::size_t>(link)];
+            // Rounding of a world position: a few ulps of the base distance plus the chain's
+            // extent, per joint on the path (at most 8).
+            Real extent = radius;
+            for (const ChainJoint& j : chain.joints) extent += j.origin.position.norm() + scale;
+            const Real noise = 64 * kEpsilon * (base + extent);
+            Vec3 local[4];
+            for (Vec3& p : local) p = rng.vec(-1, 1).normalized() * radius;
+            local[0] = Vec3::Zero();
+            const Real tm = (t0 + t1) / 2;
+            const Pose mid = linkFrame(chain, link, tm);
+            Real fastest = 0;
+            Pose prev = linkFrame(chain, link, t0);
+            Real prev_t = t0;
+            for (int k = 0; k <= kSteps; ++k) {
+                const Real t = k == kSteps ? t1 : t0 + (t1 - t0) * k / kSteps;
+                const Pose f = linkFrame(chain, link, t);
+                for (const Vec3& p : local) {
+                    const Real moved = (f.apply(p) - mid.apply(p)).norm();
+                    ASSERT_LE(moved, bound * std::abs(t - tm) + noise) << trial << " " << link;
+                    if (k == 0) continue;
+                    const Real step = (f.apply(p) - prev.apply(p)).norm();
+                    ASSERT_LE(step, bound * (t - prev_t) + noise) << trial << " " << link;
+                    fastest = std::max(fastest, (step - noise) / (t - prev_t));
+                }
+                // The link's sphere (its geometry lies within it) inside the swept box.
+                ASSERT_TRUE(box.contains(f.position - Vec3::Constant(radius)) &&
+                            box.contains(f.position + Vec3::Constant(radius)))
+                    << trial << " " << link;
+                prev = f;
+                prev_t = t;
+            }
+            ++links_checked;
+            if (fastest > bound / 2) ++tight;
+        }
+    }
+    // The bound is not vacuous: often within a factor 2 of the sampled speed.
+    EXPECT_GT(tight, links_checked / 5) << tight << " of " << links_checked;
+}
+
+// A revolute link turning about its own frame origin: its farthest points move at rate times
+// link_radius exactly, and nothing else moves it.
+TEST(ChainBounds, SingleTurningLinkBoundIsRateTimesRadius) {
+    Chain chain;
+    chain.joints.push_back(
+        joint(JointType::Revolute, -1, Vec3::Zero(), Vec3::UnitZ(), ramp(0, 3)));
+    chain.link_radius = {2};
+    EXPECT_NEAR(linkSpeedBound(chain, 0, 0, 1), 6.0, 1e-9);
+    const Aabb box = linkSweptBounds(chain, 0, 0, 1);
+    EXPECT_TRUE(box.contains(Vec3(2, 0, 0)) && box.contains(Vec3(-2, 0, 0)));
+    // A prismatic child of it, 1 m off the axis, sliding from -4 to -3 m over [0, 1]: its
+    // points lie within 2 + 4 + 1 = 7 m of the turning axis, so 3 * 7 + 1 (the slide) = 22.
+    Chain arm;
+    arm.joints.push_back(
+        joint(JointType::Revolute, -1, Vec3::Zero(), Vec3::UnitZ(), ramp(0, 3)));
+    arm.joints.push_back(
+        joint(JointType::Prismatic, 0, Vec3(0, 1, 0), Vec3::UnitX(), ramp(-4, 1)));
+    arm.link_radius = {0, 2};
+    EXPECT_NEAR(linkSpeedBound(arm, 1, 0, 1), 22.0, 1e-9);
+    EXPECT_NEAR(linkSpeedBound(arm, 0, 0, 1), 0.0, 1e-9);
 }
 
 }  // namespace
