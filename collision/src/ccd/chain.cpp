@@ -184,9 +184,9 @@ struct PathBound {
     int length = 0;
 };
 
-PathBound walkPath(const Chain& chain, int link, Real t0, Real t1) {
+PathBound walkPath(const Chain& chain, int link, Real reach, Real t0, Real t1) {
     PathBound b;
-    b.reach = chain.link_radius[static_cast<std::size_t>(link)];
+    b.reach = reach;
     for (int i = link; i >= 0; i = parentOf(chain, i)) {
         const ChainJoint& j = chain.joints[static_cast<std::size_t>(i)];
         // `reach` bounds |p - origin of link i|.
@@ -284,7 +284,15 @@ Pose linkFrame(const Chain& chain, int link, Real t) {
 
 Real linkSpeedBound(const Chain& chain, int link, Real t0, Real t1) {
     if (!validLink(chain, link)) return std::numeric_limits<Real>::infinity();
-    return walkPath(chain, link, t0, t1).speed;
+    return walkPath(chain, link, chain.link_radius[static_cast<std::size_t>(link)], t0, t1).speed;
+}
+
+Real linkPointSpeedBound(const Chain& chain, int link, Real reach, Real t0, Real t1) {
+    if (link < 0 || static_cast<std::size_t>(link) >= chain.joints.size()) {
+        CDLAB_ASSERT(false, "link index out of range");
+        return std::numeric_limits<Real>::infinity();
+    }
+    return walkPath(chain, link, reach, t0, t1).speed;
 }
 
 Aabb linkSweptBounds(const Chain& chain, int link, Real t0, Real t1) {
@@ -292,7 +300,8 @@ Aabb linkSweptBounds(const Chain& chain, int link, Real t0, Real t1) {
         const Real inf = std::numeric_limits<Real>::infinity();
         return Aabb{Vec3::Constant(-inf), Vec3::Constant(inf)};
     }
-    const PathBound b = walkPath(chain, link, t0, t1);
+    const Real radius = chain.link_radius[static_cast<std::size_t>(link)];
+    const PathBound b = walkPath(chain, link, radius, t0, t1);
     const Vec3 centre = frameOf(chain, link, Real(0.5) * (t0 + t1)).position;
     // Every point is within link_radius of the origin, which moves at most speed |t - tm|
     // from its place at the middle time tm. Pad: the rounding of forward kinematics, a few ulps
@@ -300,7 +309,7 @@ Aabb linkSweptBounds(const Chain& chain, int link, Real t0, Real t1) {
     const Real travel = Real(0.5) * std::abs(t1 - t0) * b.speed;
     const Real pad = kRoundingUlps * kEpsilon * Real(b.length + 1) *
                      (chain.base.position.norm() + b.reach + travel);
-    const Real half = travel + chain.link_radius[static_cast<std::size_t>(link)] + pad;
+    const Real half = travel + radius + pad;
     return Aabb{centre - Vec3::Constant(half), centre + Vec3::Constant(half)};
 }
 

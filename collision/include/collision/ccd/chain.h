@@ -77,6 +77,10 @@ Pose linkFrame(const Chain& chain, int link, Real t);
 /// O(path length). The derivation is at the top of chain.cpp.
 Real linkSpeedBound(const Chain& chain, int link, Real t0, Real t1);
 
+/// The same bound for the points within `reach` (m) of link `link`'s frame origin instead of
+/// link_radius[link] (a shape placed in the link frame: |its offset| + its bounding radius).
+Real linkPointSpeedBound(const Chain& chain, int link, Real reach, Real t0, Real t1);
+
 /// World AABB that contains link `link` (its geometry within link_radius of its frame
 /// origin) at every time of [t0, t1]: conservative. The frame origin at the interval's middle,
 /// grown by half the interval times linkSpeedBound plus the link radius (plus a rounding pad
@@ -105,13 +109,30 @@ struct ArticulatedToiInput : ToiQuery {
     Real t1 = 0;
 };
 
-/// Conservative advancement (Mirtich 1996) with the articulated motion bound: never later
-/// than first contact; Failed at the iteration cap with a safe t.
+/// Conservative advancement (Mirtich 1996) with the articulated motion bound: the loop of
+/// timeOfImpact (GJK gives a direction n and the gap along it at the sides' exact poses at s;
+/// s advances by (gap - target_gap) / (mu_a + mu_b)), where a link side's mu is its fastest
+/// point's speed over the rest of the step, linkPointSpeedBound on [t(s), t(t_max)] for the
+/// shape's reach from the link origin, times t1 - t0, and a rigid side's mu is timeOfImpact's
+/// directional bound. Either side may be a link, of one chain or of two.
+/// Tolerance: as timeOfImpact, a Hit is accepted once the gap is within target_gap +
+/// tolerance (0: relative_tolerance times the smaller bounding radius).
+/// Guarantee: conservative -- t is never later than the first time the gap closes to
+/// target_gap, however fast the joints turn within the step (a tip passing through a plate
+/// between two clear step ends is a Hit), up to the rounding of the gap at the poses (a few
+/// ulps of the chain's extent and its distance from the world origin). Separated: the gap
+/// stays above target_gap on [0, t_max]. Overlapped: penetrating at s = 0.
+/// Failure mode: Failed with a safe t (no contact on [0, t]) at the iteration cap -- fast
+/// joints near grazing contact need many small advances -- and, at t = 0, on bad input (null
+/// shape, link out of range, non-finite numbers, t1 < t0); non-finite poses from a malformed
+/// trajectory end it Failed at the last safe t. A Mesh stands for its convex hull.
 ToiOutput timeOfImpactArticulated(const ArticulatedToiInput& input);
 
 /// Reference: the sides' poses at `samples` + 1 evenly spaced step fractions; Hit at the
 /// first sample where collide() reports contact (Overlapped if at s = 0), else Separated.
-/// Approximate: a contact shorter than a sample interval can be missed.
+/// Approximate: a contact shorter than a sample interval can be missed. Samples span
+/// [0, t_max]; target_gap and the tolerances are ignored (contact means collide() says so).
+/// iterations = samples tested. Cost: samples + 1 collide() calls at most.
 ToiOutput firstContactSampled(const ArticulatedToiInput& input, int samples);
 
 }  // namespace collision
