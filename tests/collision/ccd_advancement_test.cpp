@@ -280,6 +280,28 @@ TEST(ConservativeAdvancement, NeverLaterThanSampledFirstContactOnRandomPairs) {
     EXPECT_EQ(failed, 0);
 }
 
+// Regression: when the cores themselves overlap at t = 0 (a capsule's segment through a thin
+// plate), the query reported Hit at t = 0 with a zero normal instead of Overlapped: the
+// Overlapped branch fell through to the gap test, whose zero direction gave a gap of 0.
+//
+//        |#|
+//   =====|#|=====   capsule along x, centred in the plate
+//        |#|
+TEST(ConservativeAdvancement, CoresOverlappingAtStartAreOverlapped) {
+    const Shape capsule = Shape::capsule(0.05, 0.5);
+    const Shape plate = Shape::box(Vec3(0.005, 1, 1));
+    Sweep sa;
+    sa.start.orientation = Quat(Eigen::AngleAxis<Real>(M_PI / 2, Vec3::UnitZ()));
+    sa.translation = Vec3(0.1, 0, 0);
+    const ToiInput in = makeInput(capsule, sa, plate, linear(Vec3(0.1, 0, 0), Vec3::Zero()));
+    ASSERT_EQ(collide(capsule, sa.start, plate, in.sweep_b.start).state,
+              ContactState::Penetrating);
+    const ToiOutput out = timeOfImpact(in);
+    EXPECT_EQ(out.state, CcdState::Overlapped);
+    EXPECT_EQ(out.t, 0);
+    EXPECT_EQ(out.distance, 0);
+}
+
 TEST(ConservativeAdvancement, OverlapCapAndBadInput) {
     const Shape s = Shape::sphere(0.5);
     ToiInput in = makeInput(s, linear(Vec3::Zero(), Vec3(1, 0, 0)), s,

@@ -71,10 +71,14 @@ Shape randomHull(cdlab_test::Rng& rng, Real size) {
 
 Shape randomShape(cdlab_test::Rng& rng, Real size) {
     switch (rng.integer(0, 3)) {
-        case 0: return Shape::sphere(size * rng.uniform(0.3, 1));
-        case 1: return Shape::box(rng.vec(0.2, 1) * size);
-        case 2: return Shape::capsule(size * rng.uniform(0.1, 0.4), size * rng.uniform(0.3, 1));
-        default: return randomHull(rng, size);
+        case 0:
+            return Shape::sphere(size * rng.uniform(0.3, 1));
+        case 1:
+            return Shape::box(rng.vec(0.2, 1) * size);
+        case 2:
+            return Shape::capsule(size * rng.uniform(0.1, 0.4), size * rng.uniform(0.3, 1));
+        default:
+            return randomHull(rng, size);
     }
 }
 
@@ -120,9 +124,14 @@ Case randomCase(cdlab_test::Rng& rng, int links, Real scale, Real base) {
     c.t0 = rng.uniform(-0.5, 1);
     c.t1 = c.t0 + rng.uniform(0.05, 0.6);
     switch (rng.integer(0, 2)) {
-        case 0: c.obstacle = Shape::box(rng.vec(0.2, 1) * scale); break;
-        case 1: c.obstacle = Shape::sphere(scale * rng.uniform(0.2, 1)); break;
-        default: c.obstacle = Shape::box(Vec3(0.01, rng.uniform(0.5, 2), rng.uniform(0.5, 2)) * scale);
+        case 0:
+            c.obstacle = Shape::box(rng.vec(0.2, 1) * scale);
+            break;
+        case 1:
+            c.obstacle = Shape::sphere(scale * rng.uniform(0.2, 1));
+            break;
+        default:
+            c.obstacle = Shape::box(Vec3(0.01, rng.uniform(0.5, 2), rng.uniform(0.5, 2)) * scale);
     }
     const int near = rng.integer(0, links - 1);
     const Real when = c.t0 + (c.t1 - c.t0) * rng.uniform(0, 1);
@@ -147,9 +156,9 @@ Real checkAgainstReference(const ArticulatedToiInput& in, const ToiOutput& out,
     }
     if (out.state == CcdState::Hit) {
         // A Hit is within the tolerance of contact: not an early give-up.
-        const Real tol = in.relative_tolerance *
-                         std::min(cdlab_test::boundingRadius(*in.side_a.shape),
-                                  cdlab_test::boundingRadius(*in.side_b.shape));
+        const Real tol =
+            in.relative_tolerance * std::min(cdlab_test::boundingRadius(*in.side_a.shape),
+                                             cdlab_test::boundingRadius(*in.side_b.shape));
         const CollideOutput c = collide(*in.side_a.shape, sidePoseAt(in, in.side_a, out.t),
                                         *in.side_b.shape, sidePoseAt(in, in.side_b, out.t));
         EXPECT_LE(c.distance, in.target_gap + tol * (1 + 1e-6)) << what;
@@ -299,7 +308,8 @@ TEST(ArticulatedToi, IterationCapReturnsFailedAtASafeTime) {
 }
 
 // A link sphere (radius 0.5 at its frame origin, base at x = 1) and a box whose face is at
-// x = 1.5: touching at s = 0 is a Hit at 0; pushed 0.1 further in, Overlapped.
+// x = 1.5: touching at s = 0 is a Hit at 0; pushed 0.1 further in, or past the sphere's
+// centre (the cores overlap), Overlapped.
 TEST(ArticulatedToi, TouchingAtStartIsAHitAtZeroAndOverlapIsOverlapped) {
     Chain chain;
     chain.base.position = Vec3(1, 0, 0);
@@ -310,7 +320,7 @@ TEST(ArticulatedToi, TouchingAtStartIsAHitAtZeroAndOverlapIsOverlapped) {
     chain.link_radius = {0.5};
     const Shape ball = Shape::sphere(0.5);
     const Shape wall = Shape::box(Vec3(0.5, 1, 1));
-    for (const Real inset : {Real(0), Real(0.1)}) {
+    for (const Real inset : {Real(0), Real(0.1), Real(0.6)}) {  // 0.6: centre inside
         ArticulatedToiInput in;
         in.side_a.shape = &ball;
         in.side_a.chain = &chain;

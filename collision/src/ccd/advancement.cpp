@@ -171,7 +171,9 @@ Real spinSpeed(const Shape& shape, const Vec3& spin) {
     return w * maxDistanceFromAxis(shape, spin / w);
 }
 
-Real shapeBoundingRadius(const Shape& shape) { return ConvexCore::fromShape(shape).boundingRadius(); }
+Real shapeBoundingRadius(const Shape& shape) {
+    return ConvexCore::fromShape(shape).boundingRadius();
+}
 
 Real sweepApproachRate(const Sweep& sweep_a, const Sweep& sweep_b, const Vec3& n, Real ra,
                        Real rb, Real spin_speed) {
@@ -238,6 +240,7 @@ ToiOutput advanceConservatively(const Shape& a, const Shape& b, const ToiQuery& 
             out.normal = last_normal;
             if (c.state == ContactState::Penetrating && t == 0) {
                 out.state = CcdState::Overlapped;
+                return out;
             } else if (c.state == ContactState::Separated) {
                 // Rounding left GJK without a direction at a positive gap: fall back to the
                 // line of centres, still a valid direction for the lower bound below.
