@@ -3,12 +3,13 @@
 // inside / below what at() does), forward kinematics against hand-computed poses (planar
 // 2-link arm, prismatic slide, fixed joint, a branch), and the per-link motion bounds against
 // finite differences of forward kinematics on random chains.
+#include "collision/ccd/chain.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
-#include "collision/ccd/chain.h"
 #include "test_chains.h"
 #include "test_random.h"
 
@@ -93,8 +94,10 @@ TEST(JointTrajectory, ClosedForms) {
 // A random trajectory of `kind`, and its scale (a bound on |q|) for the rounding allowance.
 JointTrajectory randomTrajectory(cdlab_test::Rng& rng, JointTrajectory::Kind kind) {
     switch (kind) {
-        case JointTrajectory::Kind::Constant: return constant(rng.uniform(-3, 3));
-        case JointTrajectory::Kind::Ramp: return ramp(rng.uniform(-3, 3), rng.uniform(-50, 50));
+        case JointTrajectory::Kind::Constant:
+            return constant(rng.uniform(-3, 3));
+        case JointTrajectory::Kind::Ramp:
+            return ramp(rng.uniform(-3, 3), rng.uniform(-50, 50));
         case JointTrajectory::Kind::Sine:
             return sine(rng.uniform(-3, 3), rng.uniform(-4, 4), rng.uniform(-20, 20),
                         rng.uniform(-10, 10));
@@ -149,8 +152,7 @@ TEST(JointTrajectory, RangeAndMaxRateBoundDenseSamples) {
         EXPECT_EQ(q.range(t1, t0), std::make_pair(lo, hi));
         EXPECT_EQ(q.maxRate(t1, t0), rate);
         // Rounding of one at() difference: of q's terms, and of the angle or rate * t.
-        const Real noise =
-            4 * kEpsilon * (magnitude(q) + rate * (std::abs(t0) + std::abs(t1) + 1));
+        const Real noise = 4 * kEpsilon * (magnitude(q) + rate * (std::abs(t0) + std::abs(t1) + 1));
         const Real h = (t1 - t0) / kSamples;
         Real prev = q.at(t0);
         Real prev_t = t0;
@@ -294,7 +296,6 @@ TEST(ChainKinematics, TwoChildrenOfOneLinkFollowTheirParent) {
     expectPoseNear(frames[3], Vec3(0, 3, 10), r1);
 }
 
-
 // Random chains (1..8 links, mixed joints and trajectories, scales 1e-3..1e3, the base at the
 // world origin or 1e6 from it): points of each link within link_radius of its frame origin
 // (on that sphere, where the bound is tightest) never move faster than linkSpeedBound over
@@ -309,8 +310,8 @@ TEST(ChainBounds, SpeedAndSweptBoundsHoldOnRandomChains) {
     for (int trial = 0; trial < 300; ++trial) {
         const Real scale = std::pow(Real(10), rng.uniform(-3, 3));
         const Real base = trial % 2 == 0 ? Real(1e6) : Real(0);
-        const Chain chain = cdlab_test::randomChain(rng, rng.integer(1, 8), scale, base,
-                                                    rng.uniform(0.1, 30));
+        const Chain chain =
+            cdlab_test::randomChain(rng, rng.integer(1, 8), scale, base, rng.uniform(0.1, 30));
         const Real t0 = rng.uniform(-1, 2);
         const Real t1 = t0 + std::pow(Real(10), rng.uniform(-3, 0));
         for (int link = 0; link < int(chain.joints.size()); ++link) {
@@ -360,8 +361,7 @@ TEST(ChainBounds, SpeedAndSweptBoundsHoldOnRandomChains) {
 // link_radius exactly, and nothing else moves it.
 TEST(ChainBounds, SingleTurningLinkBoundIsRateTimesRadius) {
     Chain chain;
-    chain.joints.push_back(
-        joint(JointType::Revolute, -1, Vec3::Zero(), Vec3::UnitZ(), ramp(0, 3)));
+    chain.joints.push_back(joint(JointType::Revolute, -1, Vec3::Zero(), Vec3::UnitZ(), ramp(0, 3)));
     chain.link_radius = {2};
     EXPECT_NEAR(linkSpeedBound(chain, 0, 0, 1), 6.0, 1e-9);
     const Aabb box = linkSweptBounds(chain, 0, 0, 1);
@@ -369,10 +369,8 @@ TEST(ChainBounds, SingleTurningLinkBoundIsRateTimesRadius) {
     // A prismatic child of it, 1 m off the axis, sliding from -4 to -3 m over [0, 1]: its
     // points lie within 2 + 4 + 1 = 7 m of the turning axis, so 3 * 7 + 1 (the slide) = 22.
     Chain arm;
-    arm.joints.push_back(
-        joint(JointType::Revolute, -1, Vec3::Zero(), Vec3::UnitZ(), ramp(0, 3)));
-    arm.joints.push_back(
-        joint(JointType::Prismatic, 0, Vec3(0, 1, 0), Vec3::UnitX(), ramp(-4, 1)));
+    arm.joints.push_back(joint(JointType::Revolute, -1, Vec3::Zero(), Vec3::UnitZ(), ramp(0, 3)));
+    arm.joints.push_back(joint(JointType::Prismatic, 0, Vec3(0, 1, 0), Vec3::UnitX(), ramp(-4, 1)));
     arm.link_radius = {0, 2};
     EXPECT_NEAR(linkSpeedBound(arm, 1, 0, 1), 22.0, 1e-9);
     EXPECT_NEAR(linkSpeedBound(arm, 0, 0, 1), 0.0, 1e-9);

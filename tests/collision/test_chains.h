@@ -21,8 +21,11 @@ inline collision::JointTrajectory randomJointTrajectory(Rng& rng, collision::Rea
     q.kind = static_cast<JointTrajectory::Kind>(rng.integer(0, 3));
     q.value = rng.uniform(-1, 1) * length;
     switch (q.kind) {
-        case JointTrajectory::Kind::Constant: break;
-        case JointTrajectory::Kind::Ramp: q.rate = rng.uniform(-1, 1) * speed; break;
+        case JointTrajectory::Kind::Constant:
+            break;
+        case JointTrajectory::Kind::Ramp:
+            q.rate = rng.uniform(-1, 1) * speed;
+            break;
         case JointTrajectory::Kind::Sine:
             q.amplitude = rng.uniform(-1, 1) * length;
             q.frequency = speed / (2 * Real(M_PI)) * rng.uniform(0, 1);
@@ -57,8 +60,8 @@ inline collision::Chain randomChain(Rng& rng, int links, collision::Real scale,
     for (int i = 0; i < links; ++i) {
         ChainJoint j;
         const int kind = rng.integer(0, 9);
-        j.type = kind < 5 ? JointType::Revolute
-                          : (kind < 8 ? JointType::Prismatic : JointType::Fixed);
+        j.type =
+            kind < 5 ? JointType::Revolute : (kind < 8 ? JointType::Prismatic : JointType::Fixed);
         j.parent = i == 0 ? -1 : (rng.integer(0, 4) == 0 ? rng.integer(-1, i - 1) : i - 1);
         j.origin.position = rng.vec(-1, 1) * scale;
         j.origin.orientation = rng.rotation();

@@ -35,8 +35,8 @@ ToiOutput advanceConservatively(const Shape& a, const Shape& b, const ToiQuery& 
 /// (dA - dB).n + |rotA x n| ra + |rotB x n| rb + spin_speed, with ra, rb the shapes' bounding
 /// radii about their local origins and spin_speed = spinSpeed(A) + spinSpeed(B). One side
 /// alone: pass a zero sweep and radius 0 for the other (the zero terms add exactly).
-Real sweepApproachRate(const Sweep& sweep_a, const Sweep& sweep_b, const Vec3& n, Real ra,
-                       Real rb, Real spin_speed);
+Real sweepApproachRate(const Sweep& sweep_a, const Sweep& sweep_b, const Vec3& n, Real ra, Real rb,
+                       Real spin_speed);
 
 /// |spin| times the largest distance of the shape's points from the spin axis through its
 /// local origin: the fastest a point moves by the body-frame spin, per unit step fraction.

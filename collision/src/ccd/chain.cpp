@@ -96,20 +96,18 @@ Real sineMaxRate(const JointTrajectory& q, Real t0, Real t1) {
 // Index k of the keyframe segment [keys[k], keys[k+1]] that holds t, for t strictly inside
 // the keys' span; clamped to a valid segment whatever the keys' order (no out-of-range read).
 std::size_t keySegment(const std::vector<std::pair<Real, Real>>& keys, Real t) {
-    const auto it = std::upper_bound(keys.begin(), keys.end(), t,
-                                     [](Real x, const std::pair<Real, Real>& k) {
-                                         return x < k.first;
-                                     });
+    const auto it =
+        std::upper_bound(keys.begin(), keys.end(), t,
+                         [](Real x, const std::pair<Real, Real>& k) { return x < k.first; });
     const std::size_t i = static_cast<std::size_t>(it - keys.begin());
     return std::clamp<std::size_t>(i, 1, keys.size() - 1) - 1;
 }
 
 // First segment whose end time is >= t (segments before it end before t).
 std::size_t firstSegmentFrom(const std::vector<std::pair<Real, Real>>& keys, Real t) {
-    const auto it = std::lower_bound(keys.begin(), keys.end(), t,
-                                     [](const std::pair<Real, Real>& k, Real x) {
-                                         return k.first < x;
-                                     });
+    const auto it =
+        std::lower_bound(keys.begin(), keys.end(), t,
+                         [](const std::pair<Real, Real>& k, Real x) { return k.first < x; });
     const std::size_t i = static_cast<std::size_t>(it - keys.begin());
     return i == 0 ? 0 : i - 1;
 }
@@ -118,8 +116,7 @@ std::pair<Real, Real> keyframeRange(const JointTrajectory& q, Real t0, Real t1) 
     Real lo = std::min(q.at(t0), q.at(t1));
     Real hi = std::max(q.at(t0), q.at(t1));
     const auto& keys = q.keys;
-    for (std::size_t k = firstSegmentFrom(keys, t0); k < keys.size() && keys[k].first <= t1;
-         ++k) {
+    for (std::size_t k = firstSegmentFrom(keys, t0); k < keys.size() && keys[k].first <= t1; ++k) {
         if (keys[k].first >= t0) {
             lo = std::min(lo, keys[k].second);
             hi = std::max(hi, keys[k].second);
@@ -218,9 +215,12 @@ bool validLink(const Chain& chain, int link) {
 
 Real JointTrajectory::at(Real t) const {
     switch (kind) {
-        case Kind::Constant: return value;
-        case Kind::Ramp: return value + rate * t;
-        case Kind::Sine: return value + amplitude * std::sin(sineAngle(*this, t));
+        case Kind::Constant:
+            return value;
+        case Kind::Ramp:
+            return value + rate * t;
+        case Kind::Sine:
+            return value + amplitude * std::sin(sineAngle(*this, t));
         case Kind::Keyframes: {
             if (keys.empty()) return value;
             // Held before the first key and after the last (NaN t: the first key's value).
@@ -239,10 +239,14 @@ Real JointTrajectory::at(Real t) const {
 Real JointTrajectory::maxRate(Real t0, Real t1) const {
     if (t0 > t1) std::swap(t0, t1);
     switch (kind) {
-        case Kind::Constant: return 0;
-        case Kind::Ramp: return std::abs(rate);
-        case Kind::Sine: return sineMaxRate(*this, t0, t1);
-        case Kind::Keyframes: return keyframeMaxRate(*this, t0, t1);
+        case Kind::Constant:
+            return 0;
+        case Kind::Ramp:
+            return std::abs(rate);
+        case Kind::Sine:
+            return sineMaxRate(*this, t0, t1);
+        case Kind::Keyframes:
+            return keyframeMaxRate(*this, t0, t1);
     }
     return 0;
 }
@@ -250,15 +254,18 @@ Real JointTrajectory::maxRate(Real t0, Real t1) const {
 std::pair<Real, Real> JointTrajectory::range(Real t0, Real t1) const {
     if (t0 > t1) std::swap(t0, t1);
     switch (kind) {
-        case Kind::Constant: return {value, value};
+        case Kind::Constant:
+            return {value, value};
         case Kind::Ramp: {
             // fl(value + fl(rate t)) is monotone in t: the ends bound every time between.
             const Real a = at(t0);
             const Real b = at(t1);
             return {std::min(a, b), std::max(a, b)};
         }
-        case Kind::Sine: return sineRange(*this, t0, t1);
-        case Kind::Keyframes: return keyframeRange(*this, t0, t1);
+        case Kind::Sine:
+            return sineRange(*this, t0, t1);
+        case Kind::Keyframes:
+            return keyframeRange(*this, t0, t1);
     }
     return {value, value};
 }
