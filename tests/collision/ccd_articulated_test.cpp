@@ -43,7 +43,7 @@ ContactState contactAt(const ArticulatedToiInput& in, Real s) {
 }
 
 // Brute force: the first of 4096 samples in contact, then bisection between it and the sample
-// before (apart) down to 1e-13 of the step. Returns the earliest step fraction seen in contact,
+// before (apart) down to 1e-13 of the step (or Real's resolution). Returns the earliest step fraction seen in contact,
 // or a negative number when no sample touches.
 Real referenceFirstContact(const ArticulatedToiInput& in, int samples = 4096) {
     const ToiOutput r = firstContactSampled(in, samples);
@@ -52,7 +52,8 @@ Real referenceFirstContact(const ArticulatedToiInput& in, int samples = 4096) {
     if (r.t == 0) return 0;
     Real lo = r.t - std::clamp(in.t_max, Real(0), Real(1)) / samples;
     Real hi = r.t;
-    while (hi - lo > Real(1e-13)) {
+    // 1e-13 of the step, or the resolution of Real there (float), at most 64 halvings.
+    for (int i = 0; i < 64 && hi - lo > std::max(Real(1e-13), 4 * kEpsilon * hi); ++i) {
         const Real mid = (lo + hi) / 2;
         if (contactAt(in, mid) == ContactState::Separated) {
             lo = mid;
