@@ -31,9 +31,23 @@ constexpr Real kPi = Real(M_PI);
 // this; the reference's bisection stops at 1e-13.
 constexpr Real kTimeSlack = Real(1e-9);
 
+// The query places both sides about the first chain's base (chain.h); the reference does the
+// same, so that it is as exact as the query far from the world origin.
+Vec3 originOf(const ArticulatedToiInput& in) {
+    if (in.side_a.chain != nullptr) return in.side_a.chain->base.position;
+    if (in.side_b.chain != nullptr) return in.side_b.chain->base.position;
+    return in.side_a.sweep.start.position;
+}
+
 Pose sidePoseAt(const ArticulatedToiInput& in, const ArticulatedSide& side, Real s) {
-    if (side.chain == nullptr) return side.sweep.at(s);
-    return linkFrame(*side.chain, side.link, in.t0 + s * (in.t1 - in.t0)) * side.shape_in_link;
+    const Vec3 origin = originOf(in);
+    if (side.chain == nullptr) {
+        Sweep shifted = side.sweep;
+        shifted.start.position -= origin;
+        return shifted.at(s);
+    }
+    return linkFrame(*side.chain, side.link, in.t0 + s * (in.t1 - in.t0), origin) *
+           side.shape_in_link;
 }
 
 ContactState contactAt(const ArticulatedToiInput& in, Real s) {

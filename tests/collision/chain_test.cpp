@@ -230,6 +230,10 @@ TEST(ChainKinematics, PlanarTwoLinkArmMatchesClosedForm) {
         const Vec3 tip = elbow + Vec3(l2 * std::cos(q0 + q1), l2 * std::sin(q0 + q1), 0);
         EXPECT_LE((frames[1].apply(Vec3(l2, 0, 0)) - tip).norm(), kPoseTol);
         for (int i = 0; i < 2; ++i) {
+            // About an origin: the world frame less that origin (here exactly representable).
+            const Pose about = linkFrame(chain, i, t, Vec3(1, -2, 3));
+            expectPoseNear(about, frames[static_cast<std::size_t>(i)].position - Vec3(1, -2, 3),
+                           frames[static_cast<std::size_t>(i)].orientation);
             const Pose one = linkFrame(chain, i, t);
             EXPECT_EQ(one.position, frames[static_cast<std::size_t>(i)].position);
             EXPECT_EQ(one.orientation.coeffs(),
