@@ -204,9 +204,12 @@ using cdlab_test::boundingRadius;
 
 Shape randomShape(cdlab_test::Rng& rng) {
     switch (rng.integer(0, 2)) {
-        case 0: return Shape::sphere(rng.uniform(0.05, 0.5));
-        case 1: return Shape::box(rng.vec(0.01, 0.6));
-        default: return Shape::capsule(rng.uniform(0.05, 0.3), rng.uniform(0.0, 0.6));
+        case 0:
+            return Shape::sphere(rng.uniform(0.05, 0.5));
+        case 1:
+            return Shape::box(rng.vec(0.01, 0.6));
+        default:
+            return Shape::capsule(rng.uniform(0.05, 0.3), rng.uniform(0.0, 0.6));
     }
 }
 
@@ -315,10 +318,31 @@ TEST(ConservativeAdvancement, DeformSpeedBoundsTheMovingSurface) {
     }
 }
 
+// Regression: when the cores themselves overlap at t = 0 (a capsule's segment through a thin
+// plate), the query reported Hit at t = 0 with a zero normal instead of Overlapped: the
+// Overlapped branch fell through to the gap test, whose zero direction gave a gap of 0.
+//
+//        |#|
+//   =====|#|=====   capsule along x, centred in the plate
+//        |#|
+TEST(ConservativeAdvancement, CoresOverlappingAtStartAreOverlapped) {
+    const Shape capsule = Shape::capsule(0.05, 0.5);
+    const Shape plate = Shape::box(Vec3(0.005, 1, 1));
+    Sweep sa;
+    sa.start.orientation = Quat(Eigen::AngleAxis<Real>(M_PI / 2, Vec3::UnitZ()));
+    sa.translation = Vec3(0.1, 0, 0);
+    const ToiInput in = makeInput(capsule, sa, plate, linear(Vec3(0.1, 0, 0), Vec3::Zero()));
+    ASSERT_EQ(collide(capsule, sa.start, plate, in.sweep_b.start).state, ContactState::Penetrating);
+    const ToiOutput out = timeOfImpact(in);
+    EXPECT_EQ(out.state, CcdState::Overlapped);
+    EXPECT_EQ(out.t, 0);
+    EXPECT_EQ(out.distance, 0);
+}
+
 TEST(ConservativeAdvancement, OverlapCapAndBadInput) {
     const Shape s = Shape::sphere(0.5);
-    ToiInput in = makeInput(s, linear(Vec3::Zero(), Vec3(1, 0, 0)), s,
-                            linear(Vec3(0.8, 0, 0), Vec3::Zero()));
+    ToiInput in =
+        makeInput(s, linear(Vec3::Zero(), Vec3(1, 0, 0)), s, linear(Vec3(0.8, 0, 0), Vec3::Zero()));
     EXPECT_EQ(timeOfImpact(in).state, CcdState::Overlapped);
 
     // The iteration cap gives Failed with a safe time (no contact on [0, t]).
@@ -361,9 +385,9 @@ TEST(ConservativeAdvancement, SweepPoseFollowsTheRotationVector) {
     s.rotation = Vec3(0, 0, 3 * M_PI);  // more than half a turn is kept, not wrapped
     const Pose half = s.at(0.5);
     EXPECT_NEAR((half.position - Vec3(2, 2, 3)).norm(), 0, 1e-15);
-    EXPECT_NEAR(half.orientation.angularDistance(
-                    Quat(Eigen::AngleAxis<Real>(1.5 * M_PI, Vec3::UnitZ()))),
-                0, 1e-12);
+    EXPECT_NEAR(
+        half.orientation.angularDistance(Quat(Eigen::AngleAxis<Real>(1.5 * M_PI, Vec3::UnitZ()))),
+        0, 1e-12);
 }
 
 }  // namespace
