@@ -50,6 +50,11 @@ Vec3 rotationBetween(const Quat& q0, const Quat& q1) {
 //    dropped), then each event that is the earliest for one of its moving bodies gets an
 //    impulse (restitution kCcdRestitution with response none, else the pair's;
 //    frictionless) at the witness midpoint, in (t, a, b) order.
+// Chain links (world_chains.cpp) take part with their conservative swept bounds
+// (collision::linkSweptBounds), parent-child pairs dropped unless the chain collides adjacent
+// links; their pairs go through collision::timeOfImpactArticulated. A link is infinitely heavy
+// and moves with its chain: its impulse share is nil and its prescribed velocity enters the
+// relative velocity; on_impact: stop halts the whole chain at its earliest event.
 // Limitation: one round. A body stopped early is not re-tested against the bodies whose
 // sweeps it no longer blocks, and a third body's sweep is not re-tested against the stopped
 // pose (the discrete pipeline still sees any overlap that results).
@@ -86,6 +91,7 @@ void World::buildSweeps() {
         s.moving =
             !b.is_static && (s.sweep.translation.squaredNorm() > 0 ||
                              s.sweep.rotation.squaredNorm() > 0 || s.sweep.spin.squaredNorm() > 0);
+        if (b.kinematic) sweepLink(i, s);
         sweep_order_.push_back(static_cast<BodyId>(i));
     }
     std::sort(sweep_order_.begin(), sweep_order_.end(), [this](BodyId x, BodyId y) {
@@ -105,6 +111,7 @@ void World::findSweptPairs() {
             if (swept_[j].box.min.x() > swept_[i].box.max.x()) break;
             if (!swept_[i].moving && !swept_[j].moving) continue;
             if (!swept_[i].box.overlaps(swept_[j].box)) continue;
+            if (!pairAllowed(i, j)) continue;
             ccd_pairs_.push_back({std::min(i, j), std::max(i, j)});
         }
     }
@@ -119,6 +126,10 @@ void World::queryTimesOfImpact() {
     for (const collision::ProxyPair& pair : ccd_pairs_) {
         const Body& a = bodies_[pair.a];
         const Body& b = bodies_[pair.b];
+        if (a.kinematic || b.kinematic) {
+            queryLinkImpact(pair);  // the articulated query (world_chains.cpp)
+            continue;
+        }
         collision::ToiInput in;
         in.a = &a.shape;
         in.b = &b.shape;
@@ -205,12 +216,13 @@ void World::stopAtImpacts() {
         swept_[e.b].clamp_t = std::min(swept_[e.b].clamp_t, e.t);
     }
     for (std::size_t i = 0; i < n; ++i) {
-        if (swept_[i].clamp_t < 1 && swept_[i].moving) {
+        if (swept_[i].clamp_t < 1 && swept_[i].moving && !bodies_[i].kinematic) {
             const Pose p = swept_[i].sweep.at(swept_[i].clamp_t);
             bodies_[i].position = p.position;
             bodies_[i].orientation = p.orientation;
         }
     }
+    if (!chains_.empty()) stopChainsAtImpacts();
     stats_.toi_events = static_cast<std::int64_t>(toi_events_.size());
 }
 
@@ -232,8 +244,11 @@ void World::applyImpactImpulses() {
         const Vec3 rb = e.point - b.position;
         const Mat3 inv_ia = a.invInertiaWorld();
         const Mat3 inv_ib = b.invInertiaWorld();
-        const Vec3 va = a.velocity() + (inv_ia * a.angular_momentum).cross(ra);
-        const Vec3 vb = b.velocity() + (inv_ib * b.angular_momentum).cross(rb);
+        // A link is infinitely heavy and moves with its chain's prescribed motion.
+        const Vec3 va = a.velocity() + (inv_ia * a.angular_momentum).cross(ra) +
+                        linkPointVelocity(e.a, e.point, e.t);
+        const Vec3 vb = b.velocity() + (inv_ib * b.angular_momentum).cross(rb) +
+                        linkPointVelocity(e.b, e.point, e.t);
         const Real vn = (vb - va).dot(e.normal);
         if (!(vn < 0)) continue;
         const Real k = a.inv_mass + b.inv_mass +

@@ -379,7 +379,7 @@ void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& c
         for (const auto& [id, pose] : {std::pair{e.a, e.pose_a}, std::pair{e.b, e.pose_b}}) {
             if (id < 0 || static_cast<std::size_t>(id) >= bodies.size()) continue;
             const engine::Body& b = bodies[static_cast<std::size_t>(id)];
-            if (b.is_static) continue;
+            if (b.is_static && !b.kinematic) continue;  // links move with their chain
             if (b.shape.type == collision::ShapeType::Sphere) {
                 debug.drawSphere(collision::transformSphere(b.local_bounds.sphere, pose),
                                  kToiColor);
