@@ -16,6 +16,7 @@
 
 #include "collision/assert.h"
 #include "collision/ccd/chain.h"
+#include "collision/debug_draw.h"
 #include "engine/world.h"
 
 namespace engine {
@@ -236,8 +237,23 @@ void World::queryLinkImpact(const collision::ProxyPair& pair) {
     toi_events_.push_back(e);
 }
 
+void World::drawChainSkeletons(collision::DebugDraw& draw, const collision::Color& color) const {
+    for (std::size_t c = 0; c < chains_.size(); ++c) {
+        const collision::Chain& chain = chains_[c].chain;
+        collision::chainFrames(chain, chain_state_[c].clock, frames_);
+        for (std::size_t l = 0; l < chain.joints.size(); ++l) {
+            const int parent = chain.joints[l].parent;
+            const Vec3 from = parent < 0 ? chain.base.position
+                                         : frames_[static_cast<std::size_t>(parent)].position;
+            const Vec3 to = frames_[l].position;
+            if ((to - from).squaredNorm() > 0) draw.drawLine(from, to, color);
+        }
+    }
+}
+
 // on_impact: stop: a chain with events halts at the earliest (its clock and every link's pose
-// at that time); on_impact: continue keeps its trajectory.
+// at that time), and its links' later events are dropped: the chain never got there.
+// on_impact: continue keeps its trajectory and every event.
 void World::stopChainsAtImpacts() {
     for (std::size_t c = 0; c < chains_.size(); ++c) {
         ChainState& st = chain_state_[c];
@@ -255,6 +271,16 @@ void World::stopChainsAtImpacts() {
         st.clock = st.step_start + earliest * (st.clock - st.step_start);
         st.halted = true;
         poseChain(c, st.clock);
+        const auto later = [this, c, earliest](const ToiEvent& e) {
+            if (!(e.t > earliest)) return false;
+            for (const BodyId id : {e.a, e.b}) {
+                const auto i = static_cast<std::size_t>(id);
+                if (i < link_of_.size() && link_of_[i].chain == static_cast<int>(c)) return true;
+            }
+            return false;
+        };
+        toi_events_.erase(std::remove_if(toi_events_.begin(), toi_events_.end(), later),
+                          toi_events_.end());
     }
 }
 

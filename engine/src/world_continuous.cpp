@@ -210,6 +210,8 @@ void World::queryTimesOfImpact() {
 
 // Each moving body stopped at its earliest accepted time of impact.
 void World::stopAtImpacts() {
+    // Chains first: a halted chain's later events did not happen (world_chains.cpp).
+    if (!chains_.empty()) stopChainsAtImpacts();
     const std::size_t n = bodies_.size();
     for (const ToiEvent& e : toi_events_) {
         swept_[e.a].clamp_t = std::min(swept_[e.a].clamp_t, e.t);
@@ -222,7 +224,6 @@ void World::stopAtImpacts() {
             bodies_[i].orientation = p.orientation;
         }
     }
-    if (!chains_.empty()) stopChainsAtImpacts();
     stats_.toi_events = static_cast<std::int64_t>(toi_events_.size());
 }
 

@@ -396,6 +396,7 @@ void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& c
         }
         debug.drawLine(e.point, e.point + e.normal * size, kToiColor);
     }
+    if (options.draw.bodies) world.drawChainSkeletons(debug, kSkeletonColor);
 
     // What the narrow phase confirmed: the World derives it and decides what to draw.
     engine::ContactDrawStyle style;

@@ -261,6 +261,9 @@ public:
     /// Draws the witnesses of every colliding pair (draw.contacts): a cross at each witness point
     /// and the normal from A's, sized by the smaller body so the marks stay on the pair.
     void drawContacts(collision::DebugDraw& draw, const ContactDrawStyle& style) const;
+    /// Draws every chain's skeleton at its clock: a line from each link's parent frame origin
+    /// (the base's for a root link) to its own frame origin, the joint; zero lengths skipped.
+    void drawChainSkeletons(collision::DebugDraw& draw, const collision::Color& color) const;
 
 private:
     void integrate(Real dt, const Vec3& gravity);
