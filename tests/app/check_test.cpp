@@ -277,7 +277,8 @@ TEST(Check, ChainLinksAreGradedByTheExistingExpectations) {
 
     // With ccd off the tip's centre is on the other side at frame 11 and there is no event.
     std::string off = arm;
-    off.replace(off.find("ccd: conservative_advancement"), 29, "ccd: off");
+    const std::string ccd_on = "\n  ccd: conservative_advancement\n";
+    off.replace(off.find(ccd_on), ccd_on.size(), "\n  ccd: off\n");
     rows = checkScene(parse(off + expect), 60, dir);
     EXPECT_EQ(findRow(rows, "tip never passes through plate")->reason,
               "on the other side at frame 11");
