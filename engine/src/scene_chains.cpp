@@ -23,14 +23,14 @@ constexpr std::string_view kChainKeys[] = {"name", "base", "collide_adjacent", "
 
 // A link takes a body's shape keys (and its material) plus its place in the chain. Mass and
 // velocity do not apply: a link is kinematic.
-constexpr std::string_view kLinkKeys[] = {"name",   "shape",  "radius", "half_height",
-                                          "half_extents", "file", "scale", "offset",
-                                          "parent", "joint", "restitution", "friction"};
+constexpr std::string_view kLinkKeys[] = {"name",         "shape", "radius",      "half_height",
+                                          "half_extents", "file",  "scale",       "offset",
+                                          "parent",       "joint", "restitution", "friction"};
 
 // Joint values and times beyond these are typing mistakes; they also keep every product of the
 // forward kinematics finite.
-constexpr Real kMaxJointValue = Real(1e6);  // deg, m, deg/s, m/s
-constexpr Real kMaxJointTime = Real(1e9);   // s
+constexpr Real kMaxJointValue = Real(1e6);      // deg, m, deg/s, m/s
+constexpr Real kMaxJointTime = Real(1e9);       // s
 constexpr Real kMaxJointFrequency = Real(1e3);  // Hz, as `deform.frequency`
 // An axis shorter than this (as written; it is normalised) has no direction.
 constexpr Real kMinAxisLength = Real(1e-9);
@@ -86,8 +86,7 @@ collision::JointTrajectory SceneParser::readMotion(const YAML::Node& n, const st
         t.kind = Kind::Sine;
         const std::vector<Entry> se =
             entries(e.value, p, {"amplitude", "frequency", "phase_deg", "offset"});
-        t.amplitude =
-            value(require(se, "amplitude", e.value, p).value, childPath(p, "amplitude"));
+        t.amplitude = value(require(se, "amplitude", e.value, p).value, childPath(p, "amplitude"));
         const Entry& f = require(se, "frequency", e.value, p);
         t.frequency = readReal(f.value, childPath(p, "frequency"));
         if (!(t.frequency > 0 && t.frequency <= kMaxJointFrequency)) {
@@ -218,7 +217,8 @@ void SceneParser::parseLink(const YAML::Node& n, const std::string& path,
     link_index.emplace(values.name, static_cast<int>(index));
 
     Pose offset;
-    if (const Entry* o = find(es, "offset")) offset = readPlacement(o->value, childPath(path, "offset"));
+    if (const Entry* o = find(es, "offset"))
+        offset = readPlacement(o->value, childPath(path, "offset"));
     // The body frame is the shape re-centred at its centre of mass (mesh and hull shapes).
     const Pose shape_in_link = offset * Pose{props.center_of_mass, Quat::Identity()};
 
@@ -227,8 +227,8 @@ void SceneParser::parseLink(const YAML::Node& n, const std::string& path,
     body.friction = values.friction;
     setStatic(body);
     body.kinematic = true;
-    const Real radius = shape_in_link.position.norm() +
-                        body.local_bounds.sphere.center.norm() + body.local_bounds.sphere.radius;
+    const Real radius = shape_in_link.position.norm() + body.local_bounds.sphere.center.norm() +
+                        body.local_bounds.sphere.radius;
 
     chain.chain.joints.push_back(std::move(joint));
     chain.chain.link_radius.push_back(radius);
@@ -240,8 +240,8 @@ void SceneParser::parseLink(const YAML::Node& n, const std::string& path,
 void SceneParser::parseChain(const YAML::Node& n, std::size_t index, Scene& scene,
                              std::map<std::string, std::string>& names) {
     const std::string path = indexPath("chains", index);
-    const std::vector<Entry> es =
-        entries(n, path, std::vector<std::string_view>(std::begin(kChainKeys), std::end(kChainKeys)));
+    const std::vector<Entry> es = entries(
+        n, path, std::vector<std::string_view>(std::begin(kChainKeys), std::end(kChainKeys)));
     ChainSpec chain;
     chain.name = "chain" + std::to_string(index);
     if (const Entry* name = find(es, "name")) {
@@ -251,8 +251,9 @@ void SceneParser::parseChain(const YAML::Node& n, std::size_t index, Scene& scen
     for (const ChainSpec& other : scene.chains) {
         if (other.name == chain.name) {
             const Entry* name = find(es, "name");
-            fail(name != nullptr ? name->value : n, childPath(path, "name"),
-                 "the chain name '" + chain.name + "' is already taken; chain names must be unique");
+            fail(
+                name != nullptr ? name->value : n, childPath(path, "name"),
+                "the chain name '" + chain.name + "' is already taken; chain names must be unique");
         }
     }
     if (const Entry* base = find(es, "base")) {
@@ -287,8 +288,7 @@ void SceneParser::parseChain(const YAML::Node& n, std::size_t index, Scene& scen
             fail(links.value[i], indexPath(lp, i),
                  "more than " + std::to_string(kMaxBodies) + " bodies in a scene");
         }
-        parseLink(links.value[i], indexPath(lp, i), chain.name, i, scene, chain, names,
-                  link_index);
+        parseLink(links.value[i], indexPath(lp, i), chain.name, i, scene, chain, names, link_index);
     }
     scene.chains.push_back(std::move(chain));
 }

@@ -24,26 +24,26 @@ const std::string kWorld =
 
 // Line 5 of the scene is the chain's first line ("  - name: arm").
 const std::string kArm =
-    "  - name: arm\n"                                                           // 5
-    "    base: {position: [0, -1, 0], euler_deg: [0, 0, 90]}\n"                 // 6
-    "    links:\n"                                                              // 7
-    "      - name: upper\n"                                                     // 8
-    "        shape: capsule\n"                                                  // 9
-    "        radius: 0.05\n"                                                    // 10
-    "        half_height: 0.4\n"                                                // 11
-    "        offset: {position: [0, 0.5, 0]}\n"                                 // 12
+    "  - name: arm\n"                                            // 5
+    "    base: {position: [0, -1, 0], euler_deg: [0, 0, 90]}\n"  // 6
+    "    links:\n"                                               // 7
+    "      - name: upper\n"                                      // 8
+    "        shape: capsule\n"                                   // 9
+    "        radius: 0.05\n"                                     // 10
+    "        half_height: 0.4\n"                                 // 11
+    "        offset: {position: [0, 0.5, 0]}\n"                  // 12
     "        joint: {type: revolute, axis: [0, 0, 2], motion: {ramp: {start: 10, rate: 90}}}\n"
-    "      - name: lower\n"                                                     // 14
-    "        shape: sphere\n"                                                   // 15
-    "        radius: 0.1\n"                                                     // 16
+    "      - name: lower\n"    // 14
+    "        shape: sphere\n"  // 15
+    "        radius: 0.1\n"    // 16
     "        joint: {type: prismatic, axis: [0, 1, 0], origin: {position: [0, 1, 0]},\n"
-    "                motion: {keyframes: [[0, 0], [1, 0.5]]}}\n"                // 18
-    "      - name: side\n"                                                      // 19
-    "        shape: box\n"                                                      // 20
-    "        half_extents: [0.1, 0.1, 0.1]\n"                                   // 21
-    "        parent: upper\n"                                                   // 22
+    "                motion: {keyframes: [[0, 0], [1, 0.5]]}}\n"  // 18
+    "      - name: side\n"                                        // 19
+    "        shape: box\n"                                        // 20
+    "        half_extents: [0.1, 0.1, 0.1]\n"                     // 21
+    "        parent: upper\n"                                     // 22
     "        joint: {type: revolute, axis: [1, 0, 0], motion: {sine: {amplitude: 30, "
-    "frequency: 2, phase_deg: 90, offset: 5}}}\n";                              // 23
+    "frequency: 2, phase_deg: 90, offset: 5}}}\n";  // 23
 
 std::string withArm(const std::string& from, const std::string& to) {
     std::string text = kWorld + kArm;
@@ -95,8 +95,9 @@ TEST(ChainScene, LinksAreKinematicBodiesAfterTheBodies) {
 }
 
 TEST(ChainScene, OptionsAndChainOnlyScenes) {
-    Scene s = parseScene(withArm("    links:\n", "    collide_adjacent: true\n"
-                                               "    on_impact: continue\n    links:\n"),
+    Scene s = parseScene(withArm("    links:\n",
+                                 "    collide_adjacent: true\n"
+                                 "    on_impact: continue\n    links:\n"),
                          "test.yaml", ".");
     EXPECT_TRUE(s.chains[0].collide_adjacent);
     EXPECT_EQ(s.chains[0].on_impact, ChainImpact::Continue);
@@ -127,21 +128,21 @@ TEST(ChainScene, BadValuesAreErrorsAtTheirKey) {
                        "22:17: chains[0].links[2].parent: ", "no earlier link");
     EXPECT_SCENE_ERROR(withArm("name: lower", "name: plate"), "14:15: chains[0].links[1].name: ",
                        "the name 'plate' is already taken by a body");
-    EXPECT_SCENE_ERROR(withArm("name: side", "name: upper"), "19:15: chains[0].links[2].name: ",
-                       "already taken by chains[0].links[0]");
-    EXPECT_SCENE_ERROR(withArm("shape: sphere", "shape: cone"), "15:16: chains[0].links[1].shape: ",
-                       "unknown shape 'cone'");
-    EXPECT_SCENE_ERROR(withArm("        radius: 0.1\n", ""), "14:9: chains[0].links[1].radius: ",
-                       "required key is missing");
+    EXPECT_SCENE_ERROR(withArm("name: side", "name: upper"),
+                       "19:15: chains[0].links[2].name: ", "already taken by chains[0].links[0]");
+    EXPECT_SCENE_ERROR(withArm("shape: sphere", "shape: cone"),
+                       "15:16: chains[0].links[1].shape: ", "unknown shape 'cone'");
+    EXPECT_SCENE_ERROR(withArm("        radius: 0.1\n", ""),
+                       "14:9: chains[0].links[1].radius: ", "required key is missing");
     EXPECT_SCENE_ERROR(withArm("radius: 0.1", "radius: -0.1"),
                        "16:17: chains[0].links[1].radius: ", "must be > 0");
     EXPECT_SCENE_ERROR(withArm("        parent: upper\n", "        position: [0, 0, 0]\n"),
                        "22:9: chains[0].links[2].position: ", "unknown key 'position'");
     EXPECT_SCENE_ERROR(withArm("type: revolute, axis: [1, 0, 0]", "type: fixed, axis: [1, 0, 0]"),
                        "23:30: chains[0].links[2].joint.axis: ", "does not apply to a fixed joint");
-    EXPECT_SCENE_ERROR(withArm("frequency: 2,", "frequency: 0,"),
-                       "23:92: chains[0].links[2].joint.motion.sine.frequency: ",
-                       "must be in (0, 1000]");
+    EXPECT_SCENE_ERROR(
+        withArm("frequency: 2,", "frequency: 0,"),
+        "23:92: chains[0].links[2].joint.motion.sine.frequency: ", "must be in (0, 1000]");
     EXPECT_SCENE_ERROR(withArm("{ramp: {start: 10, rate: 90}}", "{ramp: {rate: 90}, constant: 1}"),
                        "13:58: chains[0].links[0].joint.motion: ", "exactly one of");
     EXPECT_SCENE_ERROR(withArm("    links:\n", "    on_impact: halt\n    links:\n"),
