@@ -31,9 +31,23 @@ constexpr Real kPi = Real(M_PI);
 // this; the reference's bisection stops at 1e-13.
 constexpr Real kTimeSlack = Real(1e-9);
 
+// The query places both sides about the first chain's base (chain.h); the reference does the
+// same, so that it is as exact as the query far from the world origin.
+Vec3 originOf(const ArticulatedToiInput& in) {
+    if (in.side_a.chain != nullptr) return in.side_a.chain->base.position;
+    if (in.side_b.chain != nullptr) return in.side_b.chain->base.position;
+    return in.side_a.sweep.start.position;
+}
+
 Pose sidePoseAt(const ArticulatedToiInput& in, const ArticulatedSide& side, Real s) {
-    if (side.chain == nullptr) return side.sweep.at(s);
-    return linkFrame(*side.chain, side.link, in.t0 + s * (in.t1 - in.t0)) * side.shape_in_link;
+    const Vec3 origin = originOf(in);
+    if (side.chain == nullptr) {
+        Sweep shifted = side.sweep;
+        shifted.start.position -= origin;
+        return shifted.at(s);
+    }
+    return linkFrame(*side.chain, side.link, in.t0 + s * (in.t1 - in.t0), origin) *
+           side.shape_in_link;
 }
 
 ContactState contactAt(const ArticulatedToiInput& in, Real s) {
@@ -43,7 +57,7 @@ ContactState contactAt(const ArticulatedToiInput& in, Real s) {
 }
 
 // Brute force: the first of 4096 samples in contact, then bisection between it and the sample
-// before (apart) down to 1e-13 of the step. Returns the earliest step fraction seen in contact,
+// before (apart) down to 1e-13 of the step (or Real's resolution). Returns the earliest step fraction seen in contact,
 // or a negative number when no sample touches.
 Real referenceFirstContact(const ArticulatedToiInput& in, int samples = 4096) {
     const ToiOutput r = firstContactSampled(in, samples);
@@ -52,7 +66,8 @@ Real referenceFirstContact(const ArticulatedToiInput& in, int samples = 4096) {
     if (r.t == 0) return 0;
     Real lo = r.t - std::clamp(in.t_max, Real(0), Real(1)) / samples;
     Real hi = r.t;
-    while (hi - lo > Real(1e-13)) {
+    // 1e-13 of the step, or the resolution of Real there (float), at most 64 halvings.
+    for (int i = 0; i < 64 && hi - lo > std::max(Real(1e-13), 4 * kEpsilon * hi); ++i) {
         const Real mid = (lo + hi) / 2;
         if (contactAt(in, mid) == ContactState::Separated) {
             lo = mid;

@@ -19,9 +19,24 @@ namespace {
 
 Real stepTime(const ArticulatedToiInput& in, Real s) { return in.t0 + s * (in.t1 - in.t0); }
 
-Pose sidePose(const ArticulatedToiInput& in, const ArticulatedSide& side, Real s) {
-    if (side.chain == nullptr) return side.sweep.at(s);
-    return linkFrame(*side.chain, side.link, stepTime(in, s)) * side.shape_in_link;
+// Both sides are placed about one origin, the first chain's base (or A's start): a chain far
+// from the world origin then loses nothing to that distance (linkFrame about an origin), and
+// the gap is computed from positions of the size of the scene around the query.
+Vec3 queryOrigin(const ArticulatedToiInput& in) {
+    if (in.side_a.chain != nullptr) return in.side_a.chain->base.position;
+    if (in.side_b.chain != nullptr) return in.side_b.chain->base.position;
+    return in.side_a.sweep.start.position;
+}
+
+// The side's shape at step fraction s, position about `origin`.
+Pose sidePose(const ArticulatedToiInput& in, const ArticulatedSide& side, Real s,
+              const Vec3& origin) {
+    if (side.chain == nullptr) {
+        Sweep shifted = side.sweep;
+        shifted.start.position -= origin;
+        return shifted.at(s);
+    }
+    return linkFrame(*side.chain, side.link, stepTime(in, s), origin) * side.shape_in_link;
 }
 
 bool validSide(const ArticulatedSide& side) {
@@ -44,13 +59,15 @@ class ArticulatedMotion final : public AdvancementMotion {
 public:
     explicit ArticulatedMotion(const ArticulatedToiInput& in)
         : in_(in),
+          origin_(queryOrigin(in)),
           reach_a_(reach(in.side_a)),
           reach_b_(reach(in.side_b)),
           spin_speed_(spin(in.side_a) + spin(in.side_b)),
           t_end_(stepTime(in, std::clamp(in.t_max, Real(0), Real(1)))) {}
 
-    Pose poseA(Real s) const override { return sidePose(in_, in_.side_a, s); }
-    Pose poseB(Real s) const override { return sidePose(in_, in_.side_b, s); }
+    Pose poseA(Real s) const override { return sidePose(in_, in_.side_a, s, origin_); }
+    Pose poseB(Real s) const override { return sidePose(in_, in_.side_b, s, origin_); }
+    const Vec3& origin() const { return origin_; }
 
     Real approachRate(Real s, const Vec3& n) const override {
         // Rigid sides: the bound of timeOfImpact, a link side standing in as a zero sweep of
@@ -86,6 +103,7 @@ private:
     }
 
     const ArticulatedToiInput& in_;
+    Vec3 origin_;
     Real reach_a_;
     Real reach_b_;
     Real spin_speed_;
@@ -97,7 +115,12 @@ private:
 ToiOutput timeOfImpactArticulated(const ArticulatedToiInput& input) {
     if (!validInput(input)) return ToiOutput{};
     const ArticulatedMotion motion(input);
-    return advanceConservatively(*input.side_a.shape, *input.side_b.shape, input, motion);
+    ToiOutput out = advanceConservatively(*input.side_a.shape, *input.side_b.shape, input, motion);
+    if (out.normal.squaredNorm() > 0) {  // witnesses were set with the normal: back to world
+        out.point_a += motion.origin();
+        out.point_b += motion.origin();
+    }
+    return out;
 }
 
 ToiOutput firstContactSampled(const ArticulatedToiInput& input, int samples) {
@@ -107,10 +130,11 @@ ToiOutput firstContactSampled(const ArticulatedToiInput& input, int samples) {
     const Real t_max = std::clamp(input.t_max, Real(0), Real(1));
     const Shape& a = *input.side_a.shape;
     const Shape& b = *input.side_b.shape;
+    const Vec3 origin = queryOrigin(input);
     for (int k = 0; k <= samples; ++k) {
         const Real s = k == samples ? t_max : t_max * Real(k) / Real(samples);
-        const Pose pa = sidePose(input, input.side_a, s);
-        const Pose pb = sidePose(input, input.side_b, s);
+        const Pose pa = sidePose(input, input.side_a, s, origin);
+        const Pose pb = sidePose(input, input.side_b, s, origin);
         const CollideOutput c = collide(a, pa, b, pb);
         out.iterations = k + 1;
         if (c.state == ContactState::Failed) {

@@ -163,11 +163,12 @@ int parentOf(const Chain& chain, int i) {
     return p >= 0 && p < i ? p : -1;
 }
 
-// Frame of link i at t, composed recursively along its path (no allocation).
-Pose frameOf(const Chain& chain, int i, Real t) {
+// Frame of link i at t, composed recursively along its path from `root` (the base frame, or
+// the base frame shifted to another origin) without allocation.
+Pose frameOf(const Chain& chain, const Pose& root, int i, Real t) {
     const ChainJoint& j = chain.joints[static_cast<std::size_t>(i)];
     const int p = parentOf(chain, i);
-    const Pose parent = p < 0 ? chain.base : frameOf(chain, p, t);
+    const Pose parent = p < 0 ? root : frameOf(chain, root, p, t);
     Pose f = parent * j.origin * jointMotion(j, j.trajectory.at(t));
     f.orientation.normalize();
     return f;
@@ -286,7 +287,16 @@ Pose linkFrame(const Chain& chain, int link, Real t) {
         CDLAB_ASSERT(false, "link index out of range");
         return chain.base;
     }
-    return frameOf(chain, link, t);
+    return frameOf(chain, chain.base, link, t);
+}
+
+Pose linkFrame(const Chain& chain, int link, Real t, const Vec3& origin) {
+    const Pose root{chain.base.position - origin, chain.base.orientation};
+    if (link < 0 || static_cast<std::size_t>(link) >= chain.joints.size()) {
+        CDLAB_ASSERT(false, "link index out of range");
+        return root;
+    }
+    return frameOf(chain, root, link, t);
 }
 
 Real linkSpeedBound(const Chain& chain, int link, Real t0, Real t1) {
@@ -309,7 +319,7 @@ Aabb linkSweptBounds(const Chain& chain, int link, Real t0, Real t1) {
     }
     const Real radius = chain.link_radius[static_cast<std::size_t>(link)];
     const PathBound b = walkPath(chain, link, radius, t0, t1);
-    const Vec3 centre = frameOf(chain, link, Real(0.5) * (t0 + t1)).position;
+    const Vec3 centre = frameOf(chain, chain.base, link, Real(0.5) * (t0 + t1)).position;
     // Every point is within link_radius of the origin, which moves at most speed |t - tm|
     // from its place at the middle time tm. Pad: the rounding of forward kinematics, a few ulps
     // per joint of the largest coordinate involved.

@@ -69,6 +69,11 @@ void chainFrames(const Chain& chain, Real t, std::vector<Pose>& out);
 /// same value as chainFrames(chain, t, out)[link]. O(path length).
 Pose linkFrame(const Chain& chain, int link, Real t);
 
+/// The same frame with its position taken about `origin` (world axes): world position - origin,
+/// composed from base.position - origin so that a chain far from the world origin loses
+/// nothing to its distance (origin = base.position: no rounding of the base's offset at all).
+Pose linkFrame(const Chain& chain, int link, Real t, const Vec3& origin);
+
 /// Upper bound (m/s) of the speed of any point of link `link` over [t0, t1], composed link
 /// to link along the path from the base (Zhang et al. 2007): revolute joint j contributes
 /// maxRate_j times the largest distance from its axis to a point of the link, bounded by the
@@ -119,8 +124,10 @@ struct ArticulatedToiInput : ToiQuery {
 /// tolerance (0: relative_tolerance times the smaller bounding radius).
 /// Guarantee: conservative -- t is never later than the first time the gap closes to
 /// target_gap, however fast the joints turn within the step (a tip passing through a plate
-/// between two clear step ends is a Hit), up to the rounding of the gap at the poses (a few
-/// ulps of the chain's extent and its distance from the world origin). Separated: the gap
+/// between two clear step ends is a Hit), up to the rounding of the gap at the poses: both
+/// sides are placed about the first chain's base (linkFrame about an origin), so this is a few
+/// ulps of the query's own extent, whatever its distance from the world origin. Witness points
+/// are returned in world coordinates. Separated: the gap
 /// stays above target_gap on [0, t_max]. Overlapped: penetrating at s = 0.
 /// Failure mode: Failed with a safe t (no contact on [0, t]) at the iteration cap -- fast
 /// joints near grazing contact need many small advances -- and, at t = 0, on bad input (null
@@ -128,8 +135,9 @@ struct ArticulatedToiInput : ToiQuery {
 /// trajectory end it Failed at the last safe t. A Mesh stands for its convex hull.
 ToiOutput timeOfImpactArticulated(const ArticulatedToiInput& input);
 
-/// Reference: the sides' poses at `samples` + 1 evenly spaced step fractions; Hit at the
-/// first sample where collide() reports contact (Overlapped if at s = 0), else Separated.
+/// Reference: the sides' poses (about the same origin as timeOfImpactArticulated) at
+/// `samples` + 1 evenly spaced step fractions; Hit at the first sample where collide() reports
+/// contact (Overlapped if at s = 0), else Separated.
 /// Approximate: a contact shorter than a sample interval can be missed. Samples span
 /// [0, t_max]; target_gap and the tolerances are ignored (contact means collide() says so).
 /// iterations = samples tested. Cost: samples + 1 collide() calls at most.
