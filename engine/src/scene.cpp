@@ -84,6 +84,7 @@ Scene loadScene(const std::filesystem::path& file, const std::vector<SceneOverri
 World makeWorld(const Scene& scene) {
     World world(scene.world);
     for (const Body& b : scene.bodies) world.addBody(b);
+    for (const ChainSpec& c : scene.chains) world.addChain(c);
     world.detect();
     return world;
 }

@@ -216,7 +216,7 @@ ShapeType SceneParser::bodyShape(const std::vector<Entry>& es, const YAML::Node&
 BodyValues SceneParser::readBodyValues(const std::vector<Entry>& es, const YAML::Node& n,
                                        const std::string& path, std::string default_name,
                                        const std::vector<std::string_view>& shape_keys,
-                                       const Scene& scene) const {
+                                       const Scene& scene, bool needs_position) const {
     BodyValues b;
     b.name = std::move(default_name);
     b.restitution = scene.world.restitution;
@@ -231,7 +231,7 @@ BodyValues SceneParser::readBodyValues(const std::vector<Entry>& es, const YAML:
                 }
             }
         }
-    } else {
+    } else if (needs_position) {
         require(es, "position", n, path);
     }
     for (const std::string_view k : shape_keys) {
@@ -284,13 +284,7 @@ BodyValues SceneParser::readBodyValues(const std::vector<Entry>& es, const YAML:
             }
             b.orientation = Quat(raw.coeffs() / len);
         } else if (e.key == "euler_deg") {
-            const Vec3 deg = readVec3(v, p);
-            const Vec3 rad = deg * (std::numbers::pi_v<Real> / 180);
-            // Intrinsic X, then Y, then Z: R = Rx Ry Rz.
-            b.orientation = Quat(Eigen::AngleAxis<Real>(rad.x(), Vec3::UnitX())) *
-                          Quat(Eigen::AngleAxis<Real>(rad.y(), Vec3::UnitY())) *
-                          Quat(Eigen::AngleAxis<Real>(rad.z(), Vec3::UnitZ()));
-            b.orientation.normalize();
+            b.orientation = eulerDegrees(readVec3(v, p));
         } else if (e.key == "velocity") {
             b.velocity = readVec3(v, p);
             const std::string problem = speedProblem(b.velocity.stableNorm(), scene.world);

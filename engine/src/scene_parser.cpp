@@ -71,6 +71,15 @@ private:
 
 }  // namespace
 
+Quat eulerDegrees(const Vec3& deg) {
+    const Vec3 rad = deg * (std::numbers::pi_v<Real> / 180);
+    Quat q = Quat(Eigen::AngleAxis<Real>(rad.x(), Vec3::UnitX())) *
+             Quat(Eigen::AngleAxis<Real>(rad.y(), Vec3::UnitY())) *
+             Quat(Eigen::AngleAxis<Real>(rad.z(), Vec3::UnitZ()));
+    q.normalize();
+    return q;
+}
+
 std::string formatLimit(Real v) {
     std::ostringstream s;
     s << std::setprecision(6) << v;
@@ -323,7 +332,7 @@ Scene SceneParser::parse(const std::string& text) {
     if (!root.IsMap()) {
         fail(root, "scene",
              "expected a mapping with keys: world, broadphase, output, camera, draw, bodies, "
-             "expect");
+             "chains, expect");
     }
     // The first document parsed, so the probe's parser (the same one) cannot throw before it
     // reaches the second.
@@ -336,7 +345,8 @@ Scene SceneParser::parse(const std::string& text) {
              "and what follows, or merge it into the first)");
     }
     const std::vector<Entry> es =
-        entries(root, "", {"world", "broadphase", "output", "camera", "draw", "bodies", "expect"});
+        entries(root, "",
+                {"world", "broadphase", "output", "camera", "draw", "bodies", "chains", "expect"});
     // The output's frame rate first: the world's default time step is derived from it.
     if (const Entry* output = find(es, "output")) parseOutput(output->value, scene);
     parseWorld(require(es, "world", root, "").value, scene);
@@ -370,10 +380,11 @@ Scene SceneParser::parse(const std::string& text) {
             }
         }
     }
+    if (const Entry* chains = find(es, "chains")) parseChains(*chains, scene);
     if (scene.bodies.empty()) {
         const Entry* bodies = find(es, "bodies");
         fail(bodies != nullptr ? bodies->key_node : root, "bodies",
-             "a scene needs at least one body (a list under 'bodies:')");
+             "a scene needs at least one body (a list under 'bodies:', or a chain's links)");
     }
     if (const Entry* bodies = find(es, "bodies")) {
         const double pairs = estimateStartPairs(scene.bodies);

@@ -201,7 +201,7 @@ private:
     BodyValues readBodyValues(const std::vector<Entry>& es, const YAML::Node& n,
                               const std::string& path, std::string default_name,
                               const std::vector<std::string_view>& shape_keys,
-                              const Scene& scene) const;
+                              const Scene& scene, bool needs_position = true) const;
     MassProperties bodyMassProperties(const std::vector<Entry>& es, const std::string& path,
                                       ShapeType type,
                                       const std::vector<std::string_view>& shape_keys,
@@ -216,6 +216,20 @@ private:
                                    const Entry& file_entry, const std::string& path) const;
     /// `expect:` (after the bodies, whose names it refers to).
     void parseExpect(const Entry& entry, Scene& scene) const;
+    /// `chains:` (scene_chains.cpp, after the bodies): each link becomes a kinematic body
+    /// appended to scene.bodies, named uniquely among all bodies (`names`: body name -> path).
+    void parseChains(const Entry& entry, Scene& scene);
+    void parseChain(const YAML::Node& n, std::size_t index, Scene& scene,
+                    std::map<std::string, std::string>& names);
+    void parseLink(const YAML::Node& n, const std::string& path, const std::string& chain_name,
+                   std::size_t index, Scene& scene, ChainSpec& chain,
+                   std::map<std::string, std::string>& names,
+                   std::map<std::string, int>& link_index);
+    collision::ChainJoint readJoint(const YAML::Node& n, const std::string& path) const;
+    collision::JointTrajectory readMotion(const YAML::Node& n, const std::string& path,
+                                          Real unit) const;
+    /// `{position: [x, y, z], euler_deg: [rx, ry, rz]}`, both optional (identity).
+    Pose readPlacement(const YAML::Node& n, const std::string& path) const;
     RepeatSpec readRepeat(const Entry& entry, const std::string& path, const Scene& scene) const;
     void requireRoomToSeparate(const RepeatSpec& r, Real radius, const std::string& path) const;
     template <typename Place>
@@ -234,6 +248,9 @@ private:
     std::map<std::tuple<std::string, Real, int>, PreparedShape> mesh_cache_;
     std::vector<std::string> notes_;  // Scene::notes
 };
+
+/// The rotation of scene key `euler_deg`: intrinsic X, then Y, then Z (R = Rx Ry Rz), degrees.
+Quat eulerDegrees(const Vec3& deg);
 
 /// `v` with 6 significant digits, for limits in messages.
 std::string formatLimit(Real v);

@@ -453,6 +453,7 @@ void World::runCollisionPipeline() {
     Clock::time_point t = Clock::now();
     stats_.broad = {};
     broad_phase_->findPairs(flagged_, stats_.broad);
+    if (!chains_.empty()) dropExcludedPairs(flagged_);
     stats_.broad_phase_s = secondsSince(t);
     if (flagged_.size() > settings_.max_candidate_pairs) {
         throw SimulationError(std::to_string(flagged_.size()) + " candidate pairs after step " +
@@ -532,6 +533,7 @@ void World::step() {
     }
     time_ += dt;
     ++step_count_;
+    if (!chains_.empty()) moveChains();
     stats_.integrate_s = secondsSince(t);
 
     if (ccd) {

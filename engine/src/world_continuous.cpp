@@ -55,6 +55,11 @@ Vec3 rotationBetween(const Quat& q0, const Quat& q1) {
 // (deformSpeedBound x time step, ToiQuery::deform_speed_a/_b; the swept bounds grow by as much),
 // so no pair overlaps at any time before its stop, deforming surface included. The deformation
 // is prescribed and goes on after a stop; the discrete pipeline sees what it presses into.
+// Chain links (world_chains.cpp) take part with their conservative swept bounds
+// (collision::linkSweptBounds), parent-child pairs dropped unless the chain collides adjacent
+// links; their pairs go through collision::timeOfImpactArticulated. A link is infinitely heavy
+// and moves with its chain: its impulse share is nil and its prescribed velocity enters the
+// relative velocity; on_impact: stop halts the whole chain at its earliest event.
 // Limitation: one round. A body stopped early is not re-tested against the bodies whose
 // sweeps it no longer blocks, and a third body's sweep is not re-tested against the stopped
 // pose (the discrete pipeline still sees any overlap that results).
@@ -92,6 +97,7 @@ void World::buildSweeps() {
         s.moving =
             !b.is_static && (s.sweep.translation.squaredNorm() > 0 ||
                              s.sweep.rotation.squaredNorm() > 0 || s.sweep.spin.squaredNorm() > 0);
+        if (b.kinematic) sweepLink(i, s);
         sweep_order_.push_back(static_cast<BodyId>(i));
     }
     // A deforming body's surface also moves in its own frame, up to deform_speed over the step:
@@ -119,6 +125,7 @@ void World::findSweptPairs() {
             if (swept_[j].box.min.x() > swept_[i].box.max.x()) break;
             if (!swept_[i].moving && !swept_[j].moving) continue;
             if (!swept_[i].box.overlaps(swept_[j].box)) continue;
+            if (!pairAllowed(i, j)) continue;
             ccd_pairs_.push_back({std::min(i, j), std::max(i, j)});
         }
     }
@@ -133,6 +140,10 @@ void World::queryTimesOfImpact() {
     for (const collision::ProxyPair& pair : ccd_pairs_) {
         const Body& a = bodies_[pair.a];
         const Body& b = bodies_[pair.b];
+        if (a.kinematic || b.kinematic) {
+            queryLinkImpact(pair);  // the articulated query (world_chains.cpp)
+            continue;
+        }
         collision::ToiInput in;
         in.a = &a.shape;
         in.b = &b.shape;
@@ -221,13 +232,15 @@ void World::queryTimesOfImpact() {
 
 // Each moving body stopped at its earliest accepted time of impact.
 void World::stopAtImpacts() {
+    // Chains first: a halted chain's later events did not happen (world_chains.cpp).
+    if (!chains_.empty()) stopChainsAtImpacts();
     const std::size_t n = bodies_.size();
     for (const ToiEvent& e : toi_events_) {
         swept_[e.a].clamp_t = std::min(swept_[e.a].clamp_t, e.t);
         swept_[e.b].clamp_t = std::min(swept_[e.b].clamp_t, e.t);
     }
     for (std::size_t i = 0; i < n; ++i) {
-        if (swept_[i].clamp_t < 1 && swept_[i].moving) {
+        if (swept_[i].clamp_t < 1 && swept_[i].moving && !bodies_[i].kinematic) {
             const Pose p = swept_[i].sweep.at(swept_[i].clamp_t);
             bodies_[i].position = p.position;
             bodies_[i].orientation = p.orientation;
@@ -254,8 +267,11 @@ void World::applyImpactImpulses() {
         const Vec3 rb = e.point - b.position;
         const Mat3 inv_ia = a.invInertiaWorld();
         const Mat3 inv_ib = b.invInertiaWorld();
-        const Vec3 va = a.velocity() + (inv_ia * a.angular_momentum).cross(ra);
-        const Vec3 vb = b.velocity() + (inv_ib * b.angular_momentum).cross(rb);
+        // A link is infinitely heavy and moves with its chain's prescribed motion.
+        const Vec3 va = a.velocity() + (inv_ia * a.angular_momentum).cross(ra) +
+                        linkPointVelocity(e.a, e.point, e.t);
+        const Vec3 vb = b.velocity() + (inv_ib * b.angular_momentum).cross(rb) +
+                        linkPointVelocity(e.b, e.point, e.t);
         const Real vn = (vb - va).dot(e.normal);
         if (!(vn < 0)) continue;
         const Real k = a.inv_mass + b.inv_mass +

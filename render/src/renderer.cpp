@@ -379,7 +379,7 @@ void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& c
         for (const auto& [id, pose] : {std::pair{e.a, e.pose_a}, std::pair{e.b, e.pose_b}}) {
             if (id < 0 || static_cast<std::size_t>(id) >= bodies.size()) continue;
             const engine::Body& b = bodies[static_cast<std::size_t>(id)];
-            if (b.is_static) continue;
+            if (b.is_static && !b.kinematic) continue;  // links move with their chain
             if (b.shape.type == collision::ShapeType::Sphere) {
                 debug.drawSphere(collision::transformSphere(b.local_bounds.sphere, pose),
                                  kToiColor);
@@ -396,6 +396,7 @@ void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& c
         }
         debug.drawLine(e.point, e.point + e.normal * size, kToiColor);
     }
+    if (options.draw.bodies) world.drawChainSkeletons(debug, kSkeletonColor);
 
     // What the narrow phase confirmed: the World derives it and decides what to draw.
     engine::ContactDrawStyle style;
@@ -687,6 +688,17 @@ std::string hudLine(const engine::World& world, int frame, bool include_timing) 
     for (const engine::Body& b : world.bodies()) self = self || b.self_collision;
     if (self) line += "  self pairs " + std::to_string(st.self_pairs);
     if (st.refit_nodes > 0) line += "  refit nodes " + std::to_string(st.refit_nodes);
+    // Scenes with chains: the continuous stage's queries and events, and where a chain halted.
+    if (!world.chains().empty()) {
+        line += "\ntoi queries " + std::to_string(st.toi_queries) + "  iterations " +
+                std::to_string(st.toi_iterations) + "  events " + std::to_string(st.toi_events);
+        for (std::size_t c = 0; c < world.chains().size(); ++c) {
+            if (!world.chainHalted(c)) continue;
+            n = std::snprintf(buffer, sizeof buffer, "  %s halted at %.5f s",
+                              world.chains()[c].name.c_str(), double(world.chainTime(c)));
+            line.append(buffer, std::size_t(std::clamp(n, 0, int(sizeof buffer) - 1)));
+        }
+    }
     if (include_timing) {
         n = std::snprintf(
             buffer, sizeof buffer, "\nstep %.3f ms  volumes %.3f  broad %.3f  narrow %.3f ms",

@@ -276,6 +276,49 @@ TEST(Check, SameSceneSameRows) {
     fs::remove_all(dir);
 }
 
+// A chain's links are bodies with names: `toi`, `tunnelling` and `pairs` grade them as they are.
+// The shipped arm (scenes/arm.yaml) with its expectations replaced: its tip first touches the
+// plate at 0.16722176 s (derived independently in the scene's comment).
+TEST(Check, ChainLinksAreGradedByTheExistingExpectations) {
+    const fs::path dir = tempDir("chain");
+    std::string arm = slurp(fs::path(CDLAB_SOURCE_DIR) / "scenes/arm.yaml");
+    arm.erase(arm.find("expect:"));
+    const std::string expect =
+        "expect:\n"
+        "  toi:\n"
+        "    - {a: tip, b: plate, time: 0.16722176, tolerance: 5e-5}\n"
+        "    - {a: plate, b: tip, time: 0.1671, tolerance: 1e-3}\n"
+        "    - {a: tip, b: plate, time: 0.2, tolerance: 1e-3}\n"
+        "    - {a: tip, b: post, time: 0.25, tolerance: 0.1}\n"
+        "  tunnelling:\n"
+        "    - {a: tip, b: plate, passes: false}\n"
+        "    - {a: tip, b: plate, passes: true}\n";
+    std::vector<CheckRow> rows = checkScene(parse(arm + expect), 60, dir);
+    ASSERT_EQ(rows.size(), 6u);
+    EXPECT_TRUE(findRow(rows, "tip / plate in [0.16717176, 0.16722176]")->pass);
+    EXPECT_NE(findRow(rows, "plate / tip in [0.1661, 0.1671]")->reason.find("later than"),
+              std::string::npos);
+    EXPECT_NE(findRow(rows, "tip / plate in [0.199, 0.2]")->reason.find("too early"),
+              std::string::npos);
+    // The arm halts at the plate: it never reaches the post.
+    EXPECT_EQ(findRow(rows, "tip / post")->reason,
+              "the CCD stage reported no time of impact for the pair");
+    EXPECT_TRUE(findRow(rows, "tip never passes through plate")->pass);
+    EXPECT_EQ(findRow(rows, "tip passes through plate")->reason, "it never got to the other side");
+
+    // With ccd off the tip's centre is on the other side at frame 11 and there is no event.
+    std::string off = arm;
+    const std::string ccd_on = "\n  ccd: conservative_advancement\n";
+    off.replace(off.find(ccd_on), ccd_on.size(), "\n  ccd: off\n");
+    rows = checkScene(parse(off + expect), 60, dir);
+    EXPECT_EQ(findRow(rows, "tip never passes through plate")->reason,
+              "on the other side at frame 11");
+    EXPECT_TRUE(findRow(rows, "tip passes through plate")->pass);
+    EXPECT_EQ(findRow(rows, "tip / plate in [0.16717176, 0.16722176]")->reason,
+              "the CCD stage reported no time of impact for the pair");
+    fs::remove_all(dir);
+}
+
 // --- through the binary ---
 
 TEST(CheckCli, ExitCodesAndTable) {

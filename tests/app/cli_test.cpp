@@ -440,7 +440,8 @@ const std::vector<std::string> kStatsColumns = {
     "colliding",      "volume_tests", "volumes_updated", "swaps",      "narrow_tests",
     "triangle_tests", "bv_tests",     "integrate_ms",    "volumes_ms", "broadphase_ms",
     "narrowphase_ms", "ccd_ms",       "response_ms",     "step_ms",    "self_pairs",
-    "refit_nodes",    "refit_ms",     "refit_node_ns",   "rebuilds"};
+    "refit_nodes",    "refit_ms",     "refit_node_ns",   "rebuilds",   "toi_queries",
+    "toi_iterations", "toi_events"};
 
 TEST(Cli, StatsCsvHasOneRowPerFrameAndCheckBroadphasePasses) {
     const fs::path work = tempDir("stats");
@@ -467,6 +468,7 @@ TEST(Cli, StatsCsvHasOneRowPerFrameAndCheckBroadphasePasses) {
     // tiny.yaml runs without CCD and without contact response: those stages cost nothing.
     EXPECT_EQ(stats.sum("ccd_ms"), 0.0);
     EXPECT_EQ(stats.sum("response_ms"), 0.0);
+    EXPECT_EQ(stats.sum("toi_queries"), 0.0);
     EXPECT_GT(stats.sum("step_ms"), 0.0);
     fs::remove_all(work);
 }
@@ -488,6 +490,8 @@ TEST(Cli, StatsCsvTimesTheCcdAndResponseStages) {
     ASSERT_EQ(stats.rows.size(), 6u);
     EXPECT_GT(stats.sum("ccd_ms"), 0.0);
     EXPECT_GT(stats.sum("response_ms"), 0.0);
+    // Every query takes at least one iteration.
+    EXPECT_GE(stats.sum("toi_iterations"), stats.sum("toi_queries"));
     for (const auto& row : stats.rows) {
         ASSERT_EQ(row.size(), kStatsColumns.size());
         const double step = std::stod(row[stats.column("step_ms")]);

@@ -274,7 +274,7 @@ TEST(Scene, DrawBvhDepthAndContacts) {
 TEST(SceneErrors, UnknownKeysAtEveryLevel) {
     EXPECT_SCENE_ERROR("wrld:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n", "1:1: wrld: ",
                        "unknown key 'wrld' (expected one of: world, broadphase, output, camera, "
-                       "draw, bodies, expect)");
+                       "draw, bodies, chains, expect)");
     EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radus: 0.5\n    position: [0, 0, 0]\n"),
                        "5:5: bodies[0].radus: ", "unknown key 'radus' (expected one of: name,");
     EXPECT_SCENE_ERROR("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  gravty: [0,0,0]\n",

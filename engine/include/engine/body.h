@@ -45,6 +45,10 @@ struct Body {
     Real friction = Real(0.5);     ///< Coulomb coefficient >= 0; a pair uses sqrt(mu_a mu_b)
     /// Infinite mass: inv_mass = 0, inverse inertia 0, zero momenta; never moves (setStatic).
     bool is_static = false;
+    /// A chain's link (engine/chain.h): its pose is prescribed by the chain's joint
+    /// trajectories and set by the World every step; also is_static (infinite mass, zero
+    /// momenta, never integrated).
+    bool kinematic = false;
     /// Mesh bodies only: every step the world lists the body's own intersecting triangle pairs
     /// (World::selfPairs). Scene key `self_collision`.
     bool self_collision = false;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "engine/body.h"
+#include "engine/chain.h"
 #include "engine/world.h"
 
 namespace engine {
@@ -169,7 +170,10 @@ struct Scene {
     OutputSettings output;
     CameraSettings camera;
     DrawSettings draw;
+    /// Bodies of `bodies:`, then the links of `chains:` (kinematic bodies), chain by chain.
     std::vector<Body> bodies;
+    /// `chains:` (links in `bodies`, see ChainSpec::links).
+    std::vector<ChainSpec> chains;
     Expectations expect;  ///< `expect:` (self-grading), empty when absent
     /// What loading assumed or changed that the user should know, one line each,
     /// "FILE:LINE:COL: path: what" (an open mesh's mass properties from its hull, triangles an
@@ -217,7 +221,7 @@ Scene parseScene(const std::string& yaml_text, const std::string& display_name,
                  const std::filesystem::path& base_dir,
                  const std::vector<SceneOverride>& overrides);
 
-/// Builds a World holding the scene's bodies, with volumes and pairs already detected.
+/// Builds a World holding the scene's bodies and chains, with volumes and pairs already detected.
 World makeWorld(const Scene& scene);
 
 }  // namespace engine

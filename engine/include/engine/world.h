@@ -17,6 +17,7 @@
 #include "collision/debug_draw.h"
 #include "collision/volumes/bounding_volumes.h"
 #include "engine/body.h"
+#include "engine/chain.h"
 
 namespace engine {
 
@@ -191,6 +192,11 @@ public:
     World& operator=(World&&) noexcept;
 
     BodyId addBody(Body body);
+    /// Adds a chain whose links are bodies already added (ChainSpec::links, each in one chain
+    /// only): makes them kinematic (Body::kinematic, static: infinite mass, zero momenta) and
+    /// places them at the chain's frames at time(). Every step sets them to the frames at the
+    /// step's end time (world_chains.cpp). Throws std::invalid_argument on a bad spec.
+    void addChain(ChainSpec chain);
 
     /// One time step: integrate (settings().integrator); with ccd on, stop every pair at its time
     /// of impact (see world.cpp); reflect off the bounds; then detect. Throws SimulationError,
@@ -223,6 +229,15 @@ public:
     std::span<const collision::TrianglePair> selfPairs(BodyId id) const;
     Real time() const { return time_; }
     std::int64_t stepCount() const { return step_count_; }
+    std::span<const ChainSpec> chains() const { return chains_; }
+    /// The time (s) chain `chain`'s links are posed at: time() while it runs; once halted
+    /// (on_impact: stop), the time of impact it halted at. Asserts a valid index.
+    Real chainTime(std::size_t chain) const;
+    /// The chain halted at a time of impact (on_impact: stop).
+    bool chainHalted(std::size_t chain) const;
+    /// False only for a parent-child pair of links of a chain without collide_adjacent: such a
+    /// pair is never flagged, tested, coloured or stopped.
+    bool pairAllowed(BodyId a, BodyId b) const;
 
     /// FNV-1a over the bit patterns of every body's state: equal hashes = bit-identical states.
     std::uint64_t stateHash() const;
@@ -246,6 +261,9 @@ public:
     /// Draws the witnesses of every colliding pair (draw.contacts): a cross at each witness point
     /// and the normal from A's, sized by the smaller body so the marks stay on the pair.
     void drawContacts(collision::DebugDraw& draw, const ContactDrawStyle& style) const;
+    /// Draws every chain's skeleton at its clock: a line from each link's parent frame origin
+    /// (the base's for a root link) to its own frame origin, the joint; zero lengths skipped.
+    void drawChainSkeletons(collision::DebugDraw& draw, const collision::Color& color) const;
 
 private:
     void integrate(Real dt, const Vec3& gravity);
@@ -286,6 +304,32 @@ private:
         Real clamp_t = 1;     ///< earliest accepted time of impact
         bool moving = false;
     };
+    // Chains (world_chains.cpp): links to their frames at the end of the step, the parent-child
+    // pairs dropped, the links' swept bounds and articulated times of impact, halting.
+    void moveChains();
+    void dropExcludedPairs(std::vector<collision::ProxyPair>& pairs) const;
+    void sweepLink(std::size_t i, SweptBody& s) const;
+    void queryLinkImpact(const collision::ProxyPair& pair);
+    void stopChainsAtImpacts();
+    /// Velocity (m/s) of the material point at world `point` of body `id` at step fraction `s`
+    /// if it is a link of a chain moving in this step, else zero.
+    Vec3 linkPointVelocity(BodyId id, const Vec3& point, Real s) const;
+    void poseChain(std::size_t c, Real t);  ///< the links of chain c at its time t
+    struct LinkOf {
+        int chain = -1;
+        int link = -1;
+    };
+    struct ChainState {
+        Real clock = 0;       ///< s, the time the links are posed at
+        Real step_start = 0;  ///< s, the clock at the start of the step
+        bool halted = false;
+        bool moved = false;  ///< the clock advanced in this step
+    };
+    std::vector<ChainSpec> chains_;
+    std::vector<ChainState> chain_state_;
+    std::vector<LinkOf> link_of_;        ///< per body; shorter than bodies_ past the last link
+    mutable std::vector<Pose> frames_;   ///< chainFrames scratch
+    mutable std::vector<Pose> frames2_;  ///< second scratch (finite differences)
     std::vector<Pose> step_start_;
     std::vector<Vec3> step_rotation_;  ///< semi-implicit Euler's rotation of the step (ccd on)
     std::vector<Vec3> step_spin_;

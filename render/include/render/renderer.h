@@ -26,6 +26,8 @@ inline constexpr collision::Color kBodyColor{0.56f, 0.63f, 0.74f, 1.0f};
 /// Wireframes of the bodies at the times of impact the CCD stage acted on in the last step
 /// (World::toiEvents), and the contact normal there: blue.
 inline constexpr collision::Color kToiColor{0.25f, 0.5f, 1.0f, 1.0f};
+/// Chains' skeletons: joint origins joined by lines (with the bodies).
+inline constexpr collision::Color kSkeletonColor{0.92f, 0.92f, 0.85f, 1.0f};
 
 /// Witness points (small crosses) and normals (short segments from A's witness) of the confirmed
 /// contacts, with draw.contacts: magenta, a colour no state uses.
