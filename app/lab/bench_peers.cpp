@@ -5,7 +5,8 @@
 //    hashed pair cache and no dispatcher, which it only needs to free narrow-phase algorithms.
 //    Its cache is a superset of the exact pairs (btDbvtBroadphase keeps pairs while the fattened
 //    leaves overlap and removes stale ones lazily; btAxisSweep3 tests quantised boxes), so
-//    summary() filters it with the exact AABBs, outside the timed frame.
+//    deliverExact() filters it into a list of exact pairs (timed under the exact-pairs rule) and
+//    summary() filters it again for the check, untimed.
 //  - FCL's managers call back exactly for AABB-overlapping pairs; the callback only counts them.
 //    Its CollisionObject AABB for an unrotated Box is translation -/+ side/2, i.e. the same
 //    doubles as cdlab's box.
@@ -15,6 +16,7 @@
 #include <limits>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "bench_method.h"
 
@@ -169,6 +171,21 @@ public:
         return out;
     }
     std::int64_t rawPairs() const override { return raw_pairs_; }
+    void deliverExact(const MovingBoxes& boxes) override {
+        // What a caller of Bullet does before its narrow phase: keep the cache pairs whose exact
+        // boxes overlap (no sort: Bullet's order is its hash's, and none is asked of it).
+        btBroadphasePairArray& cache =
+            broad_phase_->getOverlappingPairCache()->getOverlappingPairArray();
+        exact_.clear();
+        for (int k = 0; k < cache.size(); ++k) {
+            const btBroadphasePair& p = cache[k];
+            if (p.m_pProxy0 == nullptr || p.m_pProxy1 == nullptr) continue;
+            int a = static_cast<int>(reinterpret_cast<std::intptr_t>(p.m_pProxy0->m_clientObject));
+            int b = static_cast<int>(reinterpret_cast<std::intptr_t>(p.m_pProxy1->m_clientObject));
+            if (a > b) std::swap(a, b);
+            if (boxes.aabb(a).overlaps(boxes.aabb(b))) exact_.push_back({a, b});
+        }
+    }
 
 private:
     BulletKind kind_;
@@ -176,6 +193,7 @@ private:
     std::unique_ptr<btBroadphaseInterface> broad_phase_;
     std::vector<btBroadphaseProxy*> proxies_;
     std::int64_t raw_pairs_ = 0;
+    std::vector<collision::ProxyPair> exact_;  ///< deliverExact()'s list, reused
 };
 
 #endif  // CDLAB_HAVE_BULLET
