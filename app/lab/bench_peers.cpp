@@ -25,6 +25,7 @@
 #include <BulletCollision/BroadphaseCollision/btBroadphaseProxy.h>
 #include <BulletCollision/BroadphaseCollision/btDbvtBroadphase.h>
 #include <BulletCollision/BroadphaseCollision/btOverlappingPairCache.h>
+#include <LinearMath/btAabbUtil2.h>
 #endif
 
 #ifdef CDLAB_HAVE_FCL
@@ -168,22 +169,37 @@ public:
                 static_cast<int>(reinterpret_cast<std::intptr_t>(p.m_pProxy1->m_clientObject)),
                 out);
         }
+        // The list deliverExact() made, when it ran for this frame, must be the same set: a
+        // differing one is reported as a mismatch (the count made impossible).
+        if (delivered_ && !(summarizePairs(exact_) == out)) out.pairs = -1;
+        delivered_ = false;
         return out;
     }
     std::int64_t rawPairs() const override { return raw_pairs_; }
     void deliverExact(const MovingBoxes& boxes) override {
-        // What a caller of Bullet does before its narrow phase: keep the cache pairs whose exact
-        // boxes overlap (no sort: Bullet's order is its hash's, and none is asked of it).
+        // What a caller of Bullet does before its narrow phase: keep the cache pairs whose
+        // boxes overlap, tested on the boxes the proxies hold (the exact ones when btScalar is
+        // double; float proxies hold them rounded outward, so the workload's are tested then).
+        // No sort: Bullet's order is its hash's, and none is asked of it.
         btBroadphasePairArray& cache =
             broad_phase_->getOverlappingPairCache()->getOverlappingPairArray();
         exact_.clear();
+        delivered_ = true;
         for (int k = 0; k < cache.size(); ++k) {
-            const btBroadphasePair& p = cache[k];
-            if (p.m_pProxy0 == nullptr || p.m_pProxy1 == nullptr) continue;
-            int a = static_cast<int>(reinterpret_cast<std::intptr_t>(p.m_pProxy0->m_clientObject));
-            int b = static_cast<int>(reinterpret_cast<std::intptr_t>(p.m_pProxy1->m_clientObject));
+            const btBroadphaseProxy* p0 = cache[k].m_pProxy0;
+            const btBroadphaseProxy* p1 = cache[k].m_pProxy1;
+            if (p0 == nullptr || p1 == nullptr) continue;
+            int a = static_cast<int>(reinterpret_cast<std::intptr_t>(p0->m_clientObject));
+            int b = static_cast<int>(reinterpret_cast<std::intptr_t>(p1->m_clientObject));
+            bool overlap;
+            if constexpr (sizeof(btScalar) == sizeof(collision::Real)) {
+                overlap = TestAabbAgainstAabb2(p0->m_aabbMin, p0->m_aabbMax, p1->m_aabbMin,
+                                               p1->m_aabbMax);
+            } else {
+                overlap = boxes.aabb(a).overlaps(boxes.aabb(b));
+            }
             if (a > b) std::swap(a, b);
-            if (boxes.aabb(a).overlaps(boxes.aabb(b))) exact_.push_back({a, b});
+            if (overlap) exact_.push_back({a, b});
         }
     }
 
@@ -194,6 +210,7 @@ private:
     std::vector<btBroadphaseProxy*> proxies_;
     std::int64_t raw_pairs_ = 0;
     std::vector<collision::ProxyPair> exact_;  ///< deliverExact()'s list, reused
+    bool delivered_ = false;                   ///< exact_ is this frame's
 };
 
 #endif  // CDLAB_HAVE_BULLET
