@@ -32,6 +32,8 @@
 #include <string>
 
 #include "bench_method.h"
+#include "bench_peer_tuning.h"
+#include "bench_rows.h"
 #include "bench_workload.h"
 #include "exit_codes.h"
 #include "output_files.h"
@@ -45,11 +47,6 @@ namespace {
 
 constexpr int kEdgeFrames = 100;  // frames in the "first" and "last" medians
 constexpr int kMaxOneShotRepetitions = 100;
-// The peers' tuning pass: each configuration runs the measured run's frames, stopped after at
-// most this many seconds of frame time (a stopped configuration is not ranked while one ran in
-// full: its median would cover only the frames before it slowed down).
-constexpr double kTuneBudgetSeconds = 10;
-
 double clockSeconds(clockid_t clock) {
     timespec ts{};
     clock_gettime(clock, &ts);
@@ -95,27 +92,6 @@ double median(std::vector<double> v) {
     if (v.size() % 2 == 1) return hi;
     return (*std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid)) + hi) / 2;
 }
-
-/// One method's measurement. Plain data: a child process sends it to the parent through a pipe.
-struct RunResult {
-    int failed = 0;  ///< nonzero: `note` says why
-    double insert_ms = 0;
-    double median_ms = 0;
-    double mean_ms = 0;
-    double exact_median_ms = 0;  ///< with deliverExact() in the timed frame
-    double first_median_ms = 0;
-    double last_median_ms = 0;
-    int frames_run = 0;
-    int budget_hit = 0;
-    std::int64_t pairs_last = 0;
-    std::int64_t raw_pairs_last = -1;
-    int mismatched_frames = 0;
-    int first_mismatch_frame = -1;
-    std::int64_t expected_pairs = 0;
-    std::int64_t got_pairs = 0;
-    double peak_mb = std::numeric_limits<double>::quiet_NaN();
-    char note[240] = {};
-};
 
 void setNote(RunResult& r, const std::string& text) {
     std::snprintf(r.note, sizeof(r.note), "%s", text.c_str());
@@ -318,21 +294,6 @@ RunResult measureIsolated(const BenchMethodEntry& entry, const MovingBoxes& init
     return r;
 }
 
-struct Row {
-    std::string method;
-    std::string workload;  ///< with " one-shot" for one-shot tables
-    int n = 0;
-    bool peer = false;
-    std::string family;  ///< a tuned peer's name (its winning configuration is `method`)
-    int configs = 0;     ///< configurations the tuned peer was chosen from
-    std::string tuned_by;  ///< what it was the fastest by: median_ms, exact_ms or both
-    bool skipped = false;
-    std::string skip_reason;
-    RunResult result;
-    double ratio = std::numeric_limits<double>::quiet_NaN();
-    double exact_ratio = std::numeric_limits<double>::quiet_NaN();  ///< exact-pairs rule
-};
-
 std::string format(const char* fmt, double value) {
     if (!std::isfinite(value)) return "-";
     char buf[64];
@@ -520,11 +481,6 @@ std::vector<PairSummary> referencePairs(const MovingBoxes& workload, int frames)
     return reference;
 }
 
-// A row that ran to the end and agreed with the reference: the only rows ratios are taken from.
-bool usable(const Row& row) {
-    return !row.skipped && !row.result.failed && row.result.mismatched_frames == 0;
-}
-
 // The usable peer row with the smallest `ms` (a RunResult median), or nullptr.
 const Row* bestPeer(const std::vector<Row>& rows, double RunResult::*ms) {
     const Row* best = nullptr;
@@ -590,21 +546,6 @@ void reportWorkload(std::ostream& out, std::vector<Row>& rows, const BenchOption
     out.flush();
 }
 
-/// What every method of one table runs on.
-struct TableRun {
-    const MovingBoxes& workload;
-    const std::vector<PairSummary>& reference;
-    const BenchOptions& options;
-    bool one_shot;
-    std::ostream& out;
-    std::ostream& err;
-    bool& failed;
-};
-
-std::string tableName(const MovingBoxes& workload, bool one_shot) {
-    return std::string(workloadName(workload.kind())) + (one_shot ? " one-shot" : "");
-}
-
 void printWorkloadHead(std::ostream& out, const MovingBoxes& workload,
                        const std::vector<PairSummary>& reference, const BenchOptions& options,
                        bool one_shot) {
@@ -633,7 +574,8 @@ void printWorkloadHead(std::ostream& out, const MovingBoxes& workload,
     out << head;
 }
 
-/// Runs one method on a table (or a row saying why not), reporting progress and mismatches.
+}  // namespace
+
 Row runMethod(const BenchMethodEntry& m, const TableRun& run, const BenchOptions& options) {
     const int n = run.workload.size();
     Row row;
@@ -685,93 +627,10 @@ Row runMethod(const BenchMethodEntry& m, const TableRun& run, const BenchOptions
     return row;
 }
 
+namespace {
+
 Row runMethod(const BenchMethodEntry& m, const TableRun& run) {
     return runMethod(m, run, run.options);
-}
-
-void setRatios(std::vector<Row>& rows) {
-    double best = std::numeric_limits<double>::infinity();
-    double best_exact = best;
-    for (const Row& row : rows) {
-        if (!usable(row)) continue;
-        best = std::min(best, row.result.median_ms);
-        best_exact = std::min(best_exact, row.result.exact_median_ms);
-    }
-    for (Row& row : rows) {
-        if (!usable(row) || !std::isfinite(best)) continue;
-        row.ratio = row.result.median_ms / best;
-        row.exact_ratio = row.result.exact_median_ms / best_exact;
-    }
-}
-
-// Of one peer's configurations (rows of `sweep` from `first` on), the fastest by `ms`: among
-// those that ran every frame, or, when none did, among those stopped by the budget.
-const Row* fastestConfig(const std::vector<Row>& sweep, std::size_t first, double RunResult::*ms) {
-    const Row* best = nullptr;
-    for (const bool stopped : {false, true}) {
-        for (std::size_t i = first; i < sweep.size(); ++i) {
-            const Row& row = sweep[i];
-            if (!usable(row) || (row.result.budget_hit != 0) != stopped) continue;
-            if (best == nullptr || row.result.*ms < best->result.*ms) best = &row;
-        }
-        if (best != nullptr) return best;
-    }
-    return nullptr;
-}
-
-/// Each peer's grid, every configuration on the measured run's frames; the fastest of each
-/// peer, by its own measured median, is appended to `rows` as the peer (and, when another
-/// configuration is the fastest at delivering exact pairs, that one too); every configuration's
-/// row goes to `sweep`.
-void tunePeers(const TableRun& run, std::vector<Row>& rows, std::vector<Row>& sweep) {
-    BenchOptions tuning = run.options;
-    tuning.budget_seconds = run.options.budget_seconds > 0
-                                ? std::min(run.options.budget_seconds, kTuneBudgetSeconds)
-                                : kTuneBudgetSeconds;
-    std::vector<std::string> families;
-    for (const BenchMethodEntry& m : benchMethods()) {
-        if (!m.family.empty() &&
-            std::find(families.begin(), families.end(), m.family) == families.end()) {
-            families.push_back(m.family);
-        }
-    }
-    for (const std::string& family : families) {
-        const std::size_t first = sweep.size();
-        int configs = 0;
-        std::string skip_reason;
-        for (const BenchMethodEntry& m : benchMethods()) {
-            if (m.family != family) continue;
-            Row row = runMethod(m, run, tuning);
-            if (row.skipped) {
-                skip_reason = row.skip_reason;
-            } else {
-                ++configs;
-            }
-            sweep.push_back(std::move(row));
-        }
-        const Row* best = fastestConfig(sweep, first, &RunResult::median_ms);
-        const Row* best_exact = fastestConfig(sweep, first, &RunResult::exact_median_ms);
-        if (best == nullptr) {
-            Row row;
-            row.method = family;
-            row.workload = tableName(run.workload, run.one_shot);
-            row.n = run.workload.size();
-            row.peer = true;
-            row.skipped = true;
-            row.skip_reason = configs == 0 ? skip_reason : "no configuration ran cleanly";
-            rows.push_back(std::move(row));
-            continue;
-        }
-        const auto appendWinner = [&](const Row& winner, const char* by) {
-            Row row = winner;
-            row.family = family;
-            row.configs = configs;
-            row.tuned_by = by;
-            rows.push_back(std::move(row));
-        };
-        appendWinner(*best, best_exact == best ? "median_ms and exact_ms" : "median_ms");
-        if (best_exact != best) appendWinner(*best_exact, "exact_ms");
-    }
 }
 
 }  // namespace
