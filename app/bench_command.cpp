@@ -39,8 +39,9 @@ Command addBenchBroadphaseCommand(CLI::App& bench) {
         ->capture_default_str();
     cmd->add_option("--peers", o.peers,
                     "tuned: sweep each peer's settings (DBVT margin, prediction, deferred; SAP "
-                    "world size and handle bits; FCL update and tree build) and compare with "
-                    "the best of each; all: the same and print every configuration; default: "
+                    "world size and handle bits; FCL update and tree build), each setting on all "
+                    "frames, and compare with the best of each by its median (and by the "
+                    "exact-pairs median); all: the same and print every configuration; default: "
                     "each peer at its defaults")
         ->check(CLI::IsMember({"tuned", "all", "default"}))
         ->capture_default_str();

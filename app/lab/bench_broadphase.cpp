@@ -1,20 +1,20 @@
-// app/lab/bench_broadphase.cpp -- `cdlab bench broadphase`: runs every method on the same moving-box
-// sequence and tabulates per-frame thread CPU time, build time and peak memory.
-// Fairness invariants: every method sees bit-identical boxes in the same order (each child
-// process rebuilds the workload from the same state and steps it with the same code); the timed
-// part of a frame is exactly moveAll() + findPairs(); anything a method needs only to prove its
-// answer (filtering a pair cache, hashing the pair set) runs outside the timer. Every frame's pair
-// set (count and order-independent hash) is compared with an independent reference sweep.
+// app/lab/bench_broadphase.cpp -- `cdlab bench broadphase`: runs every method on the same
+// moving-box sequence and tabulates per-frame thread CPU time, build time and peak memory. Fairness
+// invariants: every method sees bit-identical boxes in the same order (each child process rebuilds
+// the workload from the same state and steps it with the same code); the timed part of a frame is
+// exactly moveAll() + findPairs() (today's rule), and that plus deliverExact() (the exact-pairs
+// rule: a peer's filtering of its loose pair cache to exact pairs is charged to it, as cdlab's
+// methods are charged for delivering exact pairs); anything a method needs only to prove its answer
+// (hashing the pair set) runs outside the timer. Every frame's pair set (count and
+// order-independent hash) is compared with an independent reference sweep.
 #include "bench_broadphase.h"
 
 #include <fcntl.h>
 #include <malloc.h>
-#include <memory>
 #include <signal.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
-#include <vector>
 
 #include <algorithm>
 #include <cerrno>
@@ -24,12 +24,16 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <numeric>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "bench_method.h"
+#include "bench_peer_tuning.h"
+#include "bench_rows.h"
 #include "bench_workload.h"
 #include "exit_codes.h"
 #include "output_files.h"
@@ -43,10 +47,6 @@ namespace {
 
 constexpr int kEdgeFrames = 100;  // frames in the "first" and "last" medians
 constexpr int kMaxOneShotRepetitions = 100;
-// The peers' tuning pass: each configuration runs at most this many frames and seconds.
-constexpr int kTuneFrames = 100;
-constexpr double kTuneBudgetSeconds = 2;
-
 double clockSeconds(clockid_t clock) {
     timespec ts{};
     clock_gettime(clock, &ts);
@@ -101,27 +101,6 @@ double median(std::vector<double> v) {
     return (*std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid)) + hi) / 2;
 }
 
-/// One method's measurement. Plain data: a child process sends it to the parent through a pipe.
-struct RunResult {
-    int failed = 0;  ///< nonzero: `note` says why
-    double insert_ms = 0;
-    double median_ms = 0;
-    double mean_ms = 0;
-    double first_median_ms = 0;
-    double last_median_ms = 0;
-    int frames_run = 0;
-    int budget_hit = 0;
-    std::int64_t pairs_last = 0;
-    std::int64_t raw_pairs_last = -1;
-    std::int64_t potentially_colliding_last = -1;
-    int mismatched_frames = 0;
-    int first_mismatch_frame = -1;
-    std::int64_t expected_pairs = 0;
-    std::int64_t got_pairs = 0;
-    double peak_mb = std::numeric_limits<double>::quiet_NaN();
-    char note[240] = {};
-};
-
 void setNote(RunResult& r, const std::string& text) {
     std::snprintf(r.note, sizeof(r.note), "%s", text.c_str());
 }
@@ -138,8 +117,9 @@ RunResult measure(const BenchMethodEntry& entry, const MovingBoxes& initial,
     MovingBoxes boxes = initial;
     std::vector<collision::ProxyVolumes> volumes;
     boxes.volumes(volumes);
-    std::vector<double> times;
+    std::vector<double> times, exact_times;
     times.reserve(static_cast<std::size_t>(options.frames));
+    exact_times.reserve(static_cast<std::size_t>(options.frames));
     auto check = [&](BenchMethod& method, int frame) {
         const PairSummary got = method.summary(boxes);
         r.pairs_last = got.pairs;
@@ -169,8 +149,11 @@ RunResult measure(const BenchMethodEntry& entry, const MovingBoxes& initial,
         const double start = clockSeconds(clock);
         method->moveAll(boxes, volumes);
         method->findPairs();
+        const double found = clockSeconds(clock);
+        method->deliverExact(boxes);
         const double dt = clockSeconds(clock) - start;
-        times.push_back(1e3 * dt);
+        times.push_back(1e3 * (found - start));
+        exact_times.push_back(1e3 * dt);
         total += dt;
         check(*method, frame);
         if (options.budget_seconds > 0 && total > options.budget_seconds &&
@@ -186,6 +169,7 @@ RunResult measure(const BenchMethodEntry& entry, const MovingBoxes& initial,
 
     r.frames_run = static_cast<int>(times.size());
     r.median_ms = median(times);
+    r.exact_median_ms = median(exact_times);
     r.mean_ms = times.empty() ? 0
                               : std::accumulate(times.begin(), times.end(), 0.0) /
                                     static_cast<double>(times.size());
@@ -206,7 +190,7 @@ RunResult measureOneShot(const BenchMethodEntry& entry, const MovingBoxes& boxes
     std::vector<collision::ProxyVolumes> volumes;
     boxes.volumes(volumes);
     const int repetitions = oneShotRepetitions(options);
-    std::vector<double> times;
+    std::vector<double> times, exact_times;
     const clockid_t clock = frameClock(options, entry);
     double total = 0;
     for (int rep = 0; rep < repetitions; ++rep) {
@@ -214,8 +198,11 @@ RunResult measureOneShot(const BenchMethodEntry& entry, const MovingBoxes& boxes
         std::unique_ptr<BenchMethod> method = entry.create();
         method->insertAll(boxes, volumes);
         method->findPairs();
+        const double found = clockSeconds(clock);
+        method->deliverExact(boxes);
         const double dt = clockSeconds(clock) - start;
-        times.push_back(1e3 * dt);
+        times.push_back(1e3 * (found - start));
+        exact_times.push_back(1e3 * dt);
         total += dt;
         const PairSummary got = method->summary(boxes);
         r.pairs_last = got.pairs;
@@ -227,8 +214,7 @@ RunResult measureOneShot(const BenchMethodEntry& entry, const MovingBoxes& boxes
             r.got_pairs = got.pairs;
         }
         method.reset();
-        if (options.budget_seconds > 0 && total > options.budget_seconds &&
-            rep + 1 < repetitions) {
+        if (options.budget_seconds > 0 && total > options.budget_seconds && rep + 1 < repetitions) {
             r.budget_hit = 1;
             break;
         }
@@ -236,6 +222,7 @@ RunResult measureOneShot(const BenchMethodEntry& entry, const MovingBoxes& boxes
     r.insert_ms = times.front();
     r.frames_run = static_cast<int>(times.size());
     r.median_ms = median(times);
+    r.exact_median_ms = median(exact_times);
     r.mean_ms = std::accumulate(times.begin(), times.end(), 0.0) / double(times.size());
     const std::size_t edge = std::min<std::size_t>(kEdgeFrames, times.size());
     r.first_median_ms = median(std::vector<double>(times.begin(), times.begin() + edge));
@@ -317,20 +304,6 @@ RunResult measureIsolated(const BenchMethodEntry& entry, const MovingBoxes& init
     return r;
 }
 
-struct Row {
-    std::string method;
-    std::string workload;  ///< with " one-shot" for one-shot tables
-    int n = 0;
-    bool peer = false;
-    std::string family;  ///< a tuned peer's name (its winning configuration is `method`)
-    int configs = 0;     ///< configurations the tuned peer was chosen from
-    bool skipped = false;
-    std::string skip_reason;
-    std::string clock;  ///< clockName() of the method's frames
-    RunResult result;
-    double ratio = std::numeric_limits<double>::quiet_NaN();
-};
-
 std::string format(const char* fmt, double value) {
     if (!std::isfinite(value)) return "-";
     char buf[64];
@@ -340,9 +313,10 @@ std::string format(const char* fmt, double value) {
 
 void printTable(std::ostream& out, const std::vector<Row>& rows, int frames) {
     char line[400];
-    std::snprintf(line, sizeof(line), "%-34s %10s %10s %10s %10s %10s %10s %10s %8s %9s  %s\n",
-                  "method", "insert_ms", "median_ms", "mean_ms", "first100", "last100", "pairs",
-                  "vs_peer", "peak_MB", "frames", "check");
+    std::snprintf(line, sizeof(line),
+                  "%-34s %10s %10s %10s %10s %10s %10s %10s %10s %10s %8s %9s  %s\n", "method",
+                  "insert_ms", "median_ms", "mean_ms", "first100", "last100", "pairs", "vs_peer",
+                  "exact_ms", "vs_peer_ex", "peak_MB", "frames", "check");
     out << line;
     for (const Row& row : rows) {
         if (row.skipped) {
@@ -362,15 +336,20 @@ void printTable(std::ostream& out, const std::vector<Row>& rows, int frames) {
         const std::string check = r.mismatched_frames == 0
                                       ? "ok"
                                       : "MISMATCH(" + std::to_string(r.mismatched_frames) + ")";
-        const std::string tuned =
-            row.configs > 0 ? "  (best of " + std::to_string(row.configs) + " configs)" : "";
+        const std::string tuned = row.configs > 0 ? "  (best of " + std::to_string(row.configs) +
+                                                        " configs by " + row.tuned_by + ")"
+                                                  : "";
+        const auto times = [](double ratio) {
+            return format("%.2f", ratio) + (std::isfinite(ratio) ? "x" : "");
+        };
         std::snprintf(
-            line, sizeof(line), "%-34s %10s %10s %10s %10s %10s %10lld %10s %8s %9s  %s%s\n",
+            line, sizeof(line),
+            "%-34s %10s %10s %10s %10s %10s %10lld %10s %10s %10s %8s %9s  %s%s\n",
             (row.method + (row.peer ? " [peer]" : "")).c_str(), format("%.2f", r.insert_ms).c_str(),
             format("%.4f", r.median_ms).c_str(), format("%.4f", r.mean_ms).c_str(),
             format("%.4f", r.first_median_ms).c_str(), format("%.4f", r.last_median_ms).c_str(),
-            static_cast<long long>(r.pairs_last),
-            (format("%.2f", row.ratio) + (std::isfinite(row.ratio) ? "x" : "")).c_str(),
+            static_cast<long long>(r.pairs_last), times(row.ratio).c_str(),
+            format("%.4f", r.exact_median_ms).c_str(), times(row.exact_ratio).c_str(),
             format("%.1f", r.peak_mb).c_str(), frames_text.c_str(), check.c_str(), tuned.c_str());
         out << line;
     }
@@ -390,6 +369,7 @@ nlohmann::json rowJson(const Row& row) {
     if (!row.family.empty()) {
         j["tuned_peer"] = row.family;
         j["configs_swept"] = row.configs;
+        j["tuned_by"] = row.tuned_by;
     }
     if (row.skipped) {
         j["skipped"] = row.skip_reason;
@@ -411,6 +391,8 @@ nlohmann::json rowJson(const Row& row) {
         j["potentially_colliding"] = r.potentially_colliding_last;
     }
     j["ratio_to_best_peer"] = number(row.ratio);
+    j["ms_per_frame_median_exact_pairs"] = number(r.exact_median_ms);
+    j["ratio_to_best_peer_exact_pairs"] = number(row.exact_ratio);
     j["peak_mb"] = number(r.peak_mb);
     j["frames"] = r.frames_run;
     j["mismatched_frames"] = r.mismatched_frames;
@@ -512,42 +494,55 @@ std::vector<PairSummary> referencePairs(const MovingBoxes& workload, int frames)
     return reference;
 }
 
-// A row that ran to the end and agreed with the reference: the only rows ratios are taken from.
-bool usable(const Row& row) {
-    return !row.skipped && !row.result.failed && row.result.mismatched_frames == 0;
-}
-
-// One workload's rows: each method's ratio to the best peer, the table, the fastest cdlab
-// method, and notes on stopped runs and pair caches.
-void reportWorkload(std::ostream& out, std::vector<Row>& rows, const BenchOptions& options,
-                    int frames) {
-    double best_peer = std::numeric_limits<double>::infinity();
+// The usable peer row with the smallest `ms` (a RunResult median), or nullptr.
+const Row* bestPeer(const std::vector<Row>& rows, double RunResult::*ms) {
     const Row* best = nullptr;
     for (const Row& row : rows) {
-        if (row.peer && usable(row) && row.result.median_ms < best_peer) {
-            best_peer = row.result.median_ms;
+        if (row.peer && usable(row) && (best == nullptr || row.result.*ms < best->result.*ms)) {
             best = &row;
         }
     }
+    return best;
+}
+
+// The fastest cdlab method by `ms` against the best peer by the same figure, as one line.
+void printFastest(std::ostream& out, const std::vector<Row>& rows, double RunResult::*ms,
+                  double Row::*ratio, const char* rule) {
     const Row* fastest = nullptr;
-    for (Row& row : rows) {
-        if (!usable(row)) continue;
-        if (best != nullptr) row.ratio = row.result.median_ms / best_peer;
-        if (!row.peer &&
-            (fastest == nullptr || row.result.median_ms < fastest->result.median_ms)) {
+    for (const Row& row : rows) {
+        if (!row.peer && usable(row) &&
+            (fastest == nullptr || row.result.*ms < fastest->result.*ms)) {
             fastest = &row;
         }
     }
-    printTable(out, rows, frames);
-    if (fastest != nullptr) {
-        out << "fastest cdlab: " << fastest->method << " "
-            << format("%.4f", fastest->result.median_ms) << " ms/frame";
-        if (best != nullptr) {
-            out << "; best peer: " << best->method << " " << format("%.4f", best_peer)
-                << " ms/frame; ratio " << format("%.2f", fastest->ratio) << "x";
-        }
-        out << '\n';
+    if (fastest == nullptr) return;
+    out << rule << ": fastest cdlab: " << fastest->method << " "
+        << format("%.4f", fastest->result.*ms) << " ms/frame";
+    if (const Row* best = bestPeer(rows, ms)) {
+        out << "; best peer: " << best->method << " " << format("%.4f", best->result.*ms)
+            << " ms/frame; ratio " << format("%.2f", fastest->*ratio) << "x";
     }
+    out << '\n';
+}
+
+// One workload's rows: each method's ratio to the best peer under both rules, the table, the
+// fastest cdlab method, and notes on stopped runs and pair caches.
+void reportWorkload(std::ostream& out, std::vector<Row>& rows, const BenchOptions& options,
+                    int frames) {
+    const Row* best = bestPeer(rows, &RunResult::median_ms);
+    const Row* best_exact = bestPeer(rows, &RunResult::exact_median_ms);
+    for (Row& row : rows) {
+        if (!usable(row)) continue;
+        if (best != nullptr) row.ratio = row.result.median_ms / best->result.median_ms;
+        if (best_exact != nullptr) {
+            row.exact_ratio = row.result.exact_median_ms / best_exact->result.exact_median_ms;
+        }
+    }
+    printTable(out, rows, frames);
+    printFastest(out, rows, &RunResult::median_ms, &Row::ratio,
+                 "pairs as held (median_ms, vs_peer)");
+    printFastest(out, rows, &RunResult::exact_median_ms, &Row::exact_ratio,
+                 "exact pairs delivered (exact_ms, vs_peer_ex)");
     for (const Row& row : rows) {
         const RunResult& r = row.result;
         if (row.skipped || r.failed) continue;
@@ -558,7 +553,7 @@ void reportWorkload(std::ostream& out, std::vector<Row>& rows, const BenchOption
         if (r.raw_pairs_last >= 0) {
             out << "  " << row.method << ": pair cache held " << r.raw_pairs_last
                 << " pairs in the last frame (exact: " << r.pairs_last
-                << "; filtered untimed)\n";
+                << "; filtered in exact_ms, not in median_ms)\n";
         }
         if (r.potentially_colliding_last >= 0) {
             out << "  " << row.method << ": potentially colliding set held "
@@ -572,21 +567,6 @@ void reportWorkload(std::ostream& out, std::vector<Row>& rows, const BenchOption
         }
     }
     out.flush();
-}
-
-/// What every method of one table runs on.
-struct TableRun {
-    const MovingBoxes& workload;
-    const std::vector<PairSummary>& reference;
-    const BenchOptions& options;
-    bool one_shot;
-    std::ostream& out;
-    std::ostream& err;
-    bool& failed;
-};
-
-std::string tableName(const MovingBoxes& workload, bool one_shot) {
-    return std::string(workloadName(workload.kind())) + (one_shot ? " one-shot" : "");
 }
 
 void printWorkloadHead(std::ostream& out, const MovingBoxes& workload,
@@ -617,7 +597,8 @@ void printWorkloadHead(std::ostream& out, const MovingBoxes& workload,
     out << head;
 }
 
-/// Runs one method on a table (or a row saying why not), reporting progress and mismatches.
+}  // namespace
+
 Row runMethod(const BenchMethodEntry& m, const TableRun& run, const BenchOptions& options) {
     const int n = run.workload.size();
     Row row;
@@ -655,8 +636,9 @@ Row runMethod(const BenchMethodEntry& m, const TableRun& run, const BenchOptions
                 << (run.one_shot ? " repetitions\n" : " frames\n");
     }
     if (r.mismatched_frames > 0) {
-        // A peer's disagreement is the peer's own (FCL's SaP misses pairs of the boxpruning scene), so it
-        // is shown and left out of the ratios; one of ours failing its reference fails the run.
+        // A peer's disagreement is the peer's own (FCL's SaP misses pairs of the boxpruning scene),
+        // so it is shown and left out of the ratios; one of ours failing its reference fails the
+        // run.
         if (!m.peer) run.failed = true;
         std::string msg = "MISMATCH: " + m.name + " (" + row.workload + ", N=";
         msg += std::to_string(n) + ") disagrees with the reference on ";
@@ -670,70 +652,10 @@ Row runMethod(const BenchMethodEntry& m, const TableRun& run, const BenchOptions
     return row;
 }
 
+namespace {
+
 Row runMethod(const BenchMethodEntry& m, const TableRun& run) {
     return runMethod(m, run, run.options);
-}
-
-void setRatios(std::vector<Row>& rows) {
-    double best = std::numeric_limits<double>::infinity();
-    for (const Row& row : rows) {
-        if (usable(row)) best = std::min(best, row.result.median_ms);
-    }
-    for (Row& row : rows) {
-        if (usable(row) && std::isfinite(best)) row.ratio = row.result.median_ms / best;
-    }
-}
-
-/// Each peer's grid on a short run, then its fastest configuration on the full run, appended to
-/// `rows` as the peer; every short run goes to `sweep`.
-void tunePeers(const TableRun& run, std::vector<Row>& rows, std::vector<Row>& sweep) {
-    BenchOptions short_run = run.options;
-    short_run.frames = std::min(run.options.frames, kTuneFrames);
-    short_run.budget_seconds = run.options.budget_seconds > 0
-                                   ? std::min(run.options.budget_seconds, kTuneBudgetSeconds)
-                                   : kTuneBudgetSeconds;
-    std::vector<std::string> families;
-    for (const BenchMethodEntry& m : benchMethods()) {
-        if (!m.family.empty() &&
-            std::find(families.begin(), families.end(), m.family) == families.end()) {
-            families.push_back(m.family);
-        }
-    }
-    for (const std::string& family : families) {
-        const BenchMethodEntry* best = nullptr;
-        double best_ms = std::numeric_limits<double>::infinity();
-        int configs = 0;
-        std::string skip_reason;
-        for (const BenchMethodEntry& m : benchMethods()) {
-            if (m.family != family) continue;
-            Row row = runMethod(m, run, short_run);
-            if (row.skipped) {
-                skip_reason = row.skip_reason;
-            } else {
-                ++configs;
-                if (usable(row) && row.result.median_ms < best_ms) {
-                    best_ms = row.result.median_ms;
-                    best = &m;
-                }
-            }
-            sweep.push_back(std::move(row));
-        }
-        if (best == nullptr) {
-            Row row;
-            row.method = family;
-            row.workload = tableName(run.workload, run.one_shot);
-            row.n = run.workload.size();
-            row.peer = true;
-            row.skipped = true;
-            row.skip_reason = configs == 0 ? skip_reason : "no configuration ran cleanly";
-            rows.push_back(std::move(row));
-            continue;
-        }
-        Row row = runMethod(*best, run);
-        row.family = family;
-        row.configs = configs;
-        rows.push_back(std::move(row));
-    }
 }
 
 }  // namespace
@@ -764,11 +686,18 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
         << kEdgeFrames << " frames; vs_peer = median / best peer's median;\n"
         << "peak_MB = VmHWM growth of the method's own process; check = every frame's pair set "
            "(count + hash) vs an independent sort-and-sweep.\n";
+    out << "Two rules: median_ms times the pairs as each method holds them (a peer's loose "
+           "pair cache unfiltered); exact_ms adds delivering the exact pairs (the peer filters "
+           "its cache with the exact boxes, timed; cdlab's methods already deliver exact, "
+           "sorted pairs). vs_peer and vs_peer_ex are against the best peer by each.\n";
     if (tune) {
-        out << "Peers tuned: every configuration of each peer's grid runs up to " << kTuneFrames
-            << " frames / " << kTuneBudgetSeconds
-            << " s; the fastest (by median) of each peer then runs in full and is the peer "
-               "row, named peer:configuration (--peers all prints the grid).\n";
+        out << "Peers tuned: every configuration of each peer's grid runs all frames (stopped "
+               "after "
+            << kTuneBudgetSeconds
+            << " s of frame time; a stopped one is ranked only if none ran in full); the "
+               "fastest by its median is the peer row, named peer:configuration, and so is "
+               "the fastest by exact_ms when that is another (--peers all prints the "
+               "grid).\n";
     }
     if (!options.isolate) out << "(in-process run: peak memory not measured)\n";
 
@@ -795,12 +724,10 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
                 reportWorkload(out, rows, options,
                                one_shot ? oneShotRepetitions(options) : options.frames);
                 if (options.peers == "all" && !sweep.empty()) {
-                    out << "peer configurations swept (up to " << kTuneFrames << " frames / "
-                        << kTuneBudgetSeconds << " s each; vs_peer against the best of them):\n";
+                    out << "peer configurations swept (stopped after " << kTuneBudgetSeconds
+                        << " s each; vs_peer against the best of them):\n";
                     setRatios(sweep);
-                    printTable(out, sweep,
-                               std::min(one_shot ? oneShotRepetitions(options) : options.frames,
-                                         kTuneFrames));
+                    printTable(out, sweep, one_shot ? oneShotRepetitions(options) : options.frames);
                 }
                 for (Row& row : rows) all_rows.push_back(std::move(row));
                 for (Row& row : sweep) {

@@ -30,8 +30,8 @@ struct BenchOptions {
     /// on more than one thread are left out); "wall": elapsed time, every method.
     std::string clock = "thread";
     /// Which peer configurations run when no --methods is given. "tuned": every configuration
-    /// of each peer's tuning grid on a short run, then the fastest of each peer on the full run,
-    /// ratios against the fastest of those; "all": the same, printing the whole grid;
+    /// of each peer's tuning grid on the full run, the fastest of each peer by its median (and
+    /// by its exact-pairs median) its row, ratios against the fastest of those; "all": the same, printing the whole grid;
     /// "default": each peer at its default settings only.
     std::string peers = "tuned";
 };

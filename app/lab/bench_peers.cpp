@@ -5,7 +5,8 @@
 //    hashed pair cache and no dispatcher, which it only needs to free narrow-phase algorithms.
 //    Its cache is a superset of the exact pairs (btDbvtBroadphase keeps pairs while the fattened
 //    leaves overlap and removes stale ones lazily; btAxisSweep3 tests quantised boxes), so
-//    summary() filters it with the exact AABBs, outside the timed frame.
+//    deliverExact() filters it into a list of exact pairs (timed under the exact-pairs rule) and
+//    summary() filters it again for the check, untimed.
 //  - FCL's managers call back exactly for AABB-overlapping pairs; the callback only counts them.
 //    Its CollisionObject AABB for an unrotated Box is translation -/+ side/2, i.e. the same
 //    doubles as cdlab's box.
@@ -15,6 +16,7 @@
 #include <limits>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "bench_method.h"
 
@@ -23,6 +25,7 @@
 #include <BulletCollision/BroadphaseCollision/btBroadphaseProxy.h>
 #include <BulletCollision/BroadphaseCollision/btDbvtBroadphase.h>
 #include <BulletCollision/BroadphaseCollision/btOverlappingPairCache.h>
+#include <LinearMath/btAabbUtil2.h>
 #endif
 
 #ifdef CDLAB_HAVE_FCL
@@ -166,9 +169,39 @@ public:
                 static_cast<int>(reinterpret_cast<std::intptr_t>(p.m_pProxy1->m_clientObject)),
                 out);
         }
+        // The list deliverExact() made, when it ran for this frame, must be the same set: a
+        // differing one is reported as a mismatch (the count made impossible).
+        if (delivered_ && !(summarizePairs(exact_) == out)) out.pairs = -1;
+        delivered_ = false;
         return out;
     }
     std::int64_t rawPairs() const override { return raw_pairs_; }
+    void deliverExact(const MovingBoxes& boxes) override {
+        // What a caller of Bullet does before its narrow phase: keep the cache pairs whose
+        // boxes overlap, tested on the boxes the proxies hold (the exact ones when btScalar is
+        // double; float proxies hold them rounded outward, so the workload's are tested then).
+        // No sort: Bullet's order is its hash's, and none is asked of it.
+        btBroadphasePairArray& cache =
+            broad_phase_->getOverlappingPairCache()->getOverlappingPairArray();
+        exact_.clear();
+        delivered_ = true;
+        for (int k = 0; k < cache.size(); ++k) {
+            const btBroadphaseProxy* p0 = cache[k].m_pProxy0;
+            const btBroadphaseProxy* p1 = cache[k].m_pProxy1;
+            if (p0 == nullptr || p1 == nullptr) continue;
+            int a = static_cast<int>(reinterpret_cast<std::intptr_t>(p0->m_clientObject));
+            int b = static_cast<int>(reinterpret_cast<std::intptr_t>(p1->m_clientObject));
+            bool overlap;
+            if constexpr (sizeof(btScalar) == sizeof(collision::Real)) {
+                overlap = TestAabbAgainstAabb2(p0->m_aabbMin, p0->m_aabbMax, p1->m_aabbMin,
+                                               p1->m_aabbMax);
+            } else {
+                overlap = boxes.aabb(a).overlaps(boxes.aabb(b));
+            }
+            if (a > b) std::swap(a, b);
+            if (overlap) exact_.push_back({a, b});
+        }
+    }
 
 private:
     BulletKind kind_;
@@ -176,6 +209,8 @@ private:
     std::unique_ptr<btBroadphaseInterface> broad_phase_;
     std::vector<btBroadphaseProxy*> proxies_;
     std::int64_t raw_pairs_ = 0;
+    std::vector<collision::ProxyPair> exact_;  ///< deliverExact()'s list, reused
+    bool delivered_ = false;                   ///< exact_ is this frame's
 };
 
 #endif  // CDLAB_HAVE_BULLET

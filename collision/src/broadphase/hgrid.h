@@ -32,8 +32,10 @@ namespace collision {
 /// Detection §7.1.5), so it is met once. That column is known from two bits per entry: whether
 /// the entry's own min corner is in this column's row (y) and layer (z).
 ///
-/// Each frame the proxies are radix-sorted by float(min x) (a non-decreasing image of min x)
-/// and scattered into the columns stably in that order, so each column is nearly sorted; an
+/// Each frame the proxies are sorted by float(min x) (a non-decreasing image of min x): last
+/// frame's order insertion-sorted when no proxy came or went (O(n + swaps) under coherent
+/// motion; past n / 2 swaps, where boxes are dense along x, a radix sort, for kResortPause
+/// frames), a radix sort otherwise; and scattered into the columns stably in that order, so each column is nearly sorted; an
 /// insertion sort per column restores the exact (min x, id) order (sorting a column outright
 /// past a budget of shifts). Pairs are put in (a, b) order by one more radix sort (or left in
 /// the sweep's order: PairOrder). Cost per
@@ -63,6 +65,8 @@ public:
     explicit HierarchicalGrid(bool two_threads = false, PairOrder order = PairOrder::Sorted);
     ~HierarchicalGrid() override;
     std::string_view name() const override { return helper_ ? "hgrid2" : "hgrid"; }
+    void insert(ProxyId id, const ProxyVolumes& v) override;
+    void remove(ProxyId id) override;
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
     void draw(DebugDraw& draw, const Aabb& bounds) const override;
     std::string validate() const override;
@@ -149,6 +153,7 @@ private:
     void planChunks(std::size_t total, std::size_t flat_columns);
     void mergeLanePairs(std::vector<ProxyPair>& pairs);
     void sortByMinX();
+    bool resortByMinX();
     void levelLane(Lane& lane, Real top);
     void countLane(Lane& lane);
     void scatterLane(Lane& lane, std::size_t spare_slot);
@@ -163,7 +168,12 @@ private:
     Real origin_y_ = 0, origin_z_ = 0;
     std::array<Level, kMaxLevels> levels_;
     std::vector<std::uint32_t> order_;   // present proxies by (min x, id)
+    bool order_stale_ = true;            // a proxy was inserted or removed since order_ was made
+    /// Frames the radix sort runs after an insertion sort ran past its budget.
+    static constexpr int kResortPause = 16;
+    int resort_pause_ = 0;
     std::vector<std::uint64_t> packed_;  // (float min x, id) sort keys
+    std::vector<std::uint32_t> key_of_id_;  // float min x's sort key, by id
     std::vector<std::uint64_t> packed_scratch_;
     std::vector<Aabb> box_;               // their boxes
     std::vector<std::uint8_t> level_of_;  // by position in order_

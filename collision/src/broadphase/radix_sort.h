@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <span>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "collision/broadphase/broad_phase.h"
@@ -24,27 +25,31 @@ inline std::uint64_t orderedBits(T v) {
     return (b >> kTop) ? U(~b) : U(b | (U(1) << kTop));
 }
 
-// Stable LSD radix sort of `keys` by their bits [low, low + bits): as few digits as possible of
-// at most 14 bits (a 64 KiB histogram), all counted in one read pass; a digit that is the same
-// in every key costs no pass. The last pass does not store the keys: it calls emit(i, key) for
-// every key, i being its place in sorted order, so a caller writes what it needs (pairs, ids)
-// straight from it. `keys` is left in an unspecified order; `scratch` is reused storage.
-template <typename Emit>
-void lsdRadixSort(std::span<std::uint64_t> keys, std::vector<std::uint64_t>& scratch, int low,
-                  int bits, Emit&& emit) {
+// Stable LSD radix sort of n keys by their bits [low, low + bits): as few digits as possible of
+// at most 14 bits (a 64 KiB histogram), all counted in one pass that also writes the keys, from
+// load(i), into `keys` (so a caller can convert them on the way: order a pair's ids, narrow
+// them to 32 bits); a digit that is the same in every key costs no pass. The last pass does not
+// store the keys: it calls emit(i, key) for every key, i being its place in sorted order, so a
+// caller writes what it needs (pairs, ids) straight from it. `keys` and `scratch` hold n keys
+// each and are left in an unspecified order.
+template <typename Key, typename Load, typename Emit>
+void lsdRadixSortLoaded(std::size_t n, Load&& load, Key* keys, Key* scratch, int low, int bits,
+                        Emit&& emit) {
     constexpr int kMaxDigitBits = 14;
-    constexpr int kMaxDigits = (64 + kMaxDigitBits - 1) / kMaxDigitBits;
-    const std::size_t n = keys.size();
-    bits = std::clamp(bits, 1, 64 - low);
+    constexpr int kKeyBits = int(sizeof(Key)) * 8;
+    constexpr int kMaxDigits = (kKeyBits + kMaxDigitBits - 1) / kMaxDigitBits;
+    bits = std::clamp(bits, 1, kKeyBits - low);
     const int digits = (bits + kMaxDigitBits - 1) / kMaxDigitBits;
     const int width = (bits + digits - 1) / digits;
     const std::size_t buckets = std::size_t(1) << width;
-    const std::uint64_t mask = buckets - 1;
+    const Key mask = Key(buckets - 1);
     thread_local std::vector<std::uint32_t> histogram;  // reused: no allocation once grown
     histogram.assign(buckets * std::size_t(digits), 0);
     std::array<std::uint32_t*, kMaxDigits> count{};
     for (int d = 0; d < digits; ++d) count[d] = histogram.data() + buckets * std::size_t(d);
-    for (std::uint64_t k : keys) {
+    for (std::size_t i = 0; i < n; ++i) {
+        const Key k = load(i);
+        keys[i] = k;
         for (int d = 0; d < digits; ++d) ++count[d][(k >> (low + d * width)) & mask];
     }
     std::array<int, kMaxDigits> passes{};
@@ -52,9 +57,8 @@ void lsdRadixSort(std::span<std::uint64_t> keys, std::vector<std::uint64_t>& scr
     for (int d = 0; d < digits && n > 0; ++d) {
         if (count[d][(keys[0] >> (low + d * width)) & mask] != n) passes[pass_count++] = d;
     }
-    scratch.resize(n);
-    std::uint64_t* from = keys.data();
-    std::uint64_t* to = scratch.data();
+    Key* from = keys;
+    Key* to = scratch;
     for (int p = 0; p < pass_count; ++p) {
         std::uint32_t* const c = count[passes[p]];
         std::uint32_t sum = 0;
@@ -66,18 +70,29 @@ void lsdRadixSort(std::span<std::uint64_t> keys, std::vector<std::uint64_t>& scr
         const int digit_shift = low + passes[p] * width;
         if (p + 1 == pass_count) {
             for (std::size_t i = 0; i < n; ++i) {
-                const std::uint64_t k = from[i];
+                const Key k = from[i];
                 emit(std::size_t(c[(k >> digit_shift) & mask]++), k);
             }
             return;
         }
         for (std::size_t i = 0; i < n; ++i) {
-            const std::uint64_t k = from[i];
+            const Key k = from[i];
             to[c[(k >> digit_shift) & mask]++] = k;
         }
         std::swap(from, to);
     }
     for (std::size_t i = 0; i < n; ++i) emit(i, from[i]);  // already in order
+}
+
+// lsdRadixSort of `keys` as they are. `scratch` is reused storage.
+template <typename Emit>
+void lsdRadixSort(std::span<std::uint64_t> keys, std::vector<std::uint64_t>& scratch, int low,
+                  int bits, Emit&& emit) {
+    scratch.resize(keys.size());
+    std::uint64_t* const k = keys.data();
+    lsdRadixSortLoaded(
+        keys.size(), [k](std::size_t i) { return k[i]; }, k, scratch.data(), low, bits,
+        std::forward<Emit>(emit));
 }
 
 inline int bitsFor(std::uint64_t n) {
@@ -88,31 +103,43 @@ inline int bitsFor(std::uint64_t n) {
 
 /// Sorts `keys` (each (a << shift) | b, a < b < 2^shift) and writes them to `pairs` as (a, b):
 /// the sorted, unique pair list every broad phase returns. `scratch` is reused storage; `keys`
-/// is left in an unspecified order. lsdRadixSort's last pass writes the pairs themselves.
-/// With `order_ids` the keys may hold their two ids either way round ((b << shift) | a); they
-/// are put as (a, b) in the counting pass, so a caller need not order them per candidate.
+/// is left in an unspecified order. With `order_ids` the keys may hold their two ids either way
+/// round ((b << shift) | a); they are put as (a, b) in the counting pass, so a caller need not
+/// order them per candidate. Keys of at most 32 bits (up to 65,536 ids) are sorted as 32-bit
+/// integers, half the memory traffic of every pass; lsdRadixSort's last pass writes the pairs.
 inline void keysToSortedPairs(std::span<std::uint64_t> keys, std::vector<std::uint64_t>& scratch,
                               int shift, std::vector<ProxyPair>& pairs, bool order_ids = false) {
     const std::size_t n = keys.size();
     pairs.resize(n);
     const std::uint64_t id_mask = (std::uint64_t(1) << shift) - 1;
-    const auto toPair = [shift, id_mask](std::uint64_t k) {
-        return ProxyPair{static_cast<ProxyId>(k >> shift), static_cast<ProxyId>(k & id_mask)};
+    const std::uint64_t* const in = keys.data();
+    const auto load = [in, shift, id_mask, order_ids](std::size_t i) {
+        const std::uint64_t k = in[i];
+        if (!order_ids) return k;
+        const std::uint64_t x = k >> shift, y = k & id_mask;
+        const std::uint64_t swap = (x ^ y) & (std::uint64_t(0) - std::uint64_t(x > y));
+        return ((x ^ swap) << shift) | (y ^ swap);  // (min, max) by masks: no branch
     };
-    if (order_ids) {
-        for (std::uint64_t& k : keys) {
-            const std::uint64_t x = k >> shift, y = k & id_mask;
-            const std::uint64_t swap = (x ^ y) & (std::uint64_t(0) - std::uint64_t(x > y));
-            k = ((x ^ swap) << shift) | (y ^ swap);  // (min, max) by masks: no branch
-        }
-    }
+    ProxyPair* const out = pairs.data();
+    const auto emit = [out, shift, id_mask](std::size_t i, auto k) {
+        out[i] = ProxyPair{static_cast<ProxyId>(k >> shift), static_cast<ProxyId>(k & id_mask)};
+    };
     if (n <= 64) {
+        for (std::size_t i = 0; i < n; ++i) keys[i] = load(i);
         std::sort(keys.begin(), keys.end());
-        for (std::size_t i = 0; i < n; ++i) pairs[i] = toPair(keys[i]);
+        for (std::size_t i = 0; i < n; ++i) emit(i, keys[i]);
         return;
     }
-    lsdRadixSort(keys, scratch, 0, 2 * shift,
-                 [&](std::size_t i, std::uint64_t k) { pairs[i] = toPair(k); });
+    if (2 * shift <= 32) {
+        thread_local std::vector<std::uint32_t> narrow;  // reused: no allocation once grown
+        narrow.resize(2 * n);
+        lsdRadixSortLoaded(
+            n, [&load](std::size_t i) { return static_cast<std::uint32_t>(load(i)); },
+            narrow.data(), narrow.data() + n, 0, 2 * shift, emit);
+        return;
+    }
+    scratch.resize(n);
+    lsdRadixSortLoaded(n, load, keys.data(), scratch.data(), 0, 2 * shift, emit);
 }
 
 /// Writes `keys` (each (a << shift) | b or (b << shift) | a) to `pairs` as (a, b), a < b, in
