@@ -211,22 +211,8 @@ void World::queryLinkImpact(const collision::ProxyPair& pair) {
         collision::chainFrames(*s.chain, t0 + out.t * (t1 - t0), frames_);
         return frames_[static_cast<std::size_t>(s.link)] * s.shape_in_link;
     };
-    ToiEvent e;
-    e.a = pair.a;
-    e.b = pair.b;
-    e.t = out.t;
-    e.pose_a = poseAt(in.side_a);
-    e.pose_b = poseAt(in.side_b);
-    e.failed = out.state == collision::CcdState::Failed;
-    e.normal = out.normal;
-    if (!(e.normal.squaredNorm() > 0)) {
-        const Vec3 d = e.pose_b.position - e.pose_a.position;
-        const Real len = d.norm();
-        e.normal = len > 0 ? Vec3(d / len) : Vec3(Vec3::UnitX());
-        e.point = (e.pose_a.position + e.pose_b.position) / 2;
-    } else {
-        e.point = (out.point_a + out.point_b) / 2;
-    }
+    const Pose pose_a = poseAt(in.side_a);
+    const ToiEvent e = impactEvent(pair, out, pose_a, poseAt(in.side_b));
     if (e.t == 0) {
         // At the start of the step only an approaching pair is stopped (as rigid pairs).
         const Body& a = bodies_[pair.a];

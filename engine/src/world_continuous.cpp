@@ -35,10 +35,11 @@ Vec3 rotationBetween(const Quat& q0, const Quat& q1) {
 }  // namespace
 
 // The continuous stage (ccd: conservative_advancement; sphere pairs by the exact quadratic
-// root with ccd_spheres: exact). After integration every body has a sweep from its pose at the start of the step to its integrated pose: linear in position;
-// for semi-implicit Euler the integrator's rotation as a world turn about L and a body-frame
-// spin (exact for symmetric bodies, so a pose stopped mid-step keeps the energy), for the
-// other integrators the constant-axis chord from start to end.
+// root with ccd_spheres: exact). After integration every body has a sweep from its pose at the
+// start of the step to its integrated pose: linear in position; for semi-implicit Euler the
+// integrator's rotation as a world turn about L and a body-frame spin (exact for symmetric bodies,
+// so a pose stopped mid-step keeps the energy), for the other integrators the constant-axis chord
+// from start to end.
 // 1. Candidate pairs: swept bounds (AABB of the centre's segment grown by the bounding
 //    radius about the centre) overlap, at least one body moves. Sweep on x, pairs sorted.
 // 2. timeOfImpact per pair (never later than first contact, target gap kept). A pair that
@@ -132,6 +133,28 @@ void World::findSweptPairs() {
     std::sort(ccd_pairs_.begin(), ccd_pairs_.end());
 }
 
+ToiEvent World::impactEvent(const collision::ProxyPair& pair, const collision::ToiOutput& out,
+                            const Pose& pose_a, const Pose& pose_b) {
+    ToiEvent e;
+    e.a = pair.a;
+    e.b = pair.b;
+    e.t = out.t;
+    e.pose_a = pose_a;
+    e.pose_b = pose_b;
+    e.failed = out.state == collision::CcdState::Failed;
+    e.normal = out.normal;
+    if (!(e.normal.squaredNorm() > 0)) {
+        // Failed before any distance: the line of centres (or +x) is the best guess.
+        const Vec3 d = e.pose_b.position - e.pose_a.position;
+        const Real len = d.norm();
+        e.normal = len > 0 ? Vec3(d / len) : Vec3(Vec3::UnitX());
+        e.point = (e.pose_a.position + e.pose_b.position) / 2;
+    } else {
+        e.point = (out.point_a + out.point_b) / 2;
+    }
+    return e;
+}
+
 // A time of impact per candidate pair; the events kept, sorted by (t, a, b).
 void World::queryTimesOfImpact() {
     toi_events_.clear();
@@ -202,23 +225,7 @@ void World::queryTimesOfImpact() {
         if (out.state != collision::CcdState::Hit && out.state != collision::CcdState::Failed) {
             continue;
         }
-        ToiEvent e;
-        e.a = pair.a;
-        e.b = pair.b;
-        e.t = out.t;
-        e.pose_a = in.sweep_a.at(out.t);
-        e.pose_b = in.sweep_b.at(out.t);
-        e.failed = out.state == collision::CcdState::Failed;
-        e.normal = out.normal;
-        if (!(e.normal.squaredNorm() > 0)) {
-            // Failed before any distance: the line of centres (or +x) is the best guess.
-            const Vec3 d = e.pose_b.position - e.pose_a.position;
-            const Real len = d.norm();
-            e.normal = len > 0 ? Vec3(d / len) : Vec3(Vec3::UnitX());
-            e.point = (e.pose_a.position + e.pose_b.position) / 2;
-        } else {
-            e.point = (out.point_a + out.point_b) / 2;
-        }
+        const ToiEvent e = impactEvent(pair, out, in.sweep_a.at(out.t), in.sweep_b.at(out.t));
         const Real approach =
             (pointVelocity(b, e.pose_b, e.point) - pointVelocity(a, e.pose_a, e.point))
                 .dot(e.normal);

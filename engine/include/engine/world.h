@@ -298,10 +298,10 @@ private:
     // Continuous stage scratch, reused across steps (no per-step allocation once warm).
     struct SweptBody {
         collision::Sweep sweep;
-        collision::Aabb box;  ///< swept bounds over the step
-        Real radius = 0;      ///< bounding radius about the centre of mass
+        collision::Aabb box;    ///< swept bounds over the step
+        Real radius = 0;        ///< bounding radius about the centre of mass
         Real deform_speed = 0;  ///< m per step: deformation's bound on any point's speed
-        Real clamp_t = 1;     ///< earliest accepted time of impact
+        Real clamp_t = 1;       ///< earliest accepted time of impact
         bool moving = false;
     };
     // Chains (world_chains.cpp): links to their frames at the end of the step, the parent-child
@@ -310,6 +310,10 @@ private:
     void dropExcludedPairs(std::vector<collision::ProxyPair>& pairs) const;
     void sweepLink(std::size_t i, SweptBody& s) const;
     void queryLinkImpact(const collision::ProxyPair& pair);
+    /// The event of a Hit or Failed query of `pair` at the poses of its time
+    /// (world_continuous.cpp).
+    static ToiEvent impactEvent(const collision::ProxyPair& pair, const collision::ToiOutput& out,
+                                const Pose& pose_a, const Pose& pose_b);
     void stopChainsAtImpacts();
     /// Velocity (m/s) of the material point at world `point` of body `id` at step fraction `s`
     /// if it is a link of a chain moving in this step, else zero.
