@@ -31,13 +31,14 @@ using cdlab_test::slurp;
 
 fs::path tempDir(const std::string& name) { return cdlab_test::tempDir("cdlab_bp_bench_", name); }
 
-// Overlapping pairs of the workload after `frames` steps, by testing every pair of boxes with
-// the closed interval test on each axis (touching counts): independent of every broad phase and
-// of the bench's own reference sweep.
-std::int64_t bruteForcePairs(app::WorkloadKind kind, int n, std::uint64_t seed, int frames) {
+// Calls visit(a, b) for every overlapping pair of the workload after `frames` steps, by testing
+// every pair of boxes with the closed interval test on each axis (touching counts): independent
+// of every broad phase and of the bench's own reference sweep.
+template <class Visit>
+void forEachOverlappingPair(app::WorkloadKind kind, int n, std::uint64_t seed, int frames,
+                            Visit visit) {
     app::MovingBoxes boxes(kind, n, seed);
     for (int f = 0; f < frames; ++f) boxes.step();
-    std::int64_t pairs = 0;
     for (int a = 0; a < n; ++a) {
         for (int b = a + 1; b < n; ++b) {
             const collision::Aabb& ba = boxes.aabb(a);
@@ -46,9 +47,15 @@ std::int64_t bruteForcePairs(app::WorkloadKind kind, int n, std::uint64_t seed, 
             for (int k = 0; k < 3; ++k) {
                 overlap = overlap && ba.min[k] <= bb.max[k] && bb.min[k] <= ba.max[k];
             }
-            pairs += overlap ? 1 : 0;
+            if (overlap) visit(a, b);
         }
     }
+}
+
+// Overlapping pairs of the workload after `frames` steps (forEachOverlappingPair).
+std::int64_t bruteForcePairs(app::WorkloadKind kind, int n, std::uint64_t seed, int frames) {
+    std::int64_t pairs = 0;
+    forEachOverlappingPair(kind, n, seed, frames, [&](int, int) { ++pairs; });
     return pairs;
 }
 
@@ -241,22 +248,11 @@ TEST(BroadphaseBench, WallClockRunsTheTwoThreadMethodWithTheSamePairs) {
 // Boxes of the workload after `frames` steps that overlap at least one other box (closed
 // intervals, like bruteForcePairs): each must be in a potentially colliding set.
 std::int64_t boxesInSomePair(app::WorkloadKind kind, int n, std::uint64_t seed, int frames) {
-    app::MovingBoxes boxes(kind, n, seed);
-    for (int f = 0; f < frames; ++f) boxes.step();
     std::vector<char> paired(static_cast<std::size_t>(n), 0);
-    for (int a = 0; a < n; ++a) {
-        for (int b = a + 1; b < n; ++b) {
-            const collision::Aabb& ba = boxes.aabb(a);
-            const collision::Aabb& bb = boxes.aabb(b);
-            bool overlap = true;
-            for (int k = 0; k < 3; ++k) {
-                overlap = overlap && ba.min[k] <= bb.max[k] && bb.min[k] <= ba.max[k];
-            }
-            if (!overlap) continue;
-            paired[static_cast<std::size_t>(a)] = 1;
-            paired[static_cast<std::size_t>(b)] = 1;
-        }
-    }
+    forEachOverlappingPair(kind, n, seed, frames, [&](int a, int b) {
+        paired[static_cast<std::size_t>(a)] = 1;
+        paired[static_cast<std::size_t>(b)] = 1;
+    });
     return std::count(paired.begin(), paired.end(), 1);
 }
 
