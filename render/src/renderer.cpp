@@ -1,5 +1,6 @@
-// render/src/renderer.cpp -- OSMesa software rendering of a World: shaded bodies, bounding-volume
-// wireframes coloured by overlap state, world bounds, broad-phase structure, HUD text.
+// render/src/renderer.cpp -- OSMesa software rendering of a World: the GL set-up, shaded
+// bodies, the line buffers drawn (built in frame_lines.cpp), the supersampled pixels read back
+// and filtered, then the overlays (overlay.cpp).
 // Invariant: a frame is a pure function of (world state, camera, options, size). Nothing that
 // shapes a pixel reads a clock (the clock only times the stages for FrameStats), geometry is
 // generated in a fixed order, and all vertices are eye-relative, so the same state renders
@@ -13,25 +14,16 @@
 #endif
 
 #include <algorithm>
+#include <array>
 #include <chrono>
-#include <cmath>
-#include <cstdio>
 #include <cstring>
-#include <limits>
-#include <map>
-#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
-#include "camera.h"
 #include "collision/geometry/shape.h"
 #include "collision/volumes/bounding_volumes.h"
-#include "font.h"
-#include "gl_debug_draw.h"
-#include "legend.h"
-#include "osmesa_context.h"
-#include "render/volume_states.h"
-#include "tessellation.h"
+#include "renderer_impl.h"
 
 namespace render {
 namespace {
@@ -41,23 +33,6 @@ using collision::Mat3;
 using collision::Pose;
 using collision::Real;
 using collision::Vec3;
-
-constexpr Color kBoundsColor{0.74f, 0.76f, 0.82f, 1.0f};
-constexpr Color kGridColor{0.22f, 0.24f, 0.29f, 1.0f};
-/// Contact marks, as fractions of the smaller bounding radius of the pair: the half size of a
-/// witness cross and the length of the normal segment.
-constexpr Real kContactCrossFraction = Real(0.06);
-constexpr Real kContactNormalFraction = Real(0.5);
-
-/// "Nice" grid spacing (1, 2 or 5 times a power of ten) giving about `target` cells over `extent`.
-Real gridStep(Real extent, Real target) {
-    const Real raw = extent / target;
-    const Real p = std::pow(Real(10), std::floor(std::log10(raw)));
-    for (const Real m : {Real(1), Real(2), Real(5)}) {
-        if (m * p >= raw) return m * p;
-    }
-    return 10 * p;
-}
 
 // One output row of a 2x2 box filter: `width` RGB pixels, each the rounded mean
 // ((a + b + c + d + 2) >> 2) of two adjacent RGBA pixels in `r0` and the two below them in `r1`.
@@ -122,55 +97,6 @@ collision::Color stateColor(engine::BodyState state) {
     return {1.0f, 0.0f, 1.0f, 1.0f};
 }
 
-struct Renderer::Impl {
-    Impl(int w, int h) : width(w), height(h), ss(supersampleFor(w, h)), context(w * ss, h * ss) {}
-
-    int width;
-    int height;
-    int ss;
-    OsMesaContext context;
-    std::map<int, UnitSphereGrid> sphere_grids;  ///< by slice count
-    TriangleBuffer triangles;
-    LineBuffer frame_lines;                     ///< world bounds and floor grid
-    LineBuffer structure_lines;                 ///< the broad phase's own drawing
-    LineBuffer volume_lines;                    ///< bounding volumes
-    LineBuffer outline_lines;                   ///< bounding spheres' silhouettes
-    LineBuffer bvh_lines;                       ///< mesh hierarchy levels (draw.bvh_depth)
-    LineBuffer contact_lines;                   ///< contact witnesses and normals (draw.contacts)
-    std::vector<LegendEntry> structure_legend;  ///< what the broad phase's colours show
-    /// Some volume drawn is not the kind the broad phase tests: the legend says that each
-    /// volume is coloured by its own test.
-    bool own_tests = false;
-    std::optional<VolumeKind> tested_volume;  ///< the kind the broad phase tests
-    FrameStats stats;
-
-    const UnitSphereGrid& sphereGrid(int slices) {
-        auto it = sphere_grids.find(slices);
-        if (it == sphere_grids.end()) {
-            it = sphere_grids.emplace(slices, makeUnitSphereGrid(slices)).first;
-        }
-        return it->second;
-    }
-
-    CameraFrame setUpCamera(const engine::World& world, const engine::CameraSettings& camera,
-                            const FrameOptions& options);
-    void setUpGl(const CameraFrame& cam);
-    /// Tessellates and draws every body that may show, in batches.
-    void drawBodies(const engine::World& world, const CameraFrame& cam,
-                    const FrameOptions& options);
-    void buildLines(const engine::World& world, const CameraFrame& cam,
-                    const FrameOptions& options);
-    /// The bounding-volume wireframes, each kind in the colours of its own overlap test.
-    void drawVolumes(const engine::World& world, const CameraFrame& cam,
-                     const FrameOptions& options, GlDebugDraw& debug);
-    void drawKdops(const engine::World& world, const FrameOptions& options, GlDebugDraw& debug);
-    /// Draws the triangle buffer and empties it.
-    void drawTriangles(const collision::Color& color = kBodyColor);
-    void drawSelfPairs(const engine::World& world, const CameraFrame& cam);
-    void drawLines(const LineBuffer& lines, float width_px);
-    void readPixels(Image& image);
-    void drawOverlays(Image& image, const FrameOptions& options) const;
-};
 
 CameraFrame Renderer::Impl::setUpCamera(const engine::World& world,
                                         const engine::CameraSettings& camera,
@@ -335,140 +261,6 @@ void Renderer::Impl::drawSelfPairs(const engine::World& world, const CameraFrame
     drawTriangles(stateColor(engine::BodyState::Colliding));
 }
 
-void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& cam,
-                                const FrameOptions& options) {
-    frame_lines.clear();
-    structure_lines.clear();
-    volume_lines.clear();
-    outline_lines.clear();
-    bvh_lines.clear();
-    contact_lines.clear();
-    GlDebugDraw debug(cam, frame_lines);
-
-    if (options.draw.bounds) {
-        const collision::Aabb& b = world.settings().bounds;
-        // A faint floor grid on the bottom face (y is up in scenes), then the box itself.
-        const Real ext = std::max(b.extents().x(), b.extents().z());
-        if (ext > 0 && std::isfinite(ext)) {
-            const Real step = gridStep(ext, 10);
-            const Real y = b.min.y();
-            for (Real x = std::ceil(b.min.x() / step) * step; x < b.max.x(); x += step) {
-                if (x > b.min.x()) debug.drawLine({x, y, b.min.z()}, {x, y, b.max.z()}, kGridColor);
-            }
-            for (Real z = std::ceil(b.min.z() / step) * step; z < b.max.z(); z += step) {
-                if (z > b.min.z()) debug.drawLine({b.min.x(), y, z}, {b.max.x(), y, z}, kGridColor);
-            }
-        }
-        debug.drawAabb(b, kBoundsColor);
-    }
-
-    structure_legend.clear();
-    if (options.draw_structure) {
-        debug.setTarget(structure_lines);
-        debug.setLegend(&structure_legend);
-        world.broadPhase().draw(debug, world.settings().bounds);
-        debug.setLegend(nullptr);
-    }
-
-    drawVolumes(world, cam, options, debug);
-
-    // CCD: each moving body of a time-of-impact event at its pose there (spheres as spheres,
-    // other shapes as their OBB), and the contact normal, in blue. Read-only use of the events.
-    const auto bodies = world.bodies();
-    for (const engine::ToiEvent& e : world.toiEvents()) {
-        for (const auto& [id, pose] : {std::pair{e.a, e.pose_a}, std::pair{e.b, e.pose_b}}) {
-            if (id < 0 || static_cast<std::size_t>(id) >= bodies.size()) continue;
-            const engine::Body& b = bodies[static_cast<std::size_t>(id)];
-            if (b.is_static && !b.kinematic) continue;  // links move with their chain
-            if (b.shape.type == collision::ShapeType::Sphere) {
-                debug.drawSphere(collision::transformSphere(b.local_bounds.sphere, pose),
-                                 kToiColor);
-            } else {
-                debug.drawObb(collision::transformObb(b.local_bounds.obb, pose), kToiColor);
-            }
-        }
-        Real size = 0;
-        for (const engine::BodyId id : {e.a, e.b}) {
-            if (id >= 0 && static_cast<std::size_t>(id) < bodies.size()) {
-                size =
-                    std::max(size, bodies[static_cast<std::size_t>(id)].local_bounds.sphere.radius);
-            }
-        }
-        debug.drawLine(e.point, e.point + e.normal * size, kToiColor);
-    }
-    if (options.draw.bodies) world.drawChainSkeletons(debug, kSkeletonColor);
-
-    // What the narrow phase confirmed: the World derives it and decides what to draw.
-    engine::ContactDrawStyle style;
-    style.node_apart = nodeColor(collision::BvhNodeState::Apart);
-    style.node_overlapping = nodeColor(collision::BvhNodeState::Overlapping);
-    style.node_confirmed = nodeColor(collision::BvhNodeState::Confirmed);
-    style.contact = kContactColor;
-    style.cross_fraction = kContactCrossFraction;
-    style.normal_fraction = kContactNormalFraction;
-    if (options.draw.bvh_depth >= 0) {
-        debug.setTarget(bvh_lines);
-        world.drawHierarchyLevels(debug, options.draw.bvh_depth, style);
-    }
-    if (options.draw.contacts) {
-        debug.setTarget(contact_lines);
-        world.drawContacts(debug, style);
-    }
-}
-
-void Renderer::Impl::drawVolumes(const engine::World& world, const CameraFrame& cam,
-                                 const FrameOptions& options, GlDebugDraw& debug) {
-    // Each kind of volume in the colours of its own overlap test: the broad phase's flags for
-    // the kind it tests, that kind's own pairs for the others (volume_states.h).
-    tested_volume = broadPhaseVolume(world);
-    own_tests = false;
-    const bool drawn[3] = {options.draw.sphere, options.draw.aabb, options.draw.obb};
-    std::vector<engine::BodyState> kind_states[3];
-    for (const VolumeKind kind : kVolumeKinds) {
-        if (!drawn[int(kind)]) continue;
-        kind_states[int(kind)] = volumeOverlaps(world, kind).states;
-        own_tests = own_tests || tested_volume != kind;
-    }
-    const auto volumes = world.volumes();
-    debug.setTarget(volume_lines, &outline_lines);
-    for (std::size_t i = 0; i < volumes.size() && i < world.bodies().size(); ++i) {
-        auto colorOf = [&](VolumeKind kind) {
-            const std::vector<engine::BodyState>& states = kind_states[int(kind)];
-            return stateColor(i < states.size() ? states[i] : engine::BodyState::Apart);
-        };
-        const collision::ProxyVolumes& v = volumes[i];
-        auto shows = [&](const Vec3& center, Real radius) {
-            if (!options.cull || cam.mayShow(center, radius)) return true;
-            ++stats.volumes_culled;
-            return false;
-        };
-        if (options.draw.sphere && shows(v.sphere.center, v.sphere.radius)) {
-            debug.drawSphere(v.sphere, colorOf(VolumeKind::Sphere));
-        }
-        if (options.draw.aabb && shows(v.aabb.center(), Real(0.5) * v.aabb.extents().norm())) {
-            debug.drawAabb(v.aabb, colorOf(VolumeKind::Aabb));
-        }
-        if (options.draw.obb && shows(v.obb.center, v.obb.half_extents.norm())) {
-            debug.drawObb(v.obb, colorOf(VolumeKind::Obb));
-        }
-    }
-    drawKdops(world, options, debug);
-}
-
-void Renderer::Impl::drawKdops(const engine::World& world, const FrameOptions& options,
-                               GlDebugDraw& debug) {
-    // Each k-DOP in the colours of its own slab test against the other bodies' k-DOPs of the
-    // same k; drawn as the polytope its slabs bound (Klosowski et al. 1998).
-    for (std::size_t i = 0; i < engine::kDrawnKdops.size(); ++i) {
-        if (!options.draw.kdop[i]) continue;
-        own_tests = true;
-        const std::vector<collision::WorldKdop> kdops = worldKdops(world, engine::kDrawnKdops[i]);
-        const std::vector<engine::BodyState> states = kdopOverlaps(world, kdops).states;
-        for (std::size_t b = 0; b < kdops.size(); ++b) {
-            debug.drawKdop(kdops[b], stateColor(states[b]));
-        }
-    }
-}
 
 void Renderer::Impl::drawTriangles(const collision::Color& color) {
     if (triangles.count() == 0) return;
@@ -570,58 +362,6 @@ void Renderer::Impl::readPixels(Image& image) {
     }
 }
 
-void Renderer::Impl::drawOverlays(Image& image, const FrameOptions& options) const {
-    // Text is pixel art: integer scale, 2x from 720p, 3x from 1440p.
-    const int scale = height >= 1440 ? 3 : height >= 720 ? 2 : 1;
-    const int margin = 6 * scale;
-    const font::Rgb text_color{236, 238, 242};
-    const font::Rgb plate{0, 0, 0};
-    const int pad = 3 * scale;
-    if (!options.hud_text.empty()) {
-        const int w = font::textWidth(options.hud_text, scale);
-        const int h = font::textHeight(options.hud_text, scale);
-        font::blendRect(image, margin - pad, margin - pad, w + 2 * pad + scale, h + 2 * pad + scale,
-                        plate, 0.45f);
-        font::drawText(image, margin, margin, options.hud_text, scale, text_color);
-    }
-    if (!options.draw.hud) return;
-    // Legends: the state colours bottom-left, what the structure's colours show top-right.
-    const bool any_volume = options.draw.sphere || options.draw.aabb || options.draw.obb ||
-                            std::find(options.draw.kdop.begin(), options.draw.kdop.end(), true) !=
-                                options.draw.kdop.end();
-    if (any_volume || options.draw.bvh_depth >= 0) {
-        const Color apart = stateColor(engine::BodyState::Apart);
-        const Color flagged = stateColor(engine::BodyState::Flagged);
-        const Color colliding = stateColor(engine::BodyState::Colliding);
-        std::vector<LegendRow> rows;
-        if (any_volume && own_tests) {
-            rows.push_back({{std::nullopt, "each volume coloured by its own overlap test"}});
-            std::string drawn;
-            for (const std::string& name : drawnVolumeNames(options.draw)) {
-                drawn += (drawn.empty() ? "drawn: " : ", ") + name;
-            }
-            rows.push_back({{std::nullopt, drawn}});
-            rows.push_back({{apart, "apart"},
-                            {flagged, "overlaps a volume of its kind"},
-                            {colliding, "colliding"}});
-        } else {
-            std::string flagged_label = "flagged";
-            if (any_volume && tested_volume) {
-                const char* const names[3] = {"sphere", "AABB", "OBB"};
-                flagged_label += " (" + std::string(names[int(*tested_volume)]) + " test)";
-            }
-            rows.push_back({{apart, "apart"}, {flagged, flagged_label}, {colliding, "colliding"}});
-        }
-        drawLegendBlock(image, margin, height - margin - legendBlockSize(rows, scale).height, rows,
-                        scale);
-    }
-    if (!structure_legend.empty()) {
-        std::vector<LegendRow> rows;
-        for (const LegendEntry& e : structure_legend) rows.push_back({{e.color, e.label}});
-        drawLegendBlock(image, width - margin - legendBlockSize(rows, scale).width, margin, rows,
-                        scale);
-    }
-}
 
 Renderer::Renderer(int width, int height) : impl_(std::make_unique<Impl>(width, height)) {}
 
@@ -668,44 +408,5 @@ void Renderer::render(const engine::World& world, const engine::CameraSettings& 
     im.stats.readback_s = std::chrono::duration<double>(read - drawn).count();
 }
 
-std::string hudLine(const engine::World& world, int frame, bool include_timing) {
-    // Line 1: where we are and what the phases found. Line 2: the cost model's counters
-    // (F = Nv Cv + Np Cp + Nu Cu) and, with timing, the time per stage.
-    const engine::StepStats& st = world.lastStats();
-    const std::string_view bp = world.broadPhase().name();
-    char buffer[512];
-    int n = std::snprintf(
-        buffer, sizeof buffer,
-        "frame %d  t=%.3f s  %.*s  flagged %zu  colliding %zu\n"
-        "BV tests %lld  updated %lld  narrow tests %lld  triangle tests %lld",
-        frame, double(world.time()), int(bp.size()), bp.data(), world.flaggedPairs().size(),
-        world.collidingPairs().size(), static_cast<long long>(st.broad.volume_tests),
-        static_cast<long long>(st.broad.volumes_updated), static_cast<long long>(st.narrow_tests),
-        static_cast<long long>(st.triangle_tests));
-    std::string line(buffer, std::size_t(std::clamp(n, 0, int(sizeof buffer) - 1)));
-    // Only in scenes that have them: self-collision and deforming mesh bodies.
-    bool self = false;
-    for (const engine::Body& b : world.bodies()) self = self || b.self_collision;
-    if (self) line += "  self pairs " + std::to_string(st.self_pairs);
-    if (st.refit_nodes > 0) line += "  refit nodes " + std::to_string(st.refit_nodes);
-    // Scenes with chains: the continuous stage's queries and events, and where a chain halted.
-    if (!world.chains().empty()) {
-        line += "\ntoi queries " + std::to_string(st.toi_queries) + "  iterations " +
-                std::to_string(st.toi_iterations) + "  events " + std::to_string(st.toi_events);
-        for (std::size_t c = 0; c < world.chains().size(); ++c) {
-            if (!world.chainHalted(c)) continue;
-            n = std::snprintf(buffer, sizeof buffer, "  %s halted at %.5f s",
-                              world.chains()[c].name.c_str(), double(world.chainTime(c)));
-            line.append(buffer, std::size_t(std::clamp(n, 0, int(sizeof buffer) - 1)));
-        }
-    }
-    if (include_timing) {
-        n = std::snprintf(
-            buffer, sizeof buffer, "\nstep %.3f ms  volumes %.3f  broad %.3f  narrow %.3f ms",
-            1e3 * st.total_s, 1e3 * st.volumes_s, 1e3 * st.broad_phase_s, 1e3 * st.narrow_phase_s);
-        line.append(buffer, std::size_t(std::clamp(n, 0, int(sizeof buffer) - 1)));
-    }
-    return line;
-}
 
 }  // namespace render
