@@ -18,6 +18,7 @@
 #include "collision/ccd/chain.h"
 #include "collision/debug_draw.h"
 #include "engine/world.h"
+#include "toi_query.h"
 
 namespace engine {
 
@@ -194,17 +195,8 @@ void World::queryLinkImpact(const collision::ProxyPair& pair) {
     // A deforming body's surface moves in its own frame as well (links never deform).
     in.deform_speed_a = swept_[pair.a].deform_speed;
     in.deform_speed_b = swept_[pair.b].deform_speed;
-    collision::ToiOutput out = collision::timeOfImpactArticulated(in);
-    ++stats_.toi_queries;
-    stats_.toi_iterations += out.iterations;
-    if (out.state == collision::CcdState::Hit && out.t == 0 && out.distance > 0) {
-        // Already within the target gap: ask again for half the present gap (as rigid pairs).
-        in.target_gap = out.distance / 2;
-        in.tolerance = out.distance / 4;
-        out = collision::timeOfImpactArticulated(in);
-        ++stats_.toi_queries;
-        stats_.toi_iterations += out.iterations;
-    }
+    const collision::ToiOutput out =
+        askTimeOfImpact(in, stats_, [&] { return collision::timeOfImpactArticulated(in); });
     if (out.state != collision::CcdState::Hit && out.state != collision::CcdState::Failed) return;
     auto poseAt = [&](const collision::ArticulatedSide& s) {
         if (s.chain == nullptr) return s.sweep.at(out.t);

@@ -7,6 +7,7 @@
 #include "collision/bvh/bvh.h"
 #include "collision/ccd/ccd.h"
 #include "engine/world.h"
+#include "toi_query.h"
 
 namespace engine {
 
@@ -209,19 +210,7 @@ void World::queryTimesOfImpact() {
             mi.b = tree_b;
             return collision::timeOfImpactMeshes(mi).toi;
         };
-        collision::ToiOutput out = query();
-        ++stats_.toi_queries;
-        stats_.toi_iterations += out.iterations;
-        if (out.state == collision::CcdState::Hit && out.t == 0 && out.distance > 0) {
-            // Already within the target gap (typically: stopped here by the previous step).
-            // Ask again for half the present gap, so a separating pair is free to go and an
-            // approaching one still stops before contact.
-            in.target_gap = out.distance / 2;
-            in.tolerance = out.distance / 4;
-            out = query();
-            ++stats_.toi_queries;
-            stats_.toi_iterations += out.iterations;
-        }
+        const collision::ToiOutput out = askTimeOfImpact(in, stats_, query);
         if (out.state != collision::CcdState::Hit && out.state != collision::CcdState::Failed) {
             continue;
         }
