@@ -17,6 +17,10 @@ namespace app {
 
 namespace {
 
+/// A row whose mean frame time is past this multiple of its median gets a note: its median (the
+/// ranking figure) hides the frames that cost most of its run.
+constexpr double kSpikyMeanToMedian = 2.0;
+
 nlohmann::json rowJson(const Row& row) {
     auto number = [](double v) -> nlohmann::json {
         if (std::isfinite(v)) return v;
@@ -166,6 +170,12 @@ void reportWorkload(std::ostream& out, std::vector<Row>& rows, const BenchOption
     for (const Row& row : rows) {
         const RunResult& r = row.result;
         if (row.skipped || r.failed) continue;
+        if (r.mean_ms > kSpikyMeanToMedian * r.median_ms) {
+            out << "  " << row.method << ": mean " << numberText("%.4f", r.mean_ms)
+                << " ms/frame is " << numberText("%.1f", r.mean_ms / r.median_ms)
+                << "x its median: a few frames cost most of the run, which the median does not "
+                   "show\n";
+        }
         if (r.budget_hit) {
             out << "  * " << row.method << ": stopped after " << r.frames_run
                 << " frames (--budget " << options.budget_seconds << " s of frame time)\n";

@@ -18,6 +18,7 @@
 #include <string>
 
 #include "bench_broadphase.h"
+#include "bench_broadphase_report.h"
 #include "bench_method.h"
 #include "bench_workload.h"
 #include "cli_run.h"
@@ -525,6 +526,34 @@ TEST(BroadphaseBench, BadOptionsExitTwoBeforeAnyWork) {
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find(": exists and is a directory"), std::string::npos) << r.err;
     fs::remove_all(work);
+}
+
+// A row whose mean frame is far above its median (a DBVT with a wide margin re-inserts rarely,
+// at great cost) is ranked by its median like every row, and the report says what the median
+// hides; a steady row gets no such note.
+TEST(BroadphaseBench, ARowWhoseMeanIsFarAboveItsMedianIsNoted) {
+    using app::Row;
+    auto row = [](const std::string& method, bool peer, double median_ms, double mean_ms) {
+        Row r;
+        r.method = method;
+        r.peer = peer;
+        r.n = 1000;
+        r.result.median_ms = median_ms;
+        r.result.exact_median_ms = median_ms;
+        r.result.mean_ms = mean_ms;
+        r.result.frames_run = 100;
+        return r;
+    };
+    std::vector<Row> rows{row("steady", false, 1.0, 1.1), row("spiky", true, 0.5, 7.0)};
+    app::BenchOptions options;
+    options.frames = 100;
+    std::ostringstream out;
+    app::reportWorkload(out, rows, options, options.frames);
+    const std::string text = out.str();
+    EXPECT_NE(text.find("spiky: mean 7.0000 ms/frame is 14.0x its median"), std::string::npos)
+        << text;
+    EXPECT_EQ(text.find("steady: mean"), std::string::npos) << text;
+    EXPECT_DOUBLE_EQ(rows[0].ratio, 2.0);  // still ranked by the median
 }
 
 }  // namespace
