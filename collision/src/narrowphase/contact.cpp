@@ -16,6 +16,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 #include <limits>
 
 #include "geometry/shape_measures.h"
@@ -82,75 +83,94 @@ void settleSignedDistance(const CollideOutput& decided, Real tolerance, Local& l
 
 }  // namespace
 
-ContactOutput contact(const Shape& a_in, const Pose& pose_a_in, const Shape& b_in,
-                      const Pose& pose_b_in) {
-    ContactOutput failed;
-    if (!isFinite(a_in, pose_a_in) || !isFinite(b_in, pose_b_in)) return failed;
-    // A mesh is its convex hull here.
-    Shape a_hull;
-    Shape b_hull;
-    const Shape* a = &a_in;
-    const Shape* b = &b_in;
-    if (a_in.type == ShapeType::Mesh) {
-        a_hull = Shape::convexHull(a_in.hull);
-        a = &a_hull;
-    }
-    if (b_in.type == ShapeType::Mesh) {
-        b_hull = Shape::convexHull(b_in.hull);
-        b = &b_hull;
-    }
-    const bool swap = canonicalLess(*b, pose_b_in, *a, pose_a_in);
-    const Shape& first = swap ? *b : *a;
-    const Shape& second = swap ? *a : *b;
-    const Pose& pose_first = swap ? pose_b_in : pose_a_in;
-    const Pose& pose_second = swap ? pose_a_in : pose_b_in;
+namespace {
 
-    const Ctx ctx = pairContext(first, second);
-    const RelativePose rel = relativePose(pose_first, pose_second);
-    Local local;
-    local.state = ContactState::Touching;  // the routine sets Failed when it cannot
-    const CollideOutput decided =
-        pairEntry(kContactTable, first.type, second.type)(first, second, rel, ctx, local);
-    if (local.state != ContactState::Failed) settleSignedDistance(decided, ctx.tolerance, local);
-    // The output never carries NaN or a non-unit normal: anything else is Failed.
-    if (local.state == ContactState::Failed || !std::isfinite(local.signed_distance) ||
-        !local.normal.allFinite() || !(std::abs(local.normal.squaredNorm() - 1) < Real(1e-6)) ||
-        !local.point_a.allFinite() || !local.point_b.allFinite()) {
-        failed.iterations = local.iterations;
-        return failed;
-    }
-    if (local.state == ContactState::Separated) {
-        local.manifold_size = 0;
-    } else if (local.manifold_size == 0) {
-        const bool polytopes =
-            (first.type == ShapeType::Box || first.type == ShapeType::ConvexHull) &&
-            (second.type == ShapeType::Box || second.type == ShapeType::ConvexHull);
-        if (!polytopes || !polytopeManifold(first, second, rel, ctx, local)) {
-            setSingleManifold(local);
-        }
-    }
-
-    // To world, once; then mirror if the canonical order swapped A and B.
-    ContactOutput out = local;
+// The world output, once: the local contact rotated and moved by the canonically-first shape's
+// pose, then mirrored if the canonical order swapped A and B. A manifold point equal to the
+// witness point it was copied from (one-point manifolds, the deepest clipped point) takes the
+// witness's world point instead of being transformed again: the same function of the same bits.
+void toWorld(const Pose& pose_first, bool swap, ContactOutput& out) {
+    const Vec3 local_a = out.point_a;
+    const Vec3 local_b = out.point_b;
     const Mat3 rot = pose_first.rotation();
-    out.normal = rot * local.normal;
-    out.point_a = pose_first.apply(local.point_a);
-    out.point_b = pose_first.apply(local.point_b);
-    for (int i = 0; i < local.manifold_size; ++i) {
-        const auto k = static_cast<std::size_t>(i);
-        out.manifold[k].point_a = pose_first.apply(local.manifold[k].point_a);
-        out.manifold[k].point_b = pose_first.apply(local.manifold[k].point_b);
+    const Vec3 local_normal = out.normal;
+    out.normal = rot * local_normal;
+    out.point_a = pose_first.apply(local_a);
+    out.point_b = pose_first.apply(local_b);
+    const auto same = [](const Vec3& p, const Vec3& q) {
+        return std::memcmp(p.data(), q.data(), sizeof(Real) * 3) == 0;
+    };
+    for (int i = 0; i < out.manifold_size; ++i) {
+        ManifoldPoint& m = out.manifold[static_cast<std::size_t>(i)];
+        m.point_a = same(m.point_a, local_a) ? out.point_a : pose_first.apply(m.point_a);
+        m.point_b = same(m.point_b, local_b) ? out.point_b : pose_first.apply(m.point_b);
     }
     if (swap) {
         out.normal = -out.normal;
         std::swap(out.point_a, out.point_b);
         std::swap(out.feature_a, out.feature_b);
         for (int i = 0; i < out.manifold_size; ++i) {
-            auto& m = out.manifold[static_cast<std::size_t>(i)];
+            ManifoldPoint& m = out.manifold[static_cast<std::size_t>(i)];
             std::swap(m.point_a, m.point_b);
         }
     }
+}
+
+// contact() of two convex shapes (no meshes), written straight into the returned output.
+ContactOutput contactConvex(const Shape& a, const Pose& pose_a, const Shape& b,
+                            const Pose& pose_b) {
+    ContactOutput out;
+    const bool swap = canonicalLess(b, pose_b, a, pose_a);
+    const Shape& first = swap ? b : a;
+    const Shape& second = swap ? a : b;
+    const Pose& pose_first = swap ? pose_b : pose_a;
+    const Pose& pose_second = swap ? pose_a : pose_b;
+
+    const Ctx ctx = pairContext(first, second);
+    const RelativePose rel = relativePose(pose_first, pose_second);
+    out.state = ContactState::Touching;  // the routine sets Failed when it cannot
+    const CollideOutput decided =
+        pairEntry(kContactTable, first.type, second.type)(first, second, rel, ctx, out);
+    if (out.state != ContactState::Failed) settleSignedDistance(decided, ctx.tolerance, out);
+    // The output never carries NaN or a non-unit normal: anything else is Failed.
+    if (out.state == ContactState::Failed || !std::isfinite(out.signed_distance) ||
+        !out.normal.allFinite() || !(std::abs(out.normal.squaredNorm() - 1) < Real(1e-6)) ||
+        !out.point_a.allFinite() || !out.point_b.allFinite()) {
+        const std::int32_t iterations = out.iterations;
+        out = ContactOutput{};
+        out.iterations = iterations;
+        return out;
+    }
+    if (out.state == ContactState::Separated) {
+        out.manifold_size = 0;
+    } else if (out.manifold_size == 0) {
+        const bool polytopes =
+            (first.type == ShapeType::Box || first.type == ShapeType::ConvexHull) &&
+            (second.type == ShapeType::Box || second.type == ShapeType::ConvexHull);
+        if (!polytopes || !polytopeManifold(first, second, rel, ctx, out)) {
+            setSingleManifold(out);
+        }
+    }
+    toWorld(pose_first, swap, out);
     return out;
+}
+
+// A mesh is its convex hull here.
+[[gnu::noinline]] ContactOutput contactMeshHulls(const Shape& a, const Pose& pose_a,
+                                                 const Shape& b, const Pose& pose_b) {
+    const Shape a_hull = a.type == ShapeType::Mesh ? Shape::convexHull(a.hull) : a;
+    const Shape b_hull = b.type == ShapeType::Mesh ? Shape::convexHull(b.hull) : b;
+    return contactConvex(a_hull, pose_a, b_hull, pose_b);
+}
+
+}  // namespace
+
+ContactOutput contact(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b) {
+    if (!isFinite(a, pose_a) || !isFinite(b, pose_b)) return ContactOutput{};
+    if (a.type == ShapeType::Mesh || b.type == ShapeType::Mesh) {
+        return contactMeshHulls(a, pose_a, b, pose_b);
+    }
+    return contactConvex(a, pose_a, b, pose_b);
 }
 
 }  // namespace collision
