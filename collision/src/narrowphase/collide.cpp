@@ -28,13 +28,6 @@
 
 namespace collision {
 
-PairContext pairContext(const Shape& a, const Shape& b) {
-    PairContext ctx;
-    ctx.scale = std::max(boundingRadius(a), boundingRadius(b));
-    ctx.tolerance = kTouchRelativeTolerance * ctx.scale;
-    return ctx;
-}
-
 namespace collide_pairs {
 
 RoundCores sphereSphereCores(const RelativePose& b_in_a) {

@@ -5,10 +5,12 @@
 // satBoxState and refineBoxState here), so the two agree by construction.
 #pragma once
 
+#include <algorithm>
 #include <optional>
 
 #include "collision/geometry/shape.h"
 #include "collision/narrowphase/narrow_phase.h"
+#include "geometry/shape_measures.h"
 #include "narrowphase/gjk.h"
 #include "volumes/box_sat.h"
 
@@ -21,7 +23,12 @@ struct PairContext {
     Real tolerance = 0;  ///< absolute touching tolerance, kTouchRelativeTolerance * scale
 };
 
-PairContext pairContext(const Shape& a, const Shape& b);
+inline PairContext pairContext(const Shape& a, const Shape& b) {
+    PairContext ctx;
+    ctx.scale = std::max(boundingRadius(a), boundingRadius(b));
+    ctx.tolerance = kTouchRelativeTolerance * ctx.scale;
+    return ctx;
+}
 
 namespace collide_pairs {
 
