@@ -86,13 +86,13 @@ void settleSignedDistance(const CollideOutput& decided, Real tolerance, Local& l
 namespace {
 
 // The world output, once: the local contact rotated and moved by the canonically-first shape's
-// pose, then mirrored if the canonical order swapped A and B. A manifold point equal to the
-// witness point it was copied from (one-point manifolds, the deepest clipped point) takes the
-// witness's world point instead of being transformed again: the same function of the same bits.
-void toWorld(const Pose& pose_first, bool swap, ContactOutput& out) {
+// pose (`rot` its rotation matrix), then mirrored if the canonical order swapped A and B. A
+// manifold point equal to the witness point it was copied from (one-point manifolds, the deepest
+// clipped point) takes the witness's world point instead of being transformed again: the same
+// function of the same bits.
+void toWorld(const Pose& pose_first, const Mat3& rot, bool swap, ContactOutput& out) {
     const Vec3 local_a = out.point_a;
     const Vec3 local_b = out.point_b;
-    const Mat3 rot = pose_first.rotation();
     const Vec3 local_normal = out.normal;
     out.normal = rot * local_normal;
     out.point_a = pose_first.apply(local_a);
@@ -128,6 +128,9 @@ ContactOutput contactConvex(const Shape& a, const Pose& pose_a, const Shape& b,
 
     const Ctx ctx = pairContext(first, second);
     const RelativePose rel = relativePose(pose_first, pose_second);
+    // Made before the pair routine, which gives its stores time to retire before the world
+    // transform reads the matrix back as vectors.
+    const Mat3 rot = pose_first.rotation();
     out.state = ContactState::Touching;  // the routine sets Failed when it cannot
     const CollideOutput decided =
         pairEntry(kContactTable, first.type, second.type)(first, second, rel, ctx, out);
@@ -151,7 +154,7 @@ ContactOutput contactConvex(const Shape& a, const Pose& pose_a, const Shape& b,
             setSingleManifold(out);
         }
     }
-    toWorld(pose_first, swap, out);
+    toWorld(pose_first, rot, swap, out);
     return out;
 }
 
