@@ -19,6 +19,7 @@
 
 #include "collision/geometry/convex_hull.h"
 #include "narrowphase/contact_pairs.h"
+#include "narrowphase/contact_round.h"
 #include "test_random.h"
 
 namespace {

@@ -21,6 +21,7 @@
 
 #include "geometry/shape_measures.h"
 #include "narrowphase/contact_pairs.h"
+#include "narrowphase/contact_round.h"
 #include "narrowphase/pair_table.h"
 
 namespace collision {
@@ -116,24 +117,21 @@ void toWorld(const Pose& pose_first, const Mat3& rot, bool swap, ContactOutput& 
     }
 }
 
-// contact() of two convex shapes (no meshes), written straight into the returned output.
-ContactOutput contactConvex(const Shape& a, const Pose& pose_a, const Shape& b,
-                            const Pose& pose_b) {
+// contact() of the pair `first`, `second` (canonical order; `swap` when that swapped A and B)
+// with `routine`, written straight into the returned output.
+template <class Routine>
+[[gnu::always_inline]] inline ContactOutput contactPair(Routine&& routine, const Shape& first,
+                                                        const Pose& pose_first,
+                                                        const Shape& second,
+                                                        const Pose& pose_second, bool swap) {
     ContactOutput out;
-    const bool swap = canonicalLess(b, pose_b, a, pose_a);
-    const Shape& first = swap ? b : a;
-    const Shape& second = swap ? a : b;
-    const Pose& pose_first = swap ? pose_b : pose_a;
-    const Pose& pose_second = swap ? pose_a : pose_b;
-
     const Ctx ctx = pairContext(first, second);
     const RelativePose rel = relativePose(pose_first, pose_second);
     // Made before the pair routine, which gives its stores time to retire before the world
     // transform reads the matrix back as vectors.
     const Mat3 rot = pose_first.rotation();
     out.state = ContactState::Touching;  // the routine sets Failed when it cannot
-    const CollideOutput decided =
-        pairEntry(kContactTable, first.type, second.type)(first, second, rel, ctx, out);
+    const CollideOutput decided = routine(first, second, rel, ctx, out);
     if (out.state != ContactState::Failed) settleSignedDistance(decided, ctx.tolerance, out);
     // The output never carries NaN or a non-unit normal: anything else is Failed.
     if (out.state == ContactState::Failed || !std::isfinite(out.signed_distance) ||
@@ -156,6 +154,29 @@ ContactOutput contactConvex(const Shape& a, const Pose& pose_a, const Shape& b,
     }
     toWorld(pose_first, rot, swap, out);
     return out;
+}
+
+// contact() of two convex shapes (no meshes). The round closed forms are called directly, so
+// they inline and their answer reaches the world transform in registers; every other pair goes
+// through the table.
+ContactOutput contactConvex(const Shape& a, const Pose& pose_a, const Shape& b,
+                            const Pose& pose_b) {
+    const bool swap = canonicalLess(b, pose_b, a, pose_a);
+    const Shape& first = swap ? b : a;
+    const Shape& second = swap ? a : b;
+    const Pose& pose_first = swap ? pose_b : pose_a;
+    const Pose& pose_second = swap ? pose_a : pose_b;
+    if (first.type == ShapeType::Sphere && second.type == ShapeType::Sphere) {
+        return contactPair(sphereSphere, first, pose_first, second, pose_second, swap);
+    }
+    if (first.type == ShapeType::Sphere && second.type == ShapeType::Capsule) {
+        return contactPair(sphereCapsule, first, pose_first, second, pose_second, swap);
+    }
+    if (first.type == ShapeType::Capsule && second.type == ShapeType::Capsule) {
+        return contactPair(capsuleCapsule, first, pose_first, second, pose_second, swap);
+    }
+    return contactPair(pairEntry(kContactTable, first.type, second.type), first, pose_first,
+                       second, pose_second, swap);
 }
 
 // A mesh is its convex hull here.
