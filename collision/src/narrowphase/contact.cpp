@@ -1,9 +1,9 @@
 // collision/src/narrowphase/contact.cpp -- contact(): the full convex query (depth or distance,
 // normal, witness points and features, manifold), dispatched through a [ShapeType][ShapeType]
-// table to one routine per pair family (contact_pairs.h): closed forms for the round pairs and
-// sphere-box (contact_round.cpp), the box SAT with a clipped manifold for box-box
-// (contact_box_box.cpp), GJK with witnesses and EPA for every other convex pair
-// (contact_convex.cpp).
+// table to one routine per pair family (contact_pairs.h): closed forms for the round pairs
+// (contact_round.h, called directly so that they inline) and sphere-box (contact_round.cpp), the
+// box SAT with a clipped manifold for box-box (contact_box_box.cpp), GJK with witnesses and EPA
+// for every other convex pair (contact_convex.cpp).
 // Invariants: every routine computes in the canonically-first shape's frame and the world output
 // is made once at the end; contact(b, a) runs the same routine on the same arguments as
 // contact(a, b) and mirrors it, so the two are exact mirrors. The state is collide()'s: each
@@ -81,10 +81,6 @@ void settleSignedDistance(const CollideOutput& decided, Real tolerance, Local& l
     }
     local.state = decided.state;
 }
-
-}  // namespace
-
-namespace {
 
 // The world output, once: the local contact rotated and moved by the canonically-first shape's
 // pose (`rot` its rotation matrix), then mirrored if the canonical order swapped A and B. A
