@@ -28,47 +28,7 @@
 
 namespace collision {
 
-PairContext pairContext(const Shape& a, const Shape& b) {
-    PairContext ctx;
-    ctx.scale = std::max(boundingRadius(a), boundingRadius(b));
-    ctx.tolerance = kTouchRelativeTolerance * ctx.scale;
-    return ctx;
-}
-
 namespace collide_pairs {
-
-RoundCores sphereSphereCores(const RelativePose& b_in_a) {
-    RoundCores cores;
-    cores.on_b = b_in_a.position;
-    cores.distance = (cores.on_b - cores.on_a).norm();
-    return cores;
-}
-
-// RTCD 5.1.2: the sphere centre (A's origin) against the capsule's segment.
-RoundCores sphereCapsuleCores(const Shape& capsule_b, const RelativePose& b_in_a) {
-    const Real y = std::clamp(toB(b_in_a, Vec3::Zero()).y(), -capsule_b.half_height,
-                              capsule_b.half_height);
-    RoundCores cores;
-    cores.on_b = b_in_a.rotation * Vec3(0, y, 0) + b_in_a.position;
-    cores.distance = (cores.on_b - cores.on_a).norm();
-    return cores;
-}
-
-// RTCD 5.1.9 (closestSegmentSegment) on the two capsules' segments.
-RoundCores capsuleCapsuleCores(const Shape& a, const Shape& b, const RelativePose& b_in_a,
-                               const PairContext& ctx) {
-    const Vec3 pa(0, -a.half_height, 0);
-    const Vec3 qa(0, a.half_height, 0);
-    const Vec3 axis_b = b_in_a.rotation.col(1);
-    const Vec3 pb = b_in_a.position - b.half_height * axis_b;
-    const Vec3 qb = b_in_a.position + b.half_height * axis_b;
-    const SegmentParameters st = closestSegmentSegment(pa, qa, pb, qb, kEpsilon * ctx.scale);
-    RoundCores cores;
-    cores.on_a = pa + st.s * (qa - pa);
-    cores.on_b = pb + st.t * (qb - pb);
-    cores.distance = (cores.on_b - cores.on_a).norm();
-    return cores;
-}
 
 // Inside the box the depth is the radius plus the distance to the nearest face.
 SphereBoxCore sphereBoxCore(const Shape& a, const Shape& b, const RelativePose& b_in_a) {

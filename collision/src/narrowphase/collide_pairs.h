@@ -5,10 +5,13 @@
 // satBoxState and refineBoxState here), so the two agree by construction.
 #pragma once
 
+#include <algorithm>
 #include <optional>
 
 #include "collision/geometry/shape.h"
 #include "collision/narrowphase/narrow_phase.h"
+#include "geometry/closest_points.h"
+#include "geometry/shape_measures.h"
 #include "narrowphase/gjk.h"
 #include "volumes/box_sat.h"
 
@@ -21,7 +24,12 @@ struct PairContext {
     Real tolerance = 0;  ///< absolute touching tolerance, kTouchRelativeTolerance * scale
 };
 
-PairContext pairContext(const Shape& a, const Shape& b);
+inline PairContext pairContext(const Shape& a, const Shape& b) {
+    PairContext ctx;
+    ctx.scale = std::max(boundingRadius(a), boundingRadius(b));
+    ctx.tolerance = kTouchRelativeTolerance * ctx.scale;
+    return ctx;
+}
 
 namespace collide_pairs {
 
@@ -34,10 +42,40 @@ struct RoundCores {
     Vec3 on_b = Vec3::Zero();
     Real distance = 0;  ///< |on_b - on_a|
 };
-RoundCores sphereSphereCores(const RelativePose& b_in_a);
-RoundCores sphereCapsuleCores(const Shape& capsule_b, const RelativePose& b_in_a);
-RoundCores capsuleCapsuleCores(const Shape& a, const Shape& b, const RelativePose& b_in_a,
-                               const PairContext& ctx);
+
+// Inline, so that contact() calls the round closed forms directly (contact_round.h).
+inline RoundCores sphereSphereCores(const RelativePose& b_in_a) {
+    RoundCores cores;
+    cores.on_b = b_in_a.position;
+    cores.distance = (cores.on_b - cores.on_a).norm();
+    return cores;
+}
+
+// RTCD 5.1.2: the sphere centre (A's origin) against the capsule's segment.
+inline RoundCores sphereCapsuleCores(const Shape& capsule_b, const RelativePose& b_in_a) {
+    const Real y = std::clamp(toB(b_in_a, Vec3::Zero()).y(), -capsule_b.half_height,
+                              capsule_b.half_height);
+    RoundCores cores;
+    cores.on_b = b_in_a.rotation * Vec3(0, y, 0) + b_in_a.position;
+    cores.distance = (cores.on_b - cores.on_a).norm();
+    return cores;
+}
+
+// RTCD 5.1.9 (closestSegmentSegment) on the two capsules' segments.
+inline RoundCores capsuleCapsuleCores(const Shape& a, const Shape& b,
+                                      const RelativePose& b_in_a, const PairContext& ctx) {
+    const Vec3 pa(0, -a.half_height, 0);
+    const Vec3 qa(0, a.half_height, 0);
+    const Vec3 axis_b = b_in_a.rotation.col(1);
+    const Vec3 pb = b_in_a.position - b.half_height * axis_b;
+    const Vec3 qb = b_in_a.position + b.half_height * axis_b;
+    const SegmentParameters st = closestSegmentSegment(pa, qa, pb, qb, kEpsilon * ctx.scale);
+    RoundCores cores;
+    cores.on_a = pa + st.s * (qa - pa);
+    cores.on_b = pb + st.t * (qb - pb);
+    cores.distance = (cores.on_b - cores.on_a).norm();
+    return cores;
+}
 
 /// Sphere A against box B (RTCD 5.1.3), in the box's frame: the sphere centre, its clamp to the
 /// box and, when the centre is inside, the axis of the nearest face.

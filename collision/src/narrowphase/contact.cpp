@@ -1,9 +1,9 @@
 // collision/src/narrowphase/contact.cpp -- contact(): the full convex query (depth or distance,
 // normal, witness points and features, manifold), dispatched through a [ShapeType][ShapeType]
-// table to one routine per pair family (contact_pairs.h): closed forms for the round pairs and
-// sphere-box (contact_round.cpp), the box SAT with a clipped manifold for box-box
-// (contact_box_box.cpp), GJK with witnesses and EPA for every other convex pair
-// (contact_convex.cpp).
+// table to one routine per pair family (contact_pairs.h): closed forms for the round pairs
+// (contact_round.h, called directly so that they inline) and sphere-box (contact_round.cpp), the
+// box SAT with a clipped manifold for box-box (contact_box_box.cpp), GJK with witnesses and EPA
+// for every other convex pair (contact_convex.cpp).
 // Invariants: every routine computes in the canonically-first shape's frame and the world output
 // is made once at the end; contact(b, a) runs the same routine on the same arguments as
 // contact(a, b) and mirrors it, so the two are exact mirrors. The state is collide()'s: each
@@ -16,10 +16,12 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 #include <limits>
 
 #include "geometry/shape_measures.h"
 #include "narrowphase/contact_pairs.h"
+#include "narrowphase/contact_round.h"
 #include "narrowphase/pair_table.h"
 
 namespace collision {
@@ -80,77 +82,115 @@ void settleSignedDistance(const CollideOutput& decided, Real tolerance, Local& l
     local.state = decided.state;
 }
 
-}  // namespace
-
-ContactOutput contact(const Shape& a_in, const Pose& pose_a_in, const Shape& b_in,
-                      const Pose& pose_b_in) {
-    ContactOutput failed;
-    if (!isFinite(a_in, pose_a_in) || !isFinite(b_in, pose_b_in)) return failed;
-    // A mesh is its convex hull here.
-    Shape a_hull;
-    Shape b_hull;
-    const Shape* a = &a_in;
-    const Shape* b = &b_in;
-    if (a_in.type == ShapeType::Mesh) {
-        a_hull = Shape::convexHull(a_in.hull);
-        a = &a_hull;
-    }
-    if (b_in.type == ShapeType::Mesh) {
-        b_hull = Shape::convexHull(b_in.hull);
-        b = &b_hull;
-    }
-    const bool swap = canonicalLess(*b, pose_b_in, *a, pose_a_in);
-    const Shape& first = swap ? *b : *a;
-    const Shape& second = swap ? *a : *b;
-    const Pose& pose_first = swap ? pose_b_in : pose_a_in;
-    const Pose& pose_second = swap ? pose_a_in : pose_b_in;
-
-    const Ctx ctx = pairContext(first, second);
-    const RelativePose rel = relativePose(pose_first, pose_second);
-    Local local;
-    local.state = ContactState::Touching;  // the routine sets Failed when it cannot
-    const CollideOutput decided =
-        pairEntry(kContactTable, first.type, second.type)(first, second, rel, ctx, local);
-    if (local.state != ContactState::Failed) settleSignedDistance(decided, ctx.tolerance, local);
-    // The output never carries NaN or a non-unit normal: anything else is Failed.
-    if (local.state == ContactState::Failed || !std::isfinite(local.signed_distance) ||
-        !local.normal.allFinite() || !(std::abs(local.normal.squaredNorm() - 1) < Real(1e-6)) ||
-        !local.point_a.allFinite() || !local.point_b.allFinite()) {
-        failed.iterations = local.iterations;
-        return failed;
-    }
-    if (local.state == ContactState::Separated) {
-        local.manifold_size = 0;
-    } else if (local.manifold_size == 0) {
-        const bool polytopes =
-            (first.type == ShapeType::Box || first.type == ShapeType::ConvexHull) &&
-            (second.type == ShapeType::Box || second.type == ShapeType::ConvexHull);
-        if (!polytopes || !polytopeManifold(first, second, rel, ctx, local)) {
-            setSingleManifold(local);
-        }
-    }
-
-    // To world, once; then mirror if the canonical order swapped A and B.
-    ContactOutput out = local;
-    const Mat3 rot = pose_first.rotation();
-    out.normal = rot * local.normal;
-    out.point_a = pose_first.apply(local.point_a);
-    out.point_b = pose_first.apply(local.point_b);
-    for (int i = 0; i < local.manifold_size; ++i) {
-        const auto k = static_cast<std::size_t>(i);
-        out.manifold[k].point_a = pose_first.apply(local.manifold[k].point_a);
-        out.manifold[k].point_b = pose_first.apply(local.manifold[k].point_b);
+// The world output, once: the local contact rotated and moved by the canonically-first shape's
+// pose (`rot` its rotation matrix), then mirrored if the canonical order swapped A and B. A
+// manifold point equal to the witness point it was copied from (one-point manifolds, the deepest
+// clipped point) takes the witness's world point instead of being transformed again: the same
+// function of the same bits.
+void toWorld(const Pose& pose_first, const Mat3& rot, bool swap, ContactOutput& out) {
+    const Vec3 local_a = out.point_a;
+    const Vec3 local_b = out.point_b;
+    const Vec3 local_normal = out.normal;
+    out.normal = rot * local_normal;
+    out.point_a = pose_first.apply(local_a);
+    out.point_b = pose_first.apply(local_b);
+    const auto same = [](const Vec3& p, const Vec3& q) {
+        return std::memcmp(p.data(), q.data(), sizeof(Real) * 3) == 0;
+    };
+    for (int i = 0; i < out.manifold_size; ++i) {
+        ManifoldPoint& m = out.manifold[static_cast<std::size_t>(i)];
+        m.point_a = same(m.point_a, local_a) ? out.point_a : pose_first.apply(m.point_a);
+        m.point_b = same(m.point_b, local_b) ? out.point_b : pose_first.apply(m.point_b);
     }
     if (swap) {
         out.normal = -out.normal;
         std::swap(out.point_a, out.point_b);
         std::swap(out.feature_a, out.feature_b);
         for (int i = 0; i < out.manifold_size; ++i) {
-            auto& m = out.manifold[static_cast<std::size_t>(i)];
+            ManifoldPoint& m = out.manifold[static_cast<std::size_t>(i)];
             std::swap(m.point_a, m.point_b);
         }
     }
+}
+
+// contact() of the pair `first`, `second` (canonical order; `swap` when that swapped A and B)
+// with `routine`, written straight into the returned output.
+template <class Routine>
+[[gnu::always_inline]] inline ContactOutput contactPair(Routine&& routine, const Shape& first,
+                                                        const Pose& pose_first,
+                                                        const Shape& second,
+                                                        const Pose& pose_second, bool swap) {
+    ContactOutput out;
+    const Ctx ctx = pairContext(first, second);
+    const RelativePose rel = relativePose(pose_first, pose_second);
+    // Made before the pair routine, which gives its stores time to retire before the world
+    // transform reads the matrix back as vectors.
+    const Mat3 rot = pose_first.rotation();
+    out.state = ContactState::Touching;  // the routine sets Failed when it cannot
+    const CollideOutput decided = routine(first, second, rel, ctx, out);
+    if (out.state != ContactState::Failed) settleSignedDistance(decided, ctx.tolerance, out);
+    // The output never carries NaN or a non-unit normal: anything else is Failed.
+    if (out.state == ContactState::Failed || !std::isfinite(out.signed_distance) ||
+        !out.normal.allFinite() || !(std::abs(out.normal.squaredNorm() - 1) < Real(1e-6)) ||
+        !out.point_a.allFinite() || !out.point_b.allFinite()) {
+        const std::int32_t iterations = out.iterations;
+        out = ContactOutput{};
+        out.iterations = iterations;
+        return out;
+    }
+    if (out.state == ContactState::Separated) {
+        out.manifold_size = 0;
+    } else if (out.manifold_size == 0) {
+        const bool polytopes =
+            (first.type == ShapeType::Box || first.type == ShapeType::ConvexHull) &&
+            (second.type == ShapeType::Box || second.type == ShapeType::ConvexHull);
+        if (!polytopes || !polytopeManifold(first, second, rel, ctx, out)) {
+            setSingleManifold(out);
+        }
+    }
+    toWorld(pose_first, rot, swap, out);
     return out;
+}
+
+// contact() of two convex shapes (no meshes). The round closed forms are called directly, so
+// they inline and their answer reaches the world transform in registers; every other pair goes
+// through the table.
+ContactOutput contactConvex(const Shape& a, const Pose& pose_a, const Shape& b,
+                            const Pose& pose_b) {
+    const bool swap = canonicalLess(b, pose_b, a, pose_a);
+    const Shape& first = swap ? b : a;
+    const Shape& second = swap ? a : b;
+    const Pose& pose_first = swap ? pose_b : pose_a;
+    const Pose& pose_second = swap ? pose_a : pose_b;
+    if (first.type == ShapeType::Sphere && second.type == ShapeType::Sphere) {
+        return contactPair(sphereSphere, first, pose_first, second, pose_second, swap);
+    }
+    if (first.type == ShapeType::Sphere && second.type == ShapeType::Capsule) {
+        return contactPair(sphereCapsule, first, pose_first, second, pose_second, swap);
+    }
+    if (first.type == ShapeType::Capsule && second.type == ShapeType::Capsule) {
+        return contactPair(capsuleCapsule, first, pose_first, second, pose_second, swap);
+    }
+    return contactPair(pairEntry(kContactTable, first.type, second.type), first, pose_first,
+                       second, pose_second, swap);
+}
+
+// A mesh is its convex hull here.
+[[gnu::noinline]] ContactOutput contactMeshHulls(const Shape& a, const Pose& pose_a,
+                                                 const Shape& b, const Pose& pose_b) {
+    const Shape a_hull = a.type == ShapeType::Mesh ? Shape::convexHull(a.hull) : a;
+    const Shape b_hull = b.type == ShapeType::Mesh ? Shape::convexHull(b.hull) : b;
+    return contactConvex(a_hull, pose_a, b_hull, pose_b);
+}
+
+}  // namespace
+
+ContactOutput contact(const Shape& a, const Pose& pose_a, const Shape& b, const Pose& pose_b) {
+    if (!isFinite(a, pose_a) || !isFinite(b, pose_b)) return ContactOutput{};
+    if (a.type == ShapeType::Mesh || b.type == ShapeType::Mesh) {
+        return contactMeshHulls(a, pose_a, b, pose_b);
+    }
+    return contactConvex(a, pose_a, b, pose_b);
 }
 
 }  // namespace collision

@@ -15,24 +15,36 @@ namespace collision::contact_pairs {
 
 namespace {
 
-// Sutherland-Hodgman (RTCD 8.3.4): keeps the part of polygon `in` with coord[axis] * sign <= limit.
-int clipPolygon(const std::array<Vec3, 8>& in, int n, int axis, Real sign, Real limit,
+// Sutherland-Hodgman (RTCD 8.3.4): keeps the part of polygon `in` with coord[kAxis] * sign <=
+// limit. The axis is a template parameter so the coordinates stay in registers.
+template <int kAxis>
+int clipPolygon(const std::array<Vec3, 8>& in, int n, Real sign, Real limit,
                 std::array<Vec3, 8>& out) {
     int m = 0;
     for (int i = 0; i < n; ++i) {
         const Vec3& p = in[static_cast<std::size_t>(i)];
         const Vec3& q = in[static_cast<std::size_t>(i + 1 == n ? 0 : i + 1)];
-        const Real dp = sign * p[axis] - limit;
-        const Real dq = sign * q[axis] - limit;
+        const Real dp = sign * p[kAxis] - limit;
+        const Real dq = sign * q[kAxis] - limit;
         if (dp <= 0 && m < 8) out[static_cast<std::size_t>(m++)] = p;
         if ((dp < 0 && dq > 0) || (dp > 0 && dq < 0)) {
             const Real t = dp / (dp - dq);
             Vec3 x = p + t * (q - p);
-            x[axis] = sign * limit;  // exactly on the plane
+            x[kAxis] = sign * limit;  // exactly on the plane
             if (m < 8) out[static_cast<std::size_t>(m++)] = x;
         }
     }
     return m;
+}
+
+// The polygon clipped to the slabs |coord[kA1]| <= h[kA1], then |coord[kA2]| <= h[kA2].
+template <int kA1, int kA2>
+int clipToSlabs(const Vec3& h, int n, std::array<Vec3, 8>& poly) {
+    std::array<Vec3, 8> tmp;  // only the first n entries are read
+    n = clipPolygon<kA1>(poly, n, 1, h[kA1], tmp);
+    n = clipPolygon<kA1>(tmp, n, -1, h[kA1], poly);
+    n = clipPolygon<kA2>(poly, n, 1, h[kA2], tmp);
+    return clipPolygon<kA2>(tmp, n, -1, h[kA2], poly);
 }
 
 // Face contact: reference box R (half extents hr, its frame), reference face on axis k with
@@ -47,7 +59,7 @@ int clipFaceContact(const Vec3& hr, int k, Real s, const Vec3& hi, const Relativ
     const Real sm = -signOrPlus(n_in_i[m]);
     const int u = (m + 1) % 3;
     const int v = (m + 2) % 3;
-    std::array<Vec3, 8> poly{};
+    std::array<Vec3, 8> poly;  // only the first n entries are read
     const std::array<Real, 4> su{-1, 1, 1, -1};
     const std::array<Real, 4> sv{-1, -1, 1, 1};
     for (int c = 0; c < 4; ++c) {
@@ -57,14 +69,10 @@ int clipFaceContact(const Vec3& hr, int k, Real s, const Vec3& hi, const Relativ
         corner[v] = sv[static_cast<std::size_t>(c)] * hi[v];
         poly[static_cast<std::size_t>(c)] = i_in_r.rotation * corner + i_in_r.position;
     }
-    int n = 4;
-    std::array<Vec3, 8> tmp{};
-    const int a1 = (k + 1) % 3;
-    const int a2 = (k + 2) % 3;
-    n = clipPolygon(poly, n, a1, 1, hr[a1], tmp);
-    n = clipPolygon(tmp, n, a1, -1, hr[a1], poly);
-    n = clipPolygon(poly, n, a2, 1, hr[a2], tmp);
-    n = clipPolygon(tmp, n, a2, -1, hr[a2], poly);
+    // The side slabs of the reference face, axes (k + 1) % 3 then (k + 2) % 3.
+    const int n = k == 0   ? clipToSlabs<1, 2>(hr, 4, poly)
+                  : k == 1 ? clipToSlabs<2, 0>(hr, 4, poly)
+                           : clipToSlabs<0, 1>(hr, 4, poly);
     int kept = 0;
     for (int i = 0; i < n; ++i) {
         const Vec3& p = poly[static_cast<std::size_t>(i)];
@@ -187,8 +195,8 @@ bool satDetails(const Shape& a, const Shape& b, const RelativePose& rel, const C
         return true;
     }
 
-    std::array<Vec3, 8> points{};
-    std::array<Real, 8> depths{};
+    std::array<Vec3, 8> points;  // only the first count entries are read
+    std::array<Real, 8> depths;
     int count = 0;
     Vec3 n;
     if (face_kind == 0) {

@@ -1,5 +1,5 @@
 // collision/src/narrowphase/contact_features.cpp -- which feature of a shape (vertex, edge, face)
-// a witness point lies on, in the numbering of contact.h, and the one-point manifold.
+// a witness point lies on, in the numbering of contact.h.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -127,12 +127,6 @@ Feature coreFeature(const Shape& shape, const Vec3& core_point, Real tol) {
             return hullFeature(*shape.hull, core_point, tol);
     }
     return {};
-}
-
-void setSingleManifold(Local& out) {
-    out.manifold_size = 1;
-    out.manifold[0] =
-        ManifoldPoint{out.point_a, out.point_b, std::max(Real(0), -out.signed_distance)};
 }
 
 }  // namespace collision::contact_pairs

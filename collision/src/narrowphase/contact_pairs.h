@@ -47,7 +47,11 @@ Feature hullFeature(const ConvexPolytope& hull, const Vec3& p, Real tol);
 Feature coreFeature(const Shape& shape, const Vec3& core_point, Real tol);
 
 /// A one-point manifold at the witness points (round shapes, edge contacts).
-void setSingleManifold(Local& out);
+inline void setSingleManifold(Local& out) {
+    out.manifold_size = 1;
+    out.manifold[0] =
+        ManifoldPoint{out.point_a, out.point_b, std::max(Real(0), -out.signed_distance)};
+}
 
 /// Boxes and hulls that are not box-box: the manifold of their touching faces, clipped
 /// (contact_manifold.cpp). False when the contact is not face to face.
@@ -62,14 +66,8 @@ int reduceManifold(const Vec3* p, const Real* depth, int n, const Vec3& normal,
 // ---- The pair routines, in A's frame (canonical order). Each writes the details to `out`
 // (state Failed when it cannot) and returns collide()'s decision on the pair. ----
 
-/// Closed forms (contact_round.cpp, RTCD 5.1): sphere-sphere, sphere-capsule, capsule-capsule,
-/// sphere-box.
-CollideOutput sphereSphere(const Shape& a, const Shape& b, const RelativePose& rel,
-                           const Ctx& ctx, Local& out);
-CollideOutput sphereCapsule(const Shape& a, const Shape& b, const RelativePose& rel,
-                            const Ctx& ctx, Local& out);
-CollideOutput capsuleCapsule(const Shape& a, const Shape& b, const RelativePose& rel,
-                             const Ctx& ctx, Local& out);
+/// Closed forms (RTCD 5.1): sphere-sphere, sphere-capsule, capsule-capsule (inline, in
+/// contact_round.h), sphere-box (contact_round.cpp).
 CollideOutput sphereBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
                         Local& out);
 /// Box-box: the box SAT measure, with the manifold by clipping where the best axis is within the

@@ -280,14 +280,6 @@ Real ConvexCore::boundingRadius() const {
     return r + radius;
 }
 
-RelativePose relativePose(const Pose& pose_a, const Pose& pose_b) {
-    const Quat inv_a = pose_a.orientation.conjugate();
-    RelativePose rel;
-    rel.rotation = (inv_a * pose_b.orientation).toRotationMatrix();
-    rel.position = inv_a * (pose_b.position - pose_a.position);
-    return rel;
-}
-
 GjkOutput gjkDistance(const ConvexCore& a, const ConvexCore& b, const RelativePose& b_in_a,
                       Real scale) {
     const GjkRun<Vec3> run = runGjk<Vec3>(a, b, b_in_a, scale);

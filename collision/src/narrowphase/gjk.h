@@ -50,7 +50,13 @@ inline Vec3 toB(const RelativePose& b_in_a, const Vec3& p_in_a) {
 
 /// pose_a^-1 * pose_b, subtracting positions first so that far-from-origin poses lose nothing
 /// to the translation (metamorphic tests translate scenes by 1e6).
-RelativePose relativePose(const Pose& pose_a, const Pose& pose_b);
+inline RelativePose relativePose(const Pose& pose_a, const Pose& pose_b) {
+    const Quat inv_a = pose_a.orientation.conjugate();
+    RelativePose rel;
+    rel.rotation = (inv_a * pose_b.orientation).toRotationMatrix();
+    rel.position = inv_a * (pose_b.position - pose_a.position);
+    return rel;
+}
 
 enum class GjkState : std::uint8_t { Separated, Overlapping, Failed };
 

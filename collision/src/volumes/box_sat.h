@@ -196,7 +196,12 @@ inline BoxSatMeasure measureBoxSat(const Vec3& ea, const Mat3& rot, const Vec3& 
 /// rsqrtps (in the x86-64 baseline), else exact.
 inline void boxSatRsqrt(const float* in, float* out) {
 #if defined(__SSE__)
-    for (int k = 0; k < 12; k += 4) _mm_store_ps(out + k, _mm_rsqrt_ps(_mm_load_ps(in + k)));
+    // The lanes are gathered one by one, not loaded as a vector: the caller has just written
+    // them one by one, and a vector load of scalar stores waits for them to retire.
+    for (int k = 0; k < 12; k += 4) {
+        const __m128 v = _mm_setr_ps(in[k], in[k + 1], in[k + 2], in[k + 3]);
+        _mm_store_ps(out + k, _mm_rsqrt_ps(v));
+    }
 #else
     for (int k = 0; k < 12; ++k) out[k] = 1.0f / std::sqrt(in[k]);
 #endif
@@ -225,23 +230,16 @@ inline BoxSatMeasure measureBoxSatBest(
     Real stop_above = std::numeric_limits<Real>::infinity()) {
     BoxSatMeasure m;
     m.per_axis = false;
-    for (int i = 0; i < 3; ++i) {
-        const BoxSatAxis a = boxSatFaceAxisA(ea, rot, t, eb, i);
+    // The best face axis by selects, not branches (which axis wins is data, not a pattern the
+    // branch predictor can learn); the first of equal separations wins, as in measureBoxSat.
+    for (int id = 0; id < 6; ++id) {
+        const BoxSatAxis a = id < 3 ? boxSatFaceAxisA(ea, rot, t, eb, id)
+                                    : boxSatFaceAxisB(ea, rot, t, eb, id - 3);
         const Real sep = a.dist - a.ra - a.rb;
-        if (sep > m.face_sep) {
-            m.face_sep = sep;
-            m.face_box = 0;
-            m.face_axis = i;
-        }
-    }
-    for (int j = 0; j < 3; ++j) {
-        const BoxSatAxis a = boxSatFaceAxisB(ea, rot, t, eb, j);
-        const Real sep = a.dist - a.ra - a.rb;
-        if (sep > m.face_sep) {
-            m.face_sep = sep;
-            m.face_box = 1;
-            m.face_axis = j;
-        }
+        const bool better = sep > m.face_sep;
+        m.face_sep = better ? sep : m.face_sep;
+        m.face_box = better ? (id < 3 ? 0 : 1) : m.face_box;
+        m.face_axis = better ? id % 3 : m.face_axis;
     }
     m.err_bound = Real(16) * kEpsilon *
                   (t.lpNorm<1>() + ea.lpNorm<1>() + eb.lpNorm<1>());  // 1-norms >= 2-norms
