@@ -137,30 +137,26 @@ private:
         Real lo_y, hi_y, lo_z, hi_z;
         Vec3 centre_span;  // of the boxes' centres
     };
-public:
-    /// A box's largest extent, which decides its level.
-    static Real extentOf(const Aabb& b) { return (b.max - b.min).maxCoeff(); }
-    /// The boxes' bounds, taken as they are sorted.
+    /// The boxes' bounds, gathered with them.
     struct Extents {
         Real top = 0;                 // largest extent
         Real lo_y, hi_y, lo_z, hi_z;  // of the boxes
         Vec3 lo_c, hi_c;              // of their centres
     };
-
-private:
+    /// A box's largest extent, which decides its level.
+    static Real extentOf(const Aabb& b) { return (b.max - b.min).maxCoeff(); }
     static constexpr std::uint8_t kZeroSize = 0xff;  // level_of_ mark: any level will do
     static double planLevels(const std::array<std::size_t, kMaxLevels>& members,
                              const std::array<Real, kMaxLevels>& extent_sum, int level_count,
                              Real top, const Bounds& bounds, Plan& plan);
+    Extents gatherBoxes();
     // Steps of findPairs, in order (hgrid_order.cpp, hgrid_levels.cpp, hgrid.cpp).
     void chooseLevels(Real top, const Extents& x);
     std::size_t layoutColumns(std::size_t& flat_columns);
     void planChunks(std::size_t total, std::size_t flat_columns);
     void mergeLanePairs(std::vector<ProxyPair>& pairs);
-    /// Puts the proxies in order_ by (float(min x), id) and their boxes in box_, and returns
-    /// their bounds (hgrid_order.cpp).
-    Extents sortByMinX();
-    bool resortByMinX(Extents& x);
+    void sortByMinX();
+    bool resortByMinX();
     void levelLane(Lane& lane, Real top);
     void countLane(Lane& lane);
     void scatterLane(Lane& lane, std::size_t spare_slot);

@@ -1,5 +1,5 @@
 // collision/src/broadphase/hgrid_order.cpp -- hgrid's per-frame order of the proxies by min x
-// (the order the columns are scattered in), the boxes gathered in it and their bounds.
+// (the order the columns are scattered in) and the boxes gathered in it.
 // Invariant: order_ holds every present proxy by (float(min x), id), box_[p] is order_[p]'s box.
 #include "broadphase/hgrid.h"
 
@@ -13,38 +13,7 @@ namespace collision {
 
 using radix::orderedBits;
 
-namespace {
-
-// The box's share of the bounds planLevels reads.
-inline void extend(HierarchicalGrid::Extents& x, const Aabb& b) {
-    x.top = std::max(x.top, HierarchicalGrid::extentOf(b));
-    const Vec3 c = (b.min + b.max) / 2;  // centres: where the boxes are, for planLevels
-    x.lo_c = x.lo_c.cwiseMin(c);
-    x.hi_c = x.hi_c.cwiseMax(c);
-    x.lo_y = std::min(x.lo_y, b.min.y());
-    x.hi_y = std::max(x.hi_y, b.max.y());
-    x.lo_z = std::min(x.lo_z, b.min.z());
-    x.hi_z = std::max(x.hi_z, b.max.z());
-}
-
-HierarchicalGrid::Extents noExtents() {
-    HierarchicalGrid::Extents x;
-    x.lo_y = x.lo_z = std::numeric_limits<Real>::max();
-    x.hi_y = x.hi_z = std::numeric_limits<Real>::lowest();
-    x.lo_c = Vec3::Constant(std::numeric_limits<Real>::max());
-    x.hi_c = Vec3::Constant(std::numeric_limits<Real>::lowest());
-    return x;
-}
-
-// The bounds as planLevels takes them: a top extent of 1 when every box has size zero.
-HierarchicalGrid::Extents finished(HierarchicalGrid::Extents x) {
-    if (!(x.top > 0)) x.top = 1;
-    return x;
-}
-
-}  // namespace
-
-bool HierarchicalGrid::resortByMinX(Extents& x) {
+bool HierarchicalGrid::resortByMinX() {
     // The same proxies as last frame: their keys in last frame's order, insertion-sorted as
     // whole 64-bit keys, i.e. by (key, id), the order the radix sort below gives. Coherent
     // motion leaves few keys out of place; past n / 2 shifts the sort is abandoned (boxes dense
@@ -56,10 +25,8 @@ bool HierarchicalGrid::resortByMinX(Extents& x) {
     key_of_id_.resize(std::size_t(table_.capacity()));
     for (ProxyId id = 0; id < table_.capacity(); ++id) {
         if (!table_.contains(id)) continue;
-        const Aabb& b = table_.aabb(id);
-        extend(x, b);
-        const float min_x = static_cast<float>(b.min.x());
-        key_of_id_[std::size_t(id)] = static_cast<std::uint32_t>(orderedBits(min_x));
+        const float x = static_cast<float>(table_.aabb(id).min.x());
+        key_of_id_[std::size_t(id)] = static_cast<std::uint32_t>(orderedBits(x));
     }
     const std::size_t n = order_.size();
     packed_.resize(n);
@@ -84,24 +51,16 @@ bool HierarchicalGrid::resortByMinX(Extents& x) {
             return false;
         }
     }
-    box_.resize(n);
-    for (std::size_t p = 0; p < n; ++p) {
-        order_[p] = static_cast<std::uint32_t>(k[p]);
-        box_[p] = table_.aabb(ProxyId(order_[p]));
-    }
+    for (std::size_t p = 0; p < n; ++p) order_[p] = static_cast<std::uint32_t>(k[p]);
     return true;
 }
 
-HierarchicalGrid::Extents HierarchicalGrid::sortByMinX() {
-    // The bounds are taken in the pass that reads the keys, in id order (the table in
-    // sequence); the boxes are then copied in sorted order as the sort writes it.
-    Extents x = noExtents();
+void HierarchicalGrid::sortByMinX() {
     if (resort_pause_ > 0) --resort_pause_;
     if (!order_stale_ && resort_pause_ == 0 && order_.size() == std::size_t(table_.count()) &&
-        resortByMinX(x)) {
-        return finished(x);
+        resortByMinX()) {
+        return;
     }
-    x = noExtents();
     order_stale_ = false;
     // Keys: min x rounded to float (a non-decreasing map, so the order is exact up to ties of
     // the rounding, which fixColumns undoes), above the id; read in id order, sorted by the key
@@ -109,18 +68,36 @@ HierarchicalGrid::Extents HierarchicalGrid::sortByMinX() {
     packed_.clear();
     for (ProxyId id = 0; id < table_.capacity(); ++id) {
         if (!table_.contains(id)) continue;
-        const Aabb& b = table_.aabb(id);
-        extend(x, b);
-        const float min_x = static_cast<float>(b.min.x());
-        packed_.push_back(orderedBits(min_x) << 32 | std::uint64_t(std::uint32_t(id)));
+        const float x = static_cast<float>(table_.aabb(id).min.x());
+        packed_.push_back(orderedBits(x) << 32 | std::uint64_t(std::uint32_t(id)));
     }
     order_.resize(packed_.size());
-    box_.resize(packed_.size());
     radix::lsdRadixSort(packed_, packed_scratch_, 32, 32, [this](std::size_t p, std::uint64_t key) {
         order_[p] = static_cast<std::uint32_t>(key);
-        box_[p] = table_.aabb(ProxyId(order_[p]));
     });
-    return finished(x);
+}
+
+HierarchicalGrid::Extents HierarchicalGrid::gatherBoxes() {
+    // The boxes in sorted order, with their largest extent and bounds.
+    Extents x;
+    x.lo_y = x.lo_z = std::numeric_limits<Real>::max();
+    x.hi_y = x.hi_z = std::numeric_limits<Real>::lowest();
+    x.lo_c = Vec3::Constant(std::numeric_limits<Real>::max());
+    x.hi_c = Vec3::Constant(std::numeric_limits<Real>::lowest());
+    box_.resize(order_.size());
+    for (std::size_t p = 0; p < order_.size(); ++p) {
+        const Aabb& b = box_[p] = table_.aabb(ProxyId(order_[p]));
+        x.top = std::max(x.top, extentOf(b));
+        const Vec3 c = (b.min + b.max) / 2;  // centres: where the boxes are, for planLevels
+        x.lo_c = x.lo_c.cwiseMin(c);
+        x.hi_c = x.hi_c.cwiseMax(c);
+        x.lo_y = std::min(x.lo_y, b.min.y());
+        x.hi_y = std::max(x.hi_y, b.max.y());
+        x.lo_z = std::min(x.lo_z, b.min.z());
+        x.hi_z = std::max(x.hi_z, b.max.z());
+    }
+    if (!(x.top > 0)) x.top = 1;
+    return x;
 }
 
 }  // namespace collision
