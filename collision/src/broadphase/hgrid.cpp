@@ -14,12 +14,9 @@
 #include "broadphase/hgrid.h"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <sstream>
-#include <type_traits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -31,22 +28,8 @@
 namespace collision {
 
 using radix::bitsFor;
-using radix::orderedBits;
 
 namespace {
-
-inline Real extentOf(const Aabb& b) { return (b.max - b.min).maxCoeff(); }
-
-// floor(log2(x)) for x >= 1 (and large for x = inf), from the exponent bits.
-inline int floorLog2(Real x) {
-    using Bits = std::conditional_t<sizeof(Real) == 8, std::uint64_t, std::uint32_t>;
-    constexpr int kMantissa = std::numeric_limits<Real>::digits - 1;
-    constexpr int kBias = std::numeric_limits<Real>::max_exponent - 1;
-    constexpr Bits kMask = (Bits(1) << (sizeof(Real) * 8 - 1 - kMantissa)) - 1;
-    return int((std::bit_cast<Bits>(x) >> kMantissa) & kMask) - kBias;
-}
-
-constexpr std::uint8_t kZeroSize = 0xff;  // level_of_ mark: any level will do
 
 inline bool before(Real xa, std::uint32_t ia, Real xb, std::uint32_t ib) {
     return xa < xb || (xa == xb && ia < ib);
@@ -118,118 +101,6 @@ void HierarchicalGrid::remove(ProxyId id) {
     order_stale_ = true;
 }
 
-bool HierarchicalGrid::resortByMinX() {
-    // The same proxies as last frame: their keys in last frame's order, insertion-sorted as
-    // whole 64-bit keys, i.e. by (key, id), the order the radix sort below gives. Coherent
-    // motion leaves few keys out of place; past n / 2 shifts the sort is abandoned (boxes dense
-    // along x: at 10k on the bench's workloads a box passes several others a frame, and the
-    // insertion sort cost more than the radix sort) and not tried for kResortPause frames.
-    // The keys are read in id order (the table is read in sequence, as by the radix sort) and
-    // gathered in last frame's order from a 4-byte array: reading the table itself in that order
-    // cost more than the sort saved from 10k boxes on.
-    key_of_id_.resize(std::size_t(table_.capacity()));
-    for (ProxyId id = 0; id < table_.capacity(); ++id) {
-        if (!table_.contains(id)) continue;
-        const float x = static_cast<float>(table_.aabb(id).min.x());
-        key_of_id_[std::size_t(id)] = static_cast<std::uint32_t>(orderedBits(x));
-    }
-    const std::size_t n = order_.size();
-    packed_.resize(n);
-    for (std::size_t p = 0; p < n; ++p) {
-        packed_[p] = std::uint64_t(key_of_id_[order_[p]]) << 32 | std::uint64_t(order_[p]);
-    }
-    std::uint64_t* const k = packed_.data();
-    std::size_t shifts = 0;
-    const std::size_t budget = n / 2 + 64;
-    for (std::size_t i = 1; i < n; ++i) {
-        const std::uint64_t moving = k[i];
-        if (!(moving < k[i - 1])) continue;
-        std::size_t j = i;
-        do {
-            k[j] = k[j - 1];
-            --j;
-        } while (j > 0 && moving < k[j - 1]);
-        k[j] = moving;
-        shifts += i - j;
-        if (shifts > budget) {
-            resort_pause_ = kResortPause;
-            return false;
-        }
-    }
-    for (std::size_t p = 0; p < n; ++p) order_[p] = static_cast<std::uint32_t>(k[p]);
-    return true;
-}
-
-void HierarchicalGrid::sortByMinX() {
-    if (resort_pause_ > 0) --resort_pause_;
-    if (!order_stale_ && resort_pause_ == 0 && order_.size() == std::size_t(table_.count()) &&
-        resortByMinX()) {
-        return;
-    }
-    order_stale_ = false;
-    // Keys: min x rounded to float (a non-decreasing map, so the order is exact up to ties of
-    // the rounding, which fixColumns undoes), above the id; read in id order, sorted by the key
-    // alone by a stable LSD radix sort, so ties stay in id order.
-    packed_.clear();
-    for (ProxyId id = 0; id < table_.capacity(); ++id) {
-        if (!table_.contains(id)) continue;
-        const float x = static_cast<float>(table_.aabb(id).min.x());
-        packed_.push_back(orderedBits(x) << 32 | std::uint64_t(std::uint32_t(id)));
-    }
-    order_.resize(packed_.size());
-    radix::lsdRadixSort(packed_, packed_scratch_, 32, 32, [this](std::size_t p, std::uint64_t key) {
-        order_[p] = static_cast<std::uint32_t>(key);
-    });
-}
-
-HierarchicalGrid::Extents HierarchicalGrid::gatherBoxes() {
-    // The boxes in sorted order, with their largest extent and bounds.
-    Extents x;
-    x.lo_y = x.lo_z = std::numeric_limits<Real>::max();
-    x.hi_y = x.hi_z = std::numeric_limits<Real>::lowest();
-    x.lo_c = Vec3::Constant(std::numeric_limits<Real>::max());
-    x.hi_c = Vec3::Constant(std::numeric_limits<Real>::lowest());
-    box_.resize(order_.size());
-    for (std::size_t p = 0; p < order_.size(); ++p) {
-        const Aabb& b = box_[p] = table_.aabb(ProxyId(order_[p]));
-        x.top = std::max(x.top, extentOf(b));
-        const Vec3 c = (b.min + b.max) / 2;  // centres: where the boxes are, for planLevels
-        x.lo_c = x.lo_c.cwiseMin(c);
-        x.hi_c = x.hi_c.cwiseMax(c);
-        x.lo_y = std::min(x.lo_y, b.min.y());
-        x.hi_y = std::max(x.hi_y, b.max.y());
-        x.lo_z = std::min(x.lo_z, b.min.z());
-        x.hi_z = std::max(x.hi_z, b.max.z());
-    }
-    if (!(x.top > 0)) x.top = 1;
-    return x;
-}
-
-void HierarchicalGrid::levelLane(Lane& lane, Real top) {
-    // Level k has cells s_top / 8^k; a box goes to the finest level whose cells hold its
-    // extent. Zero-size boxes fit anywhere: marked here, they join the finest level in use.
-    std::array<Real, kMaxLevels> base_cell;  // s_top / 8^k
-    for (int k = 0; k < kMaxLevels; ++k) base_cell[k] = std::ldexp(top, -kLevelBits * k);
-    lane.extent_sum.fill(0);
-    lane.members.fill(0);
-    lane.zero_size = 0;
-    lane.finest = 0;
-    for (std::size_t p = lane.first; p < lane.last; ++p) {
-        const Real e = extentOf(box_[p]);
-        if (!(e > 0)) {
-            level_of_[p] = kZeroSize;
-            ++lane.zero_size;
-            continue;
-        }
-        int k = std::min(floorLog2(top / e) / kLevelBits, kMaxLevels - 1);
-        while (k > 0 && base_cell[k] < e) --k;  // guard: cell >= extent
-        level_of_[p] = static_cast<std::uint8_t>(k);
-        lane.extent_sum[k] += e;
-        ++lane.members[k];
-        lane.finest = std::max(lane.finest, k);
-    }
-}
-
 std::int64_t HierarchicalGrid::fixColumns(const Level& lv, std::size_t from, std::size_t to) {
     // Each column is in (float(min x), id) order: restore (min x, id) by insertion sort. Only
     // boxes whose min x round to the same float can be out of order, so this is one comparison
@@ -263,106 +134,6 @@ std::int64_t HierarchicalGrid::fixColumns(const Level& lv, std::size_t from, std
         shifts += static_cast<std::int64_t>(column_shifts);
     }
     return shifts;
-}
-
-double HierarchicalGrid::planLevels(const std::array<std::size_t, kMaxLevels>& members,
-                                    const std::array<Real, kMaxLevels>& extent_sum, int level_count,
-                                    Real top, const Bounds& b, Plan& plan) {
-    // Column grids: cells at least the level's own s_top / 8^k and twice its members' mean
-    // extent (columns much wider than the boxes cost more candidates, much narrower ones more
-    // entries per box: on the bench's uniform workload 1.11 ms/frame at the level's cell, 1.04
-    // at twice the mean extent), widened (doubled) until a level has at most ~2 columns per
-    // entry. Returns an estimate of the sweep's cost in candidate tests, entries counted as 3:
-    // a level's entries spread evenly over its columns and over x, each entry of one of its
-    // own members meets those that start within its x extent, each guest only the members.
-    double cost = 0;
-    std::size_t guests = 0;  // proxies of finer levels, entered as guests
-    Real guest_extent = 0;   // their extents' sum
-    for (int k = level_count - 1; k >= 0; --k) {
-        Grid& lv = plan[k];
-        lv.members = members[k];
-        lv.guests = guests;
-        if (lv.members == 0) continue;
-        const std::size_t entries = lv.members + guests;
-        const Real limit = std::max<Real>(64, 2 * Real(entries));
-        const Real mean = extent_sum[k] / Real(lv.members);
-        lv.cell = std::max(std::ldexp(top, -kLevelBits * k), kCellPerExtent * mean) *
-                  (1 + std::ldexp(Real(1), -20));
-        for (;;) {
-            lv.inv_cell = 1 / lv.cell;
-            const Real sy = (b.hi_y - b.lo_y) * lv.inv_cell;
-            const Real sz = (b.hi_z - b.lo_z) * lv.inv_cell;
-            if (!std::isfinite(sy) || !std::isfinite(sz) || lv.inv_cell == 0) {
-                lv.ny = lv.nz = 1;  // coordinates beyond the range of a column index
-                break;
-            }
-            const Real ny = std::floor(sy) + 1;
-            const Real nz = std::floor(sz) + 1;
-            if (ny * nz <= limit) {
-                lv.ny = static_cast<std::int64_t>(ny);
-                lv.nz = static_cast<std::int64_t>(nz);
-                break;
-            }
-            lv.cell *= 2;
-        }
-        const double w = double(lv.cell);
-        const double own_mean = double(mean);
-        const double guest_mean = guests > 0 ? double(guest_extent) / double(guests) : 0;
-        const double own = double(lv.members) * (1 + own_mean / w) * (1 + own_mean / w);
-        const double visiting = double(guests) * (1 + guest_mean / w) * (1 + guest_mean / w);
-        // Entries per column and unit of x, over the columns and the x range the boxes' centres
-        // occupy (not the bounds, which a few huge boxes can stretch far beyond the rest).
-        const auto across = [&](Real range) { return std::floor(double(range) / w) + 1; };
-        const double per_x = 1 / (across(b.centre_span.y()) * across(b.centre_span.z()) *
-                                  std::max(double(b.centre_span.x()), own_mean));
-        if (std::isfinite(per_x)) {
-            cost += own * own_mean * (own + visiting) * per_x + visiting * guest_mean * own * per_x;
-        }
-        cost += 3 * (own + visiting);
-        guests += lv.members;
-        guest_extent += extent_sum[k];
-    }
-    return cost;
-}
-
-// Each level's members and extents gathered from the lanes, and the levels planned both ways
-// (a hierarchy, or one level); the cheaper estimate is kept.
-void HierarchicalGrid::chooseLevels(Real top, const Extents& x) {
-    finest_ = 0;
-    for (int t = 0; t < lane_count_; ++t) finest_ = std::max(finest_, lanes_[t].finest);
-    level_count_ = finest_ + 1;
-    std::array<Real, kMaxLevels> extent_sum{};
-    std::array<std::size_t, kMaxLevels> members{};
-    for (int k = 0; k < level_count_; ++k) {
-        for (int t = 0; t < lane_count_; ++t) {
-            members[k] += lanes_[t].members[k];
-            extent_sum[k] += lanes_[t].extent_sum[k];
-        }
-    }
-    for (int t = 0; t < lane_count_; ++t) members[finest_] += lanes_[t].zero_size;
-
-    // The hierarchy pays off when one level's columns, as wide as its largest box, would hold
-    // many much smaller boxes (a few huge boxes among many small ones); with sizes spread
-    // evenly it costs more entries than it saves tests (measured on the bench's 1:100 and
-    // 1:10^4 log-uniform mixes: one level 0.80 and 0.80 ms/frame at 10k, levels 8x apart 1.14
-    // and 1.46). So the levels are planned both ways and the cheaper estimate is kept.
-    const Bounds bounds{x.lo_y, x.hi_y, x.lo_z, x.hi_z, x.hi_c - x.lo_c};
-    Plan levels_plan, flat_plan;
-    const double levels_cost =
-        planLevels(members, extent_sum, level_count_, top, bounds, levels_plan);
-    flat_ = false;
-    if (level_count_ > 1) {
-        std::array<std::size_t, kMaxLevels> one{};
-        std::array<Real, kMaxLevels> one_sum{};
-        for (int k = 0; k < level_count_; ++k) {
-            one[0] += members[k];
-            one_sum[0] += extent_sum[k];
-        }
-        flat_ = planLevels(one, one_sum, 1, top, bounds, flat_plan) <= levels_cost;
-    }
-    if (flat_) level_count_ = 1;
-    const Plan& plan = flat_ ? flat_plan : levels_plan;
-    for (int k = 0; k < level_count_; ++k) static_cast<Grid&>(levels_[k]) = plan[k];
 }
 
 // Columns laid out level after level; returns the number of entries, and the number of columns

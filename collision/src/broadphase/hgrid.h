@@ -143,11 +143,14 @@ private:
         Real lo_y, hi_y, lo_z, hi_z;  // of the boxes
         Vec3 lo_c, hi_c;              // of their centres
     };
+    /// A box's largest extent, which decides its level.
+    static Real extentOf(const Aabb& b) { return (b.max - b.min).maxCoeff(); }
+    static constexpr std::uint8_t kZeroSize = 0xff;  // level_of_ mark: any level will do
     static double planLevels(const std::array<std::size_t, kMaxLevels>& members,
                              const std::array<Real, kMaxLevels>& extent_sum, int level_count,
                              Real top, const Bounds& bounds, Plan& plan);
     Extents gatherBoxes();
-    // Steps of findPairs, in order (hgrid.cpp).
+    // Steps of findPairs, in order (hgrid_order.cpp, hgrid_levels.cpp, hgrid.cpp).
     void chooseLevels(Real top, const Extents& x);
     std::size_t layoutColumns(std::size_t& flat_columns);
     void planChunks(std::size_t total, std::size_t flat_columns);
