@@ -7,6 +7,7 @@
 #include "bvh/wide.h"
 
 #include <algorithm>
+#include <cstring>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -14,24 +15,72 @@
 #include "bvh/traversal.h"
 #include "collision/assert.h"
 
-// The lane helpers have internal linkage and are always inlined, so the AVX-versus-SSE2
-// argument passing GCC warns about (-Wpsabi) never crosses a call boundary of this file.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wpsabi"
-#endif
-
 namespace collision {
 
 namespace {
 
-[[gnu::always_inline]] inline WideLanes absLanes(WideLanes v) {
-    const WideMask magnitude = {0x7fffffffffffffff, 0x7fffffffffffffff, 0x7fffffffffffffff,
-                                0x7fffffffffffffff};
+WideLanes absLanes(WideLanes v) {
+    const WideMask magnitude = {0x7fffffffffffffff, 0x7fffffffffffffff};
     return reinterpret_cast<WideLanes>(reinterpret_cast<WideMask>(v) & magnitude);
 }
 
-[[gnu::always_inline]] inline WideMask greater(WideLanes a, WideLanes b) {
-    return reinterpret_cast<WideMask>(a > b);
+WideMask greater(WideLanes a, WideLanes b) { return reinterpret_cast<WideMask>(a > b); }
+
+WideLanes load(const double (&lanes)[4], int half) {
+    WideLanes v;
+    std::memcpy(&v, &lanes[2 * half], sizeof v);
+    return v;
+}
+
+// Lanes 2 h and 2 h + 1 of `n` against box `b`: bit 0/1 set for an overlapping lane. The
+// fifteen axes of testSat15 in its order; |R| + 16 eps enters as |R| plus 16 eps times the sum
+// of the half extents it multiplies (the same bound, fewer live registers).
+unsigned overlapHalf(const WideObbNode& n, int h, const Obb& b, Real tol) {
+    const Real e = Real(16) * kEpsilon;
+    const Vec3& hb = b.half_extents;
+    const WideLanes ha[3] = {load(n.half[0], h), load(n.half[1], h), load(n.half[2], h)};
+    WideLanes d[3];
+    for (int r = 0; r < 3; ++r) d[r] = b.center[r] - load(n.center[r], h);
+    WideLanes t[3];
+    WideLanes rot[3][3];
+    for (int i = 0; i < 3; ++i) {
+        const WideLanes a0 = load(n.axes[3 * i], h);
+        const WideLanes a1 = load(n.axes[3 * i + 1], h);
+        const WideLanes a2 = load(n.axes[3 * i + 2], h);
+        t[i] = a0 * d[0] + a1 * d[1] + a2 * d[2];
+        for (int j = 0; j < 3; ++j) {
+            rot[i][j] = a0 * b.axes(0, j) + a1 * b.axes(1, j) + a2 * b.axes(2, j);
+        }
+    }
+    const Real face_a_slack = tol + e * (hb[0] + hb[1] + hb[2]);
+    WideMask sep = {0, 0};
+    for (int i = 0; i < 3; ++i) {
+        sep |= greater(absLanes(t[i]), ha[i] + absLanes(rot[i][0]) * hb[0] +
+                                           absLanes(rot[i][1]) * hb[1] +
+                                           absLanes(rot[i][2]) * hb[2] + face_a_slack);
+    }
+    const WideLanes face_b_slack = tol + e * (ha[0] + ha[1] + ha[2]);
+    for (int j = 0; j < 3; ++j) {
+        sep |= greater(absLanes(t[0] * rot[0][j] + t[1] * rot[1][j] + t[2] * rot[2][j]),
+                       absLanes(rot[0][j]) * ha[0] + absLanes(rot[1][j]) * ha[1] +
+                           absLanes(rot[2][j]) * ha[2] + hb[j] + face_b_slack);
+    }
+    if ((sep[0] & sep[1]) != 0) return 0;
+    for (int i = 0; i < 3; ++i) {
+        const int i1 = (i + 1) % 3;
+        const int i2 = (i + 2) % 3;
+        for (int j = 0; j < 3; ++j) {
+            const int j1 = (j + 1) % 3;
+            const int j2 = (j + 2) % 3;
+            const WideLanes ra = ha[i1] * absLanes(rot[i2][j]) + ha[i2] * absLanes(rot[i1][j]) +
+                                 e * (ha[i1] + ha[i2]);
+            const WideLanes rb = hb[j1] * absLanes(rot[i][j2]) + hb[j2] * absLanes(rot[i][j1]) +
+                                 e * (hb[j1] + hb[j2]);
+            const WideLanes dist = absLanes(t[i2] * rot[i1][j] - t[i1] * rot[i2][j]);
+            sep |= greater(dist, ra + rb + tol);
+        }
+    }
+    return (sep[0] == 0 ? 1u : 0u) | (sep[1] == 0 ? 2u : 0u);
 }
 
 // Lane `l` of `node` as a box.
@@ -48,53 +97,9 @@ Obb laneBox(const WideObbNode& node, int l) {
 }  // namespace
 
 unsigned overlapLanes(const WideObbNode& n, const Obb& b, Real tol) {
-    // Per lane: B's axes and centre in the lane box's frame (rot = A^T B, t = A^T (c_b - c_a)),
-    // then the fifteen axes of testSat15 in its order, all lanes at once (Gottschalk 1996 §4).
-    WideLanes d[3];
-    for (int r = 0; r < 3; ++r) d[r] = b.center[r] - n.center[r];
-    WideLanes t[3];
-    WideLanes rot[3][3];
-    WideLanes abs_rot[3][3];
-    for (int i = 0; i < 3; ++i) {
-        t[i] = n.axes[3 * i] * d[0] + n.axes[3 * i + 1] * d[1] + n.axes[3 * i + 2] * d[2];
-        for (int j = 0; j < 3; ++j) {
-            rot[i][j] = n.axes[3 * i] * b.axes(0, j) + n.axes[3 * i + 1] * b.axes(1, j) +
-                        n.axes[3 * i + 2] * b.axes(2, j);
-            // |R| + eps keeps near-parallel edge pairs from false separations (as testSat15).
-            abs_rot[i][j] = absLanes(rot[i][j]) + Real(16) * kEpsilon;
-        }
-    }
-    const Vec3& hb = b.half_extents;
-    WideMask sep = greater(absLanes(t[0]), n.half[0] + abs_rot[0][0] * hb[0] +
-                                               abs_rot[0][1] * hb[1] + abs_rot[0][2] * hb[2] + tol);
-    for (int i = 1; i < 3; ++i) {
-        sep |= greater(absLanes(t[i]), n.half[i] + abs_rot[i][0] * hb[0] + abs_rot[i][1] * hb[1] +
-                                           abs_rot[i][2] * hb[2] + tol);
-    }
-    for (int j = 0; j < 3; ++j) {
-        sep |= greater(absLanes(t[0] * rot[0][j] + t[1] * rot[1][j] + t[2] * rot[2][j]),
-                       abs_rot[0][j] * n.half[0] + abs_rot[1][j] * n.half[1] +
-                           abs_rot[2][j] * n.half[2] + hb[j] + tol);
-    }
-    // Unused lanes repeat lane 0, so "every lane separated" needs no mask.
-    if ((sep[0] & sep[1] & sep[2] & sep[3]) != 0) return 0;
-    for (int i = 0; i < 3; ++i) {
-        const int i1 = (i + 1) % 3;
-        const int i2 = (i + 2) % 3;
-        for (int j = 0; j < 3; ++j) {
-            const int j1 = (j + 1) % 3;
-            const int j2 = (j + 2) % 3;
-            const WideLanes ra = n.half[i1] * abs_rot[i2][j] + n.half[i2] * abs_rot[i1][j];
-            const WideLanes rb = hb[j1] * abs_rot[i][j2] + hb[j2] * abs_rot[i][j1];
-            const WideLanes dist = absLanes(t[i2] * rot[i1][j] - t[i1] * rot[i2][j]);
-            sep |= greater(dist, ra + rb + tol);
-        }
-    }
-    unsigned hits = 0;
-    for (int l = 0; l < n.size; ++l) {
-        if (sep[l] == 0) hits |= 1u << l;
-    }
-    return hits;
+    unsigned hits = overlapHalf(n, 0, b, tol);
+    if (n.size > 2) hits |= overlapHalf(n, 1, b, tol) << 2;
+    return hits & ((1u << n.size) - 1);
 }
 
 WideObbTree::WideObbTree(const TriangleMesh& mesh, const BvhBuildOptions& options)

@@ -15,19 +15,19 @@
 
 namespace collision {
 
-/// Four doubles in lanes (GCC/Clang vector extension): two SSE2 registers on the x86-64
-/// baseline, one AVX register where the compiler may use it. Double lanes run the same
+/// Two doubles in lanes (GCC/Clang vector extension): one SSE2 register on the x86-64
+/// baseline. A wide node's four lanes are tested as two such halves. Double lanes run the same
 /// arithmetic as the binary tree's scalar test, so no outward rounding is needed beyond the
 /// traversal's slack.
-using WideLanes = double __attribute__((vector_size(32)));
-using WideMask = std::int64_t __attribute__((vector_size(32)));
+using WideLanes = double __attribute__((vector_size(16)));
+using WideMask = std::int64_t __attribute__((vector_size(16)));
 
 /// One wide node: up to four children, lane l holding child l's box.
 struct WideObbNode {
-    WideLanes center[3];         ///< centre coordinate r
-    WideLanes axes[9];           ///< axes[3 c + r]: component r of box axis c
-    WideLanes half[3];           ///< half extent along axis c
-    std::array<Real, 4> cost{};  ///< the child's volume (picks the node to descend)
+    alignas(16) double center[3][4];  ///< centre coordinate r
+    alignas(16) double axes[9][4];    ///< axes[3 c + r]: component r of box axis c
+    alignas(16) double half[3][4];    ///< half extent along axis c
+    std::array<Real, 4> cost{};       ///< the child's volume (picks the node to descend)
     std::array<std::int32_t, 4> child{-1, -1, -1, -1};  ///< internal child: its wide node
     std::array<std::int32_t, 4> first{};                ///< leaf child: first triangle (leaf order)
     std::array<std::int32_t, 4> count{};                ///< leaf child: triangles (> 0); 0 internal
