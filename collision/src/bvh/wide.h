@@ -1,8 +1,9 @@
 // collision/src/bvh/wide.h -- a 4-wide OBB hierarchy: the binary OBB tree collapsed so that each
 // node holds up to four children's boxes side by side (structure of arrays), and one box is tested
-// against all four in one pass of 4-lane arithmetic (Wald, Benthin, Boulos 2008, "Getting rid of
-// packets"; Dammertz et al. 2008, "Shallow bounding volume hierarchies"). The binary tree stays
-// inside: it owns the triangles and answers the queries that do not descend in tandem.
+// against all four in one pass of lane arithmetic, two SSE2 lanes at a time (Wald, Benthin, Boulos
+// 2008, "Getting rid of packets"; Dammertz et al. 2008, "Shallow bounding volume hierarchies"). The
+// binary tree stays inside: it owns the triangles and answers the queries that do not descend in
+// tandem.
 #pragma once
 
 #include <array>
