@@ -123,6 +123,10 @@ void WideObbTree::collapse() {
     nodes_.clear();
     lane_source_.clear();
     if (binary_.nodes().empty()) return;
+    // At most one wide node per internal binary node, plus the root's.
+    const std::size_t bound = binary_.nodes().size() / 2 + 2;
+    nodes_.reserve(bound);
+    lane_source_.reserve(4 * bound);
     nodes_.emplace_back();
     lane_source_.assign(4, 0);
     WideObbNode& root = nodes_[0];
