@@ -192,6 +192,9 @@ private:
 #endif
 
 std::unique_ptr<NarrowMethod> makeMethod(const std::string& name) {
+    if (name == collision::kWideObbName) {
+        return std::make_unique<CdlabMethod>(collision::kWideObbName, collision::BvhBuild::TopDown);
+    }
     for (const std::string_view bv : collision::bvhVolumeNames()) {
         if (bv == name) return std::make_unique<CdlabMethod>(bv, collision::BvhBuild::TopDown);
         if (std::string(bv) + "-bu" == name) {

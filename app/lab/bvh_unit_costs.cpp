@@ -42,6 +42,9 @@ BvhUnitCosts measureBvhUnitCosts(const collision::MeshBvh& a, const collision::M
         nv += static_cast<std::int64_t>(samples.back().node_pairs.size());
         np += static_cast<std::int64_t>(samples.back().triangle_pairs.size());
     }
+    // A hierarchy whose tests the replay cannot record (the wide tree: no typed binary tree)
+    // gives no sample at all, and no unit costs.
+    if (nv == 0) return costs;
     if (np == 0) {
         // No query reached its triangles (every pose apart at the volumes): time random pairs of
         // the meshes' triangles at the first pose instead, and say so.

@@ -31,7 +31,8 @@ struct BvhUnitCosts {
 /// tests and `triangle_target` triangle tests (each pose's list the same number of times, so
 /// poses weigh as their Nv and Np do in F), and times the replays in chunks of about one query's
 /// tests, each the fastest of 3 runs. None of this is inside a query's timed path. `a` and `b`
-/// hold the same volume type. Cost about 3 times the batch.
+/// hold the same volume type. Cost about 3 times the batch. A tree the replay cannot record
+/// (kWideObbName) gets zero costs.
 BvhUnitCosts measureBvhUnitCosts(const collision::MeshBvh& a, const collision::MeshBvh& b,
                                  std::span<const collision::Pose> poses,
                                  std::int64_t bv_target = 200000,

@@ -86,6 +86,28 @@ TEST(NarrowphaseBench, BottomUpBuildsAreCheckedToo) {
     }
 }
 
+// The wide OBB tree runs by name, answers as the brute force at every pose (and after the
+// refit), and leaves the unit-cost columns at zero (the replay records binary trees only).
+TEST(NarrowphaseBench, WideObbTreeRunsByNameAndAgreesWithBruteForce) {
+    const fs::path work = tempDir("wide");
+    const fs::path json = work / "np.json";
+    const Result r = runCdlab(
+        "bench narrowphase --triangles 600 --poses 6 --reps 1 --methods obb4,obb --json " +
+            json.string(),
+        work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(slurp(json));
+    ASSERT_EQ(j["rows"].size(), 2u);
+    const auto& wide = j["rows"][0];
+    EXPECT_EQ(wide["method"], "obb4");
+    EXPECT_EQ(wide["bool_mismatches"], 0);
+    EXPECT_EQ(wide["pair_mismatches"], 0);
+    EXPECT_TRUE(wide["refit_ok"].get<bool>());
+    EXPECT_EQ(wide["bv_test_ns"].get<double>(), 0);
+    EXPECT_GT(wide["all_nv"].get<double>(), 0);
+    EXPECT_GT(wide["all_np"].get<double>(), 0);
+}
+
 // Every FCL row runs the path an FCL user gets (one object per mesh, setTransform per query;
 // RSS through FCL's RSS traversal node) and any of FCL's split rules by suffix, and answers as
 // the brute force does on every pose.

@@ -8,6 +8,7 @@
 #include <type_traits>
 
 #include "bvh/traversal.h"
+#include "bvh/wide.h"
 #include "collision/assert.h"
 #include "collision/bvh/bvh.h"
 #include "volumes/bvh_volumes.h"
@@ -91,6 +92,83 @@ private:
     Bvh<BV> tree_;
 };
 
+// The 4-wide OBB tree (wide.h): the tandem queries run on the wide nodes, the others on the
+// binary tree it was collapsed from (same triangles, same boxes).
+class MeshBvhWide final : public MeshBvh {
+public:
+    MeshBvhWide(const TriangleMesh& mesh, const BvhBuildOptions& options) : tree_(mesh, options) {}
+    std::string_view volumeName() const override { return kWideObbName; }
+    std::int32_t nodeCount() const override {
+        return static_cast<std::int32_t>(tree_.nodes().size());
+    }
+    int depth() const override { return tree_.depth(); }
+    bool validate(std::string* error) const override { return tree_.validate(error); }
+    bool testOverlap(const MeshBvh& b, const Pose& b_in_a, BvhQueryStats* stats) const override {
+        const WideObbTree* other = otherTree(b);
+        return other != nullptr &&
+               testWide(tree_, *other, makeBvhTransform(b_in_a, scale(), other->binary().scale()),
+                        stats);
+    }
+    std::vector<TrianglePair> intersect(const MeshBvh& b, const Pose& b_in_a,
+                                        BvhQueryStats* stats) const override {
+        const WideObbTree* other = otherTree(b);
+        if (other == nullptr) return {};
+        return intersectWide(tree_, *other,
+                             makeBvhTransform(b_in_a, scale(), other->binary().scale()), stats);
+    }
+    std::int32_t triangleCount() const override { return tree_.binary().triangleCount(); }
+    std::int32_t refit(const TriangleMesh& mesh) override { return tree_.refit(mesh); }
+    MeshDistance distance(const MeshBvh& b, const Pose& b_in_a,
+                          BvhQueryStats* stats) const override {
+        const WideObbTree* other = otherTree(b);
+        if (other == nullptr) {
+            MeshDistance none;
+            none.distance = std::numeric_limits<Real>::infinity();
+            return none;
+        }
+        return distanceBvhBvh(tree_.binary(), other->binary(), b_in_a, stats);
+    }
+    std::vector<TrianglePair> intersectSelf(BvhQueryStats* stats) const override {
+        return collision::intersectSelf(tree_.binary(), stats);
+    }
+    bool sameVolumeType(const MeshBvh& b) const override {
+        return dynamic_cast<const MeshBvhWide*>(&b) != nullptr;
+    }
+    bool visitIntersecting(const MeshBvh& b, const Mat3& rotation, const Vec3& translation,
+                           TrianglePairVisitor& visitor, BvhQueryStats* stats) const override {
+        const WideObbTree* other = otherTree(b);
+        if (other == nullptr) return false;
+        const BvhTransform x =
+            makeBvhTransform(rotation, translation, scale(), other->binary().scale());
+        return visitWide(tree_, *other, x, visitor, stats);
+    }
+    bool visitNearBox(const Vec3& box_min, const Vec3& box_max, const Mat3& rotation,
+                      const Vec3& translation, TriangleVisitor& visitor,
+                      BvhQueryStats* stats) const override {
+        const Bvh<Obb>& tree = tree_.binary();
+        if (tree.nodes().empty()) return false;
+        const Real box_scale =
+            (box_max - box_min).maxCoeff() +
+            std::max(box_min.cwiseAbs().maxCoeff(), box_max.cwiseAbs().maxCoeff());
+        const Obb volume = BvTraits<Obb>::fit(boxSurfaceCorners(box_min, box_max));
+        const BvhTransform x = makeBvhTransform(rotation, translation, tree.scale(), box_scale);
+        return traverseVolume(tree, volume, x, stats,
+                              [&](std::int32_t i, const std::array<Vec3, 3>& corners) {
+                                  return visitor.visit(tree.leafTriangleId(i), corners);
+                              });
+    }
+
+private:
+    Real scale() const { return tree_.binary().scale(); }
+    const WideObbTree* otherTree(const MeshBvh& b) const {
+        const auto* other = dynamic_cast<const MeshBvhWide*>(&b);
+        CDLAB_ASSERT(other != nullptr, "BVH query between different volume types");
+        return other != nullptr ? &other->tree_ : nullptr;
+    }
+
+    WideObbTree tree_;
+};
+
 }  // namespace
 
 template <class BV>
@@ -121,6 +199,7 @@ const std::vector<std::string_view>& bvhVolumeNames() {
 
 std::unique_ptr<MeshBvh> buildMeshBvh(std::string_view volume_name, const TriangleMesh& mesh,
                                       const BvhBuildOptions& options) {
+    if (volume_name == kWideObbName) return std::make_unique<MeshBvhWide>(mesh, options);
     std::unique_ptr<MeshBvh> out;
     std::apply(
         [&](auto... bv) {

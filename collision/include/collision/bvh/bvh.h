@@ -312,7 +312,12 @@ const std::vector<std::string_view>& bvhVolumeNames();
 template <class BV>
 const Bvh<BV>* treeOf(const MeshBvh& tree);
 
-/// Builds the tree of the named volume type; nullptr for an unknown name.
+/// The 4-wide OBB hierarchy: the binary OBB tree collapsed to nodes of up to four children whose
+/// boxes are tested together. Built by buildMeshBvh under this name; treeOf finds no typed tree
+/// in it.
+inline constexpr std::string_view kWideObbName = "obb4";
+
+/// Builds the tree of the named volume type (or kWideObbName); nullptr for an unknown name.
 std::unique_ptr<MeshBvh> buildMeshBvh(std::string_view volume_name, const TriangleMesh& mesh,
                                       const BvhBuildOptions& options = {});
 
