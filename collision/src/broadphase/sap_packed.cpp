@@ -327,7 +327,8 @@ void PackedSweepAndPrune::restale() {
     stale_lanes_.pad(count);
 }
 
-void PackedSweepAndPrune::queryEscaped(BroadPhaseCounters& counters) {
+void PackedSweepAndPrune::queryEscaped(std::vector<ProxyPair>& pairs,
+                                       BroadPhaseCounters& counters) {
     // The sorted bands, as last dealt, still hold every box that has not been re-fattened
     // since (not stale): an escaped box is looked up in the bands its y range meets, by binary
     // search on min x from its min x less the band's widest box; the stale boxes' current fat
@@ -388,14 +389,35 @@ void PackedSweepAndPrune::queryEscaped(BroadPhaseCounters& counters) {
     counters.volume_tests += tests;
     radix::keysToSortedPairs(keys_, scratch_, shift_, fresh_, /*order_ids=*/true);
     // The kept candidates (no escaped member) and the fresh ones, both sorted, merged.
-    merged_.clear();
+    // The same pass writes the exact pairs (see exactPairs): one walk over the candidates, not
+    // two. Branch-free: every candidate is written to both lists, the merged count advances for
+    // a kept one, the exact count for a kept one whose boxes overlap.
+    merged_.resize(candidates_.size() + fresh_.size());
+    pairs.resize(merged_.size());
+    ProxyPair* merged = merged_.data();
+    ProxyPair* exact = pairs.data();
+    std::size_t kept = 0;
+    std::size_t count = 0;
     std::size_t f = 0;
+    const char* flag = escaped_flag_.data();
+    const auto take = [&](const ProxyPair& p) {
+        merged[kept++] = p;
+        exact[count] = p;
+        count += static_cast<std::size_t>(overlapsExactly(p));
+    };
     for (const ProxyPair& p : candidates_) {
-        if (escaped_flag_[p.a] | escaped_flag_[p.b]) continue;
-        while (f < fresh_.size() && fresh_[f] < p) merged_.push_back(fresh_[f++]);
-        merged_.push_back(p);
+        const int keep = int(flag[p.a] == 0) & int(flag[p.b] == 0);
+        if (keep != 0) {
+            while (f < fresh_.size() && fresh_[f] < p) take(fresh_[f++]);
+        }
+        merged[kept] = p;
+        kept += static_cast<std::size_t>(keep);
+        exact[count] = p;
+        count += static_cast<std::size_t>(keep & overlapsExactly(p));
     }
-    merged_.insert(merged_.end(), fresh_.begin() + static_cast<std::ptrdiff_t>(f), fresh_.end());
+    while (f < fresh_.size()) take(fresh_[f++]);
+    merged_.resize(kept);
+    pairs.resize(count);
     candidates_.swap(merged_);
 }
 
@@ -613,6 +635,7 @@ void PackedSweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCou
     counters.volumes_updated += moved_;
     moved_ = 0;
     ++frame_;
+    bool exact_done = false;
     if (dirty_) {
         // A new proxy set: exact bounds (no margin) and a full sweep, the one-shot path.
         margins_on_ = false;
@@ -628,7 +651,8 @@ void PackedSweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCou
         } else if (margins_on_ && escaped_.size() <= limit) {
             for (const ProxyId e : escaped_) fatten(e, 1.0f, true);
             restale();
-            queryEscaped(counters);
+            queryEscaped(pairs, counters);
+            exact_done = true;
             // The candidates are complete; once many boxes are stale, their list is long and
             // the bands are sorted and dealt again from the current fat boxes (no sweep).
             if (stale_ids_.size() > present_.size() / kStaleShare) resnapshot(counters);
@@ -653,22 +677,19 @@ void PackedSweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCou
     for (const ProxyId e : escaped_) escaped_flag_[e] = 0;
     escaped_.clear();
 
-    // The exact answer: every candidate (fat boxes overlap) tested on the double AABBs, as
-    // Aabb::overlaps does. Candidates are sorted, so the pairs are.
-    // Branch-free: every candidate is written, and the count advances only for an overlap
-    // (about half the candidates do, so a branch would be mispredicted as often as not).
-    pairs.resize(candidates_.size());
-    std::size_t count = 0;
-    for (const ProxyPair& p : candidates_) {
-        const Aabb& a = table_.aabb(p.a);
-        const Aabb& b = table_.aabb(p.b);
-        const int overlap = int(a.min.x() <= b.max.x()) & int(b.min.x() <= a.max.x()) &
-                            int(a.min.y() <= b.max.y()) & int(b.min.y() <= a.max.y()) &
-                            int(a.min.z() <= b.max.z()) & int(b.min.z() <= a.max.z());
-        pairs[count] = p;
-        count += static_cast<std::size_t>(overlap);
+    if (!exact_done) {
+        // The exact answer: every candidate (fat boxes overlap) tested on the double AABBs.
+        // Candidates are sorted, so the pairs are. Branch-free: every candidate is written, and
+        // the count advances only for an overlap (about half the candidates do, so a branch
+        // would be mispredicted as often as not).
+        pairs.resize(candidates_.size());
+        std::size_t count = 0;
+        for (const ProxyPair& p : candidates_) {
+            pairs[count] = p;
+            count += static_cast<std::size_t>(overlapsExactly(p));
+        }
+        pairs.resize(count);
     }
-    pairs.resize(count);
     counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
 }
 
