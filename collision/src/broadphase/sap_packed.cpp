@@ -69,7 +69,9 @@ void PackedSweepAndPrune::move(ProxyId id, const ProxyVolumes& v) {
     const Real step = shift.cwiseAbs().maxCoeff();
     if (static_cast<std::size_t>(id) < motion_.size()) {
         const float decayed = motion_[id] * kMotionDecay;
-        motion_[id] = std::isfinite(step) ? std::max(decayed, float(step)) : decayed;
+        motion_[id] = std::isfinite(step)
+                          ? std::max(decayed, float(std::min<Real>(step, kFloatMax)))
+                          : decayed;
     }
     table_.move(id, v);
     ++moved_;
@@ -168,22 +170,58 @@ void PackedSweepAndPrune::pack() {
     hi_y_ = hi_y;
 }
 
-void PackedSweepAndPrune::fatten(ProxyId id, float margin) {
+void PackedSweepAndPrune::fatten(ProxyId id, float share, bool learn) {
+    // Margins as Box2D's dynamic tree fattens a moving proxy's box (Catto, Box2D: b2_aabbMargin
+    // plus the predicted displacement): a margin on every side, and on the side each axis moves
+    // towards a lead of kLead frames of the box's mean velocity over its last fat box's lifetime.
+    // The margin is learnt from how far that lifetime's lead missed (twice the miss, at least
+    // kMinMargin and at most kMargin times the recent step): a box moving steadily is led and
+    // gets a thin margin, one jittering about a place no lead and the full margin. Without a
+    // lifetime to learn from (a rebuild) the margin is full and there is no lead.
     const Aabb& box = table_.aabb(id);
     const std::size_t k = static_cast<std::size_t>(id);
-    const Real m = margin;
-    const float lo_x = roundDown(box.min.x() - m);
-    const float lo_y = roundDown(box.min.y() - m);
-    const float lo_z = roundDown(box.min.z() - m);
-    const float hi_x = roundUp(box.max.x() + m);
-    const float hi_y = roundUp(box.max.y() + m);
-    const float hi_z = roundUp(box.max.z() + m);
-    fat_.min_x[k] = lo_x;
-    fat_.max_x[k] = hi_x;
-    fat_.min_y[k] = lo_y;
-    fat_.min_z[k] = lo_z;
-    fat_.neg_max_y[k] = -hi_y;
-    fat_.neg_max_z[k] = -hi_z;
+    if (share == 0) {
+        // No margins (the one-shot path): nothing to lead or learn from; the next fat box
+        // with margins is made by a rebuild, which learns nothing either.
+        setFat(k, box.min.x(), box.min.y(), box.min.z(), box.max.x(), box.max.y(), box.max.z());
+        return;
+    }
+    const Vec3 centre = (box.min + box.max) / 2;
+    const Real step = motion_[k];
+    if (learn && frame_ > fat_frame_[k]) {
+        const Real lived = Real(frame_ - fat_frame_[k]);
+        const Vec3 moved = centre - fat_centre_[k];
+        const Real miss = (moved - lived * lead_velocity_[k]).cwiseAbs().maxCoeff();
+        margin_[k] = std::isfinite(miss)
+                         ? std::clamp<Real>(2 * miss, kMinMargin * step, kMargin * step)
+                         : kMargin * step;
+        const Vec3 velocity = moved / lived;
+        lead_velocity_[k] = velocity.allFinite() ? velocity : Vec3::Zero();
+    } else {
+        margin_[k] = kMargin * step;
+        lead_velocity_[k] = Vec3::Zero();
+    }
+    fat_centre_[k] = centre;
+    fat_frame_[k] = frame_;
+    const Real base = Real(share) * margin_[k];
+    const Vec3 led = Real(share) * kLead * lead_velocity_[k];
+    const Vec3 lead = led.allFinite() ? led : Vec3::Zero();
+    setFat(k, box.min.x() - (base + std::max<Real>(0, -lead.x())),
+           box.min.y() - (base + std::max<Real>(0, -lead.y())),
+           box.min.z() - (base + std::max<Real>(0, -lead.z())),
+           box.max.x() + (base + std::max<Real>(0, lead.x())),
+           box.max.y() + (base + std::max<Real>(0, lead.y())),
+           box.max.z() + (base + std::max<Real>(0, lead.z())));
+}
+
+void PackedSweepAndPrune::setFat(std::size_t k, Real lo_x, Real lo_y, Real lo_z, Real hi_x,
+                                 Real hi_y, Real hi_z) {
+    fat_.min_x[k] = roundDown(lo_x);
+    fat_.max_x[k] = roundUp(hi_x);
+    fat_.min_y[k] = roundDown(lo_y);
+    fat_.min_z[k] = roundDown(lo_z);
+    fat_.neg_max_y[k] = -roundUp(hi_y);
+    fat_.neg_max_z[k] = -roundUp(hi_z);
 }
 
 bool PackedSweepAndPrune::insideFat(ProxyId id) const {
@@ -289,7 +327,8 @@ void PackedSweepAndPrune::restale() {
     stale_lanes_.pad(count);
 }
 
-void PackedSweepAndPrune::queryEscaped(BroadPhaseCounters& counters) {
+void PackedSweepAndPrune::queryEscaped(std::vector<ProxyPair>& pairs,
+                                       BroadPhaseCounters& counters) {
     // The sorted bands, as last dealt, still hold every box that has not been re-fattened
     // since (not stale): an escaped box is looked up in the bands its y range meets, by binary
     // search on min x from its min x less the band's widest box; the stale boxes' current fat
@@ -350,14 +389,35 @@ void PackedSweepAndPrune::queryEscaped(BroadPhaseCounters& counters) {
     counters.volume_tests += tests;
     radix::keysToSortedPairs(keys_, scratch_, shift_, fresh_, /*order_ids=*/true);
     // The kept candidates (no escaped member) and the fresh ones, both sorted, merged.
-    merged_.clear();
+    // The same pass writes the exact pairs (see exactPairs): one walk over the candidates, not
+    // two. Branch-free: every candidate is written to both lists, the merged count advances for
+    // a kept one, the exact count for a kept one whose boxes overlap.
+    merged_.resize(candidates_.size() + fresh_.size());
+    pairs.resize(merged_.size());
+    ProxyPair* merged = merged_.data();
+    ProxyPair* exact = pairs.data();
+    std::size_t kept = 0;
+    std::size_t count = 0;
     std::size_t f = 0;
+    const char* flag = escaped_flag_.data();
+    const auto take = [&](const ProxyPair& p) {
+        merged[kept++] = p;
+        exact[count] = p;
+        count += static_cast<std::size_t>(overlapsExactly(p));
+    };
     for (const ProxyPair& p : candidates_) {
-        if (escaped_flag_[p.a] | escaped_flag_[p.b]) continue;
-        while (f < fresh_.size() && fresh_[f] < p) merged_.push_back(fresh_[f++]);
-        merged_.push_back(p);
+        const int keep = int(flag[p.a] == 0) & int(flag[p.b] == 0);
+        if (keep != 0) {
+            while (f < fresh_.size() && fresh_[f] < p) take(fresh_[f++]);
+        }
+        merged[kept] = p;
+        kept += static_cast<std::size_t>(keep);
+        exact[count] = p;
+        count += static_cast<std::size_t>(keep & overlapsExactly(p));
     }
-    merged_.insert(merged_.end(), fresh_.begin() + static_cast<std::ptrdiff_t>(f), fresh_.end());
+    while (f < fresh_.size()) take(fresh_[f++]);
+    merged_.resize(kept);
+    pairs.resize(count);
     candidates_.swap(merged_);
 }
 
@@ -374,6 +434,10 @@ void PackedSweepAndPrune::rebuild() {
     stale_.assign(capacity, 0);
     stale_ids_.clear();
     motion_.resize(capacity, 0);
+    margin_.resize(capacity, 0);
+    lead_velocity_.resize(capacity, Vec3::Zero());
+    fat_centre_.resize(capacity, Vec3::Zero());
+    fat_frame_.resize(capacity, 0);
     present_.clear();
     for (ProxyId id = 0; id < table_.capacity(); ++id) {
         if (!table_.contains(id)) {
@@ -384,12 +448,12 @@ void PackedSweepAndPrune::rebuild() {
         }
         present_.push_back(id);
         // Margins given to all boxes at once would run out at once, and again every lifetime
-        // after (boxes moving steadily escape after about kMargin frames): each box's first
+        // after (boxes moving steadily escape after about as many frames): each box's first
         // margin is a fraction of the full one, spread over (0, 1] by a hash of its id, so the
         // escapes spread evenly over the frames of a lifetime.
         const std::uint32_t hash = static_cast<std::uint32_t>(id) * 0x9E3779B9u;
         const float share = float((hash >> 8) + 1) * 0x1.0p-24f;
-        fatten(id, margins_on_ ? share * kMargin * motion_[id] : 0.0f);
+        fatten(id, margins_on_ ? share : 0.0f, false);
     }
     shift_ = radix::bitsFor(static_cast<std::uint64_t>(capacity) + 1);
 }
@@ -570,6 +634,8 @@ void PackedSweepAndPrune::sweepBig(BroadPhaseCounters& counters) {
 void PackedSweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) {
     counters.volumes_updated += moved_;
     moved_ = 0;
+    ++frame_;
+    bool exact_done = false;
     if (dirty_) {
         // A new proxy set: exact bounds (no margin) and a full sweep, the one-shot path.
         margins_on_ = false;
@@ -583,16 +649,17 @@ void PackedSweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCou
         const std::size_t limit = present_.size() / kEscapeShare + 1;
         if (escaped_.empty()) {
         } else if (margins_on_ && escaped_.size() <= limit) {
-            for (const ProxyId e : escaped_) fatten(e, kMargin * motion_[e]);
+            for (const ProxyId e : escaped_) fatten(e, 1.0f, true);
             restale();
-            queryEscaped(counters);
+            queryEscaped(pairs, counters);
+            exact_done = true;
             // The candidates are complete; once many boxes are stale, their list is long and
             // the bands are sorted and dealt again from the current fat boxes (no sweep).
             if (stale_ids_.size() > present_.size() / kStaleShare) resnapshot(counters);
         } else if (margins_on_ && escaped_.size() <= present_.size() / 2) {
             // Many escaped at once: re-fatten them and sweep every fat box. The others keep
             // theirs, so the escapes stay spread over frames.
-            for (const ProxyId e : escaped_) fatten(e, kMargin * motion_[e]);
+            for (const ProxyId e : escaped_) fatten(e, 1.0f, true);
             fullSweep(counters);
         } else {
             // Most left their fat boxes: margins do not pay here (or not yet). Sweep
@@ -610,22 +677,19 @@ void PackedSweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCou
     for (const ProxyId e : escaped_) escaped_flag_[e] = 0;
     escaped_.clear();
 
-    // The exact answer: every candidate (fat boxes overlap) tested on the double AABBs, as
-    // Aabb::overlaps does. Candidates are sorted, so the pairs are.
-    // Branch-free: every candidate is written, and the count advances only for an overlap
-    // (about half the candidates do, so a branch would be mispredicted as often as not).
-    pairs.resize(candidates_.size());
-    std::size_t count = 0;
-    for (const ProxyPair& p : candidates_) {
-        const Aabb& a = table_.aabb(p.a);
-        const Aabb& b = table_.aabb(p.b);
-        const int overlap = int(a.min.x() <= b.max.x()) & int(b.min.x() <= a.max.x()) &
-                            int(a.min.y() <= b.max.y()) & int(b.min.y() <= a.max.y()) &
-                            int(a.min.z() <= b.max.z()) & int(b.min.z() <= a.max.z());
-        pairs[count] = p;
-        count += static_cast<std::size_t>(overlap);
+    if (!exact_done) {
+        // The exact answer: every candidate (fat boxes overlap) tested on the double AABBs.
+        // Candidates are sorted, so the pairs are. Branch-free: every candidate is written, and
+        // the count advances only for an overlap (about half the candidates do, so a branch
+        // would be mispredicted as often as not).
+        pairs.resize(candidates_.size());
+        std::size_t count = 0;
+        for (const ProxyPair& p : candidates_) {
+            pairs[count] = p;
+            count += static_cast<std::size_t>(overlapsExactly(p));
+        }
+        pairs.resize(count);
     }
-    pairs.resize(count);
     counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
 }
 

@@ -26,10 +26,10 @@ namespace collision {
 /// motion is coherent; it falls back to the radix sort when the order changed too much).
 ///
 /// Coherence (as Bullet's DBVT and Box2D's tree fatten leaves): the swept boxes are fat, the exact
-/// box grown by kMargin times its recent largest step per frame, and the candidate pairs (fat
-/// boxes overlap) are kept between frames. A frame where few boxes left their fat box re-fattens
-/// only those and looks each up in the last sorted bands (binary search on min x,
-/// O(log n + k) per band), which still hold every box not re-fattened since; the re-fattened
+/// box grown by a margin and led in the direction it moves (fatten()), and the candidate pairs
+/// (fat boxes overlap) are kept between frames. A frame where few boxes left their fat box
+/// re-fattens only those and looks each up in the last sorted bands (binary search on min x, O(log
+/// n + k) per band), which still hold every box not re-fattened since; the re-fattened
 /// ("stale") boxes are looked up in a sorted list of their own. Once many are stale, the bands
 /// are sorted and dealt again (no sweep: the candidates are complete). When many escape in one
 /// frame every fat box is swept again (margins kept); when most do, margins are not paying and
@@ -52,7 +52,9 @@ private:
     static constexpr float kBandWidth = 3.0f;  ///< band width / median y extent
     static constexpr int kBigBands = 4;        ///< a box meeting more bands than this is big
     static constexpr std::size_t kPad = 4;     ///< NaN sentinels after each swept list
-    static constexpr float kMargin = 16.0f;    ///< fat margin / recent motion per frame
+    static constexpr float kMargin = 16.0f;    ///< most fat margin / recent motion per frame
+    static constexpr float kMinMargin = 1.0f;  ///< least fat margin / recent motion per frame
+    static constexpr float kLead = 32.0f;      ///< fat lead / mean velocity, on the side it leads
     static constexpr float kMotionDecay = 0.95f;
     static constexpr std::size_t kEscapeShare = 4;  ///< a full sweep when n / this escape at once
     static constexpr std::size_t kStaleShare = 4;   ///< bands dealt again past n / this stale
@@ -99,23 +101,43 @@ private:
         keys_.push_back((static_cast<std::uint64_t>(ids_[i]) << shift_) |
                         static_cast<std::uint64_t>(ids_[j]));
     }
-    void fatten(ProxyId id, float margin);
+    /// Sets the fat box of `id`: its exact box grown by `share` of its margins and rounded
+    /// outward; `learn`: the margins learnt from the fat box's lifetime just ended (see .cpp).
+    void fatten(ProxyId id, float share, bool learn);
+    /// Stores the fat box of id k from double bounds, rounded outward to float.
+    void setFat(std::size_t k, Real lo_x, Real lo_y, Real lo_z, Real hi_x, Real hi_y, Real hi_z);
     bool insideFat(ProxyId id) const;
     void rebuild();
     /// Sorts, packs and deals the current fat boxes into bands; none stale after.
     void resnapshot(BroadPhaseCounters& counters);
     void fullSweep(BroadPhaseCounters& counters);
     void restale();
-    void queryEscaped(BroadPhaseCounters& counters);
+    /// Looks up the escaped boxes, updates candidates_ and writes the exact pairs to `pairs`.
+    void queryEscaped(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters);
+    /// Whether the candidate's double AABBs overlap, as Aabb::overlaps decides (closed test).
+    int overlapsExactly(const ProxyPair& p) const {
+        const Aabb& a = table_.aabb(p.a);
+        const Aabb& b = table_.aabb(p.b);
+        return int(a.min.x() <= b.max.x()) & int(b.min.x() <= a.max.x()) &
+               int(a.min.y() <= b.max.y()) & int(b.min.y() <= a.max.y()) &
+               int(a.min.z() <= b.max.z()) & int(b.min.z() <= a.max.z());
+    }
 
     ProxyTable table_;
     std::vector<Entry> entries_;  ///< present proxies sorted by key (ties: unspecified)
     Lanes all_;                   ///< every box in sorted order, then kPad sentinels
     std::vector<ProxyId> ids_;    ///< per sorted place
-    // Fat boxes by id (absent ids NaN): the exact box grown by kMargin times the box's recent
-    // motion per frame, rounded outward; candidates_ holds every pair whose fat boxes overlap.
+    // Fat boxes by id (absent ids NaN): the exact box grown by the margins of fatten() and
+    // rounded outward; candidates_ holds every pair whose fat boxes overlap.
     Lanes fat_;
     std::vector<float> motion_;  ///< recent largest centre step per frame, by id
+    // Per id, of its current fat box: the margin on every side, the velocity it leads by, and
+    // the centre and frame it was made at.
+    std::vector<Real> margin_;
+    std::vector<Vec3> lead_velocity_;
+    std::vector<Vec3> fat_centre_;
+    std::vector<std::int64_t> fat_frame_;
+    std::int64_t frame_ = 0;  ///< findPairs calls so far
     std::vector<ProxyId> present_;
     std::vector<ProxyId> escaped_;
     std::vector<char> stale_;         ///< by id: re-fattened since the bands were dealt
