@@ -87,8 +87,8 @@ int PackedSweepAndPrune::overlapsExactly(const ProxyPair& p) const {
     const Aabb& a = table_.aabb(p.a);
     const Aabb& b = table_.aabb(p.b);
 #if defined(__SSE2__) && !defined(CDLAB_USE_FLOAT)
-    // The six comparisons in four two-wide ones: (x, y) and (y, z) of each bound (y twice).
-    // cmple is false on a NaN, as the scalar <= is.
+    // The six comparisons as four two-wide ones, on (x, y) and (y, z) of each bound (y twice):
+    // a.min <= b.max and b.min <= a.max. cmple is false on a NaN, as the scalar <= is.
     const __m128d lo =
         _mm_and_pd(_mm_cmple_pd(_mm_loadu_pd(a.min.data()), _mm_loadu_pd(b.max.data())),
                    _mm_cmple_pd(_mm_loadu_pd(a.min.data() + 1), _mm_loadu_pd(b.max.data() + 1)));
@@ -379,22 +379,8 @@ void PackedSweepAndPrune::queryEscaped(std::vector<ProxyPair>& pairs,
                                  first + static_cast<std::ptrdiff_t>(end), from) -
                 first);
             tests += queryRange(lanes, j, box, true, [&](std::size_t at) {
-                if (!one && (band_wide_[at] || b != std::max(fe, band_first_[at]))) return;
+                if (!one && b != std::max(fe, band_first_[at])) return;
                 const ProxyId other = ids_[one ? at : band_place_[at]];
-                if (!stale_[other]) key(other);
-            });
-            if (one || wide_start_[b] + kPad == wide_start_[b + 1]) continue;
-            const auto wide_first = wide_.min_x.begin();
-            const std::size_t w = static_cast<std::size_t>(
-                std::lower_bound(
-                    wide_first + static_cast<std::ptrdiff_t>(wide_start_[b]),
-                    wide_first + static_cast<std::ptrdiff_t>(wide_start_[b + 1] - kPad),
-                    roundDown(double(box[0]) - wide_reach_[b])) -
-                wide_first);
-            tests += queryRange(wide_, w, box, true, [&](std::size_t at) {
-                const std::uint32_t entry = wide_entry_[at];
-                if (b != std::max(fe, band_first_[entry])) return;
-                const ProxyId other = ids_[band_place_[entry]];
                 if (!stale_[other]) key(other);
             });
         }
@@ -542,6 +528,7 @@ void PackedSweepAndPrune::dealBands() {
     band_place_.resize(total);
     band_first_.resize(total);
     fill_.assign(band_start_.begin(), band_start_.end() - 1);
+    band_reach_.assign(static_cast<std::size_t>(bands_), 0.0);
     // Dealt in sorted order, so every band is sorted on min x.
     for (std::size_t i = 0; i < n; ++i) {
         if (first_band_[i] < 0) continue;
@@ -550,6 +537,8 @@ void PackedSweepAndPrune::dealBands() {
             band_.copy(k, all_, i);
             band_place_[k] = static_cast<std::uint32_t>(i);
             band_first_[k] = first_band_[i];
+            band_reach_[b] =
+                std::max(band_reach_[b], double(all_.max_x[i]) - double(all_.min_x[i]));
         }
     }
     for (int b = 0; b < bands_; ++b) {
@@ -559,50 +548,6 @@ void PackedSweepAndPrune::dealBands() {
             band_place_[k] = 0;
             band_first_[k] = 0;
         }
-    }
-    dealWide();
-}
-
-void PackedSweepAndPrune::dealWide() {
-    // A look-up by binary search on min x starts its band at min x less the band's widest box,
-    // so a few wide boxes (a 1:100 size mix) would make every look-up scan far back: the boxes
-    // wider in x than kWideX median ones are copied into a sorted list per band of their own,
-    // with its own reach, and the band's reach counts only the others.
-    const std::size_t n = entries_.size();
-    sample_.clear();
-    const std::size_t stride = std::max<std::size_t>(1, n / kSample);
-    for (std::size_t i = 0; i < n; i += stride) sample_.push_back(all_.max_x[i] - all_.min_x[i]);
-    const auto mid = sample_.begin() + static_cast<std::ptrdiff_t>(sample_.size() / 2);
-    std::nth_element(sample_.begin(), mid, sample_.end());
-    const double wide_x = double(*mid) * kWideX;
-    const std::size_t total = band_start_[bands_];
-    band_wide_.assign(total, 0);
-    band_reach_.assign(static_cast<std::size_t>(bands_), 0.0);
-    wide_reach_.assign(static_cast<std::size_t>(bands_), 0.0);
-    wide_start_.assign(static_cast<std::size_t>(bands_) + 1, 0);
-    for (int b = 0; b < bands_; ++b) {
-        std::uint32_t count = 0;
-        for (std::uint32_t k = band_start_[b]; k < band_start_[b + 1] - kPad; ++k) {
-            const double extent = double(band_.max_x[k]) - double(band_.min_x[k]);
-            const bool wide = extent > wide_x;
-            band_wide_[k] = static_cast<char>(wide);
-            count += static_cast<std::uint32_t>(wide);
-            double& reach = wide ? wide_reach_[b] : band_reach_[b];
-            reach = std::max(reach, extent);
-        }
-        wide_start_[b + 1] = wide_start_[b] + count + static_cast<std::uint32_t>(kPad);
-    }
-    wide_.resize(wide_start_[bands_]);
-    wide_entry_.resize(wide_start_[bands_]);
-    for (int b = 0; b < bands_; ++b) {
-        std::uint32_t w = wide_start_[b];
-        for (std::uint32_t k = band_start_[b]; k < band_start_[b + 1] - kPad; ++k) {
-            if (!band_wide_[k]) continue;
-            wide_.copy(w, band_, k);
-            wide_entry_[w++] = k;
-        }
-        wide_.pad(w);
-        for (std::uint32_t k = w; k < w + kPad; ++k) wide_entry_[k] = band_start_[b];
     }
 }
 

@@ -51,7 +51,6 @@ private:
     static constexpr int kMaxBands = 1024;
     static constexpr float kBandWidth = 3.0f;  ///< band width / median y extent
     static constexpr int kBigBands = 4;        ///< a box meeting more bands than this is big
-    static constexpr float kWideX = 4.0f;      ///< a box wider in x than this many medians is wide
     static constexpr std::size_t kPad = 4;     ///< NaN sentinels after each swept list
     static constexpr float kMargin = 16.0f;    ///< most fat margin / recent motion per frame
     static constexpr float kMinMargin = 1.0f;  ///< least fat margin / recent motion per frame
@@ -80,8 +79,6 @@ private:
     void radixSortEntries();
     void pack();
     void dealBands();
-    /// Copies each band's wide boxes into wide_ and sets the bands' reaches.
-    void dealWide();
     void sweepBands(BroadPhaseCounters& counters);
     void sweepBig(BroadPhaseCounters& counters);
     template <typename Hit>
@@ -142,7 +139,7 @@ private:
     std::vector<ProxyId> merged_ids_;
     Lanes stale_lanes_;               ///< their fat boxes in that order, then kPad NaN
     double stale_reach_ = 0;          ///< the widest stale fat box in x
-    std::vector<double> band_reach_;  ///< per band: its widest box in x, wide ones aside
+    std::vector<double> band_reach_;  ///< per band: its widest box in x
     std::vector<char> escaped_flag_;
     std::vector<ProxyPair> candidates_;
     std::vector<ProxyPair> fresh_;
@@ -162,13 +159,6 @@ private:
     std::vector<std::uint32_t> band_place_;  ///< the entry's sorted place
     std::vector<int> band_first_;            ///< the entry's box's first band
     std::vector<std::uint32_t> big_;         ///< sorted places of the big boxes, in order
-    // The wide boxes of each band (x extent past kWideX median ones), copied apart for the
-    // look-ups of queryEscaped: a band's other boxes are searched from its narrower reach.
-    std::vector<char> band_wide_;            ///< per band entry: its box is wide
-    std::vector<std::uint32_t> wide_start_;  ///< band b's wide entries: [start[b], start[b+1])
-    Lanes wide_;                             ///< each band's wide entries, sorted, kPad NaN after
-    std::vector<std::uint32_t> wide_entry_;  ///< the wide entry's band entry
-    std::vector<double> wide_reach_;         ///< per band: its widest wide box in x
     std::vector<float> sample_;
     std::vector<std::uint32_t> fill_;
     std::vector<std::uint64_t> keys_;
