@@ -757,6 +757,69 @@ TEST(PackedSweepAndPrune, SteadilyMovingMixedSizesEqualBruteForceOnTheIncrementa
     EXPECT_GT(changed, kFrames / 2);  // the pair set really moves
 }
 
+// sap-packed looks an escaped box up in each band it meets by binary search from its min x
+// less the band's widest box. A few boxes much wider in x than the rest (rods) set that reach:
+// an escaped small box must still find a rod whose min x lies far behind its own, and a rod
+// that escaped every box along its length:
+//
+//      band |  [=============== rod ===============]       [========= rod =========]
+//           |    [.] [.]  [.]        [.]  [.]  [.]-->  [.]   [.]    [.]   [.]
+//                                              ^ escaped: its min x is far past the rod's
+//
+// Every frame must equal brute force.
+TEST(PackedSweepAndPrune, EscapedBoxesFindRodsFarBehindInX) {
+    constexpr int kBoxes = 1500;
+    constexpr int kRods = 40;
+    constexpr Real kSide = 50;
+    Rng rng(41);
+    std::vector<Vec3> centre(kBoxes), half(kBoxes), velocity(kBoxes);
+    for (int i = 0; i < kBoxes; ++i) {
+        const bool rod = i < kRods;
+        half[i] =
+            rod ? Vec3(rng.uniform(8, 20), Real(0.4), Real(0.4)) : rng.vec(Real(0.3), Real(0.6));
+        centre[i] = rng.vec(0, kSide);
+        velocity[i] = rng.vec(-1, 1).normalized() * Real(rod ? 0.01 : 0.03);
+    }
+    auto volumes = [&](int i) {
+        return ProxyVolumes{Aabb{centre[i] - half[i], centre[i] + half[i]},
+                            BoundingSphere{centre[i], half[i].norm()},
+                            Obb{centre[i], Mat3::Identity(), half[i]}};
+    };
+    std::unique_ptr<BroadPhase> fast = findBroadPhase("sap-packed")->create();
+    std::unique_ptr<BroadPhase> ref = findBroadPhase("brute")->create();
+    for (int i = 0; i < kBoxes; ++i) {
+        fast->insert(i, volumes(i));
+        ref->insert(i, volumes(i));
+    }
+    std::vector<ProxyPair> fast_pairs, ref_pairs;
+    BroadPhaseCounters first, rc;
+    fast->findPairs(fast_pairs, first);
+    ref->findPairs(ref_pairs, rc);
+    ASSERT_EQ(fast_pairs, ref_pairs);
+    constexpr int kFrames = 200;
+    int cheap_frames = 0;
+    std::int64_t rod_pairs = 0;
+    for (int frame = 1; frame <= kFrames; ++frame) {
+        for (int i = 0; i < kBoxes; ++i) {
+            centre[i] += velocity[i];
+            for (int k = 0; k < 3; ++k) {
+                if (centre[i][k] < 0 || centre[i][k] > kSide) velocity[i][k] = -velocity[i][k];
+            }
+            fast->move(i, volumes(i));
+            ref->move(i, volumes(i));
+        }
+        BroadPhaseCounters fc;
+        fast->findPairs(fast_pairs, fc);
+        ref->findPairs(ref_pairs, rc);
+        ASSERT_EQ(fast_pairs, ref_pairs) << "frame " << frame;
+        ASSERT_EQ(fast->validate(), "") << "frame " << frame;
+        cheap_frames += fc.volume_tests < first.volume_tests / 4;
+        for (const ProxyPair& p : ref_pairs) rod_pairs += p.a < kRods && p.b >= kRods;
+    }
+    EXPECT_GT(cheap_frames, kFrames / 4);  // the escape look-ups, not full sweeps
+    EXPECT_GT(rod_pairs, kFrames * 10);    // the rods really touch the small boxes
+}
+
 // sap-packed leads a moving box's fat box in the direction it moves (Box2D's predicted
 // displacement), so a box moving steadily leaves its fat box only once in many frames:
 //

@@ -115,13 +115,7 @@ private:
     /// Looks up the escaped boxes, updates candidates_ and writes the exact pairs to `pairs`.
     void queryEscaped(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters);
     /// Whether the candidate's double AABBs overlap, as Aabb::overlaps decides (closed test).
-    int overlapsExactly(const ProxyPair& p) const {
-        const Aabb& a = table_.aabb(p.a);
-        const Aabb& b = table_.aabb(p.b);
-        return int(a.min.x() <= b.max.x()) & int(b.min.x() <= a.max.x()) &
-               int(a.min.y() <= b.max.y()) & int(b.min.y() <= a.max.y()) &
-               int(a.min.z() <= b.max.z()) & int(b.min.z() <= a.max.z());
-    }
+    int overlapsExactly(const ProxyPair& p) const;
 
     ProxyTable table_;
     std::vector<Entry> entries_;  ///< present proxies sorted by key (ties: unspecified)
