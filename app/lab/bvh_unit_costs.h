@@ -31,8 +31,8 @@ struct BvhUnitCosts {
 
 /// Why a row's Cv and Cp read "-", for the tables' footnotes.
 inline constexpr const char* kUnmeasuredUnitCostsNote =
-    "Cv, Cp \"-\": not measured: obb4 tests up to four boxes of a node at once in SSE2 lanes inside its "
-    "traversal, and the replay times single node-pair tests";
+    "Cv, Cp \"-\": not measured: obb4 tests up to four boxes of a node at once in SSE2 "
+    "lanes inside its traversal, and the replay times single node-pair tests";
 
 /// Records the node pairs and triangle pairs that a.intersect(b, pose) tests at every pose
 /// (collision::recordTests), repeats those lists until a batch holds at least `bv_target` volume

@@ -187,8 +187,9 @@ void World::queryTimesOfImpact() {
         in.deform_speed_b = swept_[pair.b].deform_speed;
         // Two meshes with OBB trees (obb, or the binary tree inside obb4: obbTreeOf): their
         // surfaces, triangle pair by triangle pair under the continuous OBB test's culling (a
-        // ring may pass around a rod). Any other pair: the convex shapes, a mesh standing for its convex hull (conservative: may stop early); so
-        // is a deforming mesh, whose tree's culling assumes a rigid shape.
+        // ring may pass around a rod). Any other pair: the convex shapes, a mesh standing for its
+        // convex hull (conservative: may stop early); so is a deforming mesh, whose tree's
+        // culling assumes a rigid shape.
         const bool rigid = in.deform_speed_a == 0 && in.deform_speed_b == 0;
         const collision::Bvh<collision::Obb>* tree_a =
             rigid && a.shape.bvh != nullptr ? collision::obbTreeOf(*a.shape.bvh) : nullptr;
