@@ -140,8 +140,8 @@ Command addBenchNarrowphaseCommand(CLI::App& bench) {
         ->capture_default_str();
     cmd->add_option("--seed", o.seed, "pose seed")->capture_default_str();
     cmd->add_option("--methods", o.methods,
-                    "comma-separated (default all): volume names (NAME-bu: bottom-up build), "
-                    "obb4 (the 4-wide OBB tree; by name only, no Cv/Cp) "
+                    "comma-separated (default all): volume names (NAME-bu: bottom-up build; "
+                    "obb4, the 4-wide OBB tree, has no Cv/Cp) "
                     "and fcl-obbrss, fcl-obb, fcl-rss, fcl-kios, fcl-aabb, fcl-kdop18 "
                     "(FCL-NAME-median, FCL-NAME-center: FCL's other split rules)")
         ->delimiter(',');

@@ -114,8 +114,9 @@ void writeQueryJson(std::ostream& out, const std::filesystem::path (&paths)[2],
               {"triangle_tests", r.all.triangle_tests},
               {"time_us", r.all_us}}},
             {"unit_costs",
-             {{"bv_test_ns", r.unit.bv_test_ns},
-              {"triangle_test_ns", r.unit.triangle_test_ns},
+             {{"bv_test_ns", r.unit.measured ? nlohmann::json(r.unit.bv_test_ns) : nullptr},
+              {"triangle_test_ns",
+               r.unit.measured ? nlohmann::json(r.unit.triangle_test_ns) : nullptr},
               {"bv_tests_timed", r.unit.bv_tests_timed},
               {"triangle_tests_timed", r.unit.triangle_tests_timed},
               {"triangle_tests_from_query", r.unit.triangles_from_queries},
@@ -123,8 +124,12 @@ void writeQueryJson(std::ostream& out, const std::filesystem::path (&paths)[2],
               {"refit_nodes_timed", r.refit.nodes_timed},
               // F = Nv Cv + Np Cp for the all-pairs query, beside its measured time_us.
               {"all_pairs_model_us",
-               1e-3 * (static_cast<double>(r.all.bv_tests) * r.unit.bv_test_ns +
-                       static_cast<double>(r.all.triangle_tests) * r.unit.triangle_test_ns)}}},
+               r.unit.measured
+                   ? nlohmann::json(1e-3 * (static_cast<double>(r.all.bv_tests) *
+                                                r.unit.bv_test_ns +
+                                            static_cast<double>(r.all.triangle_tests) *
+                                                r.unit.triangle_test_ns))
+                   : nullptr}}},
         });
     }
     j["results"] = results;
@@ -150,9 +155,14 @@ void writeQueryTable(std::ostream& out, const std::filesystem::path (&paths)[2],
             << std::setw(10) << r.first.bv_tests << std::setw(10) << r.first.triangle_tests
             << std::setw(10) << r.all.bv_tests << std::setw(10) << r.all.triangle_tests
             << std::setprecision(2) << std::setw(11) << r.build_ms << std::setw(11) << r.first_us
-            << std::setw(11) << r.all_us << std::setprecision(1) << std::setw(8)
-            << r.unit.bv_test_ns << std::setw(8) << r.unit.triangle_test_ns << std::setw(8)
-            << r.refit.refit_node_ns << (r.unit.triangles_from_queries ? "" : "*") << "\n";
+            << std::setw(11) << r.all_us << std::setprecision(1);
+        if (r.unit.measured) {
+            out << std::setw(8) << r.unit.bv_test_ns << std::setw(8) << r.unit.triangle_test_ns;
+        } else {
+            out << std::setw(8) << "-" << std::setw(8) << "-";
+        }
+        out << std::setw(8) << r.refit.refit_node_ns
+            << (r.unit.triangles_from_queries ? "" : "*") << "\n";
     }
     out << "(Nv: BV tests, Np: triangle tests; build: both trees; Cv, Cp: ns per BV test and\n"
            " per triangle test, timed by replaying the all-pairs query's own tests; Cu: ns per\n"
@@ -160,6 +170,9 @@ void writeQueryTable(std::ostream& out, const std::filesystem::path (&paths)[2],
     bool random_cp = false;
     for (const Row& r : rows) random_cp = random_cp || !r.unit.triangles_from_queries;
     if (random_cp) out << ";\n * the query tested no triangles: Cp on random triangle pairs";
+    bool unmeasured = false;
+    for (const Row& r : rows) unmeasured = unmeasured || !r.unit.measured;
+    if (unmeasured) out << ";\n " << kUnmeasuredUnitCostsNote;
     out << ")\n";
 }
 

@@ -192,9 +192,6 @@ private:
 #endif
 
 std::unique_ptr<NarrowMethod> makeMethod(const std::string& name) {
-    if (name == collision::kWideObbName) {
-        return std::make_unique<CdlabMethod>(collision::kWideObbName, collision::BvhBuild::TopDown);
-    }
     for (const std::string_view bv : collision::bvhVolumeNames()) {
         if (bv == name) return std::make_unique<CdlabMethod>(bv, collision::BvhBuild::TopDown);
         if (std::string(bv) + "-bu" == name) {
@@ -400,9 +397,15 @@ void printRows(const std::vector<Row>& rows, std::ostream& out) {
         if (r.counters) {
             out << std::setprecision(0) << std::setw(11) << r.first_nv << std::setw(10)
                 << r.first_np << std::setw(11) << r.all_nv << std::setw(10) << r.all_np
-                << std::setprecision(1) << std::setw(8) << r.unit.bv_test_ns << std::setw(8)
-                << r.unit.triangle_test_ns << std::setprecision(2) << std::setw(10) << r.refit_ms
-                << std::setw(8) << r.refit_nu;
+                << std::setprecision(1);
+            if (r.unit.measured) {
+                out << std::setw(8) << r.unit.bv_test_ns << std::setw(8)
+                    << r.unit.triangle_test_ns;
+            } else {
+                out << std::setw(8) << "-" << std::setw(8) << "-";
+            }
+            out << std::setprecision(2) << std::setw(10) << r.refit_ms << std::setw(8)
+                << r.refit_nu;
         } else {
             out << std::setw(11) << "-" << std::setw(10) << "-" << std::setw(11) << "-"
                 << std::setw(10) << "-" << std::setw(8) << "-" << std::setw(8) << "-"
@@ -414,6 +417,9 @@ void printRows(const std::vector<Row>& rows, std::ostream& out) {
     out << "(Cv, Cp: ns per BV test and per triangle test, timed by replaying the tests the "
            "all-pairs"
            " queries made; refit: one tree to a deformed torus, Nu nodes updated)\n";
+    bool unmeasured = false;
+    for (const Row& r : rows) unmeasured = unmeasured || (r.counters && !r.unit.measured);
+    if (unmeasured) out << "(" << kUnmeasuredUnitCostsNote << ")\n";
 }
 
 // The fastest cdlab row and the fastest FCL row of one column, and their ratio.
@@ -467,8 +473,10 @@ nlohmann::json rowsJson(const std::vector<Row>& rows) {
             o["first_np"] = r.first_np;
             o["all_nv"] = r.all_nv;
             o["all_np"] = r.all_np;
-            o["bv_test_ns"] = r.unit.bv_test_ns;
-            o["triangle_test_ns"] = r.unit.triangle_test_ns;
+            // null when not measured (BvhUnitCosts::measured).
+            o["bv_test_ns"] = r.unit.measured ? nlohmann::json(r.unit.bv_test_ns) : nullptr;
+            o["triangle_test_ns"] =
+                r.unit.measured ? nlohmann::json(r.unit.triangle_test_ns) : nullptr;
             o["bv_tests_timed"] = r.unit.bv_tests_timed;
             o["triangle_tests_timed"] = r.unit.triangle_tests_timed;
             o["triangle_tests_from_queries"] = r.unit.triangles_from_queries;

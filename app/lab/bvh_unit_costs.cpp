@@ -42,8 +42,8 @@ BvhUnitCosts measureBvhUnitCosts(const collision::MeshBvh& a, const collision::M
         nv += static_cast<std::int64_t>(samples.back().node_pairs.size());
         np += static_cast<std::int64_t>(samples.back().triangle_pairs.size());
     }
-    // A hierarchy whose tests the replay cannot record (the wide tree: no typed binary tree)
-    // gives no sample at all, and no unit costs.
+    // A hierarchy whose tests the replay cannot record (the wide tree: its node tests run in
+    // lanes) gives no sample at all, and no unit costs.
     if (nv == 0) return costs;
     if (np == 0) {
         // No query reached its triangles (every pose apart at the volumes): time random pairs of
@@ -105,6 +105,7 @@ BvhUnitCosts measureBvhUnitCosts(const collision::MeshBvh& a, const collision::M
         &costs.triangle_hits);
     costs.bv_test_ns = 1e9 * bv_seconds / static_cast<double>(costs.bv_tests_timed);
     costs.triangle_test_ns = 1e9 * tri_seconds / static_cast<double>(costs.triangle_tests_timed);
+    costs.measured = true;
     return costs;
 }
 

@@ -24,7 +24,15 @@ struct BvhUnitCosts {
     bool triangles_from_queries = true;
     std::int64_t bv_overlaps = 0;    ///< overlapping tests in the timed batch (keeps the work)
     std::int64_t triangle_hits = 0;  ///< intersecting pairs in the timed batch
+    /// false: nothing was timed and the costs above are not measurements (no poses, an empty
+    /// mesh, or the wide tree, kWideObbName, whose node tests the replay cannot record)
+    bool measured = false;
 };
+
+/// Why a row's Cv and Cp read "-", for the tables' footnotes.
+inline constexpr const char* kUnmeasuredUnitCostsNote =
+    "Cv, Cp \"-\": not measured: obb4 tests up to four boxes of a node at once in SSE2 "
+    "lanes inside its traversal, and the replay times single node-pair tests";
 
 /// Records the node pairs and triangle pairs that a.intersect(b, pose) tests at every pose
 /// (collision::recordTests), repeats those lists until a batch holds at least `bv_target` volume
@@ -32,7 +40,7 @@ struct BvhUnitCosts {
 /// poses weigh as their Nv and Np do in F), and times the replays in chunks of about one query's
 /// tests, each the fastest of 3 runs. None of this is inside a query's timed path. `a` and `b`
 /// hold the same volume type. Cost about 3 times the batch. A tree the replay cannot record
-/// (kWideObbName) gets zero costs.
+/// (kWideObbName) gets zero costs and measured = false.
 BvhUnitCosts measureBvhUnitCosts(const collision::MeshBvh& a, const collision::MeshBvh& b,
                                  std::span<const collision::Pose> poses,
                                  std::int64_t bv_target = 200000,

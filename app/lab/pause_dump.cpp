@@ -7,6 +7,7 @@
 #include <string_view>
 #include <vector>
 
+#include "collision/bvh/bvh.h"
 #include "render/volume_states.h"
 
 namespace app {
@@ -102,6 +103,10 @@ std::string pauseDumpJson(const engine::World& world, int frame, const engine::D
             volume_states[kind.name] = std::string(volumeStateName(kind.overlaps.states[i]));
         }
         bodies.back()["volume_states"] = std::move(volume_states);
+        // A mesh body's hierarchy: the volume it was built with (world.mesh_bvh).
+        if (b.shape.bvh != nullptr) {
+            bodies.back()["mesh_bvh"] = std::string(b.shape.bvh->volumeName());
+        }
     }
     if (!kdop_kinds.empty()) {
         nlohmann::ordered_json directions = nlohmann::ordered_json::object();

@@ -15,7 +15,8 @@ namespace app {
 /// (all pair lists sorted, i < j). For every k-DOP `draw` draws (draw.kdop), each body also has
 /// "kdopK": {"k", "min", "max"} (its k / 2 slab intervals, slab i along
 /// "kdop_slab_directions"["kdopK"][i], unnormalised), and "kdopK" joins "volume_states" and
-/// "overlapping_pairs". Numbers are printed to round-trip.
+/// "overlapping_pairs". A mesh body has "mesh_bvh": the volume name of its hierarchy
+/// (collision::bvhVolumeNames()). Numbers are printed to round-trip.
 std::string pauseDumpJson(const engine::World& world, int frame, const engine::DrawSettings& draw);
 
 }  // namespace app

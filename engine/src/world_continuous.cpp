@@ -185,17 +185,16 @@ void World::queryTimesOfImpact() {
         // stage); the query bounds how far its surface moves from it in the step.
         in.deform_speed_a = swept_[pair.a].deform_speed;
         in.deform_speed_b = swept_[pair.b].deform_speed;
-        // Two meshes with OBB trees: their surfaces, triangle pair by triangle pair under the
-        // continuous OBB test's culling (a ring may pass around a rod). Any other pair: the
-        // convex shapes, a mesh standing for its convex hull (conservative: may stop early); so
-        // is a deforming mesh, whose tree's culling assumes a rigid shape.
+        // Two meshes with OBB trees (obb, or the binary tree inside obb4: obbTreeOf): their
+        // surfaces, triangle pair by triangle pair under the continuous OBB test's culling (a
+        // ring may pass around a rod). Any other pair: the convex shapes, a mesh standing for its
+        // convex hull (conservative: may stop early); so is a deforming mesh, whose tree's
+        // culling assumes a rigid shape.
         const bool rigid = in.deform_speed_a == 0 && in.deform_speed_b == 0;
         const collision::Bvh<collision::Obb>* tree_a =
-            rigid && a.shape.bvh != nullptr ? collision::treeOf<collision::Obb>(*a.shape.bvh)
-                                            : nullptr;
+            rigid && a.shape.bvh != nullptr ? collision::obbTreeOf(*a.shape.bvh) : nullptr;
         const collision::Bvh<collision::Obb>* tree_b =
-            rigid && b.shape.bvh != nullptr ? collision::treeOf<collision::Obb>(*b.shape.bvh)
-                                            : nullptr;
+            rigid && b.shape.bvh != nullptr ? collision::obbTreeOf(*b.shape.bvh) : nullptr;
         // Two spheres with ccd_spheres: exact: the closed-form root of |d0 + t dv| = ra + rb +
         // gap, exact for the sweeps' linear motion of the centres (collision/ccd/ccd.h).
         const bool exact_spheres = settings_.ccd_spheres == CcdSpheres::Exact &&

@@ -5,6 +5,7 @@
 #include <memory>
 #include <string>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 
 #include "collision/assert.h"
@@ -27,7 +28,13 @@ double secondsSince(Clock::time_point start) {
 // a uniform scaling of the mesh leaves it unchanged.
 template <class BV>
 Real volumeRatioOf(const collision::MeshBvh& tree, Real& out) {
-    if (const collision::Bvh<BV>* typed = collision::treeOf<BV>(tree)) {
+    const collision::Bvh<BV>* typed = nullptr;
+    if constexpr (std::is_same_v<BV, collision::Obb>) {
+        typed = collision::obbTreeOf(tree);  // obb, or the binary tree inside obb4
+    } else {
+        typed = collision::treeOf<BV>(tree);
+    }
+    if (typed != nullptr) {
         const auto& nodes = typed->nodes();
         Real sum = 0;
         for (const auto& n : nodes) sum += n.cost;

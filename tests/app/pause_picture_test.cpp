@@ -247,3 +247,25 @@ TEST(PausePicture, BadPauseHoldIsAClearErrorExit2) {
     }
     fs::remove_all(work);
 }
+
+// A mesh body's dump names its hierarchy's volume (world.mesh_bvh), the wide tree included;
+// other bodies have none.
+TEST(PausePicture, DumpNamesEachMeshBodysHierarchy) {
+    const fs::path work = tempDir("mesh_bvh");
+    const std::string torus = std::string(CDLAB_SOURCE_DIR) + "/assets/torus.obj";
+    const fs::path scene = writeScene(
+        work, "meshes.yaml",
+        sceneText(0, 0,
+                  "  - {name: ring, shape: mesh, file: " + torus + ", position: [-0.5, 0, 0]}\n"
+                  "  - {name: ball, shape: sphere, radius: 0.5, position: [2.5, 0, 0]}\n"));
+    const fs::path out = work / "out";
+    const CliResult r = runCdlab("run " + scene.string() +
+                                     " --set world.mesh_bvh=obb4 --no-video --pause-at 1 --out " +
+                                     out.string(),
+                                 work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json dump = nlohmann::json::parse(slurp(out / "pause_1.json"));
+    EXPECT_EQ(dump["bodies"][0]["mesh_bvh"], "obb4");
+    EXPECT_FALSE(dump["bodies"][1].contains("mesh_bvh"));
+    fs::remove_all(work);
+}

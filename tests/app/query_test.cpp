@@ -57,7 +57,7 @@ TEST(Query, JsonHasEveryVolumeTypeAndTheyAgree) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const nlohmann::json j = nlohmann::json::parse(r.out);
     EXPECT_TRUE(j["volumes_agree"].get<bool>());
-    ASSERT_EQ(j["results"].size(), 9u);
+    ASSERT_EQ(j["results"].size(), 10u);
 
     // The reference: the brute-force triangle loop on the same mesh, as the CLI imports it.
     const engine::MeshImportOutput torus =
@@ -80,8 +80,15 @@ TEST(Query, JsonHasEveryVolumeTypeAndTheyAgree) {
                   static_cast<std::int64_t>(pairs));
         EXPECT_LE(row["first_contact"]["triangle_tests"].get<std::int64_t>(),
                   row["all_pairs"]["triangle_tests"].get<std::int64_t>());
-        // Cv and Cp timed on batches of the query's own tests (at least 2e5 and 1e5).
+        // Cv and Cp timed on batches of the query's own tests (at least 2e5 and 1e5); none for
+        // the wide tree, whose node tests the replay cannot record.
         const auto& unit = row["unit_costs"];
+        if (row["bv"] == "obb4") {
+            EXPECT_TRUE(unit["bv_test_ns"].is_null());
+            EXPECT_TRUE(unit["triangle_test_ns"].is_null());
+            EXPECT_TRUE(unit["all_pairs_model_us"].is_null());
+            continue;
+        }
         EXPECT_GT(unit["bv_test_ns"].get<double>(), 0) << row["bv"];
         EXPECT_GT(unit["triangle_test_ns"].get<double>(), 0) << row["bv"];
         EXPECT_GE(unit["bv_tests_timed"].get<std::int64_t>(), 200000) << row["bv"];
@@ -91,6 +98,27 @@ TEST(Query, JsonHasEveryVolumeTypeAndTheyAgree) {
     }
     EXPECT_EQ(j["results"][7]["bv"], "rss");
     EXPECT_EQ(j["results"][8]["bv"], "lss");
+    EXPECT_EQ(j["results"][9]["bv"], "obb4");
+}
+
+// `--bv obb4` picks the wide tree alone: its answer and pairs, and "-" for the unit costs it has
+// no measurement of, with the reason under the table.
+TEST(Query, WideObbTreeByNameAnswersAndMarksItsUnitCosts) {
+    const QueryResult r =
+        runQueryCli("assets/torus.obj assets/torus.obj --bv obb4 --pose-b 0.5,0,0.1,1,0,0,0");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::istringstream table(r.out);
+    std::string line;
+    int rows = 0;
+    while (std::getline(table, line)) {
+        if (line.rfind("obb4 ", 0) != 0) continue;
+        ++rows;
+        EXPECT_NE(line.find("colliding"), std::string::npos) << line;
+        EXPECT_NE(line.find(" - "), std::string::npos) << line;
+    }
+    EXPECT_EQ(rows, 1) << r.out;
+    EXPECT_NE(r.out.find("not measured: obb4"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("\nobb "), std::string::npos) << r.out;  // no other volume's row
 }
 
 TEST(Query, FarApartIsNotCollidingAndTableIsPrinted) {
@@ -166,7 +194,7 @@ TEST(Query, SelfListsTheBruteForcePairsForEveryVolumeType) {
     nlohmann::json expected = nlohmann::json::array();
     for (const collision::TrianglePair& p : brute) expected.push_back({p.a, p.b});
     EXPECT_EQ(j["brute_force"]["self_pairs"], expected);
-    ASSERT_EQ(j["results"].size(), 9u);
+    ASSERT_EQ(j["results"].size(), 10u);
     for (const auto& row : j["results"]) {
         EXPECT_EQ(row["self_pairs"], expected) << row["bv"];
         EXPECT_GT(row["bv_tests"].get<std::int64_t>(), 0) << row["bv"];

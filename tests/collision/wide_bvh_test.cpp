@@ -13,6 +13,7 @@
 
 #include "bvh/wide.h"
 #include "collision/bvh/bvh.h"
+#include "collision/bvh/bvh_level.h"
 #include "test_meshes.h"
 #include "test_random.h"
 #include "volumes/bvh_volumes.h"
@@ -296,6 +297,37 @@ TEST(WideBvh, OtherQueriesAnswerAsTheBinaryObbTree) {
     EXPECT_TRUE(wa->validate());
     for (const Pose& p : randomPoses(9, 6, 1.5)) {
         expectBruteForceAnswer(deformed, *wa, torusB(), *wb, p, "refitted");
+    }
+}
+
+// The binary OBB tree inside is what mesh-mesh CCD (obbTreeOf) and the drawn levels
+// (bvh_level.h) use: the same nodes, cuts and overlapping node pairs as an obb tree's.
+TEST(WideBvh, BinaryTreeInsideServesCcdAndLevels) {
+    const auto wa = wide(torusA());
+    const auto wb = wide(torusB());
+    const auto oa = collision::buildMeshBvh("obb", torusA());
+    const auto ob = collision::buildMeshBvh("obb", torusB());
+    const collision::Bvh<Obb>* binary = collision::obbTreeOf(*wa);
+    ASSERT_NE(binary, nullptr);
+    EXPECT_EQ(collision::treeOf<Obb>(*wa), nullptr);
+    EXPECT_EQ(collision::obbTreeOf(*oa), collision::treeOf<Obb>(*oa));
+    EXPECT_EQ(collision::obbTreeOf(*collision::buildMeshBvh("aabb", torusA())), nullptr);
+    EXPECT_EQ(binary->nodes().size(), collision::treeOf<Obb>(*oa)->nodes().size());
+    const Pose pose = randomPoses(5, 1, 0.8).front();
+    const collision::Mat3 rotation = pose.orientation.toRotationMatrix();
+    for (const int depth : {0, 2, 5}) {
+        const auto nodes_w = collision::levelNodes(*wa, depth);
+        const auto nodes_o = collision::levelNodes(*oa, depth);
+        ASSERT_FALSE(nodes_w.empty()) << depth;
+        ASSERT_EQ(nodes_w.size(), nodes_o.size()) << depth;
+        for (std::size_t i = 0; i < nodes_w.size(); ++i) {
+            EXPECT_EQ(nodes_w[i].node, nodes_o[i].node);
+            EXPECT_EQ(nodes_w[i].triangles, nodes_o[i].triangles);
+            EXPECT_EQ(nodes_w[i].box.center, nodes_o[i].box.center);
+        }
+        EXPECT_EQ(collision::levelOverlaps(*wa, depth, *wb, rotation, pose.position),
+                  collision::levelOverlaps(*oa, depth, *ob, rotation, pose.position))
+            << depth;
     }
 }
 

@@ -215,7 +215,7 @@ TEST(SceneErrors, UnknownMeshBvh) {
     EXPECT_SCENE_ERROR("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  mesh_bvh: kdop7\n",
                        "3:13: world.mesh_bvh: ",
                        "unknown bounding volume 'kdop7' (expected one of: sphere, aabb, obb, "
-                       "kdop6, kdop14, kdop18, kdop26, rss, lss)");
+                       "kdop6, kdop14, kdop18, kdop26, rss, lss, obb4)");
     EXPECT_SCENE_ERROR("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  mesh_bvh: [obb]\n",
                        "3:13: world.mesh_bvh: ", "expected a string");
 }

@@ -244,9 +244,17 @@
     const dump = pause.dump;
     const article = text('article', undefined, 'pause');
     article.id = 'pause-' + pause.frame;
+    // The mesh hierarchies' volume names (world.mesh_bvh), when there are mesh bodies.
+    const meshBvhs = [];
+    for (const body of dump.bodies) {
+      if (body.mesh_bvh !== undefined && meshBvhs.indexOf(body.mesh_bvh) < 0) {
+        meshBvhs.push(body.mesh_bvh);
+      }
+    }
     const heading = text('h3', 'frame ' + pause.frame + ', t = ' +
         Number(dump.time).toPrecision(4) + ' s (' + dump.broadphase + ', tests ' +
-        dump.broadphase_volume + ')');
+        dump.broadphase_volume +
+        (meshBvhs.length > 0 ? '; mesh hierarchies ' + meshBvhs.join(', ') : '') + ')');
     const jump = text('button', 'show in the video', 'jump');
     jump.addEventListener('click', function () { seekTo(pause.frame); });
     heading.appendChild(jump);

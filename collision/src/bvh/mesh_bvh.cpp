@@ -97,6 +97,7 @@ private:
 class MeshBvhWide final : public MeshBvh {
 public:
     MeshBvhWide(const TriangleMesh& mesh, const BvhBuildOptions& options) : tree_(mesh, options) {}
+    const WideObbTree& tree() const { return tree_; }
     std::string_view volumeName() const override { return kWideObbName; }
     std::int32_t nodeCount() const override {
         return static_cast<std::int32_t>(tree_.nodes().size());
@@ -187,11 +188,17 @@ template const Bvh<Kdop<26>>* treeOf<Kdop<26>>(const MeshBvh&);
 template const Bvh<Rss>* treeOf<Rss>(const MeshBvh&);
 template const Bvh<Lss>* treeOf<Lss>(const MeshBvh&);
 
+const Bvh<Obb>* obbTreeOf(const MeshBvh& tree) {
+    if (const auto* wide = dynamic_cast<const MeshBvhWide*>(&tree)) return &wide->tree().binary();
+    return treeOf<Obb>(tree);
+}
+
 const std::vector<std::string_view>& bvhVolumeNames() {
     static const std::vector<std::string_view> names = [] {
         std::vector<std::string_view> out;
         std::apply([&](auto... bv) { (out.push_back(BvName<decltype(bv)>::value), ...); },
                    BvhVolumeTypes{});
+        out.push_back(kWideObbName);
         return out;
     }();
     return names;

@@ -1,6 +1,7 @@
 // collision/src/bvh/typed.h -- calling a function template with the typed trees behind MeshBvh
-// handles (treeOf over every type of BvhVolumeTypes): how the free functions on hierarchies
-// (replay, levels) reach Bvh<BV> without a virtual per operation. Private to collision.
+// handles (treeOf over every type of BvhVolumeTypes; the wide tree, kWideObbName, as the binary
+// OBB tree it was collapsed from): how the free functions on hierarchies (replay, levels) reach
+// Bvh<BV> without a virtual per operation. Private to collision.
 #pragma once
 
 #include <tuple>
@@ -31,9 +32,14 @@ R withTreeOf(const MeshBvh& tree, R fallback, F& f, std::tuple<BV...>* /*types*/
 
 }  // namespace typed_detail
 
-/// f(tree) with `tree`'s typed Bvh<BV>; `fallback` for a handle of no known type.
+/// f(tree) with `tree`'s typed Bvh<BV> (the wide tree's binary Bvh<Obb>, obbTreeOf);
+/// `fallback` for a handle of no known type.
 template <class R, class F>
 R withTree(const MeshBvh& tree, R fallback, F&& f) {
+    if (tree.volumeName() == kWideObbName) {
+        const Bvh<Obb>* binary = obbTreeOf(tree);
+        return binary != nullptr ? f(*binary) : std::move(fallback);
+    }
     return typed_detail::withTreeOf(tree, std::move(fallback), f,
                                     static_cast<BvhVolumeTypes*>(nullptr));
 }
@@ -42,6 +48,11 @@ R withTree(const MeshBvh& tree, R fallback, F&& f) {
 template <class BV>
 const Bvh<BV>* sameTypeTree(const Bvh<BV>& /*like*/, const MeshBvh& b) {
     return treeOf<BV>(b);
+}
+
+/// The binary OBB tree of `b`, an obb tree or a wide one like `like`'s owner.
+inline const Bvh<Obb>* sameTypeTree(const Bvh<Obb>& /*like*/, const MeshBvh& b) {
+    return obbTreeOf(b);
 }
 
 /// f(a, b) with the typed trees of `a` and `b`, which must hold the same volume type (asserted;

@@ -303,19 +303,26 @@ public:
 /// in `cdlab bench narrowphase` on the two-tori workload.
 inline constexpr std::string_view kDefaultMeshBvh = "obb";
 
-/// The names of BvhVolumeTypes, in order: sphere, aabb, obb, kdop6, kdop14, kdop18, kdop26,
-/// rss, lss.
+/// The names a tree can be built under (buildMeshBvh), as scenes (`world.mesh_bvh`), `cdlab
+/// query --bv` and the benchmarks accept them: BvhVolumeTypes in order (sphere, aabb, obb,
+/// kdop6, kdop14, kdop18, kdop26, rss, lss), then kWideObbName.
 const std::vector<std::string_view>& bvhVolumeNames();
 
-/// The typed tree of `tree` when it holds volume type BV, else null (mesh-mesh CCD,
-/// timeOfImpactMeshes in ccd.h, runs on OBB trees: treeOf<Obb>).
+/// The typed tree of `tree` when it holds volume type BV, else null (the wide tree,
+/// kWideObbName, holds no Bvh<BV> of its own type: see obbTreeOf).
 template <class BV>
 const Bvh<BV>* treeOf(const MeshBvh& tree);
 
 /// The 4-wide OBB hierarchy: the binary OBB tree collapsed to nodes of up to four children whose
-/// boxes are tested together. Built by buildMeshBvh under this name; treeOf finds no typed tree
-/// in it.
+/// boxes are tested together. Built by buildMeshBvh under this name. Its discrete tandem queries
+/// (testOverlap, intersect, visitIntersecting) descend the wide nodes; the rest (distance,
+/// intersectSelf, visitNearBox, mesh-mesh CCD through obbTreeOf, the drawn levels of
+/// bvh_level.h) use the binary OBB tree it was collapsed from: same triangles, same boxes.
 inline constexpr std::string_view kWideObbName = "obb4";
+
+/// The binary OBB tree of `tree`: its own for an obb tree, the one the wide tree (kWideObbName)
+/// was collapsed from, else null. Mesh-mesh CCD (timeOfImpactMeshes in ccd.h) runs on it.
+const Bvh<Obb>* obbTreeOf(const MeshBvh& tree);
 
 /// Builds the tree of the named volume type (or kWideObbName); nullptr for an unknown name.
 std::unique_ptr<MeshBvh> buildMeshBvh(std::string_view volume_name, const TriangleMesh& mesh,

@@ -24,7 +24,8 @@ struct BvhTestSample {
 /// Every node pair and triangle pair that a.intersect(b, b_in_a) tests, in its order
 /// (node_pairs.size() is its Nv, triangle_pairs.size() its Np): the same traversal with a
 /// recorder; the queries themselves record nothing. `b` must hold a's volume type (asserted;
-/// empty if not). Memory O(Nv + Np).
+/// empty if not). Empty for the wide tree (kWideObbName): its queries test up to four boxes of a
+/// node at once in lanes, not the binary tree's node pairs. Memory O(Nv + Np).
 BvhTestSample recordTests(const MeshBvh& a, const MeshBvh& b, const Pose& b_in_a);
 
 /// Runs the node-volume tests of `sample`, `repeats` times, exactly as the traversal does them
