@@ -644,6 +644,64 @@ TEST(HierarchicalGrid, PairsInFoundOrderAreTheSortedSetUnsorted) {
     EXPECT_GT(unsorted_frames, 0);
 }
 
+// sap-packed beside brute force on boxes given by their centres and half extents (read at each
+// call, so a test moves a box by changing its centre): every findPairs of the two must agree,
+// and sap-packed's invariants must hold.
+class PackedBesideBrute {
+public:
+    PackedBesideBrute(const std::vector<Vec3>& centre, const std::vector<Vec3>& half)
+        : centre_(centre),
+          half_(half),
+          fast_(findBroadPhase("sap-packed")->create()),
+          ref_(findBroadPhase("brute")->create()) {
+        for (int i = 0; i < count(); ++i) {
+            fast_->insert(i, volumes(i));
+            ref_->insert(i, volumes(i));
+        }
+    }
+    /// Moves every box to its present centre (unless `move` is false: the first frame), finds
+    /// the pairs of both and returns sap-packed's counters; mismatch() says what disagreed.
+    BroadPhaseCounters findPairs(bool move = true) {
+        if (move) {
+            for (int i = 0; i < count(); ++i) {
+                fast_->move(i, volumes(i));
+                ref_->move(i, volumes(i));
+            }
+        }
+        BroadPhaseCounters fc, rc;
+        fast_->findPairs(fast_pairs_, fc);
+        ref_->findPairs(ref_pairs_, rc);
+        mismatch_.clear();
+        if (fast_pairs_ != ref_pairs_) {
+            mismatch_ = "sap-packed found " + std::to_string(fast_pairs_.size()) +
+                        " pairs, brute force " + std::to_string(ref_pairs_.size());
+        } else {
+            mismatch_ = fast_->validate();
+        }
+        return fc;
+    }
+    /// Empty when the last findPairs agreed with brute force and sap-packed was valid.
+    const std::string& mismatch() const { return mismatch_; }
+    /// Brute force's pairs at the last findPairs.
+    const std::vector<ProxyPair>& pairs() const { return ref_pairs_; }
+
+private:
+    int count() const { return static_cast<int>(centre_.size()); }
+    ProxyVolumes volumes(int i) const {
+        const Vec3& c = centre_[static_cast<std::size_t>(i)];
+        const Vec3& h = half_[static_cast<std::size_t>(i)];
+        return ProxyVolumes{Aabb{c - h, c + h}, BoundingSphere{c, h.norm()},
+                            Obb{c, Mat3::Identity(), h}};
+    }
+
+    const std::vector<Vec3>& centre_;
+    const std::vector<Vec3>& half_;
+    std::unique_ptr<BroadPhase> fast_;
+    std::unique_ptr<BroadPhase> ref_;
+    std::vector<ProxyPair> fast_pairs_, ref_pairs_;
+    std::string mismatch_;
+};
+
 // sap-packed keeps the pairs of overlapping fat boxes between frames and re-queries only the
 // boxes that left theirs. A jittering scene (Terdiman's BoxPruning, scaled down: integer centres
 // moving by -1, 0 or +1 per axis per frame, integer half sizes, so boxes touch exactly and
@@ -658,37 +716,17 @@ TEST(PackedSweepAndPrune, JitteringBoxesEqualBruteForceWhileFatBoxesAreReused) {
         centre[i] = Vec3(rng.integer(-300, 300), rng.integer(-300, 300), rng.integer(-300, 300));
         half[i] = Vec3(rng.integer(0, 20), rng.integer(0, 20), rng.integer(0, 20));
     }
-    auto volumes = [&](int i) {
-        return ProxyVolumes{Aabb{centre[i] - half[i], centre[i] + half[i]},
-                            BoundingSphere{centre[i], half[i].norm()},
-                            Obb{centre[i], Mat3::Identity(), half[i]}};
-    };
-    std::unique_ptr<BroadPhase> fast = findBroadPhase("sap-packed")->create();
-    std::unique_ptr<BroadPhase> ref = findBroadPhase("brute")->create();
-    for (int i = 0; i < kBoxes; ++i) {
-        fast->insert(i, volumes(i));
-        ref->insert(i, volumes(i));
-    }
-    std::vector<ProxyPair> fast_pairs;
-    std::vector<ProxyPair> ref_pairs;
-    BroadPhaseCounters first;
-    fast->findPairs(fast_pairs, first);
-    BroadPhaseCounters rc;
-    ref->findPairs(ref_pairs, rc);
-    ASSERT_EQ(fast_pairs, ref_pairs);
-    ASSERT_GT(ref_pairs.size(), 300u);
+    PackedBesideBrute check(centre, half);
+    const BroadPhaseCounters first = check.findPairs(false);
+    ASSERT_EQ(check.mismatch(), "");
+    ASSERT_GT(check.pairs().size(), 300u);
     int cheap_frames = 0;
     for (int frame = 1; frame <= 200; ++frame) {
         for (int i = 0; i < kBoxes; ++i) {
             for (int k = 0; k < 3; ++k) centre[i][k] += rng.integer(-1, 1);
-            fast->move(i, volumes(i));
-            ref->move(i, volumes(i));
         }
-        BroadPhaseCounters fc;
-        fast->findPairs(fast_pairs, fc);
-        ref->findPairs(ref_pairs, rc);
-        ASSERT_EQ(fast_pairs, ref_pairs) << "frame " << frame;
-        ASSERT_EQ(fast->validate(), "") << "frame " << frame;
+        const BroadPhaseCounters fc = check.findPairs();
+        ASSERT_EQ(check.mismatch(), "") << "frame " << frame;
         cheap_frames += fc.volume_tests < first.volume_tests / 4;
     }
     EXPECT_GT(cheap_frames, 150);
@@ -718,23 +756,10 @@ TEST(PackedSweepAndPrune, SteadilyMovingMixedSizesEqualBruteForceOnTheIncrementa
         centre[i] = rng.vec(0, kSide);
         velocity[i] = rng.vec(-1, 1).normalized() * (2 * scale * rng.uniform(0.01, 0.02));
     }
-    auto volumes = [&](int i) {
-        return ProxyVolumes{Aabb{centre[i] - half[i], centre[i] + half[i]},
-                            BoundingSphere{centre[i], half[i].norm()},
-                            Obb{centre[i], Mat3::Identity(), half[i]}};
-    };
-    std::unique_ptr<BroadPhase> fast = findBroadPhase("sap-packed")->create();
-    std::unique_ptr<BroadPhase> ref = findBroadPhase("brute")->create();
-    for (int i = 0; i < kBoxes; ++i) {
-        fast->insert(i, volumes(i));
-        ref->insert(i, volumes(i));
-    }
-    std::vector<ProxyPair> fast_pairs, ref_pairs;
-    BroadPhaseCounters first, rc;
-    fast->findPairs(fast_pairs, first);
-    ref->findPairs(ref_pairs, rc);
-    ASSERT_EQ(fast_pairs, ref_pairs);
-    ASSERT_GT(ref_pairs.size(), std::size_t(kBoxes));
+    PackedBesideBrute check(centre, half);
+    check.findPairs(false);
+    ASSERT_EQ(check.mismatch(), "");
+    ASSERT_GT(check.pairs().size(), std::size_t(kBoxes));
     constexpr int kFrames = 160;
     std::int64_t changed = 0;
     for (int frame = 1; frame <= kFrames; ++frame) {
@@ -743,16 +768,11 @@ TEST(PackedSweepAndPrune, SteadilyMovingMixedSizesEqualBruteForceOnTheIncrementa
             for (int k = 0; k < 3; ++k) {
                 if (centre[i][k] < 0 || centre[i][k] > kSide) velocity[i][k] = -velocity[i][k];
             }
-            fast->move(i, volumes(i));
-            ref->move(i, volumes(i));
         }
-        const std::vector<ProxyPair> before = ref_pairs;
-        BroadPhaseCounters fc;
-        fast->findPairs(fast_pairs, fc);
-        ref->findPairs(ref_pairs, rc);
-        ASSERT_EQ(fast_pairs, ref_pairs) << "frame " << frame;
-        ASSERT_EQ(fast->validate(), "") << "frame " << frame;
-        changed += ref_pairs != before;
+        const std::vector<ProxyPair> before = check.pairs();
+        check.findPairs();
+        ASSERT_EQ(check.mismatch(), "") << "frame " << frame;
+        changed += check.pairs() != before;
     }
     EXPECT_GT(changed, kFrames / 2);  // the pair set really moves
 }
@@ -780,22 +800,9 @@ TEST(PackedSweepAndPrune, EscapedBoxesFindRodsFarBehindInX) {
         centre[i] = rng.vec(0, kSide);
         velocity[i] = rng.vec(-1, 1).normalized() * Real(rod ? 0.01 : 0.03);
     }
-    auto volumes = [&](int i) {
-        return ProxyVolumes{Aabb{centre[i] - half[i], centre[i] + half[i]},
-                            BoundingSphere{centre[i], half[i].norm()},
-                            Obb{centre[i], Mat3::Identity(), half[i]}};
-    };
-    std::unique_ptr<BroadPhase> fast = findBroadPhase("sap-packed")->create();
-    std::unique_ptr<BroadPhase> ref = findBroadPhase("brute")->create();
-    for (int i = 0; i < kBoxes; ++i) {
-        fast->insert(i, volumes(i));
-        ref->insert(i, volumes(i));
-    }
-    std::vector<ProxyPair> fast_pairs, ref_pairs;
-    BroadPhaseCounters first, rc;
-    fast->findPairs(fast_pairs, first);
-    ref->findPairs(ref_pairs, rc);
-    ASSERT_EQ(fast_pairs, ref_pairs);
+    PackedBesideBrute check(centre, half);
+    const BroadPhaseCounters first = check.findPairs(false);
+    ASSERT_EQ(check.mismatch(), "");
     constexpr int kFrames = 200;
     int cheap_frames = 0;
     std::int64_t rod_pairs = 0;
@@ -805,16 +812,11 @@ TEST(PackedSweepAndPrune, EscapedBoxesFindRodsFarBehindInX) {
             for (int k = 0; k < 3; ++k) {
                 if (centre[i][k] < 0 || centre[i][k] > kSide) velocity[i][k] = -velocity[i][k];
             }
-            fast->move(i, volumes(i));
-            ref->move(i, volumes(i));
         }
-        BroadPhaseCounters fc;
-        fast->findPairs(fast_pairs, fc);
-        ref->findPairs(ref_pairs, rc);
-        ASSERT_EQ(fast_pairs, ref_pairs) << "frame " << frame;
-        ASSERT_EQ(fast->validate(), "") << "frame " << frame;
+        const BroadPhaseCounters fc = check.findPairs();
+        ASSERT_EQ(check.mismatch(), "") << "frame " << frame;
         cheap_frames += fc.volume_tests < first.volume_tests / 4;
-        for (const ProxyPair& p : ref_pairs) rod_pairs += p.a < kRods && p.b >= kRods;
+        for (const ProxyPair& p : check.pairs()) rod_pairs += p.a < kRods && p.b >= kRods;
     }
     EXPECT_GT(cheap_frames, kFrames / 4);  // the escape look-ups, not full sweeps
     EXPECT_GT(rod_pairs, kFrames * 10);    // the rods really touch the small boxes
@@ -841,34 +843,13 @@ TEST(PackedSweepAndPrune, SteadilyMovingBoxLeavesItsLeadingFatBoxRarely) {
     centre[kStill] = Vec3(kSide - 2, 2, kSide - 2);
     half[kStill] = Vec3(1, 1, 1);
     const Vec3 velocity(-0.12, 0.1, -0.08);
-    auto volumes = [&](int i) {
-        return ProxyVolumes{Aabb{centre[i] - half[i], centre[i] + half[i]},
-                            BoundingSphere{centre[i], half[i].norm()},
-                            Obb{centre[i], Mat3::Identity(), half[i]}};
-    };
-    std::unique_ptr<BroadPhase> fast = findBroadPhase("sap-packed")->create();
-    std::unique_ptr<BroadPhase> ref = findBroadPhase("brute")->create();
-    for (int i = 0; i <= kStill; ++i) {
-        fast->insert(i, volumes(i));
-        ref->insert(i, volumes(i));
-    }
-    std::vector<ProxyPair> fast_pairs, ref_pairs;
-    BroadPhaseCounters fc, rc;
+    PackedBesideBrute check(centre, half);
     int querying_frames = 0;
     constexpr int kFrames = 300;
     for (int frame = 0; frame <= kFrames; ++frame) {
-        if (frame > 0) {
-            centre[kStill] += velocity;
-            for (int i = 0; i <= kStill; ++i) {
-                fast->move(i, volumes(i));
-                ref->move(i, volumes(i));
-            }
-        }
-        fc = BroadPhaseCounters{};
-        fast->findPairs(fast_pairs, fc);
-        ref->findPairs(ref_pairs, rc);
-        ASSERT_EQ(fast_pairs, ref_pairs) << "frame " << frame;
-        ASSERT_EQ(fast->validate(), "") << "frame " << frame;
+        if (frame > 0) centre[kStill] += velocity;
+        const BroadPhaseCounters fc = check.findPairs(frame > 0);
+        ASSERT_EQ(check.mismatch(), "") << "frame " << frame;
         if (frame > 10) querying_frames += fc.volume_tests > 0;
     }
     // About one frame in kLead (32) re-queries; with symmetric margins of 16 steps it would be
