@@ -43,14 +43,8 @@ Shape meshShape(const TriangleMesh& m, std::string_view bvh) {
                                tree);
 }
 
-const TriangleMesh& torusA() {
-    static const TriangleMesh m = cdlab_test::makeTorusMesh(1.0, 0.35, 48, 16);
-    return m;
-}
-const TriangleMesh& torusB() {
-    static const TriangleMesh m = cdlab_test::makeTorusMesh(0.8, 0.3, 40, 15);
-    return m;
-}
+using cdlab_test::torusA;
+using cdlab_test::torusB;
 
 // Two chain links: A lies in the xy plane around the origin; B stands in the xz plane (turned
 // 90 degrees about x, then 7 degrees about z so nothing lines up), its centre at (shift, 0, 0):

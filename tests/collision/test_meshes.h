@@ -65,4 +65,15 @@ inline collision::TriangleMesh makeGridCubeMesh(int n) {
     return m;
 }
 
+/// The two tori the hierarchy tests pose against each other (1,536 and 1,200 triangles), built
+/// once per test executable.
+inline const collision::TriangleMesh& torusA() {
+    static const collision::TriangleMesh m = makeTorusMesh(1.0, 0.35, 48, 16);
+    return m;
+}
+inline const collision::TriangleMesh& torusB() {
+    static const collision::TriangleMesh m = makeTorusMesh(0.8, 0.3, 40, 15);
+    return m;
+}
+
 }  // namespace cdlab_test

@@ -75,14 +75,8 @@ bool expectBruteForceAnswer(const TriangleMesh& ma, const MeshBvh& a, const Tria
     return !expected.empty();
 }
 
-const TriangleMesh& torusA() {
-    static const TriangleMesh m = cdlab_test::makeTorusMesh(1.0, 0.35, 48, 16);
-    return m;
-}
-const TriangleMesh& torusB() {
-    static const TriangleMesh m = cdlab_test::makeTorusMesh(0.8, 0.3, 40, 15);
-    return m;
-}
+using cdlab_test::torusA;
+using cdlab_test::torusB;
 
 TEST(WideBvh, CollapseKeepsEveryBinaryBoxAndValidates) {
     for (const BvhSplit split : {BvhSplit::Median, BvhSplit::Mean}) {
