@@ -1,0 +1,256 @@
+// collision/src/broadphase/sap_packed_fat.cpp -- sap-packed's coherence between frames: each
+// box's fat box (led in the direction it moves, margin learnt from how far the last lead
+// missed), and the look-ups of the boxes that left theirs, in the last dealt bands and in the
+// list of boxes re-fattened since. The invariants are at the top of sap_packed.cpp.
+#include <algorithm>
+#include <cmath>
+#include <span>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include "broadphase/float_bounds.h"
+#include "broadphase/radix_sort.h"
+#include "broadphase/sap_packed.h"
+
+namespace collision {
+
+using float_bounds::roundDown;
+using float_bounds::roundUp;
+
+void PackedSweepAndPrune::fatten(ProxyId id, float share, bool learn) {
+    // Margins as Box2D's dynamic tree fattens a moving proxy's box (Catto, Box2D: b2_aabbMargin
+    // plus the predicted displacement): a margin on every side, and on the side each axis moves
+    // towards a lead of kLead frames of the box's mean velocity over its last fat box's lifetime.
+    // The margin is learnt from how far that lifetime's lead missed (twice the miss, at least
+    // kMinMargin and at most kMargin times the recent step): a box moving steadily is led and
+    // gets a thin margin, one jittering about a place no lead and the full margin. Without a
+    // lifetime to learn from (a rebuild) the margin is full and there is no lead.
+    const Aabb& box = table_.aabb(id);
+    const std::size_t k = static_cast<std::size_t>(id);
+    if (share == 0) {
+        // No margins (the one-shot path): nothing to lead or learn from; the next fat box
+        // with margins is made by a rebuild, which learns nothing either.
+        setFat(k, box.min.x(), box.min.y(), box.min.z(), box.max.x(), box.max.y(), box.max.z());
+        return;
+    }
+    const Vec3 centre = (box.min + box.max) / 2;
+    const Real step = motion_[k];
+    if (learn && frame_ > fat_frame_[k]) {
+        const Real lived = Real(frame_ - fat_frame_[k]);
+        const Vec3 moved = centre - fat_centre_[k];
+        const Real miss = (moved - lived * lead_velocity_[k]).cwiseAbs().maxCoeff();
+        margin_[k] = std::isfinite(miss)
+                         ? std::clamp<Real>(2 * miss, kMinMargin * step, kMargin * step)
+                         : kMargin * step;
+        const Vec3 velocity = moved / lived;
+        lead_velocity_[k] = velocity.allFinite() ? velocity : Vec3::Zero();
+    } else {
+        margin_[k] = kMargin * step;
+        lead_velocity_[k] = Vec3::Zero();
+    }
+    fat_centre_[k] = centre;
+    fat_frame_[k] = frame_;
+    const Real base = Real(share) * margin_[k];
+    const Vec3 led = Real(share) * kLead * lead_velocity_[k];
+    const Vec3 lead = led.allFinite() ? led : Vec3::Zero();
+    setFat(k, box.min.x() - (base + std::max<Real>(0, -lead.x())),
+           box.min.y() - (base + std::max<Real>(0, -lead.y())),
+           box.min.z() - (base + std::max<Real>(0, -lead.z())),
+           box.max.x() + (base + std::max<Real>(0, lead.x())),
+           box.max.y() + (base + std::max<Real>(0, lead.y())),
+           box.max.z() + (base + std::max<Real>(0, lead.z())));
+}
+
+void PackedSweepAndPrune::setFat(std::size_t k, Real lo_x, Real lo_y, Real lo_z, Real hi_x,
+                                 Real hi_y, Real hi_z) {
+    fat_.min_x[k] = roundDown(lo_x);
+    fat_.max_x[k] = roundUp(hi_x);
+    fat_.min_y[k] = roundDown(lo_y);
+    fat_.min_z[k] = roundDown(lo_z);
+    fat_.neg_max_y[k] = -roundUp(hi_y);
+    fat_.neg_max_z[k] = -roundUp(hi_z);
+}
+
+bool PackedSweepAndPrune::insideFat(ProxyId id) const {
+    const Aabb& box = table_.aabb(id);
+    const std::size_t k = static_cast<std::size_t>(id);
+    return double(fat_.min_x[k]) <= box.min.x() && box.max.x() <= double(fat_.max_x[k]) &&
+           double(fat_.min_y[k]) <= box.min.y() && box.max.y() <= -double(fat_.neg_max_y[k]) &&
+           double(fat_.min_z[k]) <= box.min.z() && box.max.z() <= -double(fat_.neg_max_z[k]);
+}
+
+template <typename Hit>
+std::int64_t PackedSweepAndPrune::queryRange(const Lanes& lanes, std::size_t j,
+                                             const float (&box)[6], bool stop_past_x, Hit&& hit) {
+    // box: min x, max x, min y, max y, min z, max z. From place j (a multiple of nothing in
+    // particular), four lanes at a time, to the first group holding a box past max x
+    // (stop_past_x: the lanes are sorted on min x) or a NaN sentinel.
+    std::int64_t tests = 0;
+#if defined(__SSE2__)
+    const __m128 hi_x = _mm_set1_ps(box[1]);
+    const __m128 lo_x = _mm_set1_ps(box[0]);
+    const __m128 hi_y = _mm_set1_ps(box[3]);
+    const __m128 hi_z = _mm_set1_ps(box[5]);
+    const __m128 neg_lo_y = _mm_set1_ps(-box[2]);
+    const __m128 neg_lo_z = _mm_set1_ps(-box[4]);
+    for (;; j += 4) {
+        const __m128 min_x = _mm_loadu_ps(lanes.min_x.data() + j);
+        const __m128 in_x = _mm_cmple_ps(min_x, hi_x);
+        __m128 m = _mm_and_ps(in_x, _mm_cmple_ps(lo_x, _mm_loadu_ps(lanes.max_x.data() + j)));
+        m = _mm_and_ps(m, _mm_cmple_ps(_mm_loadu_ps(lanes.min_y.data() + j), hi_y));
+        m = _mm_and_ps(m, _mm_cmple_ps(_mm_loadu_ps(lanes.min_z.data() + j), hi_z));
+        m = _mm_and_ps(m, _mm_cmple_ps(_mm_loadu_ps(lanes.neg_max_y.data() + j), neg_lo_y));
+        m = _mm_and_ps(m, _mm_cmple_ps(_mm_loadu_ps(lanes.neg_max_z.data() + j), neg_lo_z));
+        tests += 4;
+        for (int bits = _mm_movemask_ps(m); bits != 0; bits &= bits - 1) {
+            hit(j + static_cast<std::size_t>(std::countr_zero(unsigned(bits))));
+        }
+        const int x_bits = _mm_movemask_ps(stop_past_x ? in_x : _mm_cmpord_ps(min_x, min_x));
+        if (x_bits != 0xF) break;
+    }
+#else
+    for (; stop_past_x ? lanes.min_x[j] <= box[1] : lanes.min_x[j] == lanes.min_x[j]; ++j) {
+        ++tests;
+        if (box[0] <= lanes.max_x[j] && lanes.min_x[j] <= box[1] && lanes.min_y[j] <= box[3] &&
+            lanes.min_z[j] <= box[5] && lanes.neg_max_y[j] <= -box[2] &&
+            lanes.neg_max_z[j] <= -box[4]) {
+            hit(j);
+        }
+    }
+#endif
+    return tests;
+}
+
+void PackedSweepAndPrune::restale() {
+    // The stale boxes that did not escape this frame keep their fat boxes, hence their order;
+    // this frame's escaped boxes, sorted, are merged in (ties by id: deterministic).
+    std::sort(escaped_.begin(), escaped_.end(), [this](ProxyId a, ProxyId b) {
+        const float ka = fat_.min_x[static_cast<std::size_t>(a)];
+        const float kb = fat_.min_x[static_cast<std::size_t>(b)];
+        return ka < kb || (ka == kb && a < b);
+    });
+    merged_ids_.clear();
+    std::size_t e = 0;
+    const auto before = [this](ProxyId a, ProxyId b) {
+        const float ka = fat_.min_x[static_cast<std::size_t>(a)];
+        const float kb = fat_.min_x[static_cast<std::size_t>(b)];
+        return ka < kb || (ka == kb && a < b);
+    };
+    for (const ProxyId id : stale_ids_) {
+        if (escaped_flag_[id]) continue;
+        while (e < escaped_.size() && before(escaped_[e], id)) merged_ids_.push_back(escaped_[e++]);
+        merged_ids_.push_back(id);
+    }
+    merged_ids_.insert(merged_ids_.end(), escaped_.begin() + static_cast<std::ptrdiff_t>(e),
+                       escaped_.end());
+    stale_ids_.swap(merged_ids_);
+    for (const ProxyId id : escaped_) stale_[id] = 1;
+    const std::size_t count = stale_ids_.size();
+    stale_lanes_.resize(count + kPad);
+    stale_reach_ = 0;
+    for (std::size_t i = 0; i < count; ++i) {
+        const std::size_t k = static_cast<std::size_t>(stale_ids_[i]);
+        stale_lanes_.copy(i, fat_, k);
+        stale_reach_ = std::max(stale_reach_, double(fat_.max_x[k]) - double(fat_.min_x[k]));
+    }
+    stale_lanes_.pad(count);
+}
+
+void PackedSweepAndPrune::queryEscaped(std::vector<ProxyPair>& pairs,
+                                       BroadPhaseCounters& counters) {
+    // The sorted bands, as last dealt, still hold every box that has not been re-fattened
+    // since (not stale): an escaped box is looked up in the bands its y range meets, by binary
+    // search on min x from its min x less the band's widest box; the stale boxes' current fat
+    // boxes are kept apart (stale_lanes_, sorted on min x) and looked up the same way. A
+    // pair of two escaped boxes is taken from the lower id only; a pair met in several bands
+    // only in the band of the larger min y (as in the full sweep).
+    keys_.clear();
+    std::int64_t tests = 0;
+    const std::size_t n = entries_.size();
+    const bool one = bands_ == 1;
+    const Lanes& lanes = one ? all_ : band_;
+    for (const ProxyId e : escaped_) {
+        const std::size_t k = static_cast<std::size_t>(e);
+        const float box[6] = {fat_.min_x[k],      fat_.max_x[k], fat_.min_y[k],
+                              -fat_.neg_max_y[k], fat_.min_z[k], -fat_.neg_max_z[k]};
+        const auto key = [&](ProxyId other) {
+            keys_.push_back((static_cast<std::uint64_t>(e) << shift_) |
+                            static_cast<std::uint64_t>(other));
+        };
+        const int fe = one ? 0 : bandOf(box[2]);
+        const int le = one ? 0 : bandOf(box[3]);
+        for (int b = fe; b <= le; ++b) {
+            const std::size_t begin = one ? 0 : band_start_[b];
+            const std::size_t end = one ? n : band_start_[b + 1] - kPad;
+            const float from = roundDown(double(box[0]) - band_reach_[b]);
+            const auto first = lanes.min_x.begin();
+            const std::size_t j = static_cast<std::size_t>(
+                std::lower_bound(first + static_cast<std::ptrdiff_t>(begin),
+                                 first + static_cast<std::ptrdiff_t>(end), from) -
+                first);
+            tests += queryRange(lanes, j, box, true, [&](std::size_t at) {
+                if (!one && b != std::max(fe, band_first_[at])) return;
+                const ProxyId other = ids_[one ? at : band_place_[at]];
+                if (!stale_[other]) key(other);
+            });
+        }
+        for (const std::uint32_t g : big_) {
+            ++tests;
+            const ProxyId other = ids_[g];
+            if (stale_[other]) continue;
+            if (all_.min_x[g] <= box[1] && all_.max_x[g] >= box[0] && all_.min_y[g] <= box[3] &&
+                all_.min_z[g] <= box[5] && -all_.neg_max_y[g] >= box[2] &&
+                -all_.neg_max_z[g] >= box[4]) {
+                key(other);
+            }
+        }
+        const auto first = stale_lanes_.min_x.begin();
+        const std::size_t from = static_cast<std::size_t>(
+            std::lower_bound(first, first + static_cast<std::ptrdiff_t>(stale_ids_.size()),
+                             roundDown(double(box[0]) - stale_reach_)) -
+            first);
+        tests += queryRange(stale_lanes_, from, box, true, [&](std::size_t at) {
+            const ProxyId other = stale_ids_[at];
+            if (other == e || (escaped_flag_[other] && other < e)) return;
+            key(other);
+        });
+    }
+    counters.volume_tests += tests;
+    radix::keysToSortedPairs(keys_, scratch_, shift_, fresh_, /*order_ids=*/true);
+    // The kept candidates (no escaped member) and the fresh ones, both sorted, merged.
+    // The same pass writes the exact pairs (see exactPairs): one walk over the candidates, not
+    // two. Branch-free: every candidate is written to both lists, the merged count advances for
+    // a kept one, the exact count for a kept one whose boxes overlap.
+    merged_.resize(candidates_.size() + fresh_.size());
+    pairs.resize(merged_.size());
+    ProxyPair* merged = merged_.data();
+    ProxyPair* exact = pairs.data();
+    std::size_t kept = 0;
+    std::size_t count = 0;
+    std::size_t f = 0;
+    const char* flag = escaped_flag_.data();
+    const auto take = [&](const ProxyPair& p) {
+        merged[kept++] = p;
+        exact[count] = p;
+        count += static_cast<std::size_t>(overlapsExactly(p));
+    };
+    for (const ProxyPair& p : candidates_) {
+        const int keep = int(flag[p.a] == 0) & int(flag[p.b] == 0);
+        if (keep != 0) {
+            while (f < fresh_.size() && fresh_[f] < p) take(fresh_[f++]);
+        }
+        merged[kept] = p;
+        kept += static_cast<std::size_t>(keep);
+        exact[count] = p;
+        count += static_cast<std::size_t>(keep & overlapsExactly(p));
+    }
+    while (f < fresh_.size()) take(fresh_[f++]);
+    merged_.resize(kept);
+    pairs.resize(count);
+    candidates_.swap(merged_);
+}
+
+
+}  // namespace collision
