@@ -36,59 +36,6 @@ using collision::TriangleMesh;
 using collision::TrianglePair;
 using collision::Vec3;
 
-// A torus around local z: `nu` segments around the ring, `nv` around the tube, 2 nu nv triangles.
-TriangleMesh makeTorus(Real ring, Real tube, int nu, int nv) {
-    TriangleMesh m;
-    for (int i = 0; i < nu; ++i) {
-        const Real u = 2 * std::numbers::pi_v<Real> * i / nu;
-        for (int j = 0; j < nv; ++j) {
-            const Real v = 2 * std::numbers::pi_v<Real> * j / nv;
-            const Real w = ring + tube * std::cos(v);
-            m.vertices.emplace_back(w * std::cos(u), w * std::sin(u), tube * std::sin(v));
-        }
-    }
-    auto id = [&](int i, int j) { return static_cast<std::int32_t>((i % nu) * nv + (j % nv)); };
-    for (int i = 0; i < nu; ++i) {
-        for (int j = 0; j < nv; ++j) {
-            m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-            m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-        }
-    }
-    return m;
-}
-
-// The cube [-1, 1]^3, each face an n x n grid of squares split in two triangles. With n a power of
-// two every coordinate is exact, so translated copies touch exactly.
-TriangleMesh makeGridCube(int n) {
-    TriangleMesh m;
-    for (int axis = 0; axis < 3; ++axis) {
-        for (int side = -1; side <= 1; side += 2) {
-            const int u_axis = (axis + 1) % 3;
-            const int v_axis = (axis + 2) % 3;
-            const auto base = static_cast<std::int32_t>(m.vertices.size());
-            for (int i = 0; i <= n; ++i) {
-                for (int j = 0; j <= n; ++j) {
-                    Vec3 p;
-                    p[axis] = side;
-                    p[u_axis] = -1 + Real(2) * i / n;
-                    p[v_axis] = -1 + Real(2) * j / n;
-                    m.vertices.push_back(p);
-                }
-            }
-            auto id = [&](int i, int j) {
-                return base + static_cast<std::int32_t>(i * (n + 1) + j);
-            };
-            for (int i = 0; i < n; ++i) {
-                for (int j = 0; j < n; ++j) {
-                    m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-                    m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-                }
-            }
-        }
-    }
-    return m;
-}
-
 TriangleMesh transformed(const TriangleMesh& m, Real scale, const Vec3& offset) {
     TriangleMesh out = m;
     for (Vec3& v : out.vertices) v = v * scale + offset;
@@ -107,15 +54,9 @@ std::vector<Pose> randomPoses(std::uint64_t seed, int count, Real range) {
     return poses;
 }
 
-// Small tori for the brute-force comparison (1536 and 1200 triangles).
-const TriangleMesh& torusA() {
-    static const TriangleMesh m = makeTorus(1.0, 0.35, 48, 16);
-    return m;
-}
-const TriangleMesh& torusB() {
-    static const TriangleMesh m = makeTorus(0.8, 0.3, 40, 15);
-    return m;
-}
+using cdlab_test::torusA;
+using cdlab_test::torusB;
+
 const std::vector<Pose>& differentialPoses() {
     static const std::vector<Pose> poses = randomPoses(4242, 16, 2.0);
     return poses;
@@ -270,7 +211,7 @@ TYPED_TEST(BvhTyped, SelfCollisionMatchesBruteForce) {
     EXPECT_TRUE(collision::intersectSelf(Bvh<TypeParam>(torusA())).empty());
     // A grid cube with a copy of one face's triangle pushed through the cube: it crosses the
     // faces it passes through, and the pairs come out as the brute force's.
-    TriangleMesh cube = makeGridCube(2);
+    TriangleMesh cube = cdlab_test::makeGridCubeMesh(2);
     const auto base = static_cast<std::int32_t>(cube.vertices.size());
     cube.vertices.push_back(Vec3(-1.5, 0.1, 0.2));
     cube.vertices.push_back(Vec3(1.5, 0.3, -0.1));
@@ -285,11 +226,11 @@ TYPED_TEST(BvhTyped, SelfCollisionMatchesBruteForce) {
 
 // Small tori for the distance brute force (256 and 196 triangles).
 const TriangleMesh& smallTorusA() {
-    static const TriangleMesh m = makeTorus(1.0, 0.35, 16, 8);
+    static const TriangleMesh m = cdlab_test::makeTorusMesh(1.0, 0.35, 16, 8);
     return m;
 }
 const TriangleMesh& smallTorusB() {
-    static const TriangleMesh m = makeTorus(0.8, 0.3, 14, 7);
+    static const TriangleMesh m = cdlab_test::makeTorusMesh(0.8, 0.3, 14, 7);
     return m;
 }
 const std::vector<Pose>& distancePoses() {
@@ -361,7 +302,7 @@ TYPED_TEST(BvhTyped, DistanceMatchesBruteForceWithWitnesses) {
     EXPECT_GE(separated, cdlab_test::scaled(9, 3));
     EXPECT_GE(touching, cdlab_test::scaled(9, 3));
     // Closed form: grid cubes a gap g apart along x; witnesses on the facing faces.
-    const TriangleMesh cube = makeGridCube(2);
+    const TriangleMesh cube = cdlab_test::makeGridCubeMesh(2);
     const Bvh<TypeParam> tree(cube);
     for (const Real g : {Real(0.25), Real(1e-3), Real(0)}) {
         const collision::MeshDistance d =
@@ -428,7 +369,7 @@ TYPED_TEST(BvhTyped, MeanSplitAndFatLeavesGiveTheSameAnswer) {
 //   +2, +1/8, +1/8: the same faces with the grids offset by half a cell (crossing edges);
 //   +2, +2, 0:      the cubes share only an edge line; +2, +2, +2: only a corner.
 TYPED_TEST(BvhTyped, TouchingAndCoplanarPosesMatchBruteForce) {
-    const TriangleMesh cube = makeGridCube(8);
+    const TriangleMesh cube = cdlab_test::makeGridCubeMesh(8);
     const Bvh<TypeParam> tree(cube);
     const Quat quarter_turn(std::cos(std::numbers::pi_v<Real> / 4),
                             std::sin(std::numbers::pi_v<Real> / 4), 0, 0);
@@ -462,8 +403,8 @@ TYPED_TEST(BvhTyped, TouchingAndCoplanarPosesMatchBruteForce) {
 // equal brute force on the moved scene exactly, and (these poses being generic, with no contact
 // within rounding of touching) give the original pair list.
 TYPED_TEST(BvhTyped, TranslatedAndScaledScenesGiveTheSameAnswer) {
-    const TriangleMesh small_a = makeTorus(1.0, 0.35, 24, 12);
-    const TriangleMesh small_b = makeTorus(0.8, 0.3, 20, 10);
+    const TriangleMesh small_a = cdlab_test::makeTorusMesh(1.0, 0.35, 24, 12);
+    const TriangleMesh small_b = cdlab_test::makeTorusMesh(0.8, 0.3, 20, 10);
     const std::vector<Pose> poses = randomPoses(100, 6, 1.6);
     int colliding = 0;
     for (const Real scale : {Real(1), Real(1e-4), Real(1e4)}) {
@@ -626,8 +567,8 @@ TYPED_TEST(BvhTyped, SwappingTheMeshesMirrorsThePairs) {
     EXPECT_GE(colliding, 4);
     EXPECT_LE(colliding, 12);
     // Touching grid cubes of different sizes (exact coordinates): face, edge and corner contact.
-    const TriangleMesh big = transformed(makeGridCube(4), 2, Vec3::Zero());
-    const TriangleMesh small = makeGridCube(8);
+    const TriangleMesh big = transformed(cdlab_test::makeGridCubeMesh(4), 2, Vec3::Zero());
+    const TriangleMesh small = cdlab_test::makeGridCubeMesh(8);
     const Bvh<TypeParam> tree_big(big);
     const Bvh<TypeParam> tree_small(small);
     for (const Vec3& d : {Vec3(3, 0.5, 0.25), Vec3(3, 3, 0), Vec3(3, 3, 3), Vec3(0, -3, 0.5)}) {
@@ -730,7 +671,7 @@ TEST(Bvh, SweepReferenceEqualsBruteForce) {
         non_empty += !brute.empty();
     }
     EXPECT_GT(non_empty, 3);
-    const TriangleMesh cube = makeGridCube(4);
+    const TriangleMesh cube = cdlab_test::makeGridCubeMesh(4);
     for (const Vec3& d : {Vec3(2, 0, 0), Vec3(2, 2, 0), Vec3(2, 2, 2), Vec3(0, -2, 0.5)}) {
         const Pose p{d, Quat::Identity()};
         const auto brute = collision::intersectMeshMeshBruteForce(cube, cube, p);
@@ -740,7 +681,7 @@ TEST(Bvh, SweepReferenceEqualsBruteForce) {
     // The kinds of pose the large-mesh test uses: faces flush with the grids offset by half a
     // cell, B turned about x (a quarter and a random angle: coplanar faces, crossing edges), and
     // the random cube poses.
-    const TriangleMesh fine = makeGridCube(8);
+    const TriangleMesh fine = cdlab_test::makeGridCubeMesh(8);
     std::vector<Pose> poses = {Pose{Vec3(2, 0.125, 0.125), Quat::Identity()},
                                Pose{Vec3(2, 0, 0), aboutX(std::numbers::pi_v<Real> / 2)},
                                Pose{Vec3(2, 0.7, -1.1), aboutX(Real(0.83))},

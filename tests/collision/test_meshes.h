@@ -33,7 +33,8 @@ inline collision::TriangleMesh makeTorusMesh(collision::Real ring, collision::Re
     return m;
 }
 
-/// The cube [-1, 1]^3, each face an n x n grid of squares split in two triangles (12 n^2).
+/// The cube [-1, 1]^3, each face an n x n grid of squares split in two triangles (12 n^2). With n
+/// a power of two every coordinate is exact, so translated copies touch exactly.
 inline collision::TriangleMesh makeGridCubeMesh(int n) {
     using collision::Real;
     collision::TriangleMesh m;
