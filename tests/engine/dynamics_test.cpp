@@ -11,6 +11,7 @@
 
 #include "engine/scene.h"
 #include "engine/world.h"
+#include "test_mass.h"
 
 namespace engine {
 namespace {
@@ -19,16 +20,6 @@ using collision::Shape;
 
 constexpr Integrator kAllIntegrators[] = {Integrator::ExplicitEuler, Integrator::SemiImplicitEuler,
                                           Integrator::Rk4};
-
-MassProperties boxMass(const Vec3& h, Real mass) {
-    MassProperties m;
-    m.mass = mass;
-    m.inertia = Vec3(h.y() * h.y() + h.z() * h.z(), h.x() * h.x() + h.z() * h.z(),
-                     h.x() * h.x() + h.y() * h.y())
-                    .asDiagonal();
-    m.inertia *= mass / 3;
-    return m;
-}
 
 WorldSettings openSpace(Integrator integrator, Real dt) {
     WorldSettings s;

@@ -18,29 +18,13 @@
 #include "engine/scene.h"
 #include "engine/world.h"
 #include "test_scale.h"
+#include "test_mass.h"
 
 namespace engine {
 namespace {
 
 using collision::Shape;
 const std::filesystem::path kScenes = std::filesystem::path(CDLAB_SOURCE_DIR) / "scenes";
-
-MassProperties boxMass(const Vec3& h, Real mass) {
-    MassProperties m;
-    m.mass = mass;
-    m.inertia = Vec3(h.y() * h.y() + h.z() * h.z(), h.x() * h.x() + h.z() * h.z(),
-                     h.x() * h.x() + h.y() * h.y())
-                    .asDiagonal();
-    m.inertia *= mass / 3;
-    return m;
-}
-
-MassProperties sphereMass(Real r, Real mass) {
-    MassProperties m;
-    m.mass = mass;
-    m.inertia = Mat3::Identity() * (Real(0.4) * mass * r * r);
-    return m;
-}
 
 WorldSettings impulseWorld(Real half_size) {
     WorldSettings s;

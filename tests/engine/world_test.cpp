@@ -7,28 +7,12 @@
 #include <cmath>
 #include <random>
 
+#include "test_mass.h"
+
 namespace engine {
 namespace {
 
 using collision::Shape;
-
-MassProperties boxMass(const Vec3& h, Real mass) {
-    // Solid box: I_xx = m/3 (h_y^2 + h_z^2) for half extents h.
-    MassProperties m;
-    m.mass = mass;
-    m.inertia = Vec3(h.y() * h.y() + h.z() * h.z(), h.x() * h.x() + h.z() * h.z(),
-                     h.x() * h.x() + h.y() * h.y())
-                    .asDiagonal();
-    m.inertia *= mass / 3;
-    return m;
-}
-
-MassProperties sphereMass(Real r, Real mass) {
-    MassProperties m;
-    m.mass = mass;
-    m.inertia = Mat3::Identity() * (Real(0.4) * mass * r * r);
-    return m;
-}
 
 Body movingBody(Body b, const Vec3& position, const Vec3& velocity, const Vec3& omega) {
     b.position = position;
