@@ -18,13 +18,12 @@ sweep() {
   echo "== docs/sweeps/$name"
   build/bin/cdlab sweep "$@" --float-binary build-float/bin/cdlab --out "docs/sweeps/$name"
 }
-# BEGIN sweeps
 # Broad phases and time step on the coursework scene (reference: the same scene at dt / 10).
 sweep coursework scenes/coursework.yaml \
   --vary broadphase=brute,sphere,sap,hgrid,tree,obb --vary world.time_step=0.004167,0.008333,0.033333
 # Mesh hierarchies: the node volume of the mesh bodies' BVHs (Nv, Np and time per step).
 sweep coursework_mesh_bvh scenes/coursework.yaml \
-  --vary world.mesh_bvh=sphere,aabb,obb,kdop6,kdop14,kdop18,kdop26,rss,lss
+  --vary world.mesh_bvh=sphere,aabb,obb,obb4,kdop6,kdop14,kdop18,kdop26,rss,lss
 sweep crowd scenes/crowd.yaml --vary broadphase=sap,sap1,grid,hash,hgrid,tree,octree,obb
 # CCD against the time step: missed contacts and time-of-impact error against an exact-CCD
 # reference.
@@ -40,5 +39,4 @@ sweep bounce scenes/bounce.yaml \
   --vary world.integrator=explicit_euler,semi_implicit_euler,rk4 \
   --vary world.time_step=0.016667,0.008333,0.002083
 sweep stack scenes/stack.yaml --vary world.time_step=0.033333,0.016667,0.004167
-# END sweeps
 echo "== reports in docs/sweeps/*/report.md"
