@@ -16,8 +16,11 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
-#include <cstring>
 #include <limits>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "geometry/shape_measures.h"
 #include "narrowphase/contact_pairs.h"
@@ -82,25 +85,55 @@ void settleSignedDistance(const CollideOutput& decided, Real tolerance, Local& l
     local.state = decided.state;
 }
 
+// pose.apply(p) and pose.apply(q) with the same operations in the same order (Eigen's
+// quaternion transform: uv = 2 (q.vec x v), v + w uv + q.vec x uv, then + position), the two
+// points in the two lanes of SSE2 doubles: the same bits as applying the pose to each.
+void applyPair(const Pose& pose, const Vec3& p, const Vec3& q, Vec3& world_p, Vec3& world_q) {
+#if defined(__SSE2__)
+    const Quat& o = pose.orientation;
+    const __m128d qx = _mm_set1_pd(o.x());
+    const __m128d qy = _mm_set1_pd(o.y());
+    const __m128d qz = _mm_set1_pd(o.z());
+    const __m128d qw = _mm_set1_pd(o.w());
+    const __m128d vx = _mm_set_pd(q.x(), p.x());
+    const __m128d vy = _mm_set_pd(q.y(), p.y());
+    const __m128d vz = _mm_set_pd(q.z(), p.z());
+    __m128d ux = _mm_sub_pd(_mm_mul_pd(qy, vz), _mm_mul_pd(qz, vy));
+    __m128d uy = _mm_sub_pd(_mm_mul_pd(qz, vx), _mm_mul_pd(qx, vz));
+    __m128d uz = _mm_sub_pd(_mm_mul_pd(qx, vy), _mm_mul_pd(qy, vx));
+    ux = _mm_add_pd(ux, ux);
+    uy = _mm_add_pd(uy, uy);
+    uz = _mm_add_pd(uz, uz);
+    const __m128d cx = _mm_sub_pd(_mm_mul_pd(qy, uz), _mm_mul_pd(qz, uy));
+    const __m128d cy = _mm_sub_pd(_mm_mul_pd(qz, ux), _mm_mul_pd(qx, uz));
+    const __m128d cz = _mm_sub_pd(_mm_mul_pd(qx, uy), _mm_mul_pd(qy, ux));
+    const __m128d rx = _mm_add_pd(_mm_add_pd(_mm_add_pd(vx, _mm_mul_pd(qw, ux)), cx),
+                                  _mm_set1_pd(pose.position.x()));
+    const __m128d ry = _mm_add_pd(_mm_add_pd(_mm_add_pd(vy, _mm_mul_pd(qw, uy)), cy),
+                                  _mm_set1_pd(pose.position.y()));
+    const __m128d rz = _mm_add_pd(_mm_add_pd(_mm_add_pd(vz, _mm_mul_pd(qw, uz)), cz),
+                                  _mm_set1_pd(pose.position.z()));
+    _mm_storeu_pd(world_p.data(), _mm_unpacklo_pd(rx, ry));
+    _mm_store_sd(world_p.data() + 2, rz);
+    _mm_storeu_pd(world_q.data(), _mm_unpackhi_pd(rx, ry));
+    _mm_store_sd(world_q.data() + 2, _mm_unpackhi_pd(rz, rz));
+#else
+    world_p = pose.apply(p);
+    world_q = pose.apply(q);
+#endif
+}
+
 // The world output, once: the local contact rotated and moved by the canonically-first shape's
-// pose (`rot` its rotation matrix), then mirrored if the canonical order swapped A and B. A
-// manifold point equal to the witness point it was copied from (one-point manifolds, the deepest
-// clipped point) takes the witness's world point instead of being transformed again: the same
-// function of the same bits.
+// pose (`rot` its rotation matrix), then mirrored if the canonical order swapped A and B. The
+// points are moved two at a time (applyPair), every one of them: no branch on which manifold
+// point repeats a witness.
 void toWorld(const Pose& pose_first, const Mat3& rot, bool swap, ContactOutput& out) {
-    const Vec3 local_a = out.point_a;
-    const Vec3 local_b = out.point_b;
     const Vec3 local_normal = out.normal;
     out.normal = rot * local_normal;
-    out.point_a = pose_first.apply(local_a);
-    out.point_b = pose_first.apply(local_b);
-    const auto same = [](const Vec3& p, const Vec3& q) {
-        return std::memcmp(p.data(), q.data(), sizeof(Real) * 3) == 0;
-    };
+    applyPair(pose_first, out.point_a, out.point_b, out.point_a, out.point_b);
     for (int i = 0; i < out.manifold_size; ++i) {
         ManifoldPoint& m = out.manifold[static_cast<std::size_t>(i)];
-        m.point_a = same(m.point_a, local_a) ? out.point_a : pose_first.apply(m.point_a);
-        m.point_b = same(m.point_b, local_b) ? out.point_b : pose_first.apply(m.point_b);
+        applyPair(pose_first, m.point_a, m.point_b, m.point_a, m.point_b);
     }
     if (swap) {
         out.normal = -out.normal;

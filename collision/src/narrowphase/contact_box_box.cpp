@@ -49,9 +49,11 @@ int clipToSlabs(const Vec3& h, int n, std::array<Vec3, 8>& poly) {
 
 // Face contact: reference box R (half extents hr, its frame), reference face on axis k with
 // outward sign s; incident box I (half extents hi) placed by i_in_r. Writes points of I inside
-// the reference face's slab with their depths below the face (>= -tolerance), in R's frame.
+// the reference face's slab with their depths below the face (in [-tolerance, max_depth]), in
+// R's frame.
 int clipFaceContact(const Vec3& hr, int k, Real s, const Vec3& hi, const RelativePose& i_in_r,
-                    Real tolerance, std::array<Vec3, 8>& points, std::array<Real, 8>& depths) {
+                    Real tolerance, Real max_depth, std::array<Vec3, 8>& points,
+                    std::array<Real, 8>& depths) {
     // Incident face: the face of I most anti-parallel to the reference normal.
     const Vec3 n_in_i = i_in_r.rotation.transpose() * (s * Vec3::Unit(k));
     int m = 0;
@@ -77,11 +79,9 @@ int clipFaceContact(const Vec3& hr, int k, Real s, const Vec3& hi, const Relativ
     for (int i = 0; i < n; ++i) {
         const Vec3& p = poly[static_cast<std::size_t>(i)];
         const Real depth = hr[k] - s * p[k];
-        if (depth >= -tolerance) {
-            points[static_cast<std::size_t>(kept)] = p;
-            depths[static_cast<std::size_t>(kept)] = depth;
-            ++kept;
-        }
+        points[static_cast<std::size_t>(kept)] = p;  // kept <= i < 8: kept by the count
+        depths[static_cast<std::size_t>(kept)] = depth;
+        kept += static_cast<int>(depth >= -tolerance) & static_cast<int>(depth <= max_depth);
     }
     return kept;
 }
@@ -97,46 +97,41 @@ int reduceManifold(const Vec3* p, const Real* depth, int n, const Vec3& normal,
         for (int i = 0; i < n; ++i) chosen[static_cast<std::size_t>(i)] = i;
         return n;
     }
+    // Each choice by selects, not branches: which point wins is data.
     auto at = [&](int i) -> const Vec3& { return p[i]; };
     int i0 = 0;
-    for (int i = 1; i < n; ++i) {
-        if (depth[i] > depth[i0]) i0 = i;
-    }
+    for (int i = 1; i < n; ++i) i0 = depth[i] > depth[i0] ? i : i0;
     int i1 = -1;
     Real best = -1;
     for (int i = 0; i < n; ++i) {
         const Real d = (at(i) - at(i0)).squaredNorm();
-        if (i != i0 && d > best) {
-            best = d;
-            i1 = i;
-        }
+        const bool better = i != i0 && d > best;
+        best = better ? d : best;
+        i1 = better ? i : i1;
     }
     int i2 = -1;
     Real best_area = -1;
     Real orientation = 1;
     for (int i = 0; i < n; ++i) {
-        if (i == i0 || i == i1) continue;
         const Real area = (at(i1) - at(i0)).cross(at(i) - at(i0)).dot(normal);
-        if (std::abs(area) > best_area) {
-            best_area = std::abs(area);
-            i2 = i;
-            orientation = signOrPlus(area);
-        }
+        const bool better = i != i0 && i != i1 && std::abs(area) > best_area;
+        best_area = better ? std::abs(area) : best_area;
+        i2 = better ? i : i2;
+        orientation = better ? signOrPlus(area) : orientation;
     }
     int i3 = -1;
     Real best_out = 0;
     const std::array<int, 3> tri{i0, i1, i2};
     for (int i = 0; i < n; ++i) {
-        if (i == i0 || i == i1 || i == i2) continue;
+        const bool other = i != i0 && i != i1 && i != i2;
         for (int e = 0; e < 3; ++e) {
             const Vec3& s = at(tri[static_cast<std::size_t>(e)]);
             const Vec3& t = at(tri[static_cast<std::size_t>((e + 1) % 3)]);
             // Negative signed area w.r.t. the triangle's orientation: outside edge e.
             const Real area = -orientation * (t - s).cross(at(i) - s).dot(normal);
-            if (area > best_out) {
-                best_out = area;
-                i3 = i;
-            }
+            const bool better = other && area > best_out;
+            best_out = better ? area : best_out;
+            i3 = better ? i : i3;
         }
     }
     chosen = {i0, i1, i2, i3};
@@ -199,10 +194,13 @@ bool satDetails(const Shape& a, const Shape& b, const RelativePose& rel, const C
     std::array<Real, 8> depths;
     int count = 0;
     Vec3 n;
+    // Points deeper than the contact lie beyond the far side of a thin reference box.
+    const Real max_depth = std::max(Real(0), -best) + kFeatureRelative * ctx.scale;
     if (face_kind == 0) {
         const Real s = signOrPlus(t[face_axis]);
         n = s * Vec3::Unit(face_axis);
-        count = clipFaceContact(ea, face_axis, s, eb, rel, ctx.tolerance, points, depths);
+        count =
+            clipFaceContact(ea, face_axis, s, eb, rel, ctx.tolerance, max_depth, points, depths);
     } else {
         const Vec3 axis = rot.col(face_axis);
         const Real s = signOrPlus(t.dot(axis));
@@ -211,22 +209,12 @@ bool satDetails(const Shape& a, const Shape& b, const RelativePose& rel, const C
         RelativePose a_in_b;
         a_in_b.rotation = rot.transpose();
         a_in_b.position = -(rot.transpose() * t);
-        count = clipFaceContact(eb, face_axis, -s, ea, a_in_b, ctx.tolerance, points, depths);
+        count = clipFaceContact(eb, face_axis, -s, ea, a_in_b, ctx.tolerance, max_depth, points,
+                                depths);
         for (int i = 0; i < count; ++i) {
             points[static_cast<std::size_t>(i)] = rot * points[static_cast<std::size_t>(i)] + t;
         }
     }
-    // Points deeper than the contact lie beyond the far side of a thin reference box.
-    const Real max_depth = std::max(Real(0), -best) + kFeatureRelative * ctx.scale;
-    int within = 0;
-    for (int i = 0; i < count; ++i) {
-        if (depths[static_cast<std::size_t>(i)] <= max_depth) {
-            points[static_cast<std::size_t>(within)] = points[static_cast<std::size_t>(i)];
-            depths[static_cast<std::size_t>(within)] = depths[static_cast<std::size_t>(i)];
-            ++within;
-        }
-    }
-    count = within;
     if (count == 0) return false;  // rounding at a grazing contact: let GJK/EPA answer
     std::array<int, 4> chosen{};
     const int kept = reduceManifold(points.data(), depths.data(), count, n, chosen);
