@@ -61,25 +61,6 @@ void PackedSweepAndPrune::move(ProxyId id, const ProxyVolumes& v) {
     }
 }
 
-int PackedSweepAndPrune::overlapsExactly(const ProxyPair& p) const {
-    const Aabb& a = table_.aabb(p.a);
-    const Aabb& b = table_.aabb(p.b);
-#if defined(__SSE2__) && !defined(CDLAB_USE_FLOAT)
-    // The six comparisons as four two-wide ones, on (x, y) and (y, z) of each bound (y twice):
-    // a.min <= b.max and b.min <= a.max. cmple is false on a NaN, as the scalar <= is.
-    const __m128d lo =
-        _mm_and_pd(_mm_cmple_pd(_mm_loadu_pd(a.min.data()), _mm_loadu_pd(b.max.data())),
-                   _mm_cmple_pd(_mm_loadu_pd(a.min.data() + 1), _mm_loadu_pd(b.max.data() + 1)));
-    const __m128d hi =
-        _mm_and_pd(_mm_cmple_pd(_mm_loadu_pd(b.min.data()), _mm_loadu_pd(a.max.data())),
-                   _mm_cmple_pd(_mm_loadu_pd(b.min.data() + 1), _mm_loadu_pd(a.max.data() + 1)));
-    return int(_mm_movemask_pd(_mm_and_pd(lo, hi)) == 3);
-#else
-    return int(a.min.x() <= b.max.x()) & int(b.min.x() <= a.max.x()) & int(a.min.y() <= b.max.y()) &
-           int(b.min.y() <= a.max.y()) & int(a.min.z() <= b.max.z()) & int(b.min.z() <= a.max.z());
-#endif
-}
-
 void PackedSweepAndPrune::radixSortEntries() {
     // Key bits above, the id below: one LSD radix sort on the 32 key bits (Terdiman, "Radix Sort
     // Revisited", for floats as ordered integers).
