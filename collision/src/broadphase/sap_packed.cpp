@@ -207,6 +207,8 @@ void PackedSweepAndPrune::dealBands() {
     const std::size_t n = entries_.size();
     bands_ = 1;
     big_.clear();
+    big_lanes_.resize(kPad);
+    big_lanes_.pad(0);
     // Band width: a few median y extents (of a sample). Narrower bands give each box fewer x
     // candidates but put it in more bands, and leave shorter sweeps.
     const float span = hi_y_ - lo_y_;
@@ -223,11 +225,7 @@ void PackedSweepAndPrune::dealBands() {
         bands_ = static_cast<int>(std::clamp<float>(std::ceil(span / width), 1, float(most)));
     }
     if (bands_ == 1) {
-        double reach = 0;
-        for (std::size_t i = 0; i < n; ++i) {
-            reach = std::max(reach, double(all_.max_x[i]) - double(all_.min_x[i]));
-        }
-        band_reach_.assign(1, reach);
+        prefixMaxX(all_, 0, n, all_reach_);
         return;
     }
     band_lo_ = lo_y_;
@@ -254,7 +252,6 @@ void PackedSweepAndPrune::dealBands() {
     band_place_.resize(total);
     band_first_.resize(total);
     fill_.assign(band_start_.begin(), band_start_.end() - 1);
-    band_reach_.assign(static_cast<std::size_t>(bands_), 0.0);
     // Dealt in sorted order, so every band is sorted on min x.
     for (std::size_t i = 0; i < n; ++i) {
         if (first_band_[i] < 0) continue;
@@ -263,17 +260,31 @@ void PackedSweepAndPrune::dealBands() {
             band_.copy(k, all_, i);
             band_place_[k] = static_cast<std::uint32_t>(i);
             band_first_[k] = first_band_[i];
-            band_reach_[b] =
-                std::max(band_reach_[b], double(all_.max_x[i]) - double(all_.min_x[i]));
         }
     }
+    big_lanes_.resize(big_.size() + kPad);
+    for (std::size_t g = 0; g < big_.size(); ++g) big_lanes_.copy(g, all_, big_[g]);
+    big_lanes_.pad(big_.size());
+    band_reach_.resize(total);
     for (int b = 0; b < bands_; ++b) {
         const std::uint32_t at = band_start_[b + 1] - kPad;
+        prefixMaxX(band_, band_start_[b], at, band_reach_);
         band_.pad(at);
         for (std::uint32_t k = at; k < at + kPad; ++k) {
             band_place_[k] = 0;
             band_first_[k] = 0;
         }
+    }
+}
+
+void PackedSweepAndPrune::prefixMaxX(const Lanes& lanes, std::size_t begin, std::size_t end,
+                                     std::vector<float>& reach) {
+    // std::max(x, NaN) keeps x: a NaN bound neither raises nor spoils the running maximum.
+    reach.resize(std::max(reach.size(), end));
+    float most = -kInf;
+    for (std::size_t i = begin; i < end; ++i) {
+        most = std::max(most, lanes.max_x[i]);
+        reach[i] = most;
     }
 }
 
