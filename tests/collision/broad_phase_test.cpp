@@ -777,10 +777,10 @@ TEST(PackedSweepAndPrune, SteadilyMovingMixedSizesEqualBruteForceOnTheIncrementa
     EXPECT_GT(changed, kFrames / 2);  // the pair set really moves
 }
 
-// sap-packed looks an escaped box up in each band it meets by binary search from its min x
-// less the band's widest box. A few boxes much wider in x than the rest (rods) set that reach:
-// an escaped small box must still find a rod whose min x lies far behind its own, and a rod
-// that escaped every box along its length:
+// sap-packed looks an escaped box up in each band it meets from the first box whose running
+// maximum of max x reaches its min x (binary search). A few boxes much wider in x than the rest
+// (rods) set that maximum: an escaped small box must still find a rod whose min x lies far
+// behind its own, and a rod that escaped every box along its length:
 //
 //      band |  [=============== rod ===============]       [========= rod =========]
 //           |    [.] [.]  [.]        [.]  [.]  [.]-->  [.]   [.]    [.]   [.]

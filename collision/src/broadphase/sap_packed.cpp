@@ -61,25 +61,6 @@ void PackedSweepAndPrune::move(ProxyId id, const ProxyVolumes& v) {
     }
 }
 
-int PackedSweepAndPrune::overlapsExactly(const ProxyPair& p) const {
-    const Aabb& a = table_.aabb(p.a);
-    const Aabb& b = table_.aabb(p.b);
-#if defined(__SSE2__) && !defined(CDLAB_USE_FLOAT)
-    // The six comparisons as four two-wide ones, on (x, y) and (y, z) of each bound (y twice):
-    // a.min <= b.max and b.min <= a.max. cmple is false on a NaN, as the scalar <= is.
-    const __m128d lo =
-        _mm_and_pd(_mm_cmple_pd(_mm_loadu_pd(a.min.data()), _mm_loadu_pd(b.max.data())),
-                   _mm_cmple_pd(_mm_loadu_pd(a.min.data() + 1), _mm_loadu_pd(b.max.data() + 1)));
-    const __m128d hi =
-        _mm_and_pd(_mm_cmple_pd(_mm_loadu_pd(b.min.data()), _mm_loadu_pd(a.max.data())),
-                   _mm_cmple_pd(_mm_loadu_pd(b.min.data() + 1), _mm_loadu_pd(a.max.data() + 1)));
-    return int(_mm_movemask_pd(_mm_and_pd(lo, hi)) == 3);
-#else
-    return int(a.min.x() <= b.max.x()) & int(b.min.x() <= a.max.x()) & int(a.min.y() <= b.max.y()) &
-           int(b.min.y() <= a.max.y()) & int(a.min.z() <= b.max.z()) & int(b.min.z() <= a.max.z());
-#endif
-}
-
 void PackedSweepAndPrune::radixSortEntries() {
     // Key bits above, the id below: one LSD radix sort on the 32 key bits (Terdiman, "Radix Sort
     // Revisited", for floats as ordered integers).
@@ -226,6 +207,8 @@ void PackedSweepAndPrune::dealBands() {
     const std::size_t n = entries_.size();
     bands_ = 1;
     big_.clear();
+    big_lanes_.resize(kPad);
+    big_lanes_.pad(0);
     // Band width: a few median y extents (of a sample). Narrower bands give each box fewer x
     // candidates but put it in more bands, and leave shorter sweeps.
     const float span = hi_y_ - lo_y_;
@@ -242,11 +225,7 @@ void PackedSweepAndPrune::dealBands() {
         bands_ = static_cast<int>(std::clamp<float>(std::ceil(span / width), 1, float(most)));
     }
     if (bands_ == 1) {
-        double reach = 0;
-        for (std::size_t i = 0; i < n; ++i) {
-            reach = std::max(reach, double(all_.max_x[i]) - double(all_.min_x[i]));
-        }
-        band_reach_.assign(1, reach);
+        prefixMaxX(all_, 0, n, all_reach_);
         return;
     }
     band_lo_ = lo_y_;
@@ -273,7 +252,6 @@ void PackedSweepAndPrune::dealBands() {
     band_place_.resize(total);
     band_first_.resize(total);
     fill_.assign(band_start_.begin(), band_start_.end() - 1);
-    band_reach_.assign(static_cast<std::size_t>(bands_), 0.0);
     // Dealt in sorted order, so every band is sorted on min x.
     for (std::size_t i = 0; i < n; ++i) {
         if (first_band_[i] < 0) continue;
@@ -282,17 +260,31 @@ void PackedSweepAndPrune::dealBands() {
             band_.copy(k, all_, i);
             band_place_[k] = static_cast<std::uint32_t>(i);
             band_first_[k] = first_band_[i];
-            band_reach_[b] =
-                std::max(band_reach_[b], double(all_.max_x[i]) - double(all_.min_x[i]));
         }
     }
+    big_lanes_.resize(big_.size() + kPad);
+    for (std::size_t g = 0; g < big_.size(); ++g) big_lanes_.copy(g, all_, big_[g]);
+    big_lanes_.pad(big_.size());
+    band_reach_.resize(total);
     for (int b = 0; b < bands_; ++b) {
         const std::uint32_t at = band_start_[b + 1] - kPad;
+        prefixMaxX(band_, band_start_[b], at, band_reach_);
         band_.pad(at);
         for (std::uint32_t k = at; k < at + kPad; ++k) {
             band_place_[k] = 0;
             band_first_[k] = 0;
         }
+    }
+}
+
+void PackedSweepAndPrune::prefixMaxX(const Lanes& lanes, std::size_t begin, std::size_t end,
+                                     std::vector<float>& reach) {
+    // std::max(x, NaN) keeps x: a NaN bound neither raises nor spoils the running maximum.
+    reach.resize(std::max(reach.size(), end));
+    float most = -kInf;
+    for (std::size_t i = begin; i < end; ++i) {
+        most = std::max(most, lanes.max_x[i]);
+        reach[i] = most;
     }
 }
 

@@ -5,6 +5,10 @@
 #include <cstdint>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "broadphase/proxy_table.h"
 #include "collision/broadphase/broad_phase.h"
 
@@ -28,8 +32,9 @@ namespace collision {
 /// Coherence (as Bullet's DBVT and Box2D's tree fatten leaves): the swept boxes are fat, the exact
 /// box grown by a margin and led in the direction it moves (fatten()), and the candidate pairs
 /// (fat boxes overlap) are kept between frames. A frame where few boxes left their fat box
-/// re-fattens only those and looks each up in the last sorted bands (binary search on min x, O(log
-/// n + k) per band), which still hold every box not re-fattened since; the re-fattened
+/// re-fattens only those and looks each up in the last sorted bands (binary search on the running
+/// maximum of max x, O(log n + k) per band), which still hold every box not re-fattened since
+/// (the big boxes in a list of their own, tested four at a time); the re-fattened
 /// ("stale") boxes are looked up in a sorted list of their own. Once many are stale, the bands
 /// are sorted and dealt again (no sweep: the candidates are complete). When many escape in one
 /// frame every fat box is swept again (margins kept); when most do, margins are not paying and
@@ -81,6 +86,12 @@ private:
     void dealBands();
     void sweepBands(BroadPhaseCounters& counters);
     void sweepBig(BroadPhaseCounters& counters);
+    /// reach[i] for i in [begin, end): the largest max x of lanes [begin, i] (see band_reach_).
+    static void prefixMaxX(const Lanes& lanes, std::size_t begin, std::size_t end,
+                           std::vector<float>& reach);
+    /// The first place in [begin, end) whose reach is at least lo_x (end if none).
+    static std::size_t firstReaching(const std::vector<float>& reach, std::size_t begin,
+                                     std::size_t end, float lo_x);
     template <typename Hit>
     static std::int64_t sweepRange(const Lanes& lanes, std::size_t begin, std::size_t end,
                                    Hit&& hit);
@@ -115,7 +126,26 @@ private:
     /// Looks up the escaped boxes, updates candidates_ and writes the exact pairs to `pairs`.
     void queryEscaped(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters);
     /// Whether the candidate's double AABBs overlap, as Aabb::overlaps decides (closed test).
-    int overlapsExactly(const ProxyPair& p) const;
+    /// Inline: it runs once per candidate per frame.
+    int overlapsExactly(const ProxyPair& p) const {
+        const Aabb& a = table_.aabb(p.a);
+        const Aabb& b = table_.aabb(p.b);
+#if defined(__SSE2__) && !defined(CDLAB_USE_FLOAT)
+        // The six comparisons as four two-wide ones, on (x, y) and (y, z) of each bound (y twice):
+        // a.min <= b.max and b.min <= a.max. cmple is false on a NaN, as the scalar <= is.
+        const __m128d lo = _mm_and_pd(
+            _mm_cmple_pd(_mm_loadu_pd(a.min.data()), _mm_loadu_pd(b.max.data())),
+            _mm_cmple_pd(_mm_loadu_pd(a.min.data() + 1), _mm_loadu_pd(b.max.data() + 1)));
+        const __m128d hi = _mm_and_pd(
+            _mm_cmple_pd(_mm_loadu_pd(b.min.data()), _mm_loadu_pd(a.max.data())),
+            _mm_cmple_pd(_mm_loadu_pd(b.min.data() + 1), _mm_loadu_pd(a.max.data() + 1)));
+        return int(_mm_movemask_pd(_mm_and_pd(lo, hi)) == 3);
+#else
+        return int(a.min.x() <= b.max.x()) & int(b.min.x() <= a.max.x()) &
+               int(a.min.y() <= b.max.y()) & int(b.min.y() <= a.max.y()) &
+               int(a.min.z() <= b.max.z()) & int(b.min.z() <= a.max.z());
+#endif
+    }
 
     ProxyTable table_;
     std::vector<Entry> entries_;  ///< present proxies sorted by key (ties: unspecified)
@@ -137,9 +167,12 @@ private:
     std::vector<char> stale_;         ///< by id: re-fattened since the bands were dealt
     std::vector<ProxyId> stale_ids_;  ///< the stale ids, sorted on fat min x
     std::vector<ProxyId> merged_ids_;
-    Lanes stale_lanes_;               ///< their fat boxes in that order, then kPad NaN
-    double stale_reach_ = 0;          ///< the widest stale fat box in x
-    std::vector<double> band_reach_;  ///< per band: its widest box in x
+    Lanes stale_lanes_;  ///< their fat boxes in that order, then kPad NaN
+    // Running maxima of max x along a sorted list: reach[i] = the largest max x of its entries
+    // up to i. Boxes before the first entry reaching a min x all end short of it.
+    std::vector<float> stale_reach_;  ///< along stale_lanes_
+    std::vector<float> band_reach_;   ///< along band_, each band from its start
+    std::vector<float> all_reach_;    ///< along all_ (kept when there is one band)
     std::vector<char> escaped_flag_;
     std::vector<ProxyPair> candidates_;
     std::vector<ProxyPair> fresh_;
@@ -159,6 +192,7 @@ private:
     std::vector<std::uint32_t> band_place_;  ///< the entry's sorted place
     std::vector<int> band_first_;            ///< the entry's box's first band
     std::vector<std::uint32_t> big_;         ///< sorted places of the big boxes, in order
+    Lanes big_lanes_;                        ///< their boxes in that order, then kPad NaN
     std::vector<float> sample_;
     std::vector<std::uint32_t> fill_;
     std::vector<std::uint64_t> keys_;

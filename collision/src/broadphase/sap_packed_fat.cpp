@@ -123,6 +123,15 @@ std::int64_t PackedSweepAndPrune::queryRange(const Lanes& lanes, std::size_t j,
     return tests;
 }
 
+std::size_t PackedSweepAndPrune::firstReaching(const std::vector<float>& reach, std::size_t begin,
+                                               std::size_t end, float lo_x) {
+    const auto first = reach.begin();
+    return static_cast<std::size_t>(std::lower_bound(first + static_cast<std::ptrdiff_t>(begin),
+                                                     first + static_cast<std::ptrdiff_t>(end),
+                                                     lo_x) -
+                                    first);
+}
+
 void PackedSweepAndPrune::restale() {
     // The stale boxes that did not escape this frame keep their fat boxes, hence their order;
     // this frame's escaped boxes, sorted, are merged in (ties by id: deterministic).
@@ -149,21 +158,20 @@ void PackedSweepAndPrune::restale() {
     for (const ProxyId id : escaped_) stale_[id] = 1;
     const std::size_t count = stale_ids_.size();
     stale_lanes_.resize(count + kPad);
-    stale_reach_ = 0;
     for (std::size_t i = 0; i < count; ++i) {
-        const std::size_t k = static_cast<std::size_t>(stale_ids_[i]);
-        stale_lanes_.copy(i, fat_, k);
-        stale_reach_ = std::max(stale_reach_, double(fat_.max_x[k]) - double(fat_.min_x[k]));
+        stale_lanes_.copy(i, fat_, static_cast<std::size_t>(stale_ids_[i]));
     }
+    prefixMaxX(stale_lanes_, 0, count, stale_reach_);
     stale_lanes_.pad(count);
 }
 
 void PackedSweepAndPrune::queryEscaped(std::vector<ProxyPair>& pairs,
                                        BroadPhaseCounters& counters) {
     // The sorted bands, as last dealt, still hold every box that has not been re-fattened
-    // since (not stale): an escaped box is looked up in the bands its y range meets, by binary
-    // search on min x from its min x less the band's widest box; the stale boxes' current fat
-    // boxes are kept apart (stale_lanes_, sorted on min x) and looked up the same way. A
+    // since (not stale): an escaped box is looked up in the bands its y range meets, from the
+    // first box whose running maximum of max x reaches its min x (binary search: every box
+    // before it ends short of it); the stale boxes' current fat boxes are kept apart
+    // (stale_lanes_, sorted on min x) and looked up the same way. A
     // pair of two escaped boxes is taken from the lower id only; a pair met in several bands
     // only in the band of the larger min y (as in the full sweep).
     keys_.clear();
@@ -184,33 +192,19 @@ void PackedSweepAndPrune::queryEscaped(std::vector<ProxyPair>& pairs,
         for (int b = fe; b <= le; ++b) {
             const std::size_t begin = one ? 0 : band_start_[b];
             const std::size_t end = one ? n : band_start_[b + 1] - kPad;
-            const float from = roundDown(double(box[0]) - band_reach_[b]);
-            const auto first = lanes.min_x.begin();
-            const std::size_t j = static_cast<std::size_t>(
-                std::lower_bound(first + static_cast<std::ptrdiff_t>(begin),
-                                 first + static_cast<std::ptrdiff_t>(end), from) -
-                first);
+            const std::vector<float>& reach = one ? all_reach_ : band_reach_;
+            const std::size_t j = firstReaching(reach, begin, end, box[0]);
             tests += queryRange(lanes, j, box, true, [&](std::size_t at) {
                 if (!one && b != std::max(fe, band_first_[at])) return;
                 const ProxyId other = ids_[one ? at : band_place_[at]];
                 if (!stale_[other]) key(other);
             });
         }
-        for (const std::uint32_t g : big_) {
-            ++tests;
-            const ProxyId other = ids_[g];
-            if (stale_[other]) continue;
-            if (all_.min_x[g] <= box[1] && all_.max_x[g] >= box[0] && all_.min_y[g] <= box[3] &&
-                all_.min_z[g] <= box[5] && -all_.neg_max_y[g] >= box[2] &&
-                -all_.neg_max_z[g] >= box[4]) {
-                key(other);
-            }
-        }
-        const auto first = stale_lanes_.min_x.begin();
-        const std::size_t from = static_cast<std::size_t>(
-            std::lower_bound(first, first + static_cast<std::ptrdiff_t>(stale_ids_.size()),
-                             roundDown(double(box[0]) - stale_reach_)) -
-            first);
+        tests += queryRange(big_lanes_, 0, box, false, [&](std::size_t at) {
+            const ProxyId other = ids_[big_[at]];
+            if (!stale_[other]) key(other);
+        });
+        const std::size_t from = firstReaching(stale_reach_, 0, stale_ids_.size(), box[0]);
         tests += queryRange(stale_lanes_, from, box, true, [&](std::size_t at) {
             const ProxyId other = stale_ids_[at];
             if (other == e || (escaped_flag_[other] && other < e)) return;
@@ -251,6 +245,5 @@ void PackedSweepAndPrune::queryEscaped(std::vector<ProxyPair>& pairs,
     pairs.resize(count);
     candidates_.swap(merged_);
 }
-
 
 }  // namespace collision
