@@ -269,6 +269,76 @@ TEST(BroadPhaseDifferential, FixedMembershipThroughJumpsTiesAndFloatTies) {
 // hgrid2 splits the work between two threads only from HierarchicalGrid's 4096 proxies on, so
 // the scenes above (120 and 400 boxes) run it on one. Here it runs both lanes: 5000 boxes,
 // with removals and re-insertions, against brute force on every frame.
+// insertMany is insert() called for each id in turn. One copy of each broad phase takes its
+// boxes one by one, the other in spans: the first half at once into an empty broad phase, a
+// proxy alone, then, after a findPairs (state kept between calls must notice the new set),
+// the rest at once, some of it into ids freed by removals. Both then move the same way; the
+// pairs and the broad phase's own checks must agree on every frame, and equal the reference.
+TEST(BroadPhaseDifferential, InsertManyEqualsInsertingOneByOne) {
+    constexpr int kBoxes = 400;
+    for (const BroadPhaseEntry& entry : testedBroadPhases()) {
+        SCOPED_TRACE(std::string(entry.name));
+        const BroadPhaseEntry* ref_entry = findBroadPhase(entry.reference);
+        ASSERT_NE(ref_entry, nullptr);
+        std::unique_ptr<BroadPhase> single = entry.create();
+        std::unique_ptr<BroadPhase> many = entry.create();
+        std::unique_ptr<BroadPhase> ref = ref_entry->create();
+        Rng rng(7);
+        std::vector<MovingBox> boxes = makeScene(Layout::Uniform, kBoxes, rng);
+        std::vector<ProxyVolumes> volumes;
+        for (const MovingBox& b : boxes) volumes.push_back(b.volumes());
+        const std::span<const ProxyVolumes> all(volumes);
+        std::vector<ProxyPair> single_pairs, many_pairs, ref_pairs;
+        BroadPhaseCounters counters;
+        auto expectSame = [&](const char* when) {
+            single->findPairs(single_pairs, counters);
+            many->findPairs(many_pairs, counters);
+            ref->findPairs(ref_pairs, counters);
+            ASSERT_EQ(many_pairs, single_pairs) << when;
+            ASSERT_EQ(many_pairs, ref_pairs) << when;
+            ASSERT_EQ(many->validate(), "") << when;
+        };
+        // Ids [0, 200) at once, 200 alone; [201, 400) at once after a findPairs.
+        for (int i = 0; i <= kBoxes / 2; ++i) {
+            single->insert(i, volumes[std::size_t(i)]);
+            ref->insert(i, volumes[std::size_t(i)]);
+        }
+        many->insertMany(0, all.first(kBoxes / 2));
+        many->insert(kBoxes / 2, volumes[kBoxes / 2]);
+        expectSame("after the first half");
+        for (int i = kBoxes / 2 + 1; i < kBoxes; ++i) {
+            single->insert(i, volumes[std::size_t(i)]);
+            ref->insert(i, volumes[std::size_t(i)]);
+        }
+        many->insertMany(kBoxes / 2 + 1, all.subspan(kBoxes / 2 + 1));
+        expectSame("after the second half");
+        // Ids [100, 150) removed and given back at once.
+        for (int i = 100; i < 150; ++i) {
+            single->remove(i);
+            many->remove(i);
+            ref->remove(i);
+        }
+        expectSame("after the removals");
+        for (int i = 100; i < 150; ++i) {
+            single->insert(i, volumes[std::size_t(i)]);
+            ref->insert(i, volumes[std::size_t(i)]);
+        }
+        many->insertMany(100, all.subspan(100, 50));
+        expectSame("after the ids were given back");
+        for (int frame = 0; frame < 20; ++frame) {
+            advance(boxes, Layout::Uniform);
+            for (int i = 0; i < kBoxes; ++i) {
+                const ProxyVolumes v = boxes[std::size_t(i)].volumes();
+                single->move(i, v);
+                many->move(i, v);
+                ref->move(i, v);
+            }
+            expectSame("while moving");
+        }
+        EXPECT_FALSE(many_pairs.empty());
+    }
+}
+
 TEST(BroadPhaseDifferential, TwoThreadHgridEqualsItsReferenceAboveItsThreshold) {
     const BroadPhaseEntry* entry = findBroadPhase("hgrid2");
     ASSERT_NE(entry, nullptr);

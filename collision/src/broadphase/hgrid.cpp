@@ -96,6 +96,11 @@ void HierarchicalGrid::insert(ProxyId id, const ProxyVolumes& v) {
     order_stale_ = true;
 }
 
+void HierarchicalGrid::insertMany(ProxyId first, std::span<const ProxyVolumes> v) {
+    RebuildingBroadPhase::insertMany(first, v);
+    order_stale_ = true;
+}
+
 void HierarchicalGrid::remove(ProxyId id) {
     RebuildingBroadPhase::remove(id);
     order_stale_ = true;

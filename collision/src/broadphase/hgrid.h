@@ -66,6 +66,7 @@ public:
     ~HierarchicalGrid() override;
     std::string_view name() const override { return helper_ ? "hgrid2" : "hgrid"; }
     void insert(ProxyId id, const ProxyVolumes& v) override;
+    void insertMany(ProxyId first, std::span<const ProxyVolumes> v) override;
     void remove(ProxyId id) override;
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
     void draw(DebugDraw& draw, const Aabb& bounds) const override;

@@ -4,7 +4,9 @@
 // move, not the 200 of all three volumes), each kind in its own array.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "collision/assert.h"
@@ -30,6 +32,33 @@ public:
         store(id, v);
         present_[id] = 1;
         ++count_;
+    }
+    /// insert() of ids first, first + 1, ... with the storage grown once.
+    void insertMany(ProxyId first, std::span<const ProxyVolumes> v) {
+        CDLAB_ASSERT(first >= 0, "negative proxy id");
+        const std::size_t begin = static_cast<std::size_t>(first);
+        const std::size_t end = begin + v.size();
+        if (end > present_.size()) {
+            present_.resize(end, 0);
+            if (kinds_ & kAabb) aabbs_.resize(end);
+            if (kinds_ & kSphere) spheres_.resize(end);
+            if (kinds_ & kObb) obbs_.resize(end);
+        }
+        for (std::size_t i = begin; i < end; ++i) CDLAB_ASSERT(!present_[i], "proxy inserted twice");
+        // One loop per kind: the caller's volumes are read at their stride, the table written in
+        // sequence.
+        if (kinds_ & kAabb) {
+            for (std::size_t i = 0; i < v.size(); ++i) aabbs_[begin + i] = v[i].aabb;
+        }
+        if (kinds_ & kSphere) {
+            for (std::size_t i = 0; i < v.size(); ++i) spheres_[begin + i] = v[i].sphere;
+        }
+        if (kinds_ & kObb) {
+            for (std::size_t i = 0; i < v.size(); ++i) obbs_[begin + i] = v[i].obb;
+        }
+        std::fill(present_.begin() + std::ptrdiff_t(begin), present_.begin() + std::ptrdiff_t(end),
+                  char(1));
+        count_ += static_cast<int>(v.size());
     }
     void remove(ProxyId id) {
         CDLAB_ASSERT(contains(id), "removing an absent proxy");
@@ -72,6 +101,9 @@ public:
     explicit RebuildingBroadPhase(std::uint8_t kinds = ProxyTable::kAabb) : table_(kinds) {}
 
     void insert(ProxyId id, const ProxyVolumes& v) override { table_.insert(id, v); }
+    void insertMany(ProxyId first, std::span<const ProxyVolumes> v) override {
+        table_.insertMany(first, v);
+    }
     void remove(ProxyId id) override { table_.remove(id); }
     void move(ProxyId id, const ProxyVolumes& v) override {
         table_.move(id, v);

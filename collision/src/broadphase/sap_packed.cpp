@@ -36,6 +36,11 @@ void PackedSweepAndPrune::insert(ProxyId id, const ProxyVolumes& v) {
     dirty_ = true;
 }
 
+void PackedSweepAndPrune::insertMany(ProxyId first, std::span<const ProxyVolumes> v) {
+    table_.insertMany(first, v);
+    dirty_ = true;
+}
+
 void PackedSweepAndPrune::remove(ProxyId id) {
     table_.remove(id);
     dirty_ = true;

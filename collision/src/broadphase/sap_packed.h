@@ -44,6 +44,7 @@ class PackedSweepAndPrune : public BroadPhase {
 public:
     std::string_view name() const override { return "sap-packed"; }
     void insert(ProxyId id, const ProxyVolumes& v) override;
+    void insertMany(ProxyId first, std::span<const ProxyVolumes> v) override;
     void remove(ProxyId id) override;
     void move(ProxyId id, const ProxyVolumes& v) override;
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;

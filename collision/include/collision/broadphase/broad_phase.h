@@ -50,6 +50,14 @@ public:
     virtual std::string_view name() const = 0;
     /// Adds a proxy. `id` must not be present; ids need not be dense but should be small.
     virtual void insert(ProxyId id, const ProxyVolumes& volumes) = 0;
+    /// Adds proxies first, first + 1, ..., one per entry of `volumes`, as insert() called for
+    /// each in that order would; none of those ids may be present. Default: that loop. Broad
+    /// phases that can take the boxes at once (growing their storage once) override it.
+    virtual void insertMany(ProxyId first, std::span<const ProxyVolumes> volumes) {
+        for (std::size_t i = 0; i < volumes.size(); ++i) {
+            insert(first + static_cast<ProxyId>(i), volumes[i]);
+        }
+    }
     /// Removes a present proxy.
     virtual void remove(ProxyId id) = 0;
     /// Replaces a present proxy's volumes.
