@@ -46,6 +46,11 @@ struct Builder {
     // by bottomUpSplits; null for top-down.
     const std::unordered_map<std::int64_t, std::int32_t>* splits = nullptr;
     std::vector<Vec3> scratch;  // reused: no allocation per node
+    struct KeyedId {
+        Real key;
+        std::int32_t id;
+    };
+    std::vector<KeyedId> keyed;  // partition's median selection, reused
     int depth = 0;              // longest root-to-leaf path so far (a lone leaf: 1)
 
     using Carry = typename BuildCarry<BV>::type;
@@ -196,11 +201,19 @@ struct Builder {
             const auto left = static_cast<std::int32_t>(it - begin);
             if (left > 0 && left < count) return first + left;
         }
-        // Median; ties broken by triangle index so the build is deterministic.
+        // Median; ties broken by triangle index so the build is deterministic. The selection
+        // runs on (key, id) copies, read once, instead of looking the centroid up at every
+        // comparison: the comparisons answer the same, so the ids end in the same order.
         const std::int32_t mid = count / 2;
-        std::nth_element(begin, begin + mid, end, [&](std::int32_t i, std::int32_t j) {
-            return key(i) < key(j) || (key(i) == key(j) && i < j);
-        });
+        keyed.clear();
+        for (auto it = begin; it != end; ++it) keyed.push_back({key(*it), *it});
+        std::nth_element(keyed.begin(), keyed.begin() + mid, keyed.end(),
+                         [](const KeyedId& i, const KeyedId& j) {
+                             return i.key < j.key || (i.key == j.key && i.id < j.id);
+                         });
+        for (std::int32_t k = 0; k < count; ++k) {
+            begin[k] = keyed[static_cast<std::size_t>(k)].id;
+        }
         return first + mid;
     }
 };
@@ -354,8 +367,10 @@ Bvh<BV>::Bvh(const TriangleMesh& mesh, const BvhBuildOptions& options) {
                         ids_,
                         moments,
                         opts.build == BvhBuild::BottomUp ? &splits : nullptr,
+                        {},
                         {}};
     builder.scratch.reserve(3 * n);  // the root's corners: no regrowth during the build
+    builder.keyed.reserve(n);
     typename Builder<BV>::Carry root_carry;
     builder.build(0, static_cast<std::int32_t>(n), 1, root_carry);
     // Corners into leaf order, so a leaf's triangles are contiguous in memory.
