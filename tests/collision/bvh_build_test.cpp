@@ -402,4 +402,46 @@ TYPED_TEST(BvhBuildSameAsReference, BottomUpNodesBitForBit) {
     }
 }
 
+// A refit fits every node to its range's corners in leaf order (the moved mesh's); box-like
+// volumes merge their children's bounds instead.
+TYPED_TEST(BvhBuildSameAsReference, RefitNodesBitForBit) {
+    if constexpr (collision::MergeableFit<TypeParam>) {
+        for (const auto& [mesh_name, mesh] : meshes()) {
+            for (const auto& [option_name, options] : topDownOptions()) {
+                TriangleMesh moved = mesh;
+                for (Vec3& v : moved.vertices) {
+                    v = Vec3(v.x() + Real(0.3) * std::sin(Real(3) * v.y()), -v.z() * Real(1.5),
+                             v.y() + Real(0.25) * v.x());
+                }
+                Bvh<TypeParam> refitted(mesh, options);
+                refitted.refit(moved);
+                RefTree<TypeParam> ref;
+                ref.depth = refitted.depth();
+                const auto& nodes = refitted.nodes();
+                std::vector<std::int32_t> first(nodes.size());
+                std::vector<std::int32_t> last(nodes.size());
+                for (std::size_t k = nodes.size(); k-- > 0;) {
+                    first[k] = nodes[k].isLeaf() ? nodes[k].first : first[k + 1];
+                    last[k] = nodes[k].isLeaf() ? nodes[k].first + nodes[k].count
+                                                : last[std::size_t(nodes[k].right)];
+                }
+                for (std::int32_t i = 0; i < refitted.triangleCount(); ++i) {
+                    ref.ids.push_back(refitted.leafTriangleId(i));
+                }
+                for (std::size_t k = 0; k < nodes.size(); ++k) {
+                    std::vector<Vec3> pts;
+                    for (std::int32_t i = first[k]; i < last[k]; ++i) {
+                        for (const Vec3& p : refitted.leafTriangle(i)) pts.push_back(p);
+                    }
+                    auto node = nodes[k];
+                    node.volume = refFit(pts, static_cast<TypeParam*>(nullptr));
+                    node.cost = BvTraits<TypeParam>::cost(node.volume);
+                    ref.nodes.push_back(node);
+                }
+                expectSameTree(refitted, ref, moved, mesh_name + " " + option_name + " refit");
+            }
+        }
+    }
+}
+
 }  // namespace

@@ -400,8 +400,29 @@ std::int32_t Bvh<BV>::refit(const TriangleMesh& mesh) {
         }
     }
     scale_ = (hi - lo).maxCoeff() + std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff());
-    // Ranges bottom-up: children come after their parent in depth-first order, so a reverse
-    // sweep sees both children of a node before the node.
+    // Children come after their parent in depth-first order, so a reverse sweep sees both
+    // children of a node before the node: mergeable volumes merge their children's bounds (the
+    // bounds of all the node's corners, as a fit over them gives), the others are fitted to
+    // their range's corners.
+    if constexpr (MergeableFit<BV>) {
+        std::vector<typename BvTraits<BV>::Bounds> bounds(nodes_.size());
+        for (std::size_t k = nodes_.size(); k-- > 0;) {
+            Node& node = nodes_[k];
+            if (node.isLeaf()) {
+                bounds[k] = BvTraits<BV>::bounds(corners_[std::size_t(node.first)].data(), 3);
+                for (std::int32_t i = node.first + 1; i < node.first + node.count; ++i) {
+                    bounds[k] = BvTraits<BV>::merge(
+                        bounds[k], BvTraits<BV>::bounds(corners_[std::size_t(i)].data(), 3));
+                }
+            } else {
+                bounds[k] =
+                    BvTraits<BV>::merge(bounds[k + 1], bounds[static_cast<std::size_t>(node.right)]);
+            }
+            node.volume = BvTraits<BV>::finish(bounds[k]);
+            node.cost = BvTraits<BV>::cost(node.volume);
+        }
+        return static_cast<std::int32_t>(nodes_.size());
+    }
     std::vector<std::int32_t> first(nodes_.size());
     std::vector<std::int32_t> last(nodes_.size());
     std::vector<Vec3> scratch;
