@@ -247,8 +247,8 @@ RefTree<BV> refitOverRanges(const Bvh<BV>& built, const TriangleMesh& mesh) {
     std::vector<std::int32_t> last(nodes.size());
     for (std::size_t k = nodes.size(); k-- > 0;) {
         first[k] = nodes[k].isLeaf() ? nodes[k].first : first[k + 1];
-        last[k] = nodes[k].isLeaf() ? nodes[k].first + nodes[k].count
-                                    : last[std::size_t(nodes[k].right)];
+        last[k] =
+            nodes[k].isLeaf() ? nodes[k].first + nodes[k].count : last[std::size_t(nodes[k].right)];
     }
     for (std::size_t k = 0; k < nodes.size(); ++k) {
         std::vector<Vec3> pts;
@@ -326,11 +326,11 @@ TriangleMesh degenerate() {
     };
     for (int i = 0; i < 6; ++i) {
         const Real x = Real(i);
-        add(Vec3(x, 0, 0), Vec3(x, 0, 0), Vec3(x, 0, 0));                  // a point
-        add(Vec3(x, 1, 0), Vec3(x + 1, 1, 0), Vec3(x + 2, 1, 0));          // a segment
-        add(Vec3(x, 2, 0), Vec3(x + 1, 2, 0), Vec3(x, 3, 0));              // twice the same
+        add(Vec3(x, 0, 0), Vec3(x, 0, 0), Vec3(x, 0, 0));          // a point
+        add(Vec3(x, 1, 0), Vec3(x + 1, 1, 0), Vec3(x + 2, 1, 0));  // a segment
+        add(Vec3(x, 2, 0), Vec3(x + 1, 2, 0), Vec3(x, 3, 0));      // twice the same
         add(Vec3(x, 2, 0), Vec3(x + 1, 2, 0), Vec3(x, 3, 0));
-        add(Vec3(x, 4, 0), Vec3(x + 1, 4, 1e-17), Vec3(x + 2, 4, 0));      // a sliver
+        add(Vec3(x, 4, 0), Vec3(x + 1, 4, 1e-17), Vec3(x + 2, 4, 0));       // a sliver
         add(Vec3(-0.0, x, -0.0), Vec3(0.0, x + 1, 0.0), Vec3(-0.0, x, 1));  // x = +-0
     }
     return m;
@@ -379,8 +379,8 @@ std::vector<std::pair<std::string, BvhBuildOptions>> topDownOptions() {
 template <class BV>
 class BvhBuildSameAsReference : public ::testing::Test {};
 
-using BuildVolumes = ::testing::Types<Aabb, Kdop<6>, Kdop<14>, Kdop<18>, Kdop<26>, Obb, Rss, Lss,
-                                      BoundingSphere>;
+using BuildVolumes =
+    ::testing::Types<Aabb, Kdop<6>, Kdop<14>, Kdop<18>, Kdop<26>, Obb, Rss, Lss, BoundingSphere>;
 TYPED_TEST_SUITE(BvhBuildSameAsReference, BuildVolumes);
 
 TYPED_TEST(BvhBuildSameAsReference, TopDownNodesBitForBit) {

@@ -51,7 +51,7 @@ struct Builder {
         std::int32_t id;
     };
     std::vector<KeyedId> keyed;  // partition's median selection, reused
-    int depth = 0;              // longest root-to-leaf path so far (a lone leaf: 1)
+    int depth = 0;               // longest root-to-leaf path so far (a lone leaf: 1)
 
     using Carry = typename BuildCarry<BV>::type;
 
@@ -369,7 +369,9 @@ Bvh<BV>::Bvh(const TriangleMesh& mesh, const BvhBuildOptions& options) {
                         opts.build == BvhBuild::BottomUp ? &splits : nullptr,
                         {},
                         {}};
-    builder.scratch.reserve(3 * n);  // the root's corners: no regrowth during the build
+    if constexpr (!MergeableFit<BV> && !std::is_same_v<BV, Obb>) {
+        builder.scratch.reserve(3 * n);  // the root's corners: no regrowth during the build
+    }
     builder.keyed.reserve(n);
     typename Builder<BV>::Carry root_carry;
     builder.build(0, static_cast<std::int32_t>(n), 1, root_carry);
@@ -415,8 +417,8 @@ std::int32_t Bvh<BV>::refit(const TriangleMesh& mesh) {
                         bounds[k], BvTraits<BV>::bounds(corners_[std::size_t(i)].data(), 3));
                 }
             } else {
-                bounds[k] =
-                    BvTraits<BV>::merge(bounds[k + 1], bounds[static_cast<std::size_t>(node.right)]);
+                bounds[k] = BvTraits<BV>::merge(bounds[k + 1],
+                                                bounds[static_cast<std::size_t>(node.right)]);
             }
             node.volume = BvTraits<BV>::finish(bounds[k]);
             node.cost = BvTraits<BV>::cost(node.volume);

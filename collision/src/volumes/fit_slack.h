@@ -33,6 +33,4 @@ void projectionRange(const Mat3& axes, const Points& points, const Vec3& origin,
     for (const Vec3& p : points) extendProjectionRange(axes, p, origin, lo, hi);
 }
 
-
-
 }  // namespace collision
