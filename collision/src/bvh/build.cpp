@@ -14,6 +14,7 @@
 #include "collision/assert.h"
 #include "collision/bvh/bvh.h"
 #include "volumes/bvh_volumes.h"
+#include "volumes/fit_slack.h"
 
 namespace collision {
 
@@ -21,6 +22,17 @@ namespace {
 
 // Relative tolerance of validate()'s containment check (the fits add 16-48 ulps).
 constexpr Real kValidateSlack = Real(1024) * kEpsilon;
+
+// What a subtree's build hands its parent: the bounds its volume is finished from (mergeable
+// fits), else the box of its corners (the magnitude of an OBB's slack).
+template <class BV>
+struct BuildCarry {
+    using type = Aabb;
+};
+template <MergeableFit BV>
+struct BuildCarry<BV> {
+    using type = typename BvTraits<BV>::Bounds;
+};
 
 template <class BV>
 struct Builder {
@@ -34,20 +46,32 @@ struct Builder {
     // by bottomUpSplits; null for top-down.
     const std::unordered_map<std::int64_t, std::int32_t>* splits = nullptr;
     std::vector<Vec3> scratch;  // reused: no allocation per node
-    int depth = 0;              // longest root-to-leaf path so far (a lone leaf: 1)
+    struct KeyedId {
+        Real key;
+        std::int32_t id;
+    };
+    std::vector<KeyedId> keyed;  // partition's median selection, reused
+    int depth = 0;               // longest root-to-leaf path so far (a lone leaf: 1)
+
+    using Carry = typename BuildCarry<BV>::type;
+
+    const std::array<Vec3, 3>& triangle(std::int32_t i) const {
+        return corners[static_cast<std::size_t>(ids[static_cast<std::size_t>(i)])];
+    }
 
     // Builds the subtree over leaf-order range [first, first + count) whose root is at `level`
-    // (the root: 1); returns its node index.
-    std::int32_t build(std::int32_t first, std::int32_t count, int level) {
+    // (the root: 1); returns its node index and sets `carry` for the parent. Mergeable volumes
+    // are fitted bottom-up: a leaf from its corners, any other node from its children's bounds,
+    // so each corner is visited once. Other volumes are fitted to the range before it is
+    // partitioned (an OBB's axes, origin and projections depend on that order).
+    std::int32_t build(std::int32_t first, std::int32_t count, int level, Carry& carry) {
         depth = std::max(depth, level);
         const auto index = static_cast<std::int32_t>(nodes.size());
         nodes.emplace_back();
-        scratch.clear();
-        for (std::int32_t i = first; i < first + count; ++i) {
-            const auto id = static_cast<std::size_t>(ids[static_cast<std::size_t>(i)]);
-            for (const Vec3& p : corners[id]) scratch.push_back(p);
-        }
-        {
+        if constexpr (std::is_same_v<BV, Obb>) {
+            nodes[static_cast<std::size_t>(index)].volume = obbBeforeSlack(first, count);
+        } else if constexpr (!MergeableFit<BV>) {
+            fillScratch(first, count);
             auto& node = nodes[static_cast<std::size_t>(index)];
             node.volume = fitNode(first, count);
             node.cost = BvTraits<BV>::cost(node.volume);
@@ -56,6 +80,14 @@ struct Builder {
             auto& node = nodes[static_cast<std::size_t>(index)];
             node.first = first;
             node.count = count;
+            if constexpr (MergeableFit<BV> || std::is_same_v<BV, Obb>) {
+                using Traits = std::conditional_t<MergeableFit<BV>, BvTraits<BV>, BvTraits<Aabb>>;
+                carry = Traits::bounds(triangle(first).data(), 3);
+                for (std::int32_t i = first + 1; i < first + count; ++i) {
+                    carry = Traits::merge(carry, Traits::bounds(triangle(i).data(), 3));
+                }
+                finishNode(node, carry);
+            }
             return index;
         }
         const std::int32_t split = splits
@@ -63,10 +95,60 @@ struct Builder {
                                                         static_cast<std::int64_t>(ids.size() + 1) +
                                                     count)
                                        : partition(first, count);
-        build(first, split - first, level + 1);
-        const std::int32_t right = build(split, first + count - split, level + 1);
-        nodes[static_cast<std::size_t>(index)].right = right;
+        Carry left;
+        Carry right;
+        build(first, split - first, level + 1, left);
+        const std::int32_t right_index = build(split, first + count - split, level + 1, right);
+        auto& node = nodes[static_cast<std::size_t>(index)];
+        node.right = right_index;
+        if constexpr (MergeableFit<BV>) {
+            carry = BvTraits<BV>::merge(left, right);
+            finishNode(node, carry);
+        } else if constexpr (std::is_same_v<BV, Obb>) {
+            carry = BvTraits<Aabb>::merge(left, right);
+            finishNode(node, carry);
+        }
         return index;
+    }
+
+    void finishNode(typename Bvh<BV>::Node& node, const Carry& carry) {
+        if constexpr (MergeableFit<BV>) {
+            node.volume = BvTraits<BV>::finish(carry);
+        } else if constexpr (std::is_same_v<BV, Obb>) {
+            BvTraits<Obb>::widen(node.volume, carry);
+        }
+        node.cost = BvTraits<BV>::cost(node.volume);
+    }
+
+    // The corners of leaf-order range [first, first + count), in order, into `scratch`.
+    void fillScratch(std::int32_t first, std::int32_t count) {
+        scratch.clear();
+        for (std::int32_t i = first; i < first + count; ++i) {
+            for (const Vec3& p : triangle(i)) scratch.push_back(p);
+        }
+    }
+
+    // fitNode for an OBB, read from the corners in place, without the slack (it needs the box
+    // of the corners, which the children hand up): the same axes, origin and projections.
+    Obb obbBeforeSlack(std::int32_t first, std::int32_t count) {
+        const std::array<Vec3, 3>& t0 = triangle(first);
+        Mat3 axes;
+        if (count != 1 || !triangleAxes(t0[0], t0[1], t0[2], &axes)) {
+            TriangleMoments sum;
+            for (std::int32_t i = first; i < first + count; ++i) {
+                sum.add(moments[static_cast<std::size_t>(ids[static_cast<std::size_t>(i)])]);
+            }
+            if (!momentAxes(sum, &axes)) {
+                fillScratch(first, count);
+                axes = principalAxes(scratch);
+            }
+        }
+        Vec3 lo = Vec3::Constant(std::numeric_limits<Real>::max());
+        Vec3 hi = Vec3::Constant(std::numeric_limits<Real>::lowest());
+        for (std::int32_t i = first; i < first + count; ++i) {
+            for (const Vec3& p : triangle(i)) extendProjectionRange(axes, p, t0[0], lo, hi);
+        }
+        return BvTraits<Obb>::boxOfRange(axes, t0[0], lo, hi);
     }
 
     // The node volume over `scratch` (the corners of leaf-order range [first, first + count)).
@@ -119,11 +201,19 @@ struct Builder {
             const auto left = static_cast<std::int32_t>(it - begin);
             if (left > 0 && left < count) return first + left;
         }
-        // Median; ties broken by triangle index so the build is deterministic.
+        // Median; ties broken by triangle index so the build is deterministic. The selection
+        // runs on (key, id) copies, read once, instead of looking the centroid up at every
+        // comparison: the comparisons answer the same, so the ids end in the same order.
         const std::int32_t mid = count / 2;
-        std::nth_element(begin, begin + mid, end, [&](std::int32_t i, std::int32_t j) {
-            return key(i) < key(j) || (key(i) == key(j) && i < j);
-        });
+        keyed.clear();
+        for (auto it = begin; it != end; ++it) keyed.push_back({key(*it), *it});
+        std::nth_element(keyed.begin(), keyed.begin() + mid, keyed.end(),
+                         [](const KeyedId& i, const KeyedId& j) {
+                             return i.key < j.key || (i.key == j.key && i.id < j.id);
+                         });
+        for (std::int32_t k = 0; k < count; ++k) {
+            begin[k] = keyed[static_cast<std::size_t>(k)].id;
+        }
         return first + mid;
     }
 };
@@ -277,9 +367,14 @@ Bvh<BV>::Bvh(const TriangleMesh& mesh, const BvhBuildOptions& options) {
                         ids_,
                         moments,
                         opts.build == BvhBuild::BottomUp ? &splits : nullptr,
+                        {},
                         {}};
-    builder.scratch.reserve(3 * n);  // the root's corners: no regrowth during the build
-    builder.build(0, static_cast<std::int32_t>(n), 1);
+    if constexpr (!MergeableFit<BV> && !std::is_same_v<BV, Obb>) {
+        builder.scratch.reserve(3 * n);  // the root's corners: no regrowth during the build
+    }
+    builder.keyed.reserve(n);
+    typename Builder<BV>::Carry root_carry;
+    builder.build(0, static_cast<std::int32_t>(n), 1, root_carry);
     // Corners into leaf order, so a leaf's triangles are contiguous in memory.
     std::vector<std::array<Vec3, 3>> by_mesh = std::move(corners_);
     corners_.resize(n);
@@ -307,8 +402,29 @@ std::int32_t Bvh<BV>::refit(const TriangleMesh& mesh) {
         }
     }
     scale_ = (hi - lo).maxCoeff() + std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff());
-    // Ranges bottom-up: children come after their parent in depth-first order, so a reverse
-    // sweep sees both children of a node before the node.
+    // Children come after their parent in depth-first order, so a reverse sweep sees both
+    // children of a node before the node: mergeable volumes merge their children's bounds (the
+    // bounds of all the node's corners, as a fit over them gives), the others are fitted to
+    // their range's corners.
+    if constexpr (MergeableFit<BV>) {
+        std::vector<typename BvTraits<BV>::Bounds> bounds(nodes_.size());
+        for (std::size_t k = nodes_.size(); k-- > 0;) {
+            Node& node = nodes_[k];
+            if (node.isLeaf()) {
+                bounds[k] = BvTraits<BV>::bounds(corners_[std::size_t(node.first)].data(), 3);
+                for (std::int32_t i = node.first + 1; i < node.first + node.count; ++i) {
+                    bounds[k] = BvTraits<BV>::merge(
+                        bounds[k], BvTraits<BV>::bounds(corners_[std::size_t(i)].data(), 3));
+                }
+            } else {
+                bounds[k] = BvTraits<BV>::merge(bounds[k + 1],
+                                                bounds[static_cast<std::size_t>(node.right)]);
+            }
+            node.volume = BvTraits<BV>::finish(bounds[k]);
+            node.cost = BvTraits<BV>::cost(node.volume);
+        }
+        return static_cast<std::int32_t>(nodes_.size());
+    }
     std::vector<std::int32_t> first(nodes_.size());
     std::vector<std::int32_t> last(nodes_.size());
     std::vector<Vec3> scratch;

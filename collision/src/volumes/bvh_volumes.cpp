@@ -20,6 +20,10 @@ namespace {
 
 // Largest |coordinate| plus the largest extent of the set: the magnitude the rounding of any
 // projection of these points is relative to.
+Real magnitude(const Vec3& lo, const Vec3& hi) {
+    return (hi - lo).maxCoeff() + std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff());
+}
+
 Real magnitude(const std::vector<Vec3>& pts) {
     Vec3 lo = pts[0];
     Vec3 hi = pts[0];
@@ -27,7 +31,7 @@ Real magnitude(const std::vector<Vec3>& pts) {
         lo = lo.cwiseMin(p);
         hi = hi.cwiseMax(p);
     }
-    return (hi - lo).maxCoeff() + std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff());
+    return magnitude(lo, hi);
 }
 
 }  // namespace
@@ -145,10 +149,14 @@ BoundingSphere BvTraits<BoundingSphere>::fit(const std::vector<Vec3>& corners) {
 
 Aabb BvTraits<Aabb>::fit(const std::vector<Vec3>& corners) {
     CDLAB_ASSERT(!corners.empty(), "fitting a volume to no points");
-    Aabb box{corners[0], corners[0]};
-    for (const Vec3& p : corners) {  // min/max are exact: no slack needed
-        box.min = box.min.cwiseMin(p);
-        box.max = box.max.cwiseMax(p);
+    return finish(bounds(corners.data(), corners.size()));
+}
+
+Aabb BvTraits<Aabb>::bounds(const Vec3* points, std::size_t count) {
+    Aabb box{points[0], points[0]};
+    for (std::size_t k = 0; k < count; ++k) {  // min/max are exact: no slack needed
+        box.min = box.min.cwiseMin(points[k]);
+        box.max = box.max.cwiseMax(points[k]);
     }
     return box;
 }
@@ -163,32 +171,55 @@ Obb BvTraits<Obb>::fitWithAxes(const std::vector<Vec3>& corners, const Mat3& axe
     const Vec3 origin = corners[0];
     Vec3 lo, hi;
     projectionRange(axes, corners, origin, lo, hi);  // corners[0] projects to exactly 0
-    Obb box;
-    box.axes = axes;
-    box.center = origin + axes * ((lo + hi) * Real(0.5));
-    box.half_extents = (hi - lo) * Real(0.5) + Vec3::Constant(kFitSlack * magnitude(corners));
+    Obb box = boxOfRange(axes, origin, lo, hi);
+    box.half_extents += Vec3::Constant(kFitSlack * magnitude(corners));
     return box;
+}
+
+void BvTraits<Obb>::widen(Obb& box, const Aabb& points_box) {
+    box.half_extents += Vec3::Constant(kFitSlack * magnitude(points_box.min, points_box.max));
 }
 
 template <int K>
 Kdop<K> BvTraits<Kdop<K>>::fit(const std::vector<Vec3>& corners) {
     CDLAB_ASSERT(!corners.empty(), "fitting a volume to no points");
-    Kdop<K> d;
-    d.min.fill(std::numeric_limits<Real>::infinity());
-    d.max.fill(-std::numeric_limits<Real>::infinity());
-    for (const Vec3& p : corners) {
+    return finish(bounds(corners.data(), corners.size()));
+}
+
+template <int K>
+typename BvTraits<Kdop<K>>::Bounds BvTraits<Kdop<K>>::bounds(const Vec3* points,
+                                                             std::size_t count) {
+    Bounds b;
+    b.slabs.min.fill(std::numeric_limits<Real>::infinity());
+    b.slabs.max.fill(-std::numeric_limits<Real>::infinity());
+    b.lo = points[0];
+    b.hi = points[0];
+    for (std::size_t k = 0; k < count; ++k) {
+        const Vec3& p = points[k];
         for (int i = 0; i < Kdop<K>::kSlabs; ++i) {
             const Real s = kdopDirection(kdopDirectionIndex<K>(i)).dot(p);
-            d.min[i] = std::min(d.min[i], s);
-            d.max[i] = std::max(d.max[i], s);
+            b.slabs.min[i] = std::min(b.slabs.min[i], s);
+            b.slabs.max[i] = std::max(b.slabs.max[i], s);
+        }
+        if constexpr (kNeedsBox) {
+            b.lo = b.lo.cwiseMin(p);
+            b.hi = b.hi.cwiseMax(p);
         }
     }
-    // The axis slabs are exact coordinates; the diagonal ones are rounded sums of up to three
-    // coordinates: widen every slab by a few ulps of 3 x the magnitude.
-    const Real slack = Real(3) * kFitSlack * magnitude(corners);
-    for (int i = 3; i < Kdop<K>::kSlabs; ++i) {
-        d.min[i] -= slack;
-        d.max[i] += slack;
+    return b;
+}
+
+template <int K>
+Kdop<K> BvTraits<Kdop<K>>::finish(const Bounds& b) {
+    Kdop<K> d = b.slabs;
+    if constexpr (Kdop<K>::kSlabs > 3) {
+        // The axis slabs are exact coordinates; the diagonal ones are rounded sums of up to three
+        // coordinates: widen every slab by a few ulps of 3 x the magnitude.
+        const Real slack = Real(3) * kFitSlack * magnitude(b.lo, b.hi);
+        for (int i = 3; i < Kdop<K>::kSlabs; ++i) {
+            d.min[i] -= slack;
+            d.max[i] += slack;
+        }
     }
     return d;
 }

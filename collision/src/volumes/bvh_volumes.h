@@ -135,6 +135,13 @@ struct BvTraits<BoundingSphere> {
 template <>
 struct BvTraits<Aabb> {
     static Aabb fit(const std::vector<Vec3>& corners);
+    /// The fit in mergeable parts (see MergeableFit): the box of the points is its own bounds.
+    using Bounds = Aabb;
+    static Bounds bounds(const Vec3* points, std::size_t count);
+    static Bounds merge(const Bounds& a, const Bounds& b) {
+        return Aabb{a.min.cwiseMin(b.min), a.max.cwiseMax(b.max)};
+    }
+    static Aabb finish(const Bounds& b) { return b; }
     static bool overlaps(const Aabb& a, const Aabb& b, const BvhTransform& x) {
         if (x.identity) {
             const Vec3 lo = b.min + x.t;
@@ -160,6 +167,18 @@ struct BvTraits<Obb> {
     static Obb fit(const std::vector<Vec3>& corners);
     /// The box along given orthonormal axes: exact projections plus slack.
     static Obb fitWithAxes(const std::vector<Vec3>& corners, const Mat3& axes);
+    /// fitWithAxes in parts, for a build that measures the points' box separately: the box of
+    /// the projection range [lo, hi] of the points about `origin` on `axes` (projectionRange),
+    /// then widen() by the slack relative to the points' coordinate box. The same operations, so
+    /// the same box.
+    static Obb boxOfRange(const Mat3& axes, const Vec3& origin, const Vec3& lo, const Vec3& hi) {
+        Obb box;
+        box.axes = axes;
+        box.center = origin + axes * ((lo + hi) * Real(0.5));
+        box.half_extents = (hi - lo) * Real(0.5);
+        return box;
+    }
+    static void widen(Obb& box, const Aabb& points_box);
     static bool overlaps(const Obb& a, const Obb& b, const BvhTransform& x) {
         return overlapsMoved(a, move(b, x), x);
     }
@@ -188,6 +207,32 @@ struct BvTraits<Obb> {
 template <int K>
 struct BvTraits<Kdop<K>> {
     static Kdop<K> fit(const std::vector<Vec3>& corners);
+    /// The fit in mergeable parts (see MergeableFit): the exact slab ranges before the slack,
+    /// and the points' coordinate box (the magnitude the slack is relative to; unused, and left
+    /// at the first point, for K = 6, which has no slack).
+    static constexpr bool kNeedsBox = Kdop<K>::kSlabs > 3;
+    struct Bounds {
+        Kdop<K> slabs;
+        Vec3 lo;
+        Vec3 hi;
+    };
+    static Bounds bounds(const Vec3* points, std::size_t count);
+    static Bounds merge(const Bounds& a, const Bounds& b) {
+        Bounds out;
+        for (int i = 0; i < Kdop<K>::kSlabs; ++i) {
+            out.slabs.min[i] = std::min(a.slabs.min[i], b.slabs.min[i]);
+            out.slabs.max[i] = std::max(a.slabs.max[i], b.slabs.max[i]);
+        }
+        if constexpr (kNeedsBox) {
+            out.lo = a.lo.cwiseMin(b.lo);
+            out.hi = a.hi.cwiseMax(b.hi);
+        } else {
+            out.lo = a.lo;
+            out.hi = a.hi;
+        }
+        return out;
+    }
+    static Kdop<K> finish(const Bounds& b);
     static bool overlaps(const Kdop<K>& a, const Kdop<K>& b, const BvhTransform& x) {
         constexpr int n = Kdop<K>::kSlabs;
         if (x.identity) {
@@ -360,6 +405,18 @@ struct BvTraits<Lss> {
         const Real r = s.radius;
         return pi * r * r * (2 * s.half_length) + Real(4) / Real(3) * pi * r * r * r;
     }
+};
+
+/// Volume types whose fit of a point set is finish(bounds(points)), where bounds are per-direction
+/// minima and maxima: the bounds of a union are merge() of the parts' bounds, equal to the bounds
+/// of the whole whatever the split (min and max are exact; on a tie the left operand is kept, as
+/// a scan keeps the earlier point, so only the sign of a zero bound can depend on the order). The
+/// build fits leaves from their corners and every other node from its children's bounds.
+template <class BV>
+concept MergeableFit = requires(const typename BvTraits<BV>::Bounds& b, const Vec3* p) {
+    { BvTraits<BV>::bounds(p, std::size_t{1}) } -> std::same_as<typename BvTraits<BV>::Bounds>;
+    { BvTraits<BV>::merge(b, b) } -> std::same_as<typename BvTraits<BV>::Bounds>;
+    { BvTraits<BV>::finish(b) } -> std::same_as<BV>;
 };
 
 /// Volume types fitted along given axes (fitWithAxes): the build takes their axes from summed

@@ -158,8 +158,9 @@ public:
     /// Refit for a deforming mesh: takes the vertex positions of `mesh` (the triangles the tree
     /// was built from, same order; asserted, and nothing done when the count differs), moves
     /// every triangle and refits every node volume to its triangles, keeping the tree's
-    /// structure. O(n log n); queries then answer for the deformed mesh (exact triangle tests;
-    /// the volumes may be looser than a rebuild's). Returns the nodes updated (Nu).
+    /// structure. O(n log n) (AABB and k-DOP: O(n), each node merging its children's bounds);
+    /// queries then answer for the deformed mesh (exact triangle tests; the volumes may be
+    /// looser than a rebuild's). Returns the nodes updated (Nu).
     std::int32_t refit(const TriangleMesh& mesh);
 
 private:
