@@ -18,7 +18,7 @@
 #include <cstddef>
 #include <limits>
 
-#if defined(__SSE2__)
+#if defined(__SSE2__) && !defined(CDLAB_USE_FLOAT)
 #include <emmintrin.h>
 #endif
 
@@ -89,7 +89,7 @@ void settleSignedDistance(const CollideOutput& decided, Real tolerance, Local& l
 // quaternion transform: uv = 2 (q.vec x v), v + w uv + q.vec x uv, then + position), the two
 // points in the two lanes of SSE2 doubles: the same bits as applying the pose to each.
 void applyPair(const Pose& pose, const Vec3& p, const Vec3& q, Vec3& world_p, Vec3& world_q) {
-#if defined(__SSE2__)
+#if defined(__SSE2__) && !defined(CDLAB_USE_FLOAT)
     const Quat& o = pose.orientation;
     const __m128d qx = _mm_set1_pd(o.x());
     const __m128d qy = _mm_set1_pd(o.y());
