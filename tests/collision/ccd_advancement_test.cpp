@@ -310,8 +310,8 @@ TEST(ConservativeAdvancement, DeformSpeedBoundsTheMovingSurface) {
         (on_a ? d.deform_speed_a : d.deform_speed_b) = 0.15;
         EXPECT_EQ(timeOfImpact(d).state, CcdState::Separated) << on_a;
     }
-    for (const Real bad :
-         {-0.1, std::numeric_limits<Real>::quiet_NaN(), std::numeric_limits<Real>::infinity()}) {
+    using Limits = std::numeric_limits<Real>;
+    for (const Real bad : {Real(-0.1), Limits::quiet_NaN(), Limits::infinity()}) {
         ToiInput d = in;
         d.deform_speed_b = bad;
         EXPECT_EQ(timeOfImpact(d).state, CcdState::Failed) << bad;
