@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 
@@ -38,9 +39,31 @@ using Ctx = PairContext;
 // The contact in A's frame (canonical order); world transform and mirroring happen once.
 using Local = ContactOutput;
 
-// ---- Witness features (numbering in contact.h; contact_features.cpp). ----
+// ---- Witness features (numbering in contact.h; boxFeature here, the rest in
+// contact_features.cpp). ----
 
-Feature boxFeature(const Vec3& half, const Vec3& p, Real tol);
+// Counted and chosen by selects, not branches: which of the three slabs a witness point lies on
+// is data that the branch predictor cannot learn. The same answer as testing the axes in turn:
+// the vertex, the edge along the one free axis, the face of the one axis on its plane. Inline,
+// since box-box contact() calls it twice per query.
+inline Feature boxFeature(const Vec3& half, const Vec3& p, Real tol) {
+    const int on0 = static_cast<int>(std::abs(p.x()) >= half.x() - tol);
+    const int on1 = static_cast<int>(std::abs(p.y()) >= half.y() - tol);
+    const int on2 = static_cast<int>(std::abs(p.z()) >= half.z() - tol);
+    const int b0 = static_cast<int>(p.x() > 0);
+    const int b1 = static_cast<int>(p.y() > 0);
+    const int b2 = static_cast<int>(p.z() > 0);
+    const int count = on0 + on1 + on2;
+    const int vertex = b0 + 2 * b1 + 4 * b2;
+    // The edge along the free axis k: 4k + the sign bits of the other two axes in order.
+    const int edge = on2 == 0 ? 8 + b0 + 2 * b1 : on1 == 0 ? 4 + b0 + 2 * b2 : b1 + 2 * b2;
+    const int face = on2 != 0 ? 4 + b2 : on1 != 0 ? 2 + b1 : b0;
+    constexpr std::array<FeatureType, 4> kTypes{FeatureType::Unknown, FeatureType::Face,
+                                                FeatureType::Edge, FeatureType::Vertex};
+    const std::array<std::int32_t, 4> indices{-1, face, edge, vertex};
+    return {kTypes[static_cast<std::size_t>(count)], indices[static_cast<std::size_t>(count)]};
+}
+
 Feature capsuleFeature(Real half_height, const Vec3& core_point, Real tol);
 Feature hullFeature(const ConvexPolytope& hull, const Vec3& p, Real tol);
 /// The feature of a convex core (ConvexCore of the shape) that holds `core_point`.

@@ -232,6 +232,9 @@ inline BoxSatMeasure measureBoxSatBest(
     m.per_axis = false;
     // The best face axis by selects, not branches (which axis wins is data, not a pattern the
     // branch predictor can learn); the first of equal separations wins, as in measureBoxSat.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC unroll 6
+#endif
     for (int id = 0; id < 6; ++id) {
         const BoxSatAxis a = id < 3 ? boxSatFaceAxisA(ea, rot, t, eb, id)
                                     : boxSatFaceAxisB(ea, rot, t, eb, id - 3);
@@ -277,7 +280,9 @@ inline BoxSatMeasure measureBoxSatBest(
         const Real rb = eb[j1] * std::abs(rot(i, j2)) + eb[j2] * std::abs(rot(i, j1));
         unnormalised[k] = dist - ra - rb;
         measurable[k] = len2 >= kNearParallel2;  // also false for NaN
-        len2f[k] = measurable[k] ? static_cast<float>(len2) : 1.0f;
+        // Not selected: an edge that is not measurable gets hi = +inf and no part in cut below,
+        // so its estimate (from rsqrt of a tiny, zero or NaN len2) is never used.
+        len2f[k] = static_cast<float>(len2);
     }
     len2f[9] = len2f[10] = len2f[11] = 1.0f;
     alignas(16) std::array<float, 12> inv_len{};
@@ -304,6 +309,9 @@ inline BoxSatMeasure measureBoxSatBest(
         return m;
     }
     cut -= Real(2) * m.err_bound;
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC unroll 9
+#endif
     for (int k = 0; k < 9; ++k) {
         // NaN estimates (non-finite input) are measured too.
         if (hi[static_cast<std::size_t>(k)] < cut) continue;
