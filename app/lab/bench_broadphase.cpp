@@ -153,7 +153,8 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
     out << "Two rules: median_ms times the pairs as each method holds them (a peer's loose "
            "pair cache unfiltered); exact_ms adds delivering the exact pairs (the peer filters "
            "its cache with the exact boxes, timed; cdlab's methods already deliver exact, "
-           "sorted pairs). vs_peer and vs_peer_ex are against the best peer by each.\n";
+           "sorted pairs; sap-packed-loose holds its loose candidates, as the peers' caches). "
+           "vs_peer and vs_peer_ex are against the best peer by each.\n";
     if (tune) {
         out << "Peers tuned: every configuration of each peer's grid runs all frames (stopped "
                "after "

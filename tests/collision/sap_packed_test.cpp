@@ -1,16 +1,21 @@
 // sap-packed's coherent path beside brute force: the pairs of overlapping fat boxes kept between
 // frames, fat boxes led by the motion, and the look-ups of the boxes that left theirs, on
-// jittering, steadily moving and mixed-size scenes. (The registry's differential tests in
+// jittering, steadily moving and mixed-size scenes; and its loose output (the candidates
+// themselves) beside the exact one. (The registry's differential tests in
 // broad_phase_test.cpp run it on random and adversarial scenes like every other broad phase.)
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "broadphase/sap_packed.h"
 #include "collision/broadphase/broad_phase.h"
+#include "collision/broadphase/loose_broad_phase.h"
 #include "test_random.h"
 
 namespace collision {
@@ -232,5 +237,248 @@ TEST(PackedSweepAndPrune, SteadilyMovingBoxLeavesItsLeadingFatBoxRarely) {
     EXPECT_LE(querying_frames, (kFrames - 10) / 24);
     EXPECT_GT(querying_frames, 0);
 }
+
+// A moving scene for the loose output: boxes by centre and half extents, and how a frame moves
+// them (steady velocities reflected at the walls of [lo, hi]^3, or an integer jitter).
+struct MovingScene {
+    std::vector<Vec3> centre, half, velocity;
+    Real lo = 0, hi = 1;
+    bool jitter = false;
+    Real jitter_step = 1;  ///< a jittering box moves by -1, 0 or +1 of these per axis
+
+    int size() const { return static_cast<int>(centre.size()); }
+    ProxyVolumes volumes(int i) const {
+        const Vec3& c = centre[static_cast<std::size_t>(i)];
+        const Vec3& h = half[static_cast<std::size_t>(i)];
+        return ProxyVolumes{Aabb{c - h, c + h}, BoundingSphere{c, h.norm()},
+                            Obb{c, Mat3::Identity(), h}};
+    }
+    void step(Rng& rng) {
+        for (std::size_t i = 0; i < centre.size(); ++i) {
+            for (int k = 0; k < 3; ++k) {
+                if (jitter) {
+                    centre[i][k] += jitter_step * rng.integer(-1, 1);
+                    continue;
+                }
+                centre[i][k] += velocity[i][k];
+                if (centre[i][k] < lo || centre[i][k] > hi) velocity[i][k] = -velocity[i][k];
+            }
+        }
+    }
+    /// Every coordinate and motion scaled by `s` and then moved by `shift` on every axis.
+    MovingScene transformed(Real s, Real shift) const {
+        MovingScene out = *this;
+        for (std::size_t i = 0; i < centre.size(); ++i) {
+            out.centre[i] = centre[i] * s + Vec3::Constant(shift);
+            out.half[i] = half[i] * s;
+            out.velocity[i] = velocity[i] * s;
+        }
+        out.jitter_step = jitter_step * s;
+        out.lo = lo * s + shift;
+        out.hi = hi * s + shift;
+        return out;
+    }
+};
+
+// Boxes of one size class (mixed: sizes 1:100, log-uniform, and a few huge ones spanning many
+// bands) moving 1-2 % of their size per frame, about 3 overlaps per box.
+MovingScene steadyScene(int n, bool mixed, std::uint64_t seed) {
+    Rng rng(seed);
+    MovingScene scene;
+    const Real side = mixed ? 45 : 14;
+    scene.hi = side;
+    for (int i = 0; i < n; ++i) {
+        const Real scale = !mixed ? Real(0.5)
+                           : i < 4 ? Real(12)
+                                   : Real(0.05) * std::pow(Real(100), rng.uniform(0, 1));
+        scene.half.push_back(scale * rng.vec(Real(0.8), Real(1.2)));
+        scene.centre.push_back(rng.vec(0, side));
+        scene.velocity.push_back(rng.vec(-1, 1).normalized() *
+                                 (2 * scale * rng.uniform(0.01, 0.02)));
+    }
+    return scene;
+}
+
+// Terdiman's BoxPruning motion, scaled down: integer centres and half sizes moving by -1, 0 or
+// +1 per axis per frame, so many boxes touch exactly (closed test: they overlap).
+MovingScene touchingScene(int n, std::uint64_t seed) {
+    Rng rng(seed);
+    MovingScene scene;
+    scene.jitter = true;
+    for (int i = 0; i < n; ++i) {
+        scene.centre.push_back(
+            Vec3(rng.integer(-170, 170), rng.integer(-170, 170), rng.integer(-170, 170)));
+        scene.half.push_back(Vec3(rng.integer(0, 20), rng.integer(0, 20), rng.integer(0, 20)));
+        scene.velocity.push_back(Vec3::Zero());
+    }
+    return scene;
+}
+
+// One scene through sap-packed twice, exact and loose output, and brute force; every frame:
+// (a) the loose pairs contain every exact pair (brute force), (b) each loose pair's fat boxes
+// overlap, (c) the loose pairs filtered by the exact test are the exact output, (d) the loose
+// pairs are sorted and unique. Returns what went wrong first (empty: nothing) and counts the
+// frames and the loose pairs beyond the exact ones.
+struct LooseRun {
+    std::string failure;
+    std::int64_t extra = 0;    ///< loose pairs whose AABBs do not overlap, over all frames
+    std::int64_t exact = 0;    ///< exact pairs over all frames
+    int coherent_frames = 0;   ///< frames with fewer volume tests than a quarter of the first's
+};
+
+LooseRun runLooseBesideExact(MovingScene scene, int frames, std::uint64_t seed) {
+    Rng rng(seed);
+    PackedSweepAndPrune exact;
+    PackedSweepAndPrune loose(PackedSweepAndPrune::Output::Loose);
+    std::unique_ptr<BroadPhase> brute = findBroadPhase("brute")->create();
+    const int n = scene.size();
+    for (int i = 0; i < n; ++i) {
+        exact.insert(i, scene.volumes(i));
+        loose.insert(i, scene.volumes(i));
+        brute->insert(i, scene.volumes(i));
+    }
+    LooseRun run;
+    std::vector<ProxyPair> exact_pairs, loose_pairs, brute_pairs, sorted, filtered;
+    std::int64_t first_tests = 0;
+    for (int frame = 0; frame <= frames && run.failure.empty(); ++frame) {
+        if (frame > 0) {
+            scene.step(rng);
+            for (int i = 0; i < n; ++i) {
+                exact.move(i, scene.volumes(i));
+                loose.move(i, scene.volumes(i));
+                brute->move(i, scene.volumes(i));
+            }
+        }
+        BroadPhaseCounters ec, lc, bc;
+        exact.findPairs(exact_pairs, ec);
+        loose.findPairs(loose_pairs, lc);
+        brute->findPairs(brute_pairs, bc);
+        if (frame == 0) first_tests = lc.volume_tests;
+        run.coherent_frames += frame > 0 && lc.volume_tests < first_tests / 4;
+        // Every check runs on a failing frame, so a failure names each that failed.
+        const auto fail = [&](const std::string& what) {
+            run.failure += (run.failure.empty() ? "frame " + std::to_string(frame) + ": " : "; ") +
+                           what;
+        };
+        if (exact_pairs != brute_pairs) fail("the exact output differs from brute force");
+        if (const std::string v = loose.validate(); !v.empty()) fail("loose: " + v);
+        // (a), on a sorted copy so that it does not lean on (d).
+        sorted = loose_pairs;
+        std::sort(sorted.begin(), sorted.end());
+        if (!std::includes(sorted.begin(), sorted.end(), brute_pairs.begin(), brute_pairs.end())) {
+            fail("(a) the loose pairs miss an exact pair");
+        }
+        // (b) and (c).
+        filtered.clear();
+        std::string not_fat;
+        for (const ProxyPair& p : loose_pairs) {
+            if (scene.volumes(p.a).aabb.overlaps(scene.volumes(p.b).aabb)) {
+                filtered.push_back(p);
+            } else {
+                ++run.extra;
+            }
+            if (not_fat.empty() && !loose.fatBoxesOverlap(p.a, p.b)) {
+                not_fat = "(b) a loose pair (" + std::to_string(p.a) + ", " +
+                          std::to_string(p.b) + ") whose fat boxes do not overlap";
+            }
+        }
+        if (!not_fat.empty()) fail(not_fat);
+        if (filtered != exact_pairs) {
+            fail("(c) the loose pairs filtered (" + std::to_string(filtered.size()) +
+                 ") are not the exact output (" + std::to_string(exact_pairs.size()) + ")");
+        }
+        // (d)
+        for (std::size_t k = 0; k < loose_pairs.size(); ++k) {
+            const ProxyPair& p = loose_pairs[k];
+            if (!(p.a < p.b) || (k > 0 && !(loose_pairs[k - 1] < p))) {
+                fail("(d) the loose pairs are not sorted and unique at " + std::to_string(k));
+                break;
+            }
+        }
+        if (!run.failure.empty()) break;
+        run.exact += static_cast<std::int64_t>(exact_pairs.size());
+    }
+    return run;
+}
+
+// The loose output on random and adversarial moving scenes. Each must exercise both outcomes
+// of the exact test (pairs that overlap and loose pairs that do not) and the coherent path.
+TEST(PackedSweepAndPrune, LooseOutputHoldsEveryExactPairAndOnlyFatOverlaps) {
+    constexpr int kFrames = 120;
+    const MovingScene uniform = steadyScene(900, false, 51);
+    const MovingScene mixed = steadyScene(900, true, 52);
+    struct Case {
+        const char* name;
+        MovingScene scene;
+    };
+    const Case cases[] = {
+        {"uniform", uniform},
+        {"mixed 1:100", mixed},
+        {"touching (integer jitter)", touchingScene(900, 53)},
+        // At 1e6 a float step is 1/16: the float bounds round far outward of these unit boxes.
+        {"uniform far from origin", uniform.transformed(1, 1e6)},
+        {"mixed far from origin", mixed.transformed(1, -3e6)},
+        {"mixed huge (x 1e4)", mixed.transformed(1e4, 0)},
+        {"mixed tiny (x 1e-4)", mixed.transformed(1e-4, 0)},
+        {"touching tiny and far (x 1e-3, + 50)", touchingScene(900, 54).transformed(1e-3, 50)},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.name);
+        const LooseRun run = runLooseBesideExact(c.scene, kFrames, 61);
+        ASSERT_EQ(run.failure, "");
+        EXPECT_GT(run.exact, kFrames * 300);  // both outcomes of the exact test...
+        EXPECT_GT(run.extra, 0);              // ...among the loose pairs
+        EXPECT_GT(run.coherent_frames, kFrames / 4);
+    }
+}
+
+// Inserting and removing proxies between frames rebuilds the candidates from exact boxes (no
+// margins): the loose output must stay a sorted superset and filter to the exact output.
+TEST(PackedSweepAndPrune, LooseOutputFollowsInsertsAndRemoves) {
+    MovingScene scene = steadyScene(600, true, 71);
+    Rng rng(72);
+    PackedSweepAndPrune exact;
+    PackedSweepAndPrune loose(PackedSweepAndPrune::Output::Loose);
+    std::vector<char> present(scene.centre.size(), 0);
+    std::vector<ProxyPair> exact_pairs, loose_pairs, filtered;
+    BroadPhaseCounters counters;
+    for (int frame = 0; frame < 60; ++frame) {
+        scene.step(rng);
+        for (int i = 0; i < scene.size(); ++i) {
+            const bool want = (i + frame / 10) % 3 != 0;
+            if (want && !present[i]) {
+                exact.insert(i, scene.volumes(i));
+                loose.insert(i, scene.volumes(i));
+            } else if (!want && present[i]) {
+                exact.remove(i);
+                loose.remove(i);
+            } else if (want) {
+                exact.move(i, scene.volumes(i));
+                loose.move(i, scene.volumes(i));
+            }
+            present[i] = want;
+        }
+        exact.findPairs(exact_pairs, counters);
+        loose.findPairs(loose_pairs, counters);
+        ASSERT_EQ(loose.validate(), "") << "frame " << frame;
+        ASSERT_TRUE(std::is_sorted(loose_pairs.begin(), loose_pairs.end()));
+        ASSERT_EQ(std::adjacent_find(loose_pairs.begin(), loose_pairs.end()), loose_pairs.end());
+        filtered.clear();
+        for (const ProxyPair& p : loose_pairs) {
+            ASSERT_TRUE(present[p.a] && present[p.b]) << "frame " << frame;
+            if (scene.volumes(p.a).aabb.overlaps(scene.volumes(p.b).aabb)) filtered.push_back(p);
+        }
+        ASSERT_EQ(filtered, exact_pairs) << "frame " << frame;
+        ASSERT_GT(exact_pairs.size(), 100u);
+    }
+}
+
+// The bench's and a user's way in: the factory gives the loose mode, under its own name.
+TEST(PackedSweepAndPrune, LooseFactoryNamesItsOutput) {
+    const std::unique_ptr<BroadPhase> loose = createLoosePackedSweepAndPrune();
+    EXPECT_EQ(loose->name(), "sap-packed-loose");
+    EXPECT_EQ(findBroadPhase("sap-packed-loose"), nullptr);  // never in the registry
+}
+
 }  // namespace
 }  // namespace collision

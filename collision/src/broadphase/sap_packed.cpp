@@ -24,6 +24,7 @@
 #include "broadphase/float_bounds.h"
 #include "broadphase/interval_diagram.h"
 #include "broadphase/radix_sort.h"
+#include "collision/broadphase/loose_broad_phase.h"
 #include "collision/debug_draw.h"
 
 namespace collision {
@@ -438,7 +439,10 @@ void PackedSweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCou
     for (const ProxyId e : escaped_) escaped_flag_[e] = 0;
     escaped_.clear();
 
-    if (!exact_done) {
+    if (output_ == Output::Loose) {
+        // The candidates themselves, sorted and unique: a superset of the exact pairs.
+        pairs.assign(candidates_.begin(), candidates_.end());
+    } else if (!exact_done) {
         // The exact answer: every candidate (fat boxes overlap) tested on the double AABBs.
         // Candidates are sorted, so the pairs are. Branch-free: every candidate is written, and
         // the count advances only for an overlap (about half the candidates do, so a branch
@@ -480,6 +484,15 @@ void PackedSweepAndPrune::draw(DebugDraw& draw, const Aabb& bounds) const {
     draw.legend("interval of a proxy in an overlapping pair", marked);
 }
 
+bool PackedSweepAndPrune::fatBoxesOverlap(ProxyId a, ProxyId b) const {
+    const std::size_t i = static_cast<std::size_t>(a);
+    const std::size_t j = static_cast<std::size_t>(b);
+    if (dirty_ || !table_.contains(a) || !table_.contains(b)) return false;
+    return fat_.min_x[i] <= fat_.max_x[j] && fat_.min_x[j] <= fat_.max_x[i] &&
+           fat_.min_y[i] <= -fat_.neg_max_y[j] && fat_.min_y[j] <= -fat_.neg_max_y[i] &&
+           fat_.min_z[i] <= -fat_.neg_max_z[j] && fat_.min_z[j] <= -fat_.neg_max_z[i];
+}
+
 std::string PackedSweepAndPrune::validate() const {
     if (dirty_) return {};
     if (entries_.size() != static_cast<std::size_t>(table_.count())) return "entry count mismatch";
@@ -488,8 +501,19 @@ std::string PackedSweepAndPrune::validate() const {
     }
     for (const Entry& e : entries_) {
         if (!table_.contains(e.id)) return "entry for an absent proxy";
+        if (!escaped_flag_[e.id] && !insideFat(e.id)) return "a box outside its fat box";
+    }
+    for (std::size_t k = 0; k < candidates_.size(); ++k) {
+        const ProxyPair& p = candidates_[k];
+        if (!(p.a < p.b)) return "a candidate (a, b) with a >= b";
+        if (k > 0 && !(candidates_[k - 1] < p)) return "candidates unsorted or repeated";
+        if (!fatBoxesOverlap(p.a, p.b)) return "a candidate whose fat boxes do not overlap";
     }
     return {};
+}
+
+std::unique_ptr<BroadPhase> createLoosePackedSweepAndPrune() {
+    return std::make_unique<PackedSweepAndPrune>(PackedSweepAndPrune::Output::Loose);
 }
 
 }  // namespace collision

@@ -42,14 +42,32 @@ namespace collision {
 /// (insert, remove) is swept with exact boxes: the one-shot path.
 class PackedSweepAndPrune : public BroadPhase {
 public:
-    std::string_view name() const override { return "sap-packed"; }
+    /// What findPairs writes.
+    enum class Output {
+        Exact,  ///< the overlapping pairs, as every registry broad phase (the default)
+        /// the candidate pairs: every pair whose fat boxes overlap, sorted by (a, b), unique,
+        /// with no exact confirm. A superset of the overlapping pairs, as Bullet's pair cache
+        /// is, for a caller that tests the exact boxes itself. Never in the registry (whose
+        /// entries equal brute force); reached through createLoosePackedSweepAndPrune().
+        Loose,
+    };
+    explicit PackedSweepAndPrune(Output output = Output::Exact) : output_(output) {}
+    std::string_view name() const override {
+        return output_ == Output::Loose ? "sap-packed-loose" : "sap-packed";
+    }
     void insert(ProxyId id, const ProxyVolumes& v) override;
     void insertMany(ProxyId first, std::span<const ProxyVolumes> v) override;
     void remove(ProxyId id) override;
     void move(ProxyId id, const ProxyVolumes& v) override;
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
     void draw(DebugDraw& draw, const Aabb& bounds) const override;
+    /// Checks the entries' order, and the invariant at the top of sap_packed.cpp: candidates
+    /// sorted, unique, each a pair of overlapping fat boxes, and every present box inside its fat
+    /// box unless move() flagged it as escaped. O(n + candidates).
     std::string validate() const override;
+    /// Whether the fat boxes of present proxies a and b overlap (closed test on the floats), as
+    /// of the last findPairs: the test a loose output's pairs pass. For tests and checks.
+    bool fatBoxesOverlap(ProxyId a, ProxyId b) const;
 
 private:
     static constexpr std::size_t kSample = 255;     ///< boxes sampled for the band width
@@ -124,7 +142,8 @@ private:
     void resnapshot(BroadPhaseCounters& counters);
     void fullSweep(BroadPhaseCounters& counters);
     void restale();
-    /// Looks up the escaped boxes, updates candidates_ and writes the exact pairs to `pairs`.
+    /// Looks up the escaped boxes and updates candidates_; with Output::Exact also writes the
+    /// exact pairs to `pairs` (in the same walk over the candidates).
     void queryEscaped(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters);
     /// Whether the candidate's double AABBs overlap, as Aabb::overlaps decides (closed test).
     /// Inline: it runs once per candidate per frame.
@@ -148,6 +167,7 @@ private:
 #endif
     }
 
+    Output output_;
     ProxyTable table_;
     std::vector<Entry> entries_;  ///< present proxies sorted by key (ties: unspecified)
     Lanes all_;                   ///< every box in sorted order, then kPad sentinels

@@ -213,6 +213,27 @@ void PackedSweepAndPrune::queryEscaped(std::vector<ProxyPair>& pairs,
     }
     counters.volume_tests += tests;
     radix::keysToSortedPairs(keys_, scratch_, shift_, fresh_, /*order_ids=*/true);
+    const char* flag = escaped_flag_.data();
+    if (output_ == Output::Loose) {
+        // The kept candidates (no escaped member) and the fresh ones, both sorted, merged; no
+        // exact test (the caller makes it).
+        merged_.resize(candidates_.size() + fresh_.size());
+        ProxyPair* merged = merged_.data();
+        std::size_t kept = 0;
+        std::size_t f = 0;
+        for (const ProxyPair& p : candidates_) {
+            const int keep = int(flag[p.a] == 0) & int(flag[p.b] == 0);
+            if (keep != 0) {
+                while (f < fresh_.size() && fresh_[f] < p) merged[kept++] = fresh_[f++];
+            }
+            merged[kept] = p;
+            kept += static_cast<std::size_t>(keep);
+        }
+        while (f < fresh_.size()) merged[kept++] = fresh_[f++];
+        merged_.resize(kept);
+        candidates_.swap(merged_);
+        return;
+    }
     // The kept candidates (no escaped member) and the fresh ones, both sorted, merged.
     // The same pass writes the exact pairs (see exactPairs): one walk over the candidates, not
     // two. Branch-free: every candidate is written to both lists, the merged count advances for
@@ -224,7 +245,6 @@ void PackedSweepAndPrune::queryEscaped(std::vector<ProxyPair>& pairs,
     std::size_t kept = 0;
     std::size_t count = 0;
     std::size_t f = 0;
-    const char* flag = escaped_flag_.data();
     const auto take = [&](const ProxyPair& p) {
         merged[kept++] = p;
         exact[count] = p;
