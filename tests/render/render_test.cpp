@@ -195,9 +195,9 @@ TEST(Renderer, CullingAndBatchingChangeNoPixel) {
                         world.addBody(sphereBody(name, 0.9, p));
                         break;
                     case 1:
-                        world.addBody(
-                            makeShapeBody(name, collision::Shape::box(Vec3(0.9, 0.4, 0.6)), p,
-                                          Quat(Eigen::AngleAxisd(0.1 * n, Vec3::UnitZ()))));
+                        world.addBody(makeShapeBody(
+                            name, collision::Shape::box(Vec3(0.9, 0.4, 0.6)), p,
+                            Quat(Eigen::AngleAxis<Real>(Real(0.1 * n), Vec3::UnitZ()))));
                         break;
                     default:
                         world.addBody(makeShapeBody(name, collision::Shape::capsule(0.4, 0.5), p));
