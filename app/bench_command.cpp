@@ -29,9 +29,10 @@ Command addBenchBroadphaseCommand(CLI::App& bench) {
         ->capture_default_str();
     cmd->add_option("--frames", o.frames, "measured frames per method")->capture_default_str();
     cmd->add_option("--methods", o.methods,
-                    "comma-separated (default: every AABB broad phase, sap-packed-loose -- sap-packed's "
-                    "candidates unfiltered, a loose pair cache like Bullet's -- and the default "
-                    "peers)")
+                    "comma-separated (default: every AABB broad phase, sap-packed-loose -- "
+                    "sap-packed's candidates unfiltered, a loose pair cache like Bullet's -- and "
+                    "the default peers); hgrid:found, hgrid2:found: pairs in the order found, not "
+                    "sorted")
         ->delimiter(',');
     cmd->add_option("--workload", o.workload,
                     "uniform, mixed (sizes 1:100), both (those two), wide (sizes 1:10^4) or "

@@ -12,6 +12,27 @@
 
 namespace app {
 
+namespace {
+
+// --pair-order's help: the orders, and the broad phases that have one of their own.
+std::string pairOrderHelp() {
+    std::string own;
+    for (const collision::BroadPhaseEntry& e : collision::broadPhaseRegistry()) {
+        if (!e.found_order) continue;
+        if (!own.empty()) own += ", ";
+        own += e.name;
+    }
+    return "order of the flagged and confirmed pairs (overrides the scene's pair_order): sorted "
+           "(by body ids, the default) or found (the broad phase's own order, without a final "
+           "sort: " +
+           own +
+           "; every other broad phase's own order is sorted, so found changes nothing there). "
+           "The same pairs and the same motion either way; --trace and pause dumps list pairs "
+           "sorted";
+}
+
+}  // namespace
+
 Command addRunCommand(CLI::App& cli) {
     // The flags' storage lives as long as the returned command (shared with its run function).
     struct Flags {
@@ -20,6 +41,7 @@ Command addRunCommand(CLI::App& cli) {
         std::string video;
         int frames = 0;
         std::string broad_phase;
+        std::string pair_order;
         bool no_timing = false;
         std::string stats;
         bool quiet = false;
@@ -37,6 +59,7 @@ Command addRunCommand(CLI::App& cli) {
     cmd->add_flag("--no-frames", f->run.no_frames, "do not write per-frame PNGs");
     cmd->add_option("--broadphase", f->broad_phase,
                     "broad phase (overrides the scene): " + collision::broadPhaseNames());
+    cmd->add_option("--pair-order", f->pair_order, pairOrderHelp());
     cmd->add_option("--pause-at", f->run.pause_at,
                     "pause at FRAME: write pause_FRAME.png (every bounding volume, each "
                     "coloured by its own overlap test) and pause_FRAME.json (repeatable); the "
@@ -77,7 +100,7 @@ Command addRunCommand(CLI::App& cli) {
                 RunOptions& run = f->run;
                 // A flag given with an empty value ("--broadphase ''") is an error, not "unset".
                 for (const char* name :
-                     {"--out", "--video", "--broadphase", "--stats", "--trace"}) {
+                     {"--out", "--video", "--broadphase", "--pair-order", "--stats", "--trace"}) {
                     if (cmd->count(name) > 0 && cmd->get_option(name)->as<std::string>().empty()) {
                         std::cerr << name << ": must not be empty\n";
                         return kExitBadInput;
@@ -87,6 +110,7 @@ Command addRunCommand(CLI::App& cli) {
                 if (!f->video.empty()) run.video = f->video;
                 if (cmd->count("--frames") > 0) run.frames = f->frames;
                 if (!f->broad_phase.empty()) run.broad_phase = f->broad_phase;
+                if (!f->pair_order.empty()) run.pair_order = f->pair_order;
                 if (!f->stats.empty()) run.stats_csv = f->stats;
                 for (const std::string& kv : f->set) {
                     const std::size_t eq = kv.find('=');

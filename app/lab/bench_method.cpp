@@ -15,7 +15,10 @@ namespace {
 /// reused vector.
 class CdlabMethod : public BenchMethod {
 public:
-    explicit CdlabMethod(const collision::BroadPhaseEntry& entry) : broad_phase_(entry.create()) {}
+    CdlabMethod(const collision::BroadPhaseEntry& entry, collision::PairOrder order)
+        : broad_phase_(entry.create()) {
+        broad_phase_->setPairOrder(order);
+    }
 
     void insertAll(const MovingBoxes& /*boxes*/,
                    std::span<const collision::ProxyVolumes> volumes) override {
@@ -107,9 +110,19 @@ std::vector<BenchMethodEntry> makeMethods() {
         m.foreign_threads = entry.needs_render_context;
         const collision::BroadPhaseEntry* e = &entry;
         m.create = [e]() -> std::unique_ptr<BenchMethod> {
-            return std::make_unique<CdlabMethod>(*e);
+            return std::make_unique<CdlabMethod>(*e, collision::PairOrder::Sorted);
         };
-        methods.push_back(std::move(m));
+        methods.push_back(m);
+        // Its pairs in its own order (no final sort), run only when named: `hgrid:found`.
+        if (entry.found_order) {
+            m.name += ":found";
+            m.description += "; pairs in the order found, not sorted";
+            m.default_set = false;
+            m.create = [e]() -> std::unique_ptr<BenchMethod> {
+                return std::make_unique<CdlabMethod>(*e, collision::PairOrder::Found);
+            };
+            methods.push_back(std::move(m));
+        }
     }
     // A cdlab method with a loose output, outside the registry (whose entries equal brute
     // force): its median_ms compares like for like with the peers' pair caches, its exact_ms

@@ -12,11 +12,16 @@ std::string describePairMismatch(std::string_view name, std::string_view referen
                                  std::span<const collision::ProxyPair> expected,
                                  std::span<const engine::Body> bodies) {
     if (std::equal(got.begin(), got.end(), expected.begin(), expected.end())) return {};
+    // `got` may come in the broad phase's own order (PairOrder::Found): compared as sets, on a
+    // sorted copy (the reference's pairs are sorted).
+    std::vector<collision::ProxyPair> sorted(got.begin(), got.end());
+    std::sort(sorted.begin(), sorted.end());
+    if (std::equal(sorted.begin(), sorted.end(), expected.begin(), expected.end())) return {};
     std::vector<collision::ProxyPair> missing;
     std::vector<collision::ProxyPair> extra;
-    std::set_difference(expected.begin(), expected.end(), got.begin(), got.end(),
+    std::set_difference(expected.begin(), expected.end(), sorted.begin(), sorted.end(),
                         std::back_inserter(missing));
-    std::set_difference(got.begin(), got.end(), expected.begin(), expected.end(),
+    std::set_difference(sorted.begin(), sorted.end(), expected.begin(), expected.end(),
                         std::back_inserter(extra));
     std::ostringstream out;
     auto label = [&](collision::ProxyId id) {

@@ -12,8 +12,9 @@
 
 namespace app {
 
-/// Empty when `got` equals `expected`; else a report naming the missed and extra pairs (at most
-/// 20 of each) with the bodies' ids and names.
+/// `expected` sorted, `got` sorted or in its broad phase's own order (PairOrder::Found). Empty
+/// when `got` holds exactly the pairs of `expected`; else a report naming the missed and extra
+/// pairs (at most 20 of each) with the bodies' ids and names.
 std::string describePairMismatch(std::string_view name, std::string_view reference_name,
                                  std::span<const collision::ProxyPair> got,
                                  std::span<const collision::ProxyPair> expected,

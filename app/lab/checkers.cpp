@@ -51,9 +51,14 @@ std::string colorName(engine::BodyState s) {
     return "?";
 }
 
-bool hasPair(std::span<const collision::ProxyPair> pairs, engine::BodyId a, engine::BodyId b) {
+// `pairs` in the world's pair order: a binary search when that is sorted, else a scan.
+bool hasPair(std::span<const collision::ProxyPair> pairs, collision::PairOrder order,
+             engine::BodyId a, engine::BodyId b) {
     const collision::ProxyPair key{std::min(a, b), std::max(a, b)};
-    return std::binary_search(pairs.begin(), pairs.end(), key);
+    if (order == collision::PairOrder::Sorted) {
+        return std::binary_search(pairs.begin(), pairs.end(), key);
+    }
+    return std::find(pairs.begin(), pairs.end(), key) != pairs.end();
 }
 
 // Pixels of each state colour in an image, indexed by BodyState.
@@ -323,8 +328,9 @@ public:
         for (std::size_t k = 0; k < expect_.size(); ++k) {
             const engine::PairExpectation& p = expect_[k];
             if (frame < p.frames.first || frame > p.frames.last) continue;
-            const bool flagged = hasPair(run.world.flaggedPairs(), p.a, p.b);
-            const bool colliding = hasPair(run.world.collidingPairs(), p.a, p.b);
+            const collision::PairOrder order = run.world.settings().pair_order;
+            const bool flagged = hasPair(run.world.flaggedPairs(), order, p.a, p.b);
+            const bool colliding = hasPair(run.world.collidingPairs(), order, p.a, p.b);
             const bool holds = (!p.colliding || *p.colliding == colliding) &&
                                (!p.flagged || *p.flagged == flagged);
             PairTracker& t = state_[k];

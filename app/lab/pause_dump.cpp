@@ -1,6 +1,7 @@
 // app/lab/pause_dump.cpp -- pause dumps as JSON (nlohmann::ordered_json, numbers round-trip exactly).
 #include "pause_dump.h"
 
+#include <algorithm>
 #include <array>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -16,9 +17,12 @@ namespace {
 
 nlohmann::ordered_json vec(const collision::Vec3& v) { return {v.x(), v.y(), v.z()}; }
 
+// Sorted by (a, b): the world's pairs come in its pair order (world.pair_order), the dump's do not.
 nlohmann::ordered_json pairs(std::span<const collision::ProxyPair> list) {
+    std::vector<collision::ProxyPair> sorted(list.begin(), list.end());
+    std::sort(sorted.begin(), sorted.end());
     nlohmann::ordered_json out = nlohmann::ordered_json::array();
-    for (const collision::ProxyPair& p : list) out.push_back({p.a, p.b});
+    for (const collision::ProxyPair& p : sorted) out.push_back({p.a, p.b});
     return out;
 }
 

@@ -150,8 +150,12 @@ std::string traceLine(int frame, const engine::World& world) {
     }
     line["positions"] = std::move(positions);
     line["orientations_wxyz"] = std::move(orientations);
+    // Sorted, so that the trace does not depend on the pair order (world.pair_order).
+    std::vector<collision::ProxyPair> sorted(world.collidingPairs().begin(),
+                                             world.collidingPairs().end());
+    std::sort(sorted.begin(), sorted.end());
     nlohmann::json pairs = nlohmann::json::array();
-    for (const collision::ProxyPair& p : world.collidingPairs()) pairs.push_back({p.a, p.b});
+    for (const collision::ProxyPair& p : sorted) pairs.push_back({p.a, p.b});
     line["colliding_pairs"] = std::move(pairs);
     return line.dump() + "\n";
 }
@@ -264,6 +268,16 @@ int loadRunScene(const RunOptions& options, std::ostream& err, engine::Scene& sc
         }
         scene.world.broad_phase = *options.broad_phase;
     }
+    if (options.pair_order) {
+        const std::optional<collision::PairOrder> order =
+            collision::findPairOrder(*options.pair_order);
+        if (!order) {
+            err << "--pair-order: unknown pair order '" << *options.pair_order
+                << "' (expected one of: " << collision::pairOrderNames() << ")\n";
+            return kExitBadInput;
+        }
+        scene.world.pair_order = *order;
+    }
     if (!std::isfinite(options.pause_hold_s) || options.pause_hold_s < 0 ||
         options.pause_hold_s > kMaxPauseHoldSeconds) {
         err << "--pause-hold " << options.pause_hold_s << ": must be a number of seconds from 0 "
@@ -314,6 +328,7 @@ std::string summaryJson(const RunOptions& options, const engine::Scene& scene,
     nlohmann::ordered_json summary;
     summary["scene"] = options.scene.string();
     summary["broadphase"] = scene.world.broad_phase;
+    summary["pair_order"] = std::string(collision::pairOrderName(scene.world.pair_order));
     summary["frames"] = scene.frames;
     summary["steps"] = world.stepCount();
     summary["time"] = world.time();
@@ -493,8 +508,10 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         if (want_video) out << " and " << video_path.string();
         if (options.html) out << ", the page " << (out_dir / "index.html").string();
         out << " (" << world.bodies().size() << " bodies, " << world.stepCount() << " steps, "
-            << scene.world.broad_phase << (options.check_broad_phase ? ", every step checked" : "")
-            << ")\n";
+            << scene.world.broad_phase
+            << (scene.world.pair_order == collision::PairOrder::Found ? ", pairs in found order"
+                                                                      : "")
+            << (options.check_broad_phase ? ", every step checked" : "") << ")\n";
         const double scale = double(engine::videoTimeScale(scene));
         if (want_video && std::abs(scale - 1.0) > 1e-9) {
             // A scene may ask for slow motion; say so, so that nobody reads it as real time.

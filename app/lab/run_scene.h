@@ -22,6 +22,7 @@ struct RunOptions {
     bool no_video = false;
     bool no_frames = false;                  ///< skip the per-frame PNGs
     std::optional<std::string> broad_phase;  ///< overrides the scene's broad phase
+    std::optional<std::string> pair_order;   ///< overrides the scene's pair_order
     std::vector<int> pause_at;               ///< frames to dump
     /// Seconds each pause picture stays on screen in the video (repeated at the video's fps),
     /// as a live demo holds its pause; 0 = not held. Finite, 0..kMaxPauseHoldSeconds.
@@ -35,7 +36,8 @@ struct RunOptions {
     /// Scene values replaced before validation (`--set world.time_step=0.01`).
     std::vector<engine::SceneOverride> overrides;
     /// One JSON line per frame: time, every body's position and orientation, confirmed pairs
-    /// (`cdlab sweep --float-binary` compares a float build's trace with the double one's).
+    /// sorted by (a, b) whatever the pair order (`cdlab sweep --float-binary` compares a float
+    /// build's trace with the double one's).
     std::optional<std::filesystem::path> trace;
     /// Write index.html beside the frames (run_html.h): the video, the timeline of pairs and
     /// stage times with a cursor following the video, the pause pictures with their bodies.

@@ -331,8 +331,8 @@ Scene SceneParser::parse(const std::string& text) {
     scene.name = fs::path(file_).stem().string();
     if (!root.IsMap()) {
         fail(root, "scene",
-             "expected a mapping with keys: world, broadphase, output, camera, draw, bodies, "
-             "chains, expect");
+             "expected a mapping with keys: world, broadphase, pair_order, output, camera, draw, "
+             "bodies, chains, expect");
     }
     // The first document parsed, so the probe's parser (the same one) cannot throw before it
     // reaches the second.
@@ -344,9 +344,9 @@ Scene SceneParser::parse(const std::string& text) {
              "a second YAML document: a scene file holds exactly one (remove the '---' or '...' "
              "and what follows, or merge it into the first)");
     }
-    const std::vector<Entry> es =
-        entries(root, "",
-                {"world", "broadphase", "output", "camera", "draw", "bodies", "chains", "expect"});
+    const std::vector<Entry> es = entries(root, "",
+                                          {"world", "broadphase", "pair_order", "output", "camera",
+                                           "draw", "bodies", "chains", "expect"});
     // The output's frame rate first: the world's default time step is derived from it.
     if (const Entry* output = find(es, "output")) parseOutput(output->value, scene);
     parseWorld(require(es, "world", root, "").value, scene);
@@ -359,6 +359,15 @@ Scene SceneParser::parse(const std::string& text) {
                          "' (expected one of: " + collision::broadPhaseNames() + ")");
             }
             scene.world.broad_phase = name;
+        } else if (e.key == "pair_order") {
+            const std::string name = readString(e.value, "pair_order");
+            const std::optional<collision::PairOrder> order = collision::findPairOrder(name);
+            if (!order) {
+                fail(e.value, "pair_order",
+                     "unknown pair order '" + name +
+                         "' (expected one of: " + collision::pairOrderNames() + ")");
+            }
+            scene.world.pair_order = *order;
         } else if (e.key == "camera") {
             parseCamera(e.value, scene);
         } else if (e.key == "draw") {

@@ -2,9 +2,11 @@
 // and the contact solver's pairs (the continuous stage is world_continuous.cpp, the contact
 // detail and debug drawing world_contacts.cpp, deforming and self-colliding meshes
 // world_deform.cpp).
-// Bodies are processed in id order and pairs come out of the broad phase sorted (the CCD stage
-// sorts its candidate pairs and its events by (t, a, b)), so every step does the same
-// floating-point operations in the same order: runs are bit-identical.
+// Bodies are processed in id order and pairs come out of the broad phase in an order fixed by the
+// calls made to it (sorted by default; settings().pair_order), the contact solver and the CCD
+// stage take their pairs from sweeps of their own, sorted (the CCD stage sorts its events by
+// (t, a, b)), so every step does the same floating-point operations in the same order: runs are
+// bit-identical, and the bodies' motion is the same in either pair order.
 #include "engine/world.h"
 
 #include <algorithm>
@@ -30,13 +32,16 @@ double secondsSince(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-std::unique_ptr<collision::BroadPhase> makeBroadPhase(const std::string& name) {
+std::unique_ptr<collision::BroadPhase> makeBroadPhase(const std::string& name,
+                                                      collision::PairOrder order) {
     const collision::BroadPhaseEntry* entry = collision::findBroadPhase(name);
     if (entry == nullptr) {
         throw std::invalid_argument("unknown broad phase '" + name +
                                     "' (expected one of: " + collision::broadPhaseNames() + ")");
     }
-    return entry->create();
+    std::unique_ptr<collision::BroadPhase> made = entry->create();
+    made->setPairOrder(order);
+    return made;
 }
 
 }  // namespace
@@ -171,7 +176,8 @@ std::string_view bodyStateName(BodyState state) {
 }
 
 World::World(WorldSettings settings)
-    : settings_(std::move(settings)), broad_phase_(makeBroadPhase(settings_.broad_phase)) {
+    : settings_(std::move(settings)),
+      broad_phase_(makeBroadPhase(settings_.broad_phase, settings_.pair_order)) {
     if (settings_.response == Response::Impulse) {
         solver_ = std::make_unique<ContactSolver>();
         // The six faces of the bounds, solid outside: -x, +x, -y, +y, -z, +z.
@@ -211,7 +217,7 @@ BodyId World::addBody(Body body) {
 }
 
 void World::setBroadPhase(const std::string& name) {
-    broad_phase_ = makeBroadPhase(name);
+    broad_phase_ = makeBroadPhase(name, settings_.pair_order);
     settings_.broad_phase = name;
     proxies_inserted_ = false;
 }

@@ -3,6 +3,7 @@
 // coloured by state and contact witnesses (as Box2D's b2World_Draw, the world decides what its
 // debug drawing shows; a renderer only draws lines).
 #include <algorithm>
+#include <numeric>
 #include <span>
 #include <vector>
 
@@ -83,6 +84,17 @@ void World::drawHierarchyLevels(collision::DebugDraw& draw, int depth,
             levels[i] = collision::makeBvhLevel(*tree, depth);
         }
     }
+    // colliding_ by (a, b), for the look-up of each flagged pair: the identity in sorted pair
+    // order; in the broad phase's own order (settings().pair_order) sorted here, O(c log c) in
+    // the confirmed pairs, for drawing only.
+    std::vector<std::size_t> by_pair(colliding_.size());
+    std::iota(by_pair.begin(), by_pair.end(), std::size_t(0));
+    const auto pair_less = [this](std::size_t x, std::size_t y) {
+        return colliding_[x] < colliding_[y];
+    };
+    if (!std::is_sorted(colliding_.begin(), colliding_.end())) {
+        std::sort(by_pair.begin(), by_pair.end(), pair_less);
+    }
     for (const collision::ProxyPair& p : flagged_) {
         if (!drawable(bodies_, p)) continue;
         const auto ia = static_cast<std::size_t>(p.a);
@@ -92,11 +104,13 @@ void World::drawHierarchyLevels(collision::DebugDraw& draw, int depth,
         const collision::MeshBvh* tree_a = meshTree(a);
         const collision::MeshBvh* tree_b = meshTree(b);
         if (!tree_a && !tree_b) continue;
-        const auto it = std::lower_bound(colliding_.begin(), colliding_.end(), p);
+        const auto it = std::lower_bound(
+            by_pair.begin(), by_pair.end(), p,
+            [this](std::size_t k, const collision::ProxyPair& key) { return colliding_[k] < key; });
         const collision::PairContacts* confirmed = nullptr;
-        if (it != colliding_.end() && *it == p) {
+        if (it != by_pair.end() && colliding_[*it] == p) {
             computeDetails(false, true);  // the mesh pairs' triangles; no convex contact() here
-            confirmed = &details_[static_cast<std::size_t>(it - colliding_.begin())];
+            confirmed = &details_[*it];
         }
         if (tree_a && tree_b) {
             if (!tree_a->sameVolumeType(*tree_b)) continue;

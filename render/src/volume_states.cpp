@@ -117,6 +117,10 @@ VolumeOverlaps volumeOverlaps(const engine::World& world, VolumeKind kind) {
     const auto volumes = world.volumes();
     if (broadPhaseVolume(world) == kind && world.states().size() == volumes.size()) {
         out.pairs.assign(world.flaggedPairs().begin(), world.flaggedPairs().end());
+        // In the broad phase's own order when the world asks for it (WorldSettings::pair_order).
+        if (world.settings().pair_order != collision::PairOrder::Sorted) {
+            std::sort(out.pairs.begin(), out.pairs.end());
+        }
         out.states.assign(world.states().begin(), world.states().end());
         return out;
     }

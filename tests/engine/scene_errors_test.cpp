@@ -49,8 +49,8 @@ TEST(SceneErrors, BodyNamesAreUnique) {
 
 TEST(SceneErrors, UnknownKeysAtEveryLevel) {
     EXPECT_SCENE_ERROR("wrld:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n", "1:1: wrld: ",
-                       "unknown key 'wrld' (expected one of: world, broadphase, output, camera, "
-                       "draw, bodies, chains, expect)");
+                       "unknown key 'wrld' (expected one of: world, broadphase, pair_order, "
+                       "output, camera, draw, bodies, chains, expect)");
     EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radus: 0.5\n    position: [0, 0, 0]\n"),
                        "5:5: bodies[0].radus: ", "unknown key 'radus' (expected one of: name,");
     EXPECT_SCENE_ERROR("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  gravty: [0,0,0]\n",
@@ -174,6 +174,10 @@ TEST(SceneErrors, UnknownNamesListTheChoices) {
                         0),
               0u)
         << err;
+    EXPECT_SCENE_ERROR(kHeader + "pair_order: unsorted\n", "4:13: pair_order: ",
+                       "unknown pair order 'unsorted' (expected one of: sorted, found)");
+    EXPECT_SCENE_ERROR(kHeader + "pair_order: [found]\n",
+                       "4:13: pair_order: ", "expected a string");
     EXPECT_SCENE_ERROR(withBody("  - shape: cone\n    position: [0, 0, 0]\n"),
                        "4:12: bodies[0].shape: ",
                        "unknown shape 'cone' (expected one of: sphere, box, capsule, hull, mesh)");

@@ -50,16 +50,11 @@ namespace collision {
 /// than the jobs here), so hgrid2 keeps the second core busy while frames come quickly.
 class HierarchicalGrid : public RebuildingBroadPhase {
 public:
-    /// The order findPairs writes its pairs in.
-    enum class PairOrder {
-        Sorted,  ///< by (a, b), as every broad phase writes them (the default)
-        /// each pair as (a, b), a < b, in the order the sweep met them, with no sort: the same
-        /// list for the same sequence of calls, for a caller that needs the set, not the order
-        /// (the sort is 10-20 % of a frame, 1k to 100k boxes). One lane only: with two
-        /// (hgrid2, from kTwoLaneMinimum proxies) the pairs come sorted, since which lane
-        /// sweeps which columns varies from run to run.
-        Found,
-    };
+    /// PairOrder::Found: each pair as (a, b), a < b, in the order the sweep met them, with no
+    /// final sort (the sort is 10-30 % of a one-shot frame, 10k to 100k boxes). One lane only:
+    /// with two (hgrid2, from kTwoLaneMinimum proxies) the pairs come sorted, since which lane
+    /// sweeps which columns varies from run to run.
+    using PairOrder = collision::PairOrder;
     /// `two_threads`: count, scatter and sweep split between this thread and a helper thread
     /// (from kTwoLaneMinimum proxies); the pairs are the same either way.
     explicit HierarchicalGrid(bool two_threads = false, PairOrder order = PairOrder::Sorted);
@@ -69,6 +64,7 @@ public:
     void insertMany(ProxyId first, std::span<const ProxyVolumes> v) override;
     void remove(ProxyId id) override;
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
+    void setPairOrder(PairOrder order) override { pair_order_ = order; }
     void draw(DebugDraw& draw, const Aabb& bounds) const override;
     std::string validate() const override;
 

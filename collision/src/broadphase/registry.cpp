@@ -47,10 +47,12 @@ const BroadPhaseEntry kRegistry[] = {
          return std::make_unique<GridBroadPhase>(GridBroadPhase::Mode::Hashed);
      }},
     {"hgrid", "hierarchical hash grid (Mirtich TR-97-23 §2.2)", "aabb", "brute",
-     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<HierarchicalGrid>(); }},
+     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<HierarchicalGrid>(); }, 1, false,
+     /*found_order=*/true},
     {"hgrid2", "hgrid on two threads (a helper thread from 4096 proxies; same pairs)", "aabb",
      "brute",
-     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<HierarchicalGrid>(true); }, 2},
+     []() -> std::unique_ptr<BroadPhase> { return std::make_unique<HierarchicalGrid>(true); }, 2,
+     false, /*found_order=*/true},
     {"tree", "dynamic AABB tree: fat leaves, SAH insertion, rotations", "aabb", "brute",
      []() -> std::unique_ptr<BroadPhase> { return std::make_unique<DynamicAabbTree>(); }},
     {"octree", "loose octree (k = 2)", "aabb", "brute",
@@ -66,6 +68,18 @@ const BroadPhaseEntry kRegistry[] = {
 };
 
 }  // namespace
+
+std::string_view pairOrderName(PairOrder order) {
+    return order == PairOrder::Found ? "found" : "sorted";
+}
+
+std::optional<PairOrder> findPairOrder(std::string_view name) {
+    if (name == "sorted") return PairOrder::Sorted;
+    if (name == "found") return PairOrder::Found;
+    return std::nullopt;
+}
+
+std::string pairOrderNames() { return "sorted, found"; }
 
 std::span<const BroadPhaseEntry> broadPhaseRegistry() { return kRegistry; }
 

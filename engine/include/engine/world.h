@@ -101,6 +101,12 @@ struct WorldSettings {
     Vec3 gravity = Vec3::Zero();      ///< m/s^2
     Real time_step = Real(1) / 60;    ///< s, > 0
     std::string broad_phase = "sap";  ///< registry name
+    /// The order flaggedPairs() and collidingPairs() come in (scene key `pair_order`): sorted by
+    /// (a, b) (default), or the broad phase's own order (collision::PairOrder::Found), which
+    /// saves hgrid its final sort. Either way the same pairs, and the same list for the same run.
+    /// The motion does not depend on it: the contact solver and the CCD stage find their pairs
+    /// by sweeps of their own and sort them.
+    collision::PairOrder pair_order = collision::PairOrder::Sorted;
     /// Node volume of mesh bodies' hierarchies (collision::bvhVolumeNames()); scene key
     /// `world.mesh_bvh`. Read when mesh bodies are built (scene loading), not by the World.
     std::string mesh_bvh{collision::kDefaultMeshBvh};
@@ -205,16 +211,19 @@ public:
     void step();
     /// Recomputes volumes, pairs and states at the current state, without moving anything.
     void detect();
-    /// Replaces the broad phase (state kept); throws std::invalid_argument on an unknown name.
+    /// Replaces the broad phase (state kept; it writes in settings().pair_order); throws
+    /// std::invalid_argument on an unknown name.
     void setBroadPhase(const std::string& name);
 
     const WorldSettings& settings() const { return settings_; }
     std::span<const Body> bodies() const { return bodies_; }
     std::span<const collision::ProxyVolumes> volumes() const { return volumes_; }
     std::span<const BodyState> states() const { return states_; }
-    /// Pairs whose volumes overlap according to the broad phase (sorted, a < b).
+    /// Pairs whose volumes overlap according to the broad phase (a < b, each once), in
+    /// settings().pair_order: sorted by default.
     std::span<const collision::ProxyPair> flaggedPairs() const { return flagged_; }
-    /// Flagged pairs the narrow phase confirmed (touching or penetrating), sorted.
+    /// Flagged pairs the narrow phase confirmed (touching or penetrating), in flaggedPairs()
+    /// order (so sorted by default).
     std::span<const collision::ProxyPair> collidingPairs() const { return colliding_; }
     /// Pairs the contact solver pushed apart in the last step (a positive normal impulse, which
     /// includes speculative contacts that had not touched yet), sorted; empty without response.

@@ -48,7 +48,8 @@ struct VolumeOverlaps {
 
 /// The overlaps of the world's volumes of `kind` at its last detect() or step(). For the kind
 /// the broad phase tests these are the world's own flagged pairs and states (the broad phases
-/// report exactly their volume's overlaps); any other kind is found afresh by the registry's
+/// report exactly their volume's overlaps; sorted here when the world keeps them in the broad
+/// phase's own order, WorldSettings::pair_order); any other kind is found afresh by the registry's
 /// sorting broad phase for that volume (sap, sphere, obb: exact tests, each checked against its
 /// brute-force reference), O(n log n + pairs).
 VolumeOverlaps volumeOverlaps(const engine::World& world, VolumeKind kind);

@@ -1,11 +1,13 @@
 // collision/broadphase/broad_phase.h -- the seam where broad phases are swapped, and their
 // registry. A broad phase holds proxies (one per body, by id) with their bounding volumes and
 // reports the candidate pairs whose volumes overlap. Every implementation reports the same pair set
-// as its brute-force reference: pairs sorted by (a, b), a < b, no duplicates, touching counts.
+// as its brute-force reference: pairs sorted by (a, b), a < b, no duplicates, touching counts;
+// or, when its user asks for PairOrder::Found, the same pairs in the order it met them.
 #pragma once
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -26,6 +28,26 @@ struct ProxyPair {
     friend bool operator==(const ProxyPair&, const ProxyPair&) = default;
     friend auto operator<=>(const ProxyPair&, const ProxyPair&) = default;
 };
+
+/// The order findPairs writes its pairs in.
+enum class PairOrder {
+    /// By (a, b): the default, the order every broad phase can be compared in with `==`.
+    Sorted,
+    /// The broad phase's own order: the same pairs, each as (a, b) with a < b, no duplicates, in
+    /// the order its sweep met them, without a final sort. Deterministic: the same sequence of
+    /// calls gives the same list. For a caller that needs the set, not the order. Only a broad
+    /// phase whose registry row has `found_order` writes anything but sorted pairs (hgrid, and
+    /// hgrid2 while it runs on one thread); every other one meets its pairs in sorted order or
+    /// sorts them anyway, so it writes the same sorted list.
+    Found,
+};
+
+/// "sorted" or "found".
+std::string_view pairOrderName(PairOrder order);
+/// The order of that name; nullopt for any other name.
+std::optional<PairOrder> findPairOrder(std::string_view name);
+/// "sorted, found", for error messages and --help.
+std::string pairOrderNames();
 
 /// The volumes a broad phase may look at. Each broad phase uses the one it is built on.
 struct ProxyVolumes {
@@ -62,8 +84,12 @@ public:
     virtual void remove(ProxyId id) = 0;
     /// Replaces a present proxy's volumes.
     virtual void move(ProxyId id, const ProxyVolumes& volumes) = 0;
-    /// Writes every overlapping pair into `pairs` (cleared first), sorted, unique.
+    /// Writes every overlapping pair into `pairs` (cleared first), unique, a < b, sorted by
+    /// (a, b) unless setPairOrder(PairOrder::Found) was called.
     virtual void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) = 0;
+    /// The order the next findPairs calls write in (default Sorted). A broad phase without an
+    /// order of its own (no `found_order` in its registry row) keeps writing sorted pairs.
+    virtual void setPairOrder(PairOrder /*order*/) {}
     /// Draws the broad phase's own structure (cells, intervals, nodes) as it was at the last
     /// findPairs, in kStructurePalette colours, and names each colour with DebugDraw::legend.
     /// `bounds` is the box the picture frames (the world bounds): what has no place in space of
@@ -87,6 +113,9 @@ struct BroadPhaseEntry {
     /// Needs a rendering context (a VisibilityOracle factory, see visibility_oracle.h): create()
     /// throws BroadPhaseUnavailable without one.
     bool needs_render_context = false;
+    /// PairOrder::Found leaves out a final sort: its pairs come in an order of its own. Without
+    /// this the found order is the sorted one.
+    bool found_order = false;
 };
 
 std::span<const BroadPhaseEntry> broadPhaseRegistry();
