@@ -45,7 +45,11 @@ const CheckRow* findRow(const std::vector<CheckRow>& rows, const std::string& fr
     for (const CheckRow& r : rows) {
         if (r.expectation.find(fragment) != std::string::npos) return &r;
     }
-    return nullptr;
+    // A missing row fails the test with its name, not with a null dereference in the caller.
+    ADD_FAILURE() << "no check row contains \"" << fragment << "\"";
+    static thread_local CheckRow missing;
+    missing = CheckRow{"(missing) " + fragment, false, "no such row"};
+    return &missing;
 }
 
 TEST(Check, ExpectationsThatHoldPass) {
