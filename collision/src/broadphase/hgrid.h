@@ -51,9 +51,9 @@ namespace collision {
 class HierarchicalGrid : public RebuildingBroadPhase {
 public:
     /// PairOrder::Found: each pair as (a, b), a < b, in the order the sweep met them, with no
-    /// final sort (the sort is 10-30 % of a one-shot frame, 10k to 100k boxes). One lane only:
-    /// with two (hgrid2, from kTwoLaneMinimum proxies) the pairs come sorted, since which lane
-    /// sweeps which columns varies from run to run.
+    /// final sort (BoxPruning one-shot: the sort is about a third of the frame at 100k boxes, a
+    /// few per cent at 10k). One lane only: with two (hgrid2, from kTwoLaneMinimum proxies) the
+    /// pairs come sorted, since which lane sweeps which columns varies from run to run.
     using PairOrder = collision::PairOrder;
     /// `two_threads`: count, scatter and sweep split between this thread and a helper thread
     /// (from kTwoLaneMinimum proxies); the pairs are the same either way.
