@@ -19,6 +19,8 @@ public:
         : broad_phase_(entry.create()) {
         broad_phase_->setPairOrder(order);
     }
+    explicit CdlabMethod(std::unique_ptr<collision::BroadPhase> broad_phase)
+        : broad_phase_(std::move(broad_phase)) {}
 
     void insertAll(const MovingBoxes& /*boxes*/,
                    std::span<const collision::ProxyVolumes> volumes) override {
@@ -36,7 +38,7 @@ public:
         return broad_phase_->potentiallyCollidingSize();
     }
 
-private:
+protected:
     std::unique_ptr<collision::BroadPhase> broad_phase_;
     std::vector<collision::ProxyPair> pairs_;
     collision::BroadPhaseCounters counters_;
@@ -46,21 +48,10 @@ private:
 /// the registry's. Its findPairs() list is a superset of the exact pairs, as a Bullet pair cache
 /// is, and is treated the same way: rawPairs() is its size, deliverExact() keeps the pairs whose
 /// exact boxes overlap (timed under the exact-pairs rule), summary() filters it again, untimed.
-class LooseCdlabMethod : public BenchMethod {
+class LooseCdlabMethod : public CdlabMethod {
 public:
-    explicit LooseCdlabMethod(std::unique_ptr<collision::BroadPhase> broad_phase)
-        : broad_phase_(std::move(broad_phase)) {}
+    using CdlabMethod::CdlabMethod;
 
-    void insertAll(const MovingBoxes& /*boxes*/,
-                   std::span<const collision::ProxyVolumes> volumes) override {
-        broad_phase_->insertMany(0, volumes);
-    }
-    void moveAll(const MovingBoxes& /*boxes*/,
-                 std::span<const collision::ProxyVolumes> volumes) override {
-        for (std::size_t i = 0; i < volumes.size(); ++i) {
-            broad_phase_->move(static_cast<collision::ProxyId>(i), volumes[i]);
-        }
-    }
     void findPairs() override {
         broad_phase_->findPairs(loose_, counters_);
         delivered_ = false;
@@ -89,11 +80,9 @@ public:
     std::int64_t rawPairs() const override { return static_cast<std::int64_t>(loose_.size()); }
 
 private:
-    std::unique_ptr<collision::BroadPhase> broad_phase_;
     std::vector<collision::ProxyPair> loose_;
     std::vector<collision::ProxyPair> exact_;
     bool delivered_ = false;
-    collision::BroadPhaseCounters counters_;
 };
 
 std::vector<BenchMethodEntry> makeMethods() {
