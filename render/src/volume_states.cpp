@@ -117,8 +117,9 @@ VolumeOverlaps volumeOverlaps(const engine::World& world, VolumeKind kind) {
     const auto volumes = world.volumes();
     if (broadPhaseVolume(world) == kind && world.states().size() == volumes.size()) {
         out.pairs.assign(world.flaggedPairs().begin(), world.flaggedPairs().end());
-        // In the broad phase's own order when the world asks for it (WorldSettings::pair_order).
-        if (world.settings().pair_order != collision::PairOrder::Sorted) {
+        // In the broad phase's own order when the world asks for it (WorldSettings::pair_order);
+        // most rows write sorted pairs whatever the setting, and those need no sort.
+        if (!std::is_sorted(out.pairs.begin(), out.pairs.end())) {
             std::sort(out.pairs.begin(), out.pairs.end());
         }
         out.states.assign(world.states().begin(), world.states().end());
