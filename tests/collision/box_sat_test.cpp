@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -43,6 +45,64 @@ void expectSameBestAxes(const BoxSatMeasure& full, const BoxSatMeasure& best, in
     EXPECT_TRUE(sameBits(full.err_bound, best.err_bound)) << sample;
     EXPECT_TRUE(full.per_axis);
     EXPECT_FALSE(best.per_axis);
+}
+
+// The nine edge estimates as measureBoxSatBest first computed them, one edge at a time in
+// scalars: the reference for boxSatEdgeEstimates, whose SSE2 form computes two edges per
+// instruction.
+void referenceEdgeEstimates(const Vec3& ea, const Mat3& rot, const Vec3& t, const Vec3& eb,
+                            std::array<Real, 9>& hi, Real& cut, Real& max_hi) {
+    alignas(16) std::array<float, 12> len2f{};
+    std::array<Real, 9> unnormalised;
+    std::array<bool, 9> measurable;
+    for (int k = 0; k < 9; ++k) {
+        const int i = k / 3;
+        const int j = k % 3;
+        const int i1 = (i + 1) % 3;
+        const int i2 = (i + 2) % 3;
+        const int j1 = (j + 1) % 3;
+        const int j2 = (j + 2) % 3;
+        const Real r1 = rot(i1, j);
+        const Real r2 = rot(i2, j);
+        const Real len2 = r1 * r1 + r2 * r2;
+        const Real dist = std::abs(t[i2] * r1 - t[i1] * r2);
+        const Real ra = ea[i1] * std::abs(r2) + ea[i2] * std::abs(r1);
+        const Real rb = eb[j1] * std::abs(rot(i, j2)) + eb[j2] * std::abs(rot(i, j1));
+        unnormalised[static_cast<std::size_t>(k)] = dist - ra - rb;
+        measurable[static_cast<std::size_t>(k)] = len2 >= Real(1e-8);
+        len2f[static_cast<std::size_t>(k)] = static_cast<float>(len2);
+    }
+    len2f[9] = len2f[10] = len2f[11] = 1.0f;
+    alignas(16) std::array<float, 12> inv_len{};
+    collision::boxSatRsqrt(len2f.data(), inv_len.data());
+    cut = -std::numeric_limits<Real>::infinity();
+    max_hi = -std::numeric_limits<Real>::infinity();
+    for (std::size_t k = 0; k < 9; ++k) {
+        const Real e = unnormalised[k] * static_cast<Real>(inv_len[k]);
+        const Real slack = Real(1e-3) * std::abs(e);
+        hi[k] = measurable[k] ? e + slack : std::numeric_limits<Real>::infinity();
+        if (measurable[k]) cut = std::max(cut, e - slack);
+        max_hi = std::max(max_hi, hi[k]);
+    }
+}
+
+// Bitwise, NaN matching any NaN (the lanes may carry another NaN payload).
+bool sameValue(Real x, Real y) { return sameBits(x, y) || (std::isnan(x) && std::isnan(y)); }
+
+// An exact rotation of the cube's symmetry group: entries 0 and +-1, zeros of either sign.
+Mat3 cubeRotation(cdlab_test::Rng& rng) {
+    std::array<int, 3> perm{0, 1, 2};
+    for (int k = 2; k > 0; --k) std::swap(perm[static_cast<std::size_t>(k)],
+                                          perm[static_cast<std::size_t>(rng.integer(0, k))]);
+    Mat3 r = Mat3::Zero();
+    for (int k = 0; k < 3; ++k) {
+        r(k, perm[static_cast<std::size_t>(k)]) = rng.integer(0, 1) ? Real(1) : Real(-1);
+        // Negative zeros beside the ones, as a product of such matrices has.
+        for (int c = 0; c < 3; ++c) {
+            if (c != perm[static_cast<std::size_t>(k)] && rng.integer(0, 1)) r(k, c) = -Real(0);
+        }
+    }
+    return r;
 }
 
 // A rotation `angle` radians off an axis-aligned one (angle 0: exactly parallel edges).
@@ -97,6 +157,51 @@ TEST(BoxSat, BestAxesMeasureMatchesTheFullMeasureBitForBit) {
     EXPECT_GT(edges_skipped, 10000);
     EXPECT_GT(not_clear, 20000);
     EXPECT_LT(edges_skipped, 190000);
+}
+
+TEST(BoxSat, EdgeEstimatesEqualTheirScalarReference) {
+    cdlab_test::Rng rng(20261127);
+    int near_parallel = 0;
+    for (int sample = 0; sample < 300000; ++sample) {
+        const int kind = sample % 6;
+        const Real scale = std::pow(Real(10), rng.uniform(-4, 4));
+        Vec3 ea = scale * rng.vec(0.01, 1.5);
+        Vec3 eb = scale * rng.vec(0.01, 1.5);
+        Mat3 rot = (rng.rotation().conjugate() * rng.rotation()).toRotationMatrix();
+        Vec3 t = scale * rng.uniform(0, 3) * (rng.rotation() * Vec3::UnitX());
+        if (kind == 1) {
+            const Real angle = std::pow(Real(10), rng.uniform(-12, -1));
+            rot = rot * nearAligned(rng, angle).toRotationMatrix();
+        }
+        if (kind == 2) rot = nearAligned(rng, Real(0)).toRotationMatrix();
+        if (kind == 3) rot = cubeRotation(rng);
+        if (kind == 4) t += Vec3::Constant(Real(1e6));
+        if (kind == 5 && sample % 60 == 5) {  // touching, zero and non-finite entries
+            const int which = rng.integer(0, 3);
+            if (which == 0) t = Vec3::Zero();
+            const Real nan = std::numeric_limits<Real>::quiet_NaN();
+            if (which == 1) rot(rng.integer(0, 2), rng.integer(0, 2)) = nan;
+            if (which == 2) t[rng.integer(0, 2)] = std::numeric_limits<Real>::infinity();
+            if (which == 3) ea[rng.integer(0, 2)] = Real(0);
+        }
+        std::array<Real, 9> hi;
+        std::array<Real, 9> want_hi;
+        Real cut = -std::numeric_limits<Real>::infinity();
+        Real max_hi = -std::numeric_limits<Real>::infinity();
+        Real want_cut = 0;
+        Real want_max_hi = 0;
+        collision::boxSatEdgeEstimates(ea, rot, t, eb, hi, cut, max_hi);
+        referenceEdgeEstimates(ea, rot, t, eb, want_hi, want_cut, want_max_hi);
+        for (std::size_t k = 0; k < 9; ++k) {
+            ASSERT_TRUE(sameValue(hi[k], want_hi[k])) << "sample " << sample << " edge " << k;
+            if (want_hi[k] == std::numeric_limits<Real>::infinity()) ++near_parallel;
+        }
+        ASSERT_TRUE(sameValue(cut, want_cut)) << "sample " << sample;
+        ASSERT_TRUE(sameValue(max_hi, want_max_hi)) << "sample " << sample;
+    }
+    // Both kinds of edge were reached: measurable ones with finite bounds, near-parallel ones.
+    EXPECT_GT(near_parallel, 50000);
+    EXPECT_LT(near_parallel, 2000000);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -183,6 +184,29 @@ TEST(ContactBoxBox, ReduceManifoldEqualsItsBranchingReference) {
         if (n > 4) ++reduced;
     }
     EXPECT_GT(reduced, 30000);
+}
+
+// signOrPlus by a mask against the select it replaces, on the values where the two could part:
+// zeros of either sign, NaN of either sign, infinities, subnormals, the extremes.
+TEST(ContactBoxBox, SignOrPlusEqualsItsSelect) {
+    const Real nan = std::numeric_limits<Real>::quiet_NaN();
+    const Real inf = std::numeric_limits<Real>::infinity();
+    const Real tiny = std::numeric_limits<Real>::denorm_min();
+    const Real big = std::numeric_limits<Real>::max();
+    const std::vector<Real> special{0,    -Real(0), nan,  -nan,  inf,  -inf, tiny,
+                                    -tiny, big,      -big, Real(1), Real(-1), Real(1e-300)};
+    cdlab_test::Rng rng(5);
+    std::vector<Real> values = special;
+    for (int i = 0; i < 1000; ++i) values.push_back(rng.uniform(-1, 1));
+    int negative = 0;
+    for (const Real x : values) {
+        const Real want = x < 0 ? Real(-1) : Real(1);
+        const Real got = pairs::signOrPlus(x);
+        EXPECT_EQ(std::memcmp(&got, &want, sizeof(Real)), 0) << x;
+        if (want < 0) ++negative;
+    }
+    EXPECT_GT(negative, 400);
+    EXPECT_LT(negative, 600);
 }
 
 }  // namespace

@@ -32,6 +32,7 @@ namespace collision {
 using contact_pairs::Ctx;
 using contact_pairs::Local;
 using contact_pairs::boxBox;
+using contact_pairs::boxBoxWitness;
 using contact_pairs::convexConvex;
 using contact_pairs::sphereSphere;
 using contact_pairs::sphereBox;
@@ -87,7 +88,8 @@ void settleSignedDistance(const CollideOutput& decided, Real tolerance, Local& l
 
 // pose.apply(p) and pose.apply(q) with the same operations in the same order (Eigen's
 // quaternion transform: uv = 2 (q.vec x v), v + w uv + q.vec x uv, then + position), the two
-// points in the two lanes of SSE2 doubles: the same bits as applying the pose to each.
+// points in the two lanes of SSE2 doubles: the same bits as applying the pose to each. Both are
+// read before either result is written, so world_p and world_q may be q and p.
 void applyPair(const Pose& pose, const Vec3& p, const Vec3& q, Vec3& world_p, Vec3& world_q) {
 #if defined(__SSE2__) && !defined(CDLAB_USE_FLOAT)
     const Quat& o = pose.orientation;
@@ -118,41 +120,57 @@ void applyPair(const Pose& pose, const Vec3& p, const Vec3& q, Vec3& world_p, Ve
     _mm_storeu_pd(world_q.data(), _mm_unpackhi_pd(rx, ry));
     _mm_store_sd(world_q.data() + 2, _mm_unpackhi_pd(rz, rz));
 #else
-    world_p = pose.apply(p);
-    world_q = pose.apply(q);
+    // p and q are read before either result is written: the results may go to each other's
+    // places.
+    const Vec3 moved_p = pose.apply(p);
+    const Vec3 moved_q = pose.apply(q);
+    world_p = moved_p;
+    world_q = moved_q;
 #endif
 }
 
 // The world output, once: the local contact rotated and moved by the canonically-first shape's
 // pose (`rot` its rotation matrix), then mirrored if the canonical order swapped A and B. The
-// points are moved two at a time (applyPair), every one of them: no branch on which manifold
-// point repeats a witness.
-void toWorld(const Pose& pose_first, const Mat3& rot, bool swap, ContactOutput& out) {
-    const Vec3 local_normal = out.normal;
-    out.normal = rot * local_normal;
-    applyPair(pose_first, out.point_a, out.point_b, out.point_a, out.point_b);
+// points are moved two at a time (applyPair), each pair written to its mirrored places
+// directly; the witness points, when they are a copy of manifold entry `witness_entry` (-1:
+// they are not), are copied from its world points, which are the same bits. Which shape is
+// first is data the branch predictor cannot learn: the mirroring picks places and signs by
+// index, not by a branch.
+void toWorld(const Pose& pose_first, const Mat3& rot, bool swap, int witness_entry,
+             ContactOutput& out) {
+    const auto s = static_cast<std::size_t>(swap);
+    const Vec3 normal = rot * out.normal;
+    constexpr std::array<Real, 2> kSign{1, -1};
+    out.normal = normal * kSign[s];  // exact: a sign flip
+    const std::array<Feature, 2> features{out.feature_a, out.feature_b};
+    out.feature_a = features[s];
+    out.feature_b = features[1 - s];
+    const bool copy_witness = witness_entry >= 0 && witness_entry < out.manifold_size;
+    if (!copy_witness) {
+        const std::array<Vec3*, 2> points{&out.point_a, &out.point_b};
+        applyPair(pose_first, *points[0], *points[1], *points[s], *points[1 - s]);
+    }
     for (int i = 0; i < out.manifold_size; ++i) {
         ManifoldPoint& m = out.manifold[static_cast<std::size_t>(i)];
-        applyPair(pose_first, m.point_a, m.point_b, m.point_a, m.point_b);
+        const std::array<Vec3*, 2> points{&m.point_a, &m.point_b};
+        applyPair(pose_first, *points[0], *points[1], *points[s], *points[1 - s]);
     }
-    if (swap) {
-        out.normal = -out.normal;
-        std::swap(out.point_a, out.point_b);
-        std::swap(out.feature_a, out.feature_b);
-        for (int i = 0; i < out.manifold_size; ++i) {
-            ManifoldPoint& m = out.manifold[static_cast<std::size_t>(i)];
-            std::swap(m.point_a, m.point_b);
-        }
+    if (copy_witness) {
+        const ManifoldPoint& m = out.manifold[static_cast<std::size_t>(witness_entry)];
+        out.point_a = m.point_a;  // already mirrored
+        out.point_b = m.point_b;
     }
 }
 
 // contact() of the pair `first`, `second` (canonical order; `swap` when that swapped A and B)
-// with `routine`, written straight into the returned output.
+// with `routine`, written straight into the returned output. `witness_entry` is read after the
+// routine ran: the manifold entry its witness points are a copy of, or -1.
 template <class Routine>
 [[gnu::always_inline]] inline ContactOutput contactPair(Routine&& routine, const Shape& first,
                                                         const Pose& pose_first,
                                                         const Shape& second,
-                                                        const Pose& pose_second, bool swap) {
+                                                        const Pose& pose_second, bool swap,
+                                                        const int& witness_entry) {
     ContactOutput out;
     const Ctx ctx = pairContext(first, second);
     const RelativePose rel = relativePose(pose_first, pose_second);
@@ -181,7 +199,7 @@ template <class Routine>
             setSingleManifold(out);
         }
     }
-    toWorld(pose_first, rot, swap, out);
+    toWorld(pose_first, rot, swap, witness_entry, out);
     return out;
 }
 
@@ -191,21 +209,40 @@ template <class Routine>
 ContactOutput contactConvex(const Shape& a, const Pose& pose_a, const Shape& b,
                             const Pose& pose_b) {
     const bool swap = canonicalLess(b, pose_b, a, pose_a);
-    const Shape& first = swap ? b : a;
-    const Shape& second = swap ? a : b;
-    const Pose& pose_first = swap ? pose_b : pose_a;
-    const Pose& pose_second = swap ? pose_a : pose_b;
+    // Picked by index, not a branch: the canonical order is data.
+    const auto s = static_cast<std::size_t>(swap);
+    const std::array<const Shape*, 2> shapes{&a, &b};
+    const std::array<const Pose*, 2> poses{&pose_a, &pose_b};
+    const Shape& first = *shapes[s];
+    const Shape& second = *shapes[1 - s];
+    const Pose& pose_first = *poses[s];
+    const Pose& pose_second = *poses[1 - s];
+    constexpr int kNoWitnessEntry = -1;
     if (first.type == ShapeType::Sphere && second.type == ShapeType::Sphere) {
-        return contactPair(sphereSphere, first, pose_first, second, pose_second, swap);
+        return contactPair(sphereSphere, first, pose_first, second, pose_second, swap,
+                           kNoWitnessEntry);
     }
     if (first.type == ShapeType::Sphere && second.type == ShapeType::Capsule) {
-        return contactPair(sphereCapsule, first, pose_first, second, pose_second, swap);
+        return contactPair(sphereCapsule, first, pose_first, second, pose_second, swap,
+                           kNoWitnessEntry);
     }
     if (first.type == ShapeType::Capsule && second.type == ShapeType::Capsule) {
-        return contactPair(capsuleCapsule, first, pose_first, second, pose_second, swap);
+        return contactPair(capsuleCapsule, first, pose_first, second, pose_second, swap,
+                           kNoWitnessEntry);
+    }
+    // Box-box names the manifold entry its witness points repeat, so they are moved once.
+    if (first.type == ShapeType::Box && second.type == ShapeType::Box) {
+        int witness_entry = -1;
+        const auto box_box = [&witness_entry](const Shape& box_a, const Shape& box_b,
+                                              const RelativePose& rel, const Ctx& ctx,
+                                              Local& out) {
+            return boxBoxWitness(box_a, box_b, rel, ctx, out, witness_entry);
+        };
+        return contactPair(box_box, first, pose_first, second, pose_second, swap,
+                           witness_entry);
     }
     return contactPair(pairEntry(kContactTable, first.type, second.type), first, pose_first,
-                       second, pose_second, swap);
+                       second, pose_second, swap, kNoWitnessEntry);
 }
 
 // A mesh is its convex hull here.

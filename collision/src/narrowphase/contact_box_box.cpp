@@ -142,9 +142,10 @@ namespace {
 
 // The details from the SAT measure: the edge-edge closest points, or the reference face clipped
 // against the incident one. False when the best axis proves a gap larger than the tolerance or
-// the clipped manifold is empty (GJK/EPA then give the details).
+// the clipped manifold is empty (GJK/EPA then give the details). When true, the witness points
+// are a copy of manifold entry `witness_entry`.
 bool satDetails(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
-                const BoxSatMeasure& sat, Local& out) {
+                const BoxSatMeasure& sat, Local& out, int& witness_entry) {
     const Mat3& rot = rel.rotation;
     const Vec3& t = rel.position;
     const Vec3& ea = a.half_extents;
@@ -187,6 +188,7 @@ bool satDetails(const Shape& a, const Shape& b, const RelativePose& rel, const C
         out.feature_a = boxFeature(ea, out.point_a, tol);
         out.feature_b = boxFeature(eb, toB(rel, out.point_b), tol);
         setSingleManifold(out);
+        witness_entry = 0;
         return true;
     }
 
@@ -240,19 +242,23 @@ bool satDetails(const Shape& a, const Shape& b, const RelativePose& rel, const C
     out.point_b = out.manifold[static_cast<std::size_t>(deepest)].point_b;
     out.feature_a = boxFeature(ea, out.point_a, tol);
     out.feature_b = boxFeature(eb, toB(rel, out.point_b), tol);
+    witness_entry = deepest;
     return true;
 }
 
 }  // namespace
 
-CollideOutput boxBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
-                     Local& out) {
+CollideOutput boxBoxWitness(const Shape& a, const Shape& b, const RelativePose& rel,
+                            const Ctx& ctx, Local& out, int& witness_entry) {
+    witness_entry = -1;
     // Clear overlaps (satBoxState's first test) need only the best axes.
     const BoxSatMeasure best =
         measureBoxSatBest(a.half_extents, rel.rotation, rel.position, b.half_extents,
                           -ctx.tolerance);
     if (best.max_sep + best.err_bound < -ctx.tolerance) {
-        if (!satDetails(a, b, rel, ctx, best, out)) convexConvex(a, b, rel, ctx, out);
+        if (!satDetails(a, b, rel, ctx, best, out, witness_entry)) {
+            convexConvex(a, b, rel, ctx, out);
+        }
         CollideOutput decision;
         decision.state = ContactState::Penetrating;
         return decision;
@@ -260,7 +266,9 @@ CollideOutput boxBox(const Shape& a, const Shape& b, const RelativePose& rel, co
     const BoxSatMeasure sat =
         measureBoxSat(a.half_extents, rel.rotation, rel.position, b.half_extents);
     if (const std::optional<ContactState> proven = collide_pairs::satBoxState(sat, ctx.tolerance)) {
-        if (!satDetails(a, b, rel, ctx, sat, out)) convexConvex(a, b, rel, ctx, out);
+        if (!satDetails(a, b, rel, ctx, sat, out, witness_entry)) {
+            convexConvex(a, b, rel, ctx, out);
+        }
         CollideOutput decision;
         decision.state = *proven;
         return decision;
@@ -271,11 +279,19 @@ CollideOutput boxBox(const Shape& a, const Shape& b, const RelativePose& rel, co
     if (sat.face_sep > ctx.tolerance && sat.edge_sep > ctx.tolerance) return decision;
     Local details;
     details.state = ContactState::Touching;
-    if (satDetails(a, b, rel, ctx, sat, details)) {
+    int details_witness = -1;
+    if (satDetails(a, b, rel, ctx, sat, details, details_witness)) {
         details.iterations = out.iterations;
         out = details;
+        witness_entry = details_witness;
     }
     return decision;
+}
+
+CollideOutput boxBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
+                     Local& out) {
+    int witness_entry = -1;
+    return boxBoxWitness(a, b, rel, ctx, out, witness_entry);
 }
 
 }  // namespace collision::contact_pairs

@@ -12,6 +12,10 @@
 #include <cstdint>
 #include <limits>
 
+#if defined(__SSE2__) && !defined(CDLAB_USE_FLOAT)
+#include <emmintrin.h>
+#endif
+
 #include "collision/narrowphase/contact.h"
 #include "narrowphase/collide_pairs.h"
 #include "narrowphase/gjk.h"
@@ -32,7 +36,16 @@ inline constexpr Real kParallelSin = Real(1e-6);
 // same).
 inline constexpr Real kEdgeBias = std::max(Real(1e-9), Real(64) * kEpsilon);
 
-inline Real signOrPlus(Real x) { return x < 0 ? Real(-1) : Real(1); }
+// -1 below zero, else +1 (-0 and NaN included). A mask, not a select: the sign is data the branch
+// predictor cannot learn, and GCC compiles the select (and 1 - 2 (x < 0)) to a branch.
+inline Real signOrPlus(Real x) {
+#if defined(__SSE2__) && !defined(CDLAB_USE_FLOAT)
+    const __m128d below = _mm_cmplt_sd(_mm_set_sd(x), _mm_setzero_pd());
+    return _mm_cvtsd_f64(_mm_add_sd(_mm_set_sd(1.0), _mm_and_pd(below, _mm_set_sd(-2.0))));
+#else
+    return x < 0 ? Real(-1) : Real(1);
+#endif
+}
 
 using Ctx = PairContext;
 
@@ -97,6 +110,10 @@ CollideOutput sphereBox(const Shape& a, const Shape& b, const RelativePose& rel,
 /// tolerance, GJK otherwise (contact_box_box.cpp).
 CollideOutput boxBox(const Shape& a, const Shape& b, const RelativePose& rel, const Ctx& ctx,
                      Local& out);
+/// boxBox, also naming the manifold entry whose points the witness points are a copy of
+/// (`witness_entry`, -1 when none is), so that the world transform can copy them too.
+CollideOutput boxBoxWitness(const Shape& a, const Shape& b, const RelativePose& rel,
+                            const Ctx& ctx, Local& out, int& witness_entry);
 /// Any convex pair: GJK with witnesses, EPA when the cores overlap (contact_convex.cpp).
 CollideOutput convexConvex(const Shape& a, const Shape& b, const RelativePose& rel,
                            const Ctx& ctx, Local& out);

@@ -13,6 +13,9 @@
 #if defined(__SSE__)
 #include <xmmintrin.h>
 #endif
+#if defined(__SSE2__) && !defined(CDLAB_USE_FLOAT)
+#include <emmintrin.h>
+#endif
 
 #include "collision/assert.h"
 #include "collision/math.h"
@@ -207,6 +210,179 @@ inline void boxSatRsqrt(const float* in, float* out) {
 #endif
 }
 
+// The estimates of the nine edge axes A_i x B_j (k = 3 i + j) for measureBoxSatBest: hi[k] an
+// upper bound on edge k's separation (+inf for an edge closer to parallel than
+// kBoxSatNearParallel2, which is always measured), and over the other edges, in order of k,
+// cut = max of the lower bounds and max_hi = max of hi. Unnormalised (Gottschalk, Lin, Manocha
+// 1996, "OBBTree" §4: with L = A_i x B_j, t.L, ra and rb are two products each of entries of R
+// and |R|), scaled by an approximate 1 / |L| (SSE rsqrtps, relative error below 1.5 * 2^-12,
+// allowed for as kBoxSatRsqrtRelative).
+inline constexpr Real kBoxSatNearParallel2 = Real(1e-8);
+inline constexpr Real kBoxSatRsqrtRelative = Real(1e-3);
+
+#if defined(__SSE2__) && !defined(CDLAB_USE_FLOAT)
+[[gnu::always_inline]] inline __m128d boxSatAbs(__m128d x) {
+    return _mm_andnot_pd(_mm_set1_pd(-0.0), x);
+}
+
+// Two edges in the two lanes, each with the scalar form's operations in its order, so every
+// lane holds the scalar form's bits. r1, r2 are R(i1, j), R(i2, j) and q1, q2 their absolute
+// values; a_j1, a_j2 are |R(i, j1)|, |R(i, j2)|; the rest the entries of t, ea, eb at those
+// indices (i1, i2 and j1, j2 follow i and j cyclically). Writes |L|^2 and the unnormalised
+// separation |t.L| - ra - rb.
+[[gnu::always_inline]] inline void boxSatEdgeLanes(__m128d r1, __m128d r2, __m128d q1, __m128d q2,
+                                                   __m128d t_i1, __m128d t_i2, __m128d ea_i1,
+                                                   __m128d ea_i2, __m128d eb_j1, __m128d eb_j2,
+                                                   __m128d a_j1, __m128d a_j2, __m128d& len2,
+                                                   __m128d& sep) {
+    len2 = _mm_add_pd(_mm_mul_pd(r1, r1), _mm_mul_pd(r2, r2));
+    const __m128d dist = boxSatAbs(_mm_sub_pd(_mm_mul_pd(t_i2, r1), _mm_mul_pd(t_i1, r2)));
+    const __m128d ra = _mm_add_pd(_mm_mul_pd(ea_i1, q2), _mm_mul_pd(ea_i2, q1));
+    const __m128d rb = _mm_add_pd(_mm_mul_pd(eb_j1, a_j2), _mm_mul_pd(eb_j2, a_j1));
+    sep = _mm_sub_pd(_mm_sub_pd(dist, ra), rb);
+}
+
+// hi and lo of two edges from |L|^2, the unnormalised separation and ~1 / |L|, stored at
+// hi_out, lo_out: +inf and -inf for an edge that is not measurable.
+[[gnu::always_inline]] inline void boxSatEdgeBounds(__m128d len2, __m128d sep, __m128d inv_len,
+                                                    double* hi_out, double* lo_out) {
+    const __m128d e = _mm_mul_pd(sep, inv_len);
+    const __m128d slack = _mm_mul_pd(_mm_set1_pd(kBoxSatRsqrtRelative), boxSatAbs(e));
+    const __m128d measurable = _mm_cmpge_pd(len2, _mm_set1_pd(kBoxSatNearParallel2));
+    const __m128d inf = _mm_set1_pd(std::numeric_limits<Real>::infinity());
+    _mm_storeu_pd(hi_out, _mm_or_pd(_mm_and_pd(measurable, _mm_add_pd(e, slack)),
+                                    _mm_andnot_pd(measurable, inf)));
+    _mm_storeu_pd(lo_out, _mm_or_pd(_mm_and_pd(measurable, _mm_sub_pd(e, slack)),
+                                    _mm_andnot_pd(measurable, _mm_xor_pd(inf, _mm_set1_pd(-0.0)))));
+}
+
+// Four edges (two pairs) at once: one rsqrtps on their |L|^2 rounded to float.
+[[gnu::always_inline]] inline void boxSatEdgeBounds4(__m128d len2_a, __m128d sep_a,
+                                                     __m128d len2_b, __m128d sep_b,
+                                                     double* hi_out, double* lo_out) {
+    const __m128 inv = _mm_rsqrt_ps(_mm_movelh_ps(_mm_cvtpd_ps(len2_a), _mm_cvtpd_ps(len2_b)));
+    boxSatEdgeBounds(len2_a, sep_a, _mm_cvtps_pd(inv), hi_out, lo_out);
+    boxSatEdgeBounds(len2_b, sep_b, _mm_cvtps_pd(_mm_movehl_ps(inv, inv)), hi_out + 2,
+                     lo_out + 2);
+}
+
+// The lanes in pairs: (i = 0, 1) for each j, then (i = 2; j = 0, 1), then (i = 2, j = 2) in the
+// low lane. The maxima are taken one edge at a time in order of k, as the scalar form does.
+inline void boxSatEdgeEstimates(const Vec3& ea, const Mat3& rot, const Vec3& t, const Vec3& eb,
+                                std::array<Real, 9>& hi, Real& cut, Real& max_hi) {
+    const double* d = rot.data();  // column-major: R(r, c) = d[r + 3 c]
+    const __m128d t01 = _mm_loadu_pd(t.data());
+    const __m128d t12 = _mm_loadu_pd(t.data() + 1);
+    const __m128d t20 = _mm_shuffle_pd(t12, t01, 1);
+    const __m128d ea01 = _mm_loadu_pd(ea.data());
+    const __m128d ea12 = _mm_loadu_pd(ea.data() + 1);
+    const __m128d ea20 = _mm_shuffle_pd(ea12, ea01, 1);
+    // Rows 0, 1 and rows 1, 2 of each column, and their absolute values. Plain arrays:
+    // std::array drops __m128d's alignment attribute.
+    __m128d c01[3];
+    __m128d c12[3];
+    __m128d abs01[3];
+    __m128d abs12[3];
+    for (int j = 0; j < 3; ++j) {
+        c01[j] = _mm_loadu_pd(d + 3 * j);
+        c12[j] = _mm_loadu_pd(d + 3 * j + 1);
+        abs01[j] = boxSatAbs(c01[j]);
+        abs12[j] = boxSatAbs(c12[j]);
+    }
+    // Edge k's bounds at lane kLane[k] of these (lane l of pair p is 2 p + l; the last high lane
+    // is not an edge).
+    std::array<Real, 10> hi_lanes;
+    std::array<Real, 10> lo_lanes;
+    constexpr std::array<std::size_t, 9> kLane{0, 2, 4, 1, 3, 5, 6, 7, 8};
+    // i = 0, 1 (i1 = 1, 2; i2 = 2, 0) with column j: r1 = (R(1, j), R(2, j)), r2 = (R(2, j),
+    // R(0, j)); R(i, j1) and R(i, j2) are rows 0 and 1 of columns j1 and j2.
+    __m128d len2[3];
+    __m128d sep[3];
+    for (int j = 0; j < 3; ++j) {
+        const int j1 = (j + 1) % 3;
+        const int j2 = (j + 2) % 3;
+        boxSatEdgeLanes(c12[j], _mm_shuffle_pd(c12[j], c01[j], 1), abs12[j],
+                        _mm_shuffle_pd(abs12[j], abs01[j], 1), t12, t20, ea12, ea20,
+                        _mm_set1_pd(eb[j1]), _mm_set1_pd(eb[j2]), abs01[j1], abs01[j2], len2[j],
+                        sep[j]);
+    }
+    boxSatEdgeBounds4(len2[0], sep[0], len2[1], sep[1], hi_lanes.data(), lo_lanes.data());
+    // i = 2 (i1 = 0, i2 = 1), j = 0, 1 (j1 = 1, 2; j2 = 2, 0): r1 = (R(0, 0), R(0, 1)), r2 =
+    // (R(1, 0), R(1, 1)).
+    const __m128d t0 = _mm_set1_pd(t[0]);
+    const __m128d t1 = _mm_set1_pd(t[1]);
+    const __m128d ea0 = _mm_set1_pd(ea[0]);
+    const __m128d ea1 = _mm_set1_pd(ea[1]);
+    const __m128d eb01 = _mm_loadu_pd(eb.data());
+    const __m128d eb12 = _mm_loadu_pd(eb.data() + 1);
+    const __m128d eb20 = _mm_shuffle_pd(eb12, eb01, 1);
+    __m128d len2_q;
+    __m128d sep_q;
+    boxSatEdgeLanes(_mm_unpacklo_pd(c01[0], c01[1]), _mm_unpackhi_pd(c01[0], c01[1]),
+                    _mm_unpacklo_pd(abs01[0], abs01[1]), _mm_unpackhi_pd(abs01[0], abs01[1]), t0,
+                    t1, ea0, ea1, eb12, eb20, _mm_unpackhi_pd(abs12[1], abs12[2]),
+                    _mm_unpackhi_pd(abs12[2], abs12[0]), len2_q, sep_q);
+    boxSatEdgeBounds4(len2[2], sep[2], len2_q, sep_q, hi_lanes.data() + 4, lo_lanes.data() + 4);
+    // i = 2, j = 2 (j1 = 0, j2 = 1) in the low lane: r1 = R(0, 2), r2 = R(1, 2).
+    __m128d len2_z;
+    __m128d sep_z;
+    boxSatEdgeLanes(c01[2], _mm_unpackhi_pd(c01[2], c01[2]), abs01[2],
+                    _mm_unpackhi_pd(abs01[2], abs01[2]), t0, t1, ea0, ea1, eb01, eb12,
+                    _mm_unpackhi_pd(abs12[0], abs12[0]), _mm_unpackhi_pd(abs12[1], abs12[1]),
+                    len2_z, sep_z);
+    const __m128 inv_z = _mm_rsqrt_ps(_mm_cvtpd_ps(len2_z));
+    boxSatEdgeBounds(len2_z, sep_z, _mm_cvtps_pd(inv_z), hi_lanes.data() + 8,
+                     lo_lanes.data() + 8);
+    for (std::size_t k = 0; k < 9; ++k) {
+        hi[k] = hi_lanes[kLane[k]];
+        cut = std::max(cut, lo_lanes[kLane[k]]);
+        max_hi = std::max(max_hi, hi[k]);
+    }
+}
+#else
+inline void boxSatEdgeEstimates(const Vec3& ea, const Mat3& rot, const Vec3& t, const Vec3& eb,
+                                std::array<Real, 9>& hi, Real& cut, Real& max_hi) {
+    alignas(16) std::array<float, 12> len2f{};
+    std::array<Real, 9> unnormalised;
+    std::array<bool, 9> measurable;
+    // Edge k = 3 i + j: i1, i2 follow i and j1, j2 follow j cyclically.
+    constexpr std::array<int, 9> kI{0, 0, 0, 1, 1, 1, 2, 2, 2};
+    constexpr std::array<int, 9> kJ{0, 1, 2, 0, 1, 2, 0, 1, 2};
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC unroll 9
+#endif
+    for (std::size_t k = 0; k < 9; ++k) {
+        const int i = kI[k];
+        const int j = kJ[k];
+        const int i1 = (i + 1) % 3;
+        const int i2 = (i + 2) % 3;
+        const int j1 = (j + 1) % 3;
+        const int j2 = (j + 2) % 3;
+        const Real r1 = rot(i1, j);
+        const Real r2 = rot(i2, j);
+        const Real len2 = r1 * r1 + r2 * r2;
+        const Real dist = std::abs(t[i2] * r1 - t[i1] * r2);
+        const Real ra = ea[i1] * std::abs(r2) + ea[i2] * std::abs(r1);
+        const Real rb = eb[j1] * std::abs(rot(i, j2)) + eb[j2] * std::abs(rot(i, j1));
+        unnormalised[k] = dist - ra - rb;
+        measurable[k] = len2 >= kBoxSatNearParallel2;  // also false for NaN
+        // Not selected: an edge that is not measurable gets hi = +inf and no part in cut below,
+        // so its estimate (from rsqrt of a tiny, zero or NaN len2) is never used.
+        len2f[k] = static_cast<float>(len2);
+    }
+    len2f[9] = len2f[10] = len2f[11] = 1.0f;
+    alignas(16) std::array<float, 12> inv_len{};
+    boxSatRsqrt(len2f.data(), inv_len.data());
+    for (std::size_t k = 0; k < 9; ++k) {
+        const Real e = unnormalised[k] * static_cast<Real>(inv_len[k]);
+        const Real slack = kBoxSatRsqrtRelative * std::abs(e);
+        hi[k] = measurable[k] ? e + slack : std::numeric_limits<Real>::infinity();
+        if (measurable[k]) cut = std::max(cut, e - slack);
+        max_hi = std::max(max_hi, hi[k]);
+    }
+}
+#endif
+
 /// The fields of measureBoxSat(...) that need no per-axis arrays -- face_sep, face_box,
 /// face_axis, max_sep, err_bound, and edge_sep, edge_a, edge_b, edge_axis -- bit for bit, with
 /// per_axis false; except that when every edge axis is provably below the best face axis the
@@ -218,14 +394,16 @@ inline void boxSatRsqrt(const float* in, float* out) {
 /// them, in the same order with the same tie rule, so the best edge, its separation and its axis
 /// are the same numbers. Unnormalised separation / |L| and measureBoxSat's value are both within
 /// 8 eps (|t.L| + ra + rb) <= err_bound / 2 of the true separation, and the approximate 1 / |L|
-/// is within kRsqrtRelative of 1 / |L|, so an edge whose estimate interval lies below another's
-/// by more than 2 err_bound is below that edge's measured value.
+/// is within kBoxSatRsqrtRelative of 1 / |L|, so an edge whose estimate interval lies below
+/// another's by more than 2 err_bound is below that edge's measured value (boxSatEdgeEstimates).
 ///
 /// With `stop_above` finite it returns early, the edge fields unset and max_sep only a lower
 /// bound on the measure's, once max_sep + err_bound >= stop_above is certain: callers that only
 /// act on a clear overlap (max_sep + err_bound < -tolerance) pass -tolerance and fall back to the
 /// full measure, so pairs apart or touching pay little for the attempt.
-inline BoxSatMeasure measureBoxSatBest(
+// Not inlined: inlined into box-box contact(), the SSE2 estimates and the caller's state no
+// longer fit the registers, and the spills cost more instructions than the call.
+[[gnu::noinline]] inline BoxSatMeasure measureBoxSatBest(
     const Vec3& ea, const Mat3& rot, const Vec3& t, const Vec3& eb,
     Real stop_above = std::numeric_limits<Real>::infinity()) {
     BoxSatMeasure m;
@@ -250,53 +428,13 @@ inline BoxSatMeasure measureBoxSatBest(
         m.max_sep = m.face_sep;
         return m;
     }
-    // Unnormalised estimates s / |L|, 1 / |L| from the SSE reciprocal square root (relative
-    // error below 1.5 * 2^-12): an edge is measured unless its estimate plus that error is below
-    // the best estimate minus that error by more than 2 err_bound. Edges closer to parallel than
-    // kNearParallel2 are always measured.
-    constexpr Real kNearParallel2 = Real(1e-8);
-    constexpr Real kRsqrtRelative = Real(1e-3);
-    alignas(16) std::array<float, 12> len2f{};
-    std::array<Real, 9> unnormalised;
-    std::array<bool, 9> measurable;
-    // Edge k = 3 i + j: i1, i2 follow i and j1, j2 follow j cyclically.
-    constexpr std::array<int, 9> kI{0, 0, 0, 1, 1, 1, 2, 2, 2};
-    constexpr std::array<int, 9> kJ{0, 1, 2, 0, 1, 2, 0, 1, 2};
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC unroll 9
-#endif
-    for (std::size_t k = 0; k < 9; ++k) {
-        const int i = kI[k];
-        const int j = kJ[k];
-        const int i1 = (i + 1) % 3;
-        const int i2 = (i + 2) % 3;
-        const int j1 = (j + 1) % 3;
-        const int j2 = (j + 2) % 3;
-        const Real r1 = rot(i1, j);
-        const Real r2 = rot(i2, j);
-        const Real len2 = r1 * r1 + r2 * r2;
-        const Real dist = std::abs(t[i2] * r1 - t[i1] * r2);
-        const Real ra = ea[i1] * std::abs(r2) + ea[i2] * std::abs(r1);
-        const Real rb = eb[j1] * std::abs(rot(i, j2)) + eb[j2] * std::abs(rot(i, j1));
-        unnormalised[k] = dist - ra - rb;
-        measurable[k] = len2 >= kNearParallel2;  // also false for NaN
-        // Not selected: an edge that is not measurable gets hi = +inf and no part in cut below,
-        // so its estimate (from rsqrt of a tiny, zero or NaN len2) is never used.
-        len2f[k] = static_cast<float>(len2);
-    }
-    len2f[9] = len2f[10] = len2f[11] = 1.0f;
-    alignas(16) std::array<float, 12> inv_len{};
-    boxSatRsqrt(len2f.data(), inv_len.data());
+    // An edge is measured unless its estimate plus the rsqrt error is below the best estimate
+    // minus that error by more than 2 err_bound; edges closer to parallel than
+    // kBoxSatNearParallel2 are always measured.
     std::array<Real, 9> hi;
     Real cut = -std::numeric_limits<Real>::infinity();
     Real max_hi = -std::numeric_limits<Real>::infinity();
-    for (std::size_t k = 0; k < 9; ++k) {
-        const Real e = unnormalised[k] * static_cast<Real>(inv_len[k]);
-        const Real slack = kRsqrtRelative * std::abs(e);
-        hi[k] = measurable[k] ? e + slack : std::numeric_limits<Real>::infinity();
-        if (measurable[k]) cut = std::max(cut, e - slack);
-        max_hi = std::max(max_hi, hi[k]);
-    }
+    boxSatEdgeEstimates(ea, rot, t, eb, hi, cut, max_hi);
     // The edge with the best lower estimate measures at least cut - err_bound.
     if (cut >= stop_above) {
         m.max_sep = std::max(m.face_sep, cut - m.err_bound);
