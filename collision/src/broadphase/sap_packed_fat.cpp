@@ -165,7 +165,7 @@ void PackedSweepAndPrune::restale() {
     stale_lanes_.pad(count);
 }
 
-void PackedSweepAndPrune::queryEscaped(std::vector<ProxyPair>& pairs,
+void PackedSweepAndPrune::queryEscaped(std::vector<ProxyPair>* exact_pairs,
                                        BroadPhaseCounters& counters) {
     // The sorted bands, as last dealt, still hold every box that has not been re-fattened
     // since (not stale): an escaped box is looked up in the bands its y range meets, from the
@@ -214,7 +214,7 @@ void PackedSweepAndPrune::queryEscaped(std::vector<ProxyPair>& pairs,
     counters.volume_tests += tests;
     radix::keysToSortedPairs(keys_, scratch_, shift_, fresh_, /*order_ids=*/true);
     const char* flag = escaped_flag_.data();
-    if (output_ == Output::Loose) {
+    if (exact_pairs == nullptr) {
         // The kept candidates (no escaped member) and the fresh ones, both sorted, merged; no
         // exact test (the caller makes it).
         merged_.resize(candidates_.size() + fresh_.size());
@@ -238,6 +238,7 @@ void PackedSweepAndPrune::queryEscaped(std::vector<ProxyPair>& pairs,
     // The same pass writes the exact pairs (see exactPairs): one walk over the candidates, not
     // two. Branch-free: every candidate is written to both lists, the merged count advances for
     // a kept one, the exact count for a kept one whose boxes overlap.
+    std::vector<ProxyPair>& pairs = *exact_pairs;
     merged_.resize(candidates_.size() + fresh_.size());
     pairs.resize(merged_.size());
     ProxyPair* merged = merged_.data();
