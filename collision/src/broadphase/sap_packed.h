@@ -84,6 +84,11 @@ private:
     static constexpr float kMargin = 16.0f;    ///< most fat margin / recent motion per frame
     static constexpr float kMinMargin = 1.0f;  ///< least fat margin / recent motion per frame
     static constexpr float kLead = 32.0f;      ///< fat lead / mean velocity, on the side it leads
+    /// A box moving steadily: mean speed over its last fat box's lifetime at least kSteady of
+    /// its recent step. Its lead does the work: a longer one, and a thinner most margin.
+    static constexpr float kSteady = 0.9f;
+    static constexpr float kSteadyLead = 64.0f;
+    static constexpr float kSteadyMargin = 2.0f;
     static constexpr float kMotionDecay = 0.95f;
     static constexpr std::size_t kEscapeShare = 4;  ///< a full sweep when n / this escape at once
     static constexpr std::size_t kStaleShare = 4;   ///< bands dealt again past n / this stale
