@@ -45,29 +45,34 @@ protected:
 };
 
 /// A cdlab broad phase with a loose output (collision/broadphase/loose_broad_phase.h), driven like
-/// the registry's. Its findPairs() list is a superset of the exact pairs, as a Bullet pair cache
-/// is, and is treated the same way: rawPairs() is its size, deliverExact() keeps the pairs whose
-/// exact boxes overlap (timed under the exact-pairs rule), summary() filters it again, untimed.
+/// the registry's but read as a Bullet pair cache is: findPairs() brings the held list up to date
+/// (updatePairs) and the list is read in place (heldPairs), no copy. It is a superset of the
+/// exact pairs and is treated as the peers' caches: rawPairs() is its size, deliverExact() keeps
+/// the pairs whose exact boxes overlap (timed under the exact-pairs rule), summary() filters it
+/// again, untimed.
 class LooseCdlabMethod : public CdlabMethod {
 public:
-    using CdlabMethod::CdlabMethod;
+    explicit LooseCdlabMethod(std::unique_ptr<collision::LooseBroadPhase> broad_phase)
+        : CdlabMethod(nullptr), loose_(broad_phase.get()) {
+        broad_phase_ = std::move(broad_phase);
+    }
 
     void findPairs() override {
-        broad_phase_->findPairs(loose_, counters_);
+        loose_->updatePairs(counters_);
         delivered_ = false;
     }
     void deliverExact(const MovingBoxes& boxes) override {
         // What its caller does before a narrow phase: keep the pairs whose exact boxes (the
         // workload's, as the Bullet rows with float proxies test them) overlap. Stays sorted.
         exact_.clear();
-        for (const collision::ProxyPair& p : loose_) {
+        for (const collision::ProxyPair& p : loose_->heldPairs()) {
             if (boxes.aabb(p.a).overlaps(boxes.aabb(p.b))) exact_.push_back(p);
         }
         delivered_ = true;
     }
     PairSummary summary(const MovingBoxes& boxes) override {
         PairSummary out;
-        for (const collision::ProxyPair& p : loose_) {
+        for (const collision::ProxyPair& p : loose_->heldPairs()) {
             if (!boxes.aabb(p.a).overlaps(boxes.aabb(p.b))) continue;
             ++out.pairs;
             out.hash += pairHash(p.a, p.b);
@@ -77,10 +82,12 @@ public:
         if (delivered_ && !(summarizePairs(exact_) == out)) out.pairs = -1;
         return out;
     }
-    std::int64_t rawPairs() const override { return static_cast<std::int64_t>(loose_.size()); }
+    std::int64_t rawPairs() const override {
+        return static_cast<std::int64_t>(loose_->heldPairs().size());
+    }
 
 private:
-    std::vector<collision::ProxyPair> loose_;
+    collision::LooseBroadPhase* loose_;  ///< broad_phase_, as its loose interface
     std::vector<collision::ProxyPair> exact_;
     bool delivered_ = false;
 };

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -470,6 +471,59 @@ TEST(PackedSweepAndPrune, LooseOutputFollowsInsertsAndRemoves) {
         }
         ASSERT_EQ(filtered, exact_pairs) << "frame " << frame;
         ASSERT_GT(exact_pairs.size(), 100u);
+    }
+}
+
+// The held list read in place (updatePairs, heldPairs: no copy, as a Bullet pair cache is read)
+// is the list findPairs writes, frame after frame, through the coherent path and the full
+// sweeps; and the exact mode holds the same candidates (the output mode changes only what is
+// written).
+TEST(PackedSweepAndPrune, LooseHeldPairsAreTheLooseOutput) {
+    for (MovingScene scene : {steadyScene(700, true, 81), touchingScene(700, 82)}) {
+        Rng rng(83);
+        PackedSweepAndPrune written(PackedSweepAndPrune::Output::Loose);
+        PackedSweepAndPrune held(PackedSweepAndPrune::Output::Loose);
+        PackedSweepAndPrune exact;
+        for (int i = 0; i < scene.size(); ++i) {
+            written.insert(i, scene.volumes(i));
+            held.insert(i, scene.volumes(i));
+            exact.insert(i, scene.volumes(i));
+        }
+        std::vector<ProxyPair> loose_pairs, exact_pairs;
+        int coherent_frames = 0;
+        int looser_frames = 0;  // frames whose loose list holds more than the exact pairs
+        std::int64_t first_tests = 0;
+        for (int frame = 0; frame <= 80; ++frame) {
+            if (frame > 0) {
+                scene.step(rng);
+                for (int i = 0; i < scene.size(); ++i) {
+                    written.move(i, scene.volumes(i));
+                    held.move(i, scene.volumes(i));
+                    exact.move(i, scene.volumes(i));
+                }
+            }
+            BroadPhaseCounters wc, hc, ec;
+            written.findPairs(loose_pairs, wc);
+            held.updatePairs(hc);
+            exact.findPairs(exact_pairs, ec);
+            const std::span<const ProxyPair> in_place = held.heldPairs();
+            ASSERT_TRUE(std::equal(in_place.begin(), in_place.end(), loose_pairs.begin(),
+                                   loose_pairs.end()))
+                << "frame " << frame << ": held " << in_place.size() << ", written "
+                << loose_pairs.size();
+            const std::span<const ProxyPair> written_held = written.heldPairs();
+            ASSERT_TRUE(std::equal(written_held.begin(), written_held.end(), loose_pairs.begin(),
+                                   loose_pairs.end()));
+            const std::span<const ProxyPair> exact_held = exact.heldPairs();
+            ASSERT_TRUE(std::equal(exact_held.begin(), exact_held.end(), loose_pairs.begin(),
+                                   loose_pairs.end()));
+            ASSERT_EQ(hc.pairs_flagged, static_cast<std::int64_t>(loose_pairs.size()));
+            looser_frames += loose_pairs.size() > exact_pairs.size();
+            if (frame == 0) first_tests = hc.volume_tests;
+            coherent_frames += frame > 0 && hc.volume_tests < first_tests / 4;
+        }
+        EXPECT_GT(coherent_frames, 20);
+        EXPECT_GT(looser_frames, 40);
     }
 }
 

@@ -394,6 +394,32 @@ void PackedSweepAndPrune::sweepBig(BroadPhaseCounters& counters) {
 }
 
 void PackedSweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) {
+    if (output_ == Output::Loose) {
+        // The candidates themselves, sorted and unique: a superset of the exact pairs.
+        update(nullptr, counters);
+        pairs.assign(candidates_.begin(), candidates_.end());
+    } else if (!update(&pairs, counters)) {
+        // The exact answer: every candidate (fat boxes overlap) tested on the double AABBs.
+        // Candidates are sorted, so the pairs are. Branch-free: every candidate is written, and
+        // the count advances only for an overlap (about half the candidates do, so a branch
+        // would be mispredicted as often as not).
+        pairs.resize(candidates_.size());
+        std::size_t count = 0;
+        for (const ProxyPair& p : candidates_) {
+            pairs[count] = p;
+            count += static_cast<std::size_t>(overlapsExactly(p));
+        }
+        pairs.resize(count);
+    }
+    counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
+}
+
+void PackedSweepAndPrune::updatePairs(BroadPhaseCounters& counters) {
+    update(nullptr, counters);
+    counters.pairs_flagged += static_cast<std::int64_t>(candidates_.size());
+}
+
+bool PackedSweepAndPrune::update(std::vector<ProxyPair>* exact, BroadPhaseCounters& counters) {
     counters.volumes_updated += moved_;
     moved_ = 0;
     ++frame_;
@@ -413,8 +439,8 @@ void PackedSweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCou
         } else if (margins_on_ && escaped_.size() <= limit) {
             for (const ProxyId e : escaped_) fatten(e, 1.0f, true);
             restale();
-            queryEscaped(pairs, counters);
-            exact_done = true;
+            queryEscaped(exact, counters);
+            exact_done = exact != nullptr;
             // The candidates are complete; once many boxes are stale, their list is long and
             // the bands are sorted and dealt again from the current fat boxes (no sweep).
             if (stale_ids_.size() > present_.size() / kStaleShare) resnapshot(counters);
@@ -438,24 +464,7 @@ void PackedSweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCou
     }
     for (const ProxyId e : escaped_) escaped_flag_[e] = 0;
     escaped_.clear();
-
-    if (output_ == Output::Loose) {
-        // The candidates themselves, sorted and unique: a superset of the exact pairs.
-        pairs.assign(candidates_.begin(), candidates_.end());
-    } else if (!exact_done) {
-        // The exact answer: every candidate (fat boxes overlap) tested on the double AABBs.
-        // Candidates are sorted, so the pairs are. Branch-free: every candidate is written, and
-        // the count advances only for an overlap (about half the candidates do, so a branch
-        // would be mispredicted as often as not).
-        pairs.resize(candidates_.size());
-        std::size_t count = 0;
-        for (const ProxyPair& p : candidates_) {
-            pairs[count] = p;
-            count += static_cast<std::size_t>(overlapsExactly(p));
-        }
-        pairs.resize(count);
-    }
-    counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
+    return exact_done;
 }
 
 void PackedSweepAndPrune::draw(DebugDraw& draw, const Aabb& bounds) const {
@@ -512,7 +521,7 @@ std::string PackedSweepAndPrune::validate() const {
     return {};
 }
 
-std::unique_ptr<BroadPhase> createLoosePackedSweepAndPrune() {
+std::unique_ptr<LooseBroadPhase> createLoosePackedSweepAndPrune() {
     return std::make_unique<PackedSweepAndPrune>(PackedSweepAndPrune::Output::Loose);
 }
 

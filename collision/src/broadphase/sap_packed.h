@@ -10,7 +10,7 @@
 #endif
 
 #include "broadphase/proxy_table.h"
-#include "collision/broadphase/broad_phase.h"
+#include "collision/broadphase/loose_broad_phase.h"
 
 namespace collision {
 
@@ -40,7 +40,7 @@ namespace collision {
 /// frame every fat box is swept again (margins kept); when most do, margins are not paying and
 /// everything is swept with exact boxes, margins tried again kRetryFrames later. A new proxy set
 /// (insert, remove) is swept with exact boxes: the one-shot path.
-class PackedSweepAndPrune : public BroadPhase {
+class PackedSweepAndPrune : public LooseBroadPhase {
 public:
     /// What findPairs writes.
     enum class Output {
@@ -60,6 +60,11 @@ public:
     void remove(ProxyId id) override;
     void move(ProxyId id, const ProxyVolumes& v) override;
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
+    /// findPairs() without writing pairs: the candidates brought up to date, none confirmed.
+    void updatePairs(BroadPhaseCounters& counters) override;
+    /// The candidates of the last findPairs() or updatePairs() (either output): every pair whose
+    /// fat boxes overlap, sorted, unique.
+    std::span<const ProxyPair> heldPairs() const override { return candidates_; }
     void draw(DebugDraw& draw, const Aabb& bounds) const override;
     /// Checks the entries' order, and the invariant at the top of sap_packed.cpp: candidates
     /// sorted, unique, each a pair of overlapping fat boxes, and every present box inside its fat
@@ -79,6 +84,11 @@ private:
     static constexpr float kMargin = 16.0f;    ///< most fat margin / recent motion per frame
     static constexpr float kMinMargin = 1.0f;  ///< least fat margin / recent motion per frame
     static constexpr float kLead = 32.0f;      ///< fat lead / mean velocity, on the side it leads
+    /// A box moving steadily: mean speed over its last fat box's lifetime at least kSteady of
+    /// its recent step. Its lead does the work: a longer one, and a thinner most margin.
+    static constexpr float kSteady = 0.9f;
+    static constexpr float kSteadyLead = 64.0f;
+    static constexpr float kSteadyMargin = 2.0f;
     static constexpr float kMotionDecay = 0.95f;
     static constexpr std::size_t kEscapeShare = 4;  ///< a full sweep when n / this escape at once
     static constexpr std::size_t kStaleShare = 4;   ///< bands dealt again past n / this stale
@@ -142,9 +152,12 @@ private:
     void resnapshot(BroadPhaseCounters& counters);
     void fullSweep(BroadPhaseCounters& counters);
     void restale();
-    /// Looks up the escaped boxes and updates candidates_; with Output::Exact also writes the
-    /// exact pairs to `pairs` (in the same walk over the candidates).
-    void queryEscaped(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters);
+    /// Brings candidates_ up to date with the current boxes. Given `exact`, a frame that walks
+    /// the candidates anyway also writes the exact pairs there; returns whether it did.
+    bool update(std::vector<ProxyPair>* exact, BroadPhaseCounters& counters);
+    /// Looks up the escaped boxes and updates candidates_; given `exact`, also writes the exact
+    /// pairs there (in the same walk over the candidates).
+    void queryEscaped(std::vector<ProxyPair>* exact, BroadPhaseCounters& counters);
     /// Whether the candidate's double AABBs overlap, as Aabb::overlaps decides (closed test).
     /// Inline: it runs once per candidate per frame.
     int overlapsExactly(const ProxyPair& p) const {

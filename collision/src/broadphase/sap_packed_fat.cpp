@@ -25,8 +25,14 @@ void PackedSweepAndPrune::fatten(ProxyId id, float share, bool learn) {
     // towards a lead of kLead frames of the box's mean velocity over its last fat box's lifetime.
     // The margin is learnt from how far that lifetime's lead missed (twice the miss, at least
     // kMinMargin and at most kMargin times the recent step): a box moving steadily is led and
-    // gets a thin margin, one jittering about a place no lead and the full margin. Without a
-    // lifetime to learn from (a rebuild) the margin is full and there is no lead.
+    // gets a thin margin, one jittering about a place no lead and the full margin. A box whose
+    // mean speed over the lifetime is about its step per frame (kSteady) moves steadily: it is
+    // led twice as far (kSteadyLead), so it escapes half as often, and a large miss of its lead
+    // is a turn (a bounce), which the next lead follows, so its margin stays at most
+    // kSteadyMargin steps (a full one would hold every neighbour of its long lead for a
+    // lifetime). A random walk's mean speed falls as its lifetime grows: it keeps the full
+    // margin and the short lead. Without a lifetime to learn from (a rebuild) the margin is
+    // full and there is no lead.
     const Aabb& box = table_.aabb(id);
     const std::size_t k = static_cast<std::size_t>(id);
     if (share == 0) {
@@ -37,14 +43,17 @@ void PackedSweepAndPrune::fatten(ProxyId id, float share, bool learn) {
     }
     const Vec3 centre = (box.min + box.max) / 2;
     const Real step = motion_[k];
+    bool steady = false;
     if (learn && frame_ > fat_frame_[k]) {
         const Real lived = Real(frame_ - fat_frame_[k]);
         const Vec3 moved = centre - fat_centre_[k];
         const Real miss = (moved - lived * lead_velocity_[k]).cwiseAbs().maxCoeff();
-        margin_[k] = std::isfinite(miss)
-                         ? std::clamp<Real>(2 * miss, kMinMargin * step, kMargin * step)
-                         : kMargin * step;
         const Vec3 velocity = moved / lived;
+        steady = velocity.cwiseAbs().maxCoeff() >= kSteady * step;
+        const Real most = steady ? kSteadyMargin : kMargin;
+        margin_[k] = std::isfinite(miss)
+                         ? std::clamp<Real>(2 * miss, kMinMargin * step, most * step)
+                         : kMargin * step;
         lead_velocity_[k] = velocity.allFinite() ? velocity : Vec3::Zero();
     } else {
         margin_[k] = kMargin * step;
@@ -53,7 +62,7 @@ void PackedSweepAndPrune::fatten(ProxyId id, float share, bool learn) {
     fat_centre_[k] = centre;
     fat_frame_[k] = frame_;
     const Real base = Real(share) * margin_[k];
-    const Vec3 led = Real(share) * kLead * lead_velocity_[k];
+    const Vec3 led = Real(share) * (steady ? kSteadyLead : kLead) * lead_velocity_[k];
     const Vec3 lead = led.allFinite() ? led : Vec3::Zero();
     setFat(k, box.min.x() - (base + std::max<Real>(0, -lead.x())),
            box.min.y() - (base + std::max<Real>(0, -lead.y())),
@@ -165,7 +174,7 @@ void PackedSweepAndPrune::restale() {
     stale_lanes_.pad(count);
 }
 
-void PackedSweepAndPrune::queryEscaped(std::vector<ProxyPair>& pairs,
+void PackedSweepAndPrune::queryEscaped(std::vector<ProxyPair>* exact_pairs,
                                        BroadPhaseCounters& counters) {
     // The sorted bands, as last dealt, still hold every box that has not been re-fattened
     // since (not stale): an escaped box is looked up in the bands its y range meets, from the
@@ -214,7 +223,7 @@ void PackedSweepAndPrune::queryEscaped(std::vector<ProxyPair>& pairs,
     counters.volume_tests += tests;
     radix::keysToSortedPairs(keys_, scratch_, shift_, fresh_, /*order_ids=*/true);
     const char* flag = escaped_flag_.data();
-    if (output_ == Output::Loose) {
+    if (exact_pairs == nullptr) {
         // The kept candidates (no escaped member) and the fresh ones, both sorted, merged; no
         // exact test (the caller makes it).
         merged_.resize(candidates_.size() + fresh_.size());
@@ -238,6 +247,7 @@ void PackedSweepAndPrune::queryEscaped(std::vector<ProxyPair>& pairs,
     // The same pass writes the exact pairs (see exactPairs): one walk over the candidates, not
     // two. Branch-free: every candidate is written to both lists, the merged count advances for
     // a kept one, the exact count for a kept one whose boxes overlap.
+    std::vector<ProxyPair>& pairs = *exact_pairs;
     merged_.resize(candidates_.size() + fresh_.size());
     pairs.resize(merged_.size());
     ProxyPair* merged = merged_.data();
