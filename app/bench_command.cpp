@@ -32,7 +32,8 @@ Command addBenchBroadphaseCommand(CLI::App& bench) {
                     "comma-separated (default: every AABB broad phase, sap-packed-loose -- "
                     "sap-packed's candidates unfiltered, a loose pair cache like Bullet's -- and "
                     "the default peers); hgrid:found, hgrid2:found: pairs in the order found, not "
-                    "sorted")
+                    "sorted; terdiman-v17: Terdiman's BoxPruning17, a peer when built with "
+                    "-DCDLAB_BOXPRUNING_DIR")
         ->delimiter(',');
     cmd->add_option("--workload", o.workload,
                     "uniform, mixed (sizes 1:100), both (those two), wide (sizes 1:10^4) or "

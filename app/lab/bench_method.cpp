@@ -134,6 +134,7 @@ std::vector<BenchMethodEntry> makeMethods() {
     };
     methods.push_back(std::move(loose));
     appendPeerMethods(methods);
+    appendBoxPruningPeer(methods);
     return methods;
 }
 

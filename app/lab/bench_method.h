@@ -75,5 +75,8 @@ const BenchMethodEntry* findBenchMethod(std::string_view name);
 
 /// Peer configurations, appended to benchMethods(); defined in bench_peers.cpp.
 void appendPeerMethods(std::vector<BenchMethodEntry>& methods);
+/// Terdiman's BoxPruning17 as `terdiman-v17` when configured with CDLAB_BOXPRUNING_DIR, else
+/// nothing; defined in bench_boxpruning_peer.cpp.
+void appendBoxPruningPeer(std::vector<BenchMethodEntry>& methods);
 
 }  // namespace app
