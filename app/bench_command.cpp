@@ -33,7 +33,7 @@ Command addBenchBroadphaseCommand(CLI::App& bench) {
                     "sap-packed's candidates unfiltered, a loose pair cache like Bullet's -- and "
                     "the default peers); hgrid:found, hgrid2:found: pairs in the order found, not "
                     "sorted; terdiman-v17: Terdiman's BoxPruning17, a peer when built with "
-                    "-DCDLAB_BOXPRUNING_DIR")
+                    "-DCDLAB_BOXPRUNING_DIR (float boxes: exact on the boxpruning workload)")
         ->delimiter(',');
     cmd->add_option("--workload", o.workload,
                     "uniform, mixed (sizes 1:100), both (those two), wide (sizes 1:10^4) or "

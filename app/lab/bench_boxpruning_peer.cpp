@@ -67,7 +67,8 @@ void appendBoxPruningPeer([[maybe_unused]] std::vector<BenchMethodEntry>& method
         "Terdiman's BoxPruning17 CompleteBoxPruning (radix sort, 5 YZ buckets, SSE), "
         "one-shot every frame, boxes as floats";
     m.peer = true;
-    m.default_set = true;
+    // Named only: on workloads whose bounds are not floats, rounding can change the pair set.
+    m.default_set = false;
     m.create = []() -> std::unique_ptr<BenchMethod> {
         return std::make_unique<BoxPruningV17Method>();
     };
