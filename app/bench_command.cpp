@@ -60,6 +60,12 @@ Command addBenchBroadphaseCommand(CLI::App& bench) {
                     "elapsed time, every method")
         ->check(CLI::IsMember({"thread", "wall"}))
         ->capture_default_str();
+    cmd->add_option("--rounds", o.rounds,
+                    "run each table's rows this many times, interleaved (every other round in "
+                    "reverse order), and report medians over the rounds with each round's ratios "
+                    "(a machine that runs slow for a stretch then costs a round, not a row)")
+        ->check(CLI::Range(1, kMaxBenchRounds))
+        ->capture_default_str();
     cmd->add_flag("--in-process", f->in_process,
                   "do not fork per method (no per-method peak memory)");
     return {cmd, [f, cmd]() {

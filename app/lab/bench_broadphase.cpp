@@ -15,6 +15,7 @@
 
 #include "bench_broadphase_measure.h"
 #include "bench_broadphase_report.h"
+#include "bench_broadphase_rounds.h"
 #include "bench_method.h"
 #include "bench_peer_tuning.h"
 #include "bench_rows.h"
@@ -68,6 +69,10 @@ bool resolveBenchOptions(const BenchOptions& options, std::ostream& err,
     }
     if (options.frames < 1) {
         err << "--frames: " << options.frames << "; need at least 1\n";
+        return false;
+    }
+    if (options.rounds < 1 || options.rounds > kMaxBenchRounds) {
+        err << "--rounds: " << options.rounds << "; need 1 to " << kMaxBenchRounds << "\n";
         return false;
     }
     if (options.clock != "thread" && options.clock != "wall") {
@@ -164,6 +169,12 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
                "the fastest by exact_ms when that is another (--peers all prints the "
                "grid).\n";
     }
+    if (options.rounds > 1) {
+        out << "Rounds: " << options.rounds
+            << "; each table's rows run once per round, interleaved (every other round in "
+               "reverse order); each figure is the median over the rounds"
+            << (tune ? " (the peers' grids are swept in the first round)" : "") << ".\n";
+    }
     if (!options.isolate) out << "(in-process run: peak memory not measured)\n";
 
     bool failed = false;
@@ -186,6 +197,7 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
                 for (const BenchMethodEntry* m : methods) rows.push_back(runMethod(*m, run));
                 std::vector<Row> sweep;
                 if (tune) tunePeers(run, rows, sweep);
+                runRounds(run, rows);
                 reportWorkload(out, rows, options,
                                one_shot ? oneShotRepetitions(options) : options.frames);
                 if (options.peers == "all" && !sweep.empty()) {

@@ -34,7 +34,15 @@ struct BenchOptions {
     /// by its exact-pairs median) its row, ratios against the fastest of those; "all": the same, printing the whole grid;
     /// "default": each peer at its default settings only.
     std::string peers = "tuned";
+    /// Each table's rows (cdlab's methods and the tuned peers' winners) run this many times,
+    /// interleaved: round r runs every row once, in reverse order on even rounds, so a stretch
+    /// in which the machine runs slow costs each row one round instead of costing one row its
+    /// whole figure. Each figure is then the median over the rounds; the per-round ratios are
+    /// printed beside it. The peers' tuning runs in the first round only. 1..kMaxBenchRounds.
+    int rounds = 1;
 };
+
+constexpr int kMaxBenchRounds = 50;
 
 /// A small configuration for smoke tests: 200 boxes, 20 frames, both workloads, all methods.
 /// Runs in well under a second per method in Release.

@@ -8,9 +8,11 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bench_broadphase_measure.h"
+#include "bench_broadphase_rounds.h"
 #include "output_files.h"
 
 namespace app {
@@ -62,6 +64,21 @@ nlohmann::json rowJson(const Row& row) {
     j["peak_mb"] = number(r.peak_mb);
     j["frames"] = r.frames_run;
     j["mismatched_frames"] = r.mismatched_frames;
+    if (!row.rounds.empty()) {
+        nlohmann::json rounds = nlohmann::json::array();
+        for (std::size_t k = 0; k < row.rounds.size(); ++k) {
+            nlohmann::json round;
+            round["ms_per_frame_median"] = number(row.rounds[k].median_ms);
+            round["ms_per_frame_median_exact_pairs"] = number(row.rounds[k].exact_median_ms);
+            round["insert_ms"] = number(row.rounds[k].insert_ms);
+            if (k < row.round_ratios.size()) {
+                round["ratio_to_best_peer"] = number(row.round_ratios[k]);
+                round["ratio_to_best_peer_exact_pairs"] = number(row.round_exact_ratios[k]);
+            }
+            rounds.push_back(std::move(round));
+        }
+        j["rounds"] = std::move(rounds);
+    }
     return j;
 }
 
@@ -76,9 +93,21 @@ const Row* bestPeer(const std::vector<Row>& rows, double RunResult::*ms) {
     return best;
 }
 
-// The fastest cdlab method by `ms` against the best peer by the same figure, as one line.
+// "0.43 0.44 0.65x": a row's ratios in each round.
+std::string roundRatiosText(const std::vector<double>& ratios) {
+    std::string text;
+    for (double ratio : ratios) {
+        if (!text.empty()) text += ' ';
+        text += numberText("%.2f", ratio);
+    }
+    text += 'x';
+    return text;
+}
+
+// The fastest cdlab method by `ms` against the best peer by the same figure, as one line (with
+// its ratio in each round when the table ran in rounds).
 void printFastest(std::ostream& out, const std::vector<Row>& rows, double RunResult::*ms,
-                  double Row::*ratio, const char* rule) {
+                  double Row::*ratio, std::vector<double> Row::*round_ratios, const char* rule) {
     const Row* fastest = nullptr;
     for (const Row& row : rows) {
         if (!row.peer && usable(row) &&
@@ -92,10 +121,35 @@ void printFastest(std::ostream& out, const std::vector<Row>& rows, double RunRes
     if (const Row* best = bestPeer(rows, ms)) {
         out << "; best peer: " << best->method << " " << numberText("%.4f", best->result.*ms)
             << " ms/frame; ratio " << numberText("%.2f", fastest->*ratio) << "x";
+        if (!(fastest->*round_ratios).empty()) {
+            out << " (by round: " << roundRatiosText(fastest->*round_ratios) << ")";
+        }
     }
     out << '\n';
 }
 
+
+// Each row's figures in each round, when the table ran in rounds.
+void printRounds(std::ostream& out, const std::vector<Row>& rows, const BenchOptions& options) {
+    if (options.rounds <= 1) return;
+    out << "rounds: " << options.rounds
+        << ", interleaved (every other round in reverse order); the figures above are medians "
+           "over the rounds. Per round: median_ms (vs_peer against that round's best peer), "
+           "exact_ms (vs_peer_ex):\n";
+    for (const Row& row : rows) {
+        if (row.rounds.empty()) continue;
+        std::string ms, exact_ms;
+        for (const RunResult& r : row.rounds) {
+            ms += ' ';
+            ms += numberText("%.4f", r.median_ms);
+            exact_ms += ' ';
+            exact_ms += numberText("%.4f", r.exact_median_ms);
+        }
+        out << "  " << row.method << (row.peer ? " [peer]" : "") << ":" << ms << " ("
+            << roundRatiosText(row.round_ratios) << ");" << exact_ms << " ("
+            << roundRatiosText(row.round_exact_ratios) << ")\n";
+    }
+}
 
 }  // namespace
 
@@ -162,11 +216,13 @@ void reportWorkload(std::ostream& out, std::vector<Row>& rows, const BenchOption
             row.exact_ratio = row.result.exact_median_ms / best_exact->result.exact_median_ms;
         }
     }
+    setRoundRatios(rows);
     printTable(out, rows, frames);
-    printFastest(out, rows, &RunResult::median_ms, &Row::ratio,
+    printFastest(out, rows, &RunResult::median_ms, &Row::ratio, &Row::round_ratios,
                  "pairs as held (median_ms, vs_peer)");
     printFastest(out, rows, &RunResult::exact_median_ms, &Row::exact_ratio,
-                 "exact pairs delivered (exact_ms, vs_peer_ex)");
+                 &Row::round_exact_ratios, "exact pairs delivered (exact_ms, vs_peer_ex)");
+    printRounds(out, rows, options);
     for (const Row& row : rows) {
         const RunResult& r = row.result;
         if (row.skipped || r.failed) continue;
@@ -234,6 +290,7 @@ bool writeBenchJson(const std::filesystem::path& file, const BenchOptions& optio
     doc["seed"] = options.seed;
     doc["clock"] = options.clock;
     doc["peers"] = options.peers;
+    doc["rounds"] = options.rounds;
     doc["rows"] = nlohmann::json::array();
     for (const Row& row : rows) doc["rows"].push_back(rowJson(row));
     return writeTextReporting(file, doc.dump(2) + "\n", err);

@@ -48,9 +48,14 @@ struct Row {
     bool skipped = false;
     std::string skip_reason;
     std::string clock;  ///< clockName() of the method's frames
-    RunResult result;
+    RunResult result;  ///< with --rounds R > 1: each figure the median over `rounds`
     double ratio = std::numeric_limits<double>::quiet_NaN();
     double exact_ratio = std::numeric_limits<double>::quiet_NaN();  ///< exact-pairs rule
+    /// With --rounds R > 1: the row's result in each round, and its ratios to the best peer of
+    /// that round under each rule (empty otherwise).
+    std::vector<RunResult> rounds;
+    std::vector<double> round_ratios;
+    std::vector<double> round_exact_ratios;
 };
 
 /// What every method of one table runs on.

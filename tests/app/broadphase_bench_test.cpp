@@ -530,6 +530,65 @@ TEST(BroadphaseBench, BadOptionsExitTwoBeforeAnyWork) {
     fs::remove_all(work);
 }
 
+// --rounds R runs each row R times, interleaved (A B, B A, A B): every row reports each round,
+// its figures are the medians over them, and in every round the best peer has ratio 1.
+TEST(BroadphaseBench, RoundsInterleaveTheRowsAndReportMediansOverThem) {
+    std::string peer;
+    for (const app::BenchMethodEntry& m : app::benchMethods()) {
+        if (m.peer && m.default_set && m.family.empty()) {
+            peer = m.name;
+            break;
+        }
+    }
+    if (peer.empty()) GTEST_SKIP() << "built without Bullet and FCL";
+    const fs::path work = tempDir("rounds");
+    const fs::path json = work / "rounds.json";
+    const Result r = runCdlab("bench broadphase --sizes 200 --frames 6 --workload uniform "
+                              "--in-process --rounds 3 --methods sap-packed," +
+                                  peer + " --json " + json.string(),
+                              work);
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    const nlohmann::json doc = nlohmann::json::parse(slurp(json));
+    EXPECT_EQ(doc["rounds"], 3);
+    ASSERT_EQ(doc["rows"].size(), 2u);
+    std::vector<double> best_ratio(3, 1e300);
+    for (const nlohmann::json& row : doc["rows"]) {
+        ASSERT_TRUE(row.contains("rounds")) << row.dump();
+        ASSERT_EQ(row["rounds"].size(), 3u) << row.dump();
+        std::vector<double> medians, exact;
+        for (std::size_t k = 0; k < 3; ++k) {
+            const nlohmann::json& round = row["rounds"][k];
+            medians.push_back(round["ms_per_frame_median"].get<double>());
+            exact.push_back(round["ms_per_frame_median_exact_pairs"].get<double>());
+            if (row["peer"].get<bool>()) {
+                best_ratio[k] = std::min(best_ratio[k], round["ratio_to_best_peer"].get<double>());
+            }
+        }
+        std::sort(medians.begin(), medians.end());
+        std::sort(exact.begin(), exact.end());
+        EXPECT_EQ(row["ms_per_frame_median"].get<double>(), medians[1]) << row.dump();
+        EXPECT_EQ(row["ms_per_frame_median_exact_pairs"].get<double>(), exact[1]) << row.dump();
+        EXPECT_EQ(row["frames"], 6) << row.dump();
+    }
+    for (double ratio : best_ratio) EXPECT_EQ(ratio, 1.0);
+    // The progress lines name the methods in the order they ran: A B, then B A, then A B.
+    std::vector<std::string> ran;
+    std::istringstream err(r.err);
+    for (std::string line; std::getline(err, line);) {
+        for (const std::string& method : {std::string("sap-packed"), peer}) {
+            if (line.find("] " + method + ": ") != std::string::npos) ran.push_back(method);
+        }
+    }
+    const std::vector<std::string> expected{"sap-packed", peer, peer, "sap-packed", "sap-packed",
+                                            peer};
+    EXPECT_EQ(ran, expected) << r.err;
+    EXPECT_NE(r.out.find("(by round: "), std::string::npos) << r.out;
+    const Result bad = runCdlab("bench broadphase --sizes 50 --frames 2 --rounds 0", work);
+    EXPECT_EQ(bad.exit_code, 2) << bad.out << bad.err;
+    EXPECT_NE(bad.err.find("--rounds"), std::string::npos) << bad.err;
+    fs::remove_all(work);
+}
+
 // A row whose mean frame is far above its median (a DBVT with a wide margin re-inserts rarely,
 // at great cost) is ranked by its median like every row, and the report says what the median
 // hides; a steady row gets no such note.
