@@ -158,6 +158,9 @@ private:
     /// Looks up the escaped boxes and updates candidates_; given `exact`, also writes the exact
     /// pairs there (in the same walk over the candidates).
     void queryEscaped(std::vector<ProxyPair>* exact, BroadPhaseCounters& counters);
+    /// The candidates with no escaped member and the fresh ones (fresh_), both sorted, merged
+    /// into candidates_ (queryEscaped without the exact pairs).
+    void mergeFresh();
     /// Whether the candidate's double AABBs overlap, as Aabb::overlaps decides (closed test).
     /// Inline: it runs once per candidate per frame.
     int overlapsExactly(const ProxyPair& p) const {
