@@ -159,8 +159,10 @@ private:
     /// pairs there (in the same walk over the candidates).
     void queryEscaped(std::vector<ProxyPair>* exact, BroadPhaseCounters& counters);
     /// The candidates with no escaped member and the fresh ones (fresh_), both sorted, merged
-    /// into candidates_ (queryEscaped without the exact pairs).
-    void mergeFresh();
+    /// into candidates_; with kExact, the exact pairs among them written to *exact_pairs.
+    /// Out of line: inlined into queryEscaped, the walk's state did not stay in registers.
+    template <bool kExact>
+    [[gnu::noinline]] void mergeFresh(std::vector<ProxyPair>* exact_pairs);
     /// Whether the candidate's double AABBs overlap, as Aabb::overlaps decides (closed test).
     /// Inline: it runs once per candidate per frame.
     int overlapsExactly(const ProxyPair& p) const {
