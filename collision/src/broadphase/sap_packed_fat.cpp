@@ -237,9 +237,10 @@ void PackedSweepAndPrune::mergeFresh(std::vector<ProxyPair>* exact_pairs) {
     // for a kept one, the exact count for a kept one whose boxes overlap. A pair is compared as
     // one 64-bit key (a above b: the (a, b) order) with the next fresh one's, held in a
     // register (all ones past the last). Fresh pairs are few among the candidates, so the one
-    // branch, taken at a kept candidate past the next fresh pair, is seldom taken: a quarter
-    // fewer mispredicted branches than testing the fresh list at every kept candidate
-    // (callgrind, 10k uniform). No fresh pair is a kept candidate (each has an escaped member).
+    // branch, taken at a kept candidate past the next fresh pair, is seldom taken: a fifth
+    // fewer mispredicted branches in queryEscaped than testing the fresh list at every kept
+    // candidate (callgrind, 1k mixed and 10k uniform). No fresh pair is a kept candidate (each
+    // has an escaped member).
     const char* flag = escaped_flag_.data();
     const auto keyOf = [](const ProxyPair& p) {
         return (std::uint64_t(std::uint32_t(p.a)) << 32) | std::uint32_t(p.b);
