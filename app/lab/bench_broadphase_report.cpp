@@ -132,10 +132,9 @@ void printFastest(std::ostream& out, const std::vector<Row>& rows, double RunRes
 // Each row's figures in each round, when the table ran in rounds.
 void printRounds(std::ostream& out, const std::vector<Row>& rows, const BenchOptions& options) {
     if (options.rounds <= 1) return;
-    out << "rounds: " << options.rounds
-        << ", interleaved (every other round in reverse order); the figures above are medians "
-           "over the rounds. Per round: median_ms (vs_peer against that round's best peer), "
-           "exact_ms (vs_peer_ex):\n";
+    out << "each of the " << options.rounds
+        << " rounds (the figures above are their medians): median_ms (vs_peer against that "
+           "round's best peer); exact_ms (vs_peer_ex):\n";
     for (const Row& row : rows) {
         if (row.rounds.empty()) continue;
         std::string ms, exact_ms;

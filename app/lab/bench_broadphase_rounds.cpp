@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <ostream>
 #include <string>
@@ -62,7 +63,15 @@ void runRounds(const TableRun& run, std::vector<Row>& rows) {
             Row& row = rows[i];
             if (!usable(row)) continue;
             const BenchMethodEntry* entry = findBenchMethod(row.method);
-            if (entry == nullptr) continue;  // every row's method is a registered entry
+            if (entry == nullptr) {
+                // Every row comes from a registered method; say so rather than mix a one-round
+                // figure into a table of medians.
+                row.result.failed = 1;
+                std::snprintf(row.result.note, sizeof(row.result.note),
+                              "no method named %s to run again", row.method.c_str());
+                run.failed = true;
+                continue;
+            }
             const Row again = runMethod(*entry, run, run.options);
             if (!usable(again)) {
                 row.result = again.result;
