@@ -9,11 +9,13 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "broadphase/float_bounds.h"
 #include "broadphase/sap_packed.h"
 #include "collision/broadphase/broad_phase.h"
 #include "collision/broadphase/loose_broad_phase.h"
@@ -533,6 +535,47 @@ TEST(PackedSweepAndPrune, LooseFactoryNamesItsOutput) {
     EXPECT_EQ(loose->name(), "sap-packed-loose");
     EXPECT_EQ(findBroadPhase("sap-packed-loose"), nullptr);  // never in the registry
 }
+
+// The packed boxes' conservativeness rests on these two: roundDown(x) is the largest float <= x
+// and roundUp(x) the smallest float >= x, for every finite double, including those between two
+// floats, on a tie, below the smallest denormal, and beyond the float range (where the answer is
+// +-FLT_MAX or +-infinity). Checked by definition: r <= x < the next float above r.
+TEST(FloatBounds, RoundDownIsTheLargestFloatBelowAndRoundUpTheSmallestAbove) {
+    using float_bounds::roundDown;
+    using float_bounds::roundUp;
+    constexpr float kInf = std::numeric_limits<float>::infinity();
+    constexpr float kMax = std::numeric_limits<float>::max();
+    constexpr double kDoubleMax = std::numeric_limits<double>::max();
+    std::vector<double> xs = {0.0, -0.0, 1e-50, -1e-50, 1e-300, -1e-300, 1e39, -1e39, kDoubleMax,
+                              -kDoubleMax};
+    const float floats[] = {0.0f, 1.0f, -1.0f, kMax, -kMax, std::numeric_limits<float>::min(),
+                            std::numeric_limits<float>::denorm_min(), 2048.0f, 1e7f, 0.1f};
+    for (const float f : floats) {
+        for (const float g : {f, -f}) {
+            const double d = g;
+            const double up = std::nextafter(g, kInf);
+            xs.insert(xs.end(), {d, std::nextafter(d, 1e300), std::nextafter(d, -1e300),
+                                 (d + up) / 2});  // the tie between g and the next float
+        }
+    }
+    Rng rng(41);
+    for (int i = 0; i < 20000; ++i) {
+        const double x = std::ldexp(rng.uniform(-1, 1), rng.integer(-160, 135));
+        xs.push_back(x);
+    }
+    for (const double x : xs) {
+        if (!std::isfinite(x)) continue;
+        SCOPED_TRACE(x);
+        const float lo = roundDown(x);
+        ASSERT_LE(double(lo), x);
+        ASSERT_GT(double(std::nextafter(lo, kInf)), x);
+        const float hi = roundUp(x);
+        ASSERT_GE(double(hi), x);
+        ASSERT_LT(double(std::nextafter(hi, -kInf)), x);
+    }
+    EXPECT_TRUE(std::isnan(roundDown(std::numeric_limits<double>::quiet_NaN())));
+}
+
 
 }  // namespace
 }  // namespace collision
