@@ -382,6 +382,9 @@ void HierarchicalGrid::sweepLane(Lane& lane, std::vector<ProxyPair>& pairs) {
     const int shift = id_shift_;
     std::size_t count = 0;
     std::int64_t tests = 0;
+    // Room for as many pairs as entries up front: growing from empty copied the keys several
+    // times over in a one-shot frame.
+    if (lane.keys.size() < entries_.size()) lane.keys.resize(entries_.size());
     for (;;) {
         const std::size_t chunk = next_chunk_.fetch_add(1);
         if (chunk + 1 >= chunks_.size()) break;
