@@ -576,6 +576,5 @@ TEST(FloatBounds, RoundDownIsTheLargestFloatBelowAndRoundUpTheSmallestAbove) {
     EXPECT_TRUE(std::isnan(roundDown(std::numeric_limits<double>::quiet_NaN())));
 }
 
-
 }  // namespace
 }  // namespace collision
