@@ -359,7 +359,9 @@ void HierarchicalGrid::scatterLane(Lane& lane, std::size_t spare_slot) {
                     const std::uint32_t slot = next[cells[i]];
                     next[cells[i]] = slot + used[i];
                     entry.flags = flags[i] | level_bit;
-                    out[used[i] ? slot : spare] = entry;
+                    // The slot or the spare one, chosen by a mask: written as `used ? slot :
+                    // spare`, GCC branched on it, mispredicted about 0.8 times a box.
+                    out[spare ^ ((slot ^ spare) & (0u - used[i]))] = entry;
                 }
                 continue;
             }
