@@ -1,12 +1,15 @@
 // The broad phases' pair sort (keysToSortedPairs) against std::sort on every path: few keys (a
 // comparison sort), keys of at most 32 bits (radix-sorted as 32-bit integers) and wider ones
-// (as 64-bit), with ids either way round in the keys and the smallest and largest ids.
+// (as 64-bit), with ids either way round in the keys and the smallest and largest ids; and the
+// order-preserving map of coordinates to integers the coordinate sorts use.
 #include "broadphase/radix_sort.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <random>
 #include <set>
 #include <utility>
@@ -62,6 +65,33 @@ TEST(KeysToSortedPairs, EqualsStdSortOnEveryPath) {
             EXPECT_EQ(pairs, in.sorted) << "shift " << c.shift << ", " << c.count << " pairs";
         }
     }
+}
+
+// orderedBits is strictly increasing over floats and doubles, negative and positive, tiny and
+// huge, infinite, and maps -0 and +0 alike: an LSD radix sort of its values sorts the numbers.
+template <typename T>
+void expectOrderedBitsIncreasing() {
+    constexpr T kInf = std::numeric_limits<T>::infinity();
+    std::vector<T> v = {-kInf, -std::numeric_limits<T>::max(), T(-2048), T(-1), T(-0.5),
+                        -std::numeric_limits<T>::min(), -std::numeric_limits<T>::denorm_min(), T(0),
+                        std::numeric_limits<T>::denorm_min(), std::numeric_limits<T>::min(),
+                        T(0.5), T(1), T(2048), std::numeric_limits<T>::max(), kInf};
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> unit(-1, 1);
+    std::uniform_int_distribution<int> exponent(-120, 120);
+    for (int i = 0; i < 5000; ++i) v.push_back(T(std::ldexp(unit(rng), exponent(rng))));
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());  // -0 == +0: one of them stays
+    for (std::size_t i = 1; i < v.size(); ++i) {
+        EXPECT_LT(radix::orderedBits(v[i - 1]), radix::orderedBits(v[i]))
+            << v[i - 1] << " " << v[i];
+    }
+    EXPECT_EQ(radix::orderedBits(T(-0.0)), radix::orderedBits(T(0)));
+}
+
+TEST(OrderedBits, IncreasesWithTheValueAndMapsBothZerosAlike) {
+    expectOrderedBitsIncreasing<float>();
+    expectOrderedBitsIncreasing<double>();
 }
 
 }  // namespace
