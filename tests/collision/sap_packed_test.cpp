@@ -576,5 +576,28 @@ TEST(FloatBounds, RoundDownIsTheLargestFloatBelowAndRoundUpTheSmallestAbove) {
     EXPECT_TRUE(std::isnan(roundDown(std::numeric_limits<double>::quiet_NaN())));
 }
 
+// firstReaching is std::lower_bound: on non-decreasing arrays of every length to 40 with many
+// ties, from every start, for values below, between, equal to and above the entries.
+TEST(PackedSweepAndPrune, FirstReachingIsLowerBound) {
+    Rng rng(5);
+    for (int n = 0; n <= 40; ++n) {
+        for (int trial = 0; trial < 20; ++trial) {
+            std::vector<float> reach(static_cast<std::size_t>(n));
+            float v = -3;
+            for (float& r : reach) r = v += float(rng.integer(0, 2));  // steps of 0, 1 or 2
+            for (std::size_t begin = 0; begin <= reach.size(); ++begin) {
+                for (float x = -5; x <= v + 2; x += 0.5f) {
+                    const auto want = static_cast<std::size_t>(
+                        std::lower_bound(reach.begin() + std::ptrdiff_t(begin), reach.end(), x) -
+                        reach.begin());
+                    ASSERT_EQ(PackedSweepAndPrune::firstReaching(reach, begin, reach.size(), x),
+                              want)
+                        << "n " << n << " begin " << begin << " x " << x;
+                }
+            }
+        }
+    }
+}
+
 }  // namespace
 }  // namespace collision

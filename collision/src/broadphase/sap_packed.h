@@ -74,6 +74,11 @@ public:
     /// of the last findPairs: the test a loose output's pairs pass. For tests and checks.
     bool fatBoxesOverlap(ProxyId a, ProxyId b) const;
 
+    /// The first place in [begin, end) whose reach (non-decreasing there) is at least lo_x, end
+    /// if none: std::lower_bound. Public for its test.
+    static std::size_t firstReaching(const std::vector<float>& reach, std::size_t begin,
+                                     std::size_t end, float lo_x);
+
 private:
     static constexpr std::size_t kSample = 255;     ///< boxes sampled for the band width
     static constexpr std::size_t kMinPerBand = 16;  ///< fewer bands than n / this
@@ -118,17 +123,15 @@ private:
     /// reach[i] for i in [begin, end): the largest max x of lanes [begin, i] (see band_reach_).
     static void prefixMaxX(const Lanes& lanes, std::size_t begin, std::size_t end,
                            std::vector<float>& reach);
-    /// The first place in [begin, end) whose reach is at least lo_x (end if none).
-    static std::size_t firstReaching(const std::vector<float>& reach, std::size_t begin,
-                                     std::size_t end, float lo_x);
     template <typename Hit>
     static std::int64_t sweepRange(const Lanes& lanes, std::size_t begin, std::size_t end,
                                    Hit&& hit);
-    /// Tests `box` against lanes from place j on, four at a time, calling hit(place) for each
-    /// overlap; stops at the first group with a box past max x (stop_past_x) or a NaN.
-    template <typename Hit>
-    static std::int64_t queryRange(const Lanes& lanes, std::size_t j, const float (&box)[6],
-                                   bool stop_past_x, Hit&& hit);
+    /// Tests `box` against lanes from place j on, four at a time, writing the place of each
+    /// overlap to hits (room for one per place from j to the end, plus 4) and returning how
+    /// many; stops at the first group with a box past max x (stop_past_x) or a NaN. Adds the
+    /// boxes tested to `tests`.
+    static std::size_t queryRange(const Lanes& lanes, std::size_t j, const float (&box)[6],
+                                  bool stop_past_x, std::uint32_t* hits, std::int64_t& tests);
     int bandOf(float y) const {
         const float t = (y - band_lo_) * band_scale_;
         // Compare before converting: a NaN or huge t must not reach the integer conversion.
@@ -235,6 +238,7 @@ private:
     std::vector<float> sample_;
     std::vector<std::uint32_t> fill_;
     std::vector<std::uint64_t> keys_;
+    std::vector<std::uint32_t> hits_;  ///< queryRange's output
     std::vector<std::uint64_t> scratch_;
     int shift_ = 1;
     bool dirty_ = true;
