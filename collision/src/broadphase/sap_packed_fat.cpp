@@ -139,9 +139,9 @@ std::size_t PackedSweepAndPrune::queryRange(const Lanes& lanes, std::size_t j,
 std::size_t PackedSweepAndPrune::firstReaching(const std::vector<float>& reach, std::size_t begin,
                                                std::size_t end, float lo_x) {
     // std::lower_bound, with the halving chosen by a select rather than a branch: which half
-    // holds the answer is data, and at 10k boxes std::lower_bound's branch was mispredicted
-    // about every other step of every look-up. The window [base, base + n) always holds the
-    // last place before the answer or the answer itself.
+    // holds the answer is data (callgrind, 10k mixed, 30 frames: 45k fewer mispredictions in the
+    // look-ups than std::lower_bound). The window [base, base + n) always holds the last place
+    // before the answer or the answer itself.
     if (begin >= end) return begin;
     const float* base = reach.data() + begin;
     std::size_t n = end - begin;
