@@ -11,8 +11,9 @@ namespace app {
 
 namespace {
 
-/// A cdlab registry broad phase: insertMany() of every box, move() per proxy, findPairs() into a
-/// reused vector.
+/// A cdlab registry broad phase (one that decides on AABBs) reading the workload's array of
+/// boxes, as the peers read it box by box: insertBoxes() and moveBoxes() take it at once;
+/// findPairs() writes into a reused vector.
 class CdlabMethod : public BenchMethod {
 public:
     CdlabMethod(const collision::BroadPhaseEntry& entry, collision::PairOrder order)
@@ -22,15 +23,13 @@ public:
     explicit CdlabMethod(std::unique_ptr<collision::BroadPhase> broad_phase)
         : broad_phase_(std::move(broad_phase)) {}
 
-    void insertAll(const MovingBoxes& /*boxes*/,
-                   std::span<const collision::ProxyVolumes> volumes) override {
-        broad_phase_->insertMany(0, volumes);
+    void insertAll(const MovingBoxes& boxes,
+                   std::span<const collision::ProxyVolumes> /*volumes*/) override {
+        broad_phase_->insertBoxes(0, boxes.aabbs());
     }
-    void moveAll(const MovingBoxes& /*boxes*/,
-                 std::span<const collision::ProxyVolumes> volumes) override {
-        for (std::size_t i = 0; i < volumes.size(); ++i) {
-            broad_phase_->move(static_cast<collision::ProxyId>(i), volumes[i]);
-        }
+    void moveAll(const MovingBoxes& boxes,
+                 std::span<const collision::ProxyVolumes> /*volumes*/) override {
+        broad_phase_->moveBoxes(0, boxes.aabbs());
     }
     void findPairs() override { broad_phase_->findPairs(pairs_, counters_); }
     PairSummary summary(const MovingBoxes& /*boxes*/) override { return summarizePairs(pairs_); }

@@ -161,6 +161,7 @@ void MovingBoxes::generateBoxPruning(int n, std::uint64_t seed) {
     lower_ = -kBoxPruningRange - kBoxPruningHalf;
     side_ = 2 * (kBoxPruningRange + kBoxPruningHalf) - 1;
     frame_ = 0;
+    makeBoxes();
 }
 
 void MovingBoxes::jitter() {
@@ -171,6 +172,7 @@ void MovingBoxes::jitter() {
         }
     }
     ++frame_;
+    makeBoxes();
 }
 
 void MovingBoxes::place() {
@@ -180,6 +182,7 @@ void MovingBoxes::place() {
         center_[i] = half_[i] + unit_[i].cwiseProduct(room);
     }
     frame_ = 0;
+    makeBoxes();
 }
 
 void MovingBoxes::step() {
@@ -204,13 +207,21 @@ void MovingBoxes::step() {
         }
     }
     ++frame_;
+    makeBoxes();
+}
+
+void MovingBoxes::makeBoxes() {
+    box_.resize(center_.size());
+    for (std::size_t i = 0; i < center_.size(); ++i) {
+        box_[i] = collision::Aabb{center_[i] - half_[i], center_[i] + half_[i]};
+    }
 }
 
 void MovingBoxes::volumes(std::vector<collision::ProxyVolumes>& out) const {
     out.resize(center_.size());
     for (std::size_t i = 0; i < center_.size(); ++i) {
         collision::ProxyVolumes& v = out[i];
-        v.aabb = aabb(static_cast<int>(i));
+        v.aabb = box_[i];
         v.sphere.center = center_[i];
         v.sphere.radius = half_[i].norm();
         v.obb.center = center_[i];

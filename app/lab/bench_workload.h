@@ -65,10 +65,10 @@ public:
 
     const std::vector<collision::Vec3>& centers() const { return center_; }
     const std::vector<collision::Vec3>& halfExtents() const { return half_; }
-    /// Box i's exact AABB: centre -/+ half extents (the same doubles every peer sees).
-    collision::Aabb aabb(int i) const {
-        return collision::Aabb{center_[i] - half_[i], center_[i] + half_[i]};
-    }
+    /// Box i's exact AABB: centre -/+ half extents (the same doubles every peer sees). Made
+    /// when the boxes move, untimed, so every method reads its boxes from this one array.
+    const collision::Aabb& aabb(int i) const { return box_[static_cast<std::size_t>(i)]; }
+    const std::vector<collision::Aabb>& aabbs() const { return box_; }
     /// Every box's volumes for cdlab broad phases: the AABB, its circumscribed sphere, and the
     /// AABB as an axis-aligned OBB. `out` is resized to size().
     void volumes(std::vector<collision::ProxyVolumes>& out) const;
@@ -77,6 +77,7 @@ private:
     void place();
     void generateBoxPruning(int n, std::uint64_t seed);
     void jitter();
+    void makeBoxes();
 
     WorkloadKind kind_;
     collision::Real side_ = 1;
@@ -87,6 +88,7 @@ private:
     std::vector<collision::Vec3> center_;
     std::vector<collision::Vec3> half_;
     std::vector<collision::Vec3> velocity_;
+    std::vector<collision::Aabb> box_;  // centre -/+ half extents, for aabb()
 };
 
 /// Counts the overlapping pairs of a frame (closed test, as collision::Aabb::overlaps), written

@@ -101,6 +101,11 @@ void HierarchicalGrid::insertMany(ProxyId first, std::span<const ProxyVolumes> v
     order_stale_ = true;
 }
 
+void HierarchicalGrid::insertBoxes(ProxyId first, std::span<const Aabb> boxes) {
+    RebuildingBroadPhase::insertBoxes(first, boxes);
+    order_stale_ = true;
+}
+
 void HierarchicalGrid::remove(ProxyId id) {
     RebuildingBroadPhase::remove(id);
     order_stale_ = true;

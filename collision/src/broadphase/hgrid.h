@@ -62,6 +62,7 @@ public:
     std::string_view name() const override { return helper_ ? "hgrid2" : "hgrid"; }
     void insert(ProxyId id, const ProxyVolumes& v) override;
     void insertMany(ProxyId first, std::span<const ProxyVolumes> v) override;
+    void insertBoxes(ProxyId first, std::span<const Aabb> boxes) override;
     void remove(ProxyId id) override;
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
     void setPairOrder(PairOrder order) override { pair_order_ = order; }

@@ -35,16 +35,7 @@ public:
     }
     /// insert() of ids first, first + 1, ... with the storage grown once.
     void insertMany(ProxyId first, std::span<const ProxyVolumes> v) {
-        CDLAB_ASSERT(first >= 0, "negative proxy id");
-        const std::size_t begin = static_cast<std::size_t>(first);
-        const std::size_t end = begin + v.size();
-        if (end > present_.size()) {
-            present_.resize(end, 0);
-            if (kinds_ & kAabb) aabbs_.resize(end);
-            if (kinds_ & kSphere) spheres_.resize(end);
-            if (kinds_ & kObb) obbs_.resize(end);
-        }
-        for (std::size_t i = begin; i < end; ++i) CDLAB_ASSERT(!present_[i], "proxy inserted twice");
+        const std::size_t begin = makeRoom(first, v.size());
         // One loop per kind: the caller's volumes are read at their stride, the table written in
         // sequence.
         if (kinds_ & kAabb) {
@@ -56,9 +47,18 @@ public:
         if (kinds_ & kObb) {
             for (std::size_t i = 0; i < v.size(); ++i) obbs_[begin + i] = v[i].obb;
         }
-        std::fill(present_.begin() + std::ptrdiff_t(begin), present_.begin() + std::ptrdiff_t(end),
-                  char(1));
-        count_ += static_cast<int>(v.size());
+        markPresent(begin, v.size());
+    }
+    /// insertMany() of volumesOfBox(boxes[i]): the boxes copied as they are, the other kinds
+    /// the table keeps derived from them.
+    void insertBoxes(ProxyId first, std::span<const Aabb> boxes) {
+        const std::size_t begin = makeRoom(first, boxes.size());
+        if (kinds_ == kAabb) {
+            std::copy(boxes.begin(), boxes.end(), aabbs_.begin() + std::ptrdiff_t(begin));
+        } else {
+            for (std::size_t i = 0; i < boxes.size(); ++i) store(begin + i, volumesOfBox(boxes[i]));
+        }
+        markPresent(begin, boxes.size());
     }
     void remove(ProxyId id) {
         CDLAB_ASSERT(contains(id), "removing an absent proxy");
@@ -68,6 +68,15 @@ public:
     void move(ProxyId id, const ProxyVolumes& v) {
         CDLAB_ASSERT(contains(id), "moving an absent proxy");
         store(id, v);
+    }
+    /// move() to volumesOfBox(box).
+    void moveBox(ProxyId id, const Aabb& box) {
+        CDLAB_ASSERT(contains(id), "moving an absent proxy");
+        if (kinds_ == kAabb) {
+            aabbs_[id] = box;
+        } else {
+            store(id, volumesOfBox(box));
+        }
     }
     bool contains(ProxyId id) const {
         return id >= 0 && static_cast<std::size_t>(id) < present_.size() && present_[id];
@@ -79,7 +88,26 @@ public:
     int count() const { return count_; }
 
 private:
-    void store(ProxyId id, const ProxyVolumes& v) {
+    /// Grows the storage to hold ids first, first + 1, ..., first + n - 1, which must be absent;
+    /// returns first as an index.
+    std::size_t makeRoom(ProxyId first, std::size_t n) {
+        CDLAB_ASSERT(first >= 0, "negative proxy id");
+        const std::size_t begin = static_cast<std::size_t>(first);
+        const std::size_t end = begin + n;
+        if (end > present_.size()) {
+            present_.resize(end, 0);
+            if (kinds_ & kAabb) aabbs_.resize(end);
+            if (kinds_ & kSphere) spheres_.resize(end);
+            if (kinds_ & kObb) obbs_.resize(end);
+        }
+        for (std::size_t i = begin; i < end; ++i) CDLAB_ASSERT(!present_[i], "proxy inserted twice");
+        return begin;
+    }
+    void markPresent(std::size_t begin, std::size_t n) {
+        std::fill_n(present_.begin() + std::ptrdiff_t(begin), n, char(1));
+        count_ += static_cast<int>(n);
+    }
+    void store(std::size_t id, const ProxyVolumes& v) {
         if (kinds_ & kAabb) aabbs_[id] = v.aabb;
         if (kinds_ & kSphere) spheres_[id] = v.sphere;
         if (kinds_ & kObb) obbs_[id] = v.obb;
@@ -104,10 +132,19 @@ public:
     void insertMany(ProxyId first, std::span<const ProxyVolumes> v) override {
         table_.insertMany(first, v);
     }
+    void insertBoxes(ProxyId first, std::span<const Aabb> boxes) override {
+        table_.insertBoxes(first, boxes);
+    }
     void remove(ProxyId id) override { table_.remove(id); }
-    void move(ProxyId id, const ProxyVolumes& v) override {
+    void move(ProxyId id, const ProxyVolumes& v) final {
         table_.move(id, v);
         ++moved_;
+    }
+    void moveBoxes(ProxyId first, std::span<const Aabb> boxes) final {
+        for (std::size_t i = 0; i < boxes.size(); ++i) {
+            table_.moveBox(first + static_cast<ProxyId>(i), boxes[i]);
+        }
+        moved_ += static_cast<std::int64_t>(boxes.size());
     }
 
 protected:

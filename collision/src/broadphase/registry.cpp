@@ -16,6 +16,28 @@
 
 namespace collision {
 
+ProxyVolumes volumesOfBox(const Aabb& box) {
+    ProxyVolumes v;
+    v.aabb = box;
+    v.sphere.center = v.obb.center = box.center();
+    v.obb.half_extents = box.extents() / 2;
+    v.obb.axes = Mat3::Identity();
+    v.sphere.radius = v.obb.half_extents.norm();
+    return v;
+}
+
+void BroadPhase::insertBoxes(ProxyId first, std::span<const Aabb> boxes) {
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+        insert(first + static_cast<ProxyId>(i), volumesOfBox(boxes[i]));
+    }
+}
+
+void BroadPhase::moveBoxes(ProxyId first, std::span<const Aabb> boxes) {
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+        move(first + static_cast<ProxyId>(i), volumesOfBox(boxes[i]));
+    }
+}
+
 namespace {
 
 using Brute = BruteForceBroadPhase;

@@ -42,14 +42,27 @@ void PackedSweepAndPrune::insertMany(ProxyId first, std::span<const ProxyVolumes
     dirty_ = true;
 }
 
+void PackedSweepAndPrune::insertBoxes(ProxyId first, std::span<const Aabb> boxes) {
+    table_.insertBoxes(first, boxes);
+    dirty_ = true;
+}
+
 void PackedSweepAndPrune::remove(ProxyId id) {
     table_.remove(id);
     dirty_ = true;
 }
 
-void PackedSweepAndPrune::move(ProxyId id, const ProxyVolumes& v) {
+void PackedSweepAndPrune::move(ProxyId id, const ProxyVolumes& v) { moveBox(id, v.aabb); }
+
+void PackedSweepAndPrune::moveBoxes(ProxyId first, std::span<const Aabb> boxes) {
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+        moveBox(first + static_cast<ProxyId>(i), boxes[i]);
+    }
+}
+
+void PackedSweepAndPrune::moveBox(ProxyId id, const Aabb& box) {
     // How far the box moves per frame, remembered with a slow decay: the fattening margin.
-    const Vec3 shift = (v.aabb.min + v.aabb.max - table_.aabb(id).min - table_.aabb(id).max) / 2;
+    const Vec3 shift = (box.min + box.max - table_.aabb(id).min - table_.aabb(id).max) / 2;
     const Real step = shift.cwiseAbs().maxCoeff();
     if (static_cast<std::size_t>(id) < motion_.size()) {
         const float decayed = motion_[id] * kMotionDecay;
@@ -57,7 +70,7 @@ void PackedSweepAndPrune::move(ProxyId id, const ProxyVolumes& v) {
                           ? std::max(decayed, float(std::min<Real>(step, kFloatMax)))
                           : decayed;
     }
-    table_.move(id, v);
+    table_.moveBox(id, box);
     ++moved_;
     // Whether it left its fat box, tested here while the box is at hand (a proxy set changed
     // since the last findPairs is rebuilt whole: nothing to note).

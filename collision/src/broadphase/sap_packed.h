@@ -57,8 +57,10 @@ public:
     }
     void insert(ProxyId id, const ProxyVolumes& v) override;
     void insertMany(ProxyId first, std::span<const ProxyVolumes> v) override;
+    void insertBoxes(ProxyId first, std::span<const Aabb> boxes) override;
     void remove(ProxyId id) override;
     void move(ProxyId id, const ProxyVolumes& v) override;
+    void moveBoxes(ProxyId first, std::span<const Aabb> boxes) override;
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
     /// findPairs() without writing pairs: the candidates brought up to date, none confirmed.
     void updatePairs(BroadPhaseCounters& counters) override;
@@ -96,6 +98,9 @@ private:
     static constexpr float kSteadyMargin = 2.0f;
     static constexpr float kMotionDecay = 0.95f;
     static constexpr std::size_t kEscapeShare = 4;  ///< a full sweep when n / this escape at once
+
+    /// move() of a box: move() and moveBoxes() share it, inlined in the loop of the second.
+    void moveBox(ProxyId id, const Aabb& box);
     static constexpr std::size_t kStaleShare = 4;   ///< bands dealt again past n / this stale
     static constexpr int kRetryFrames = 32;
 

@@ -56,6 +56,11 @@ struct ProxyVolumes {
     Obb obb;
 };
 
+/// The volumes of a proxy known only by its box: the box, its circumscribed sphere (the centre,
+/// the half diagonal) and the box as an axis-aligned OBB. What insertBoxes() and moveBoxes()
+/// give a broad phase that decides on spheres or OBBs.
+ProxyVolumes volumesOfBox(const Aabb& box);
+
 /// Cost-model counters of one findPairs call (F = Nv·Cv + Np·Cp + Nu·Cu).
 struct BroadPhaseCounters {
     std::int64_t volume_tests = 0;     ///< Nv: bounding-volume overlap tests made
@@ -80,6 +85,15 @@ public:
             insert(first + static_cast<ProxyId>(i), volumes[i]);
         }
     }
+    /// insertMany() for a caller that has boxes alone, as a contiguous array (a PhysX-style
+    /// bounds array): proxies first, first + 1, ... get volumesOfBox(boxes[i]). A broad phase
+    /// that decides on AABBs reads the boxes and builds no other volume. Default: insert() of
+    /// each volumesOfBox.
+    virtual void insertBoxes(ProxyId first, std::span<const Aabb> boxes);
+    /// move() for every proxy of such an array: as move(first + i, volumesOfBox(boxes[i])) for
+    /// each i in order would. The proxies must be present. Default: that loop. Broad phases that
+    /// decide on AABBs override it to read the array in one pass, without a call per proxy.
+    virtual void moveBoxes(ProxyId first, std::span<const Aabb> boxes);
     /// Removes a present proxy.
     virtual void remove(ProxyId id) = 0;
     /// Replaces a present proxy's volumes.
