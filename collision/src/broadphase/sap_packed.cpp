@@ -52,31 +52,33 @@ void PackedSweepAndPrune::remove(ProxyId id) {
     dirty_ = true;
 }
 
+[[gnu::always_inline]] inline void PackedSweepAndPrune::moveBox(ProxyId id, const Aabb& box) {
+    // How far the box moves per frame, remembered with a slow decay: the fattening margin. A
+    // step that is not finite leaves the decayed value (>= 0, as every motion is).
+    const Vec3 shift = (box.min + box.max - table_.aabb(id).min - table_.aabb(id).max) / 2;
+    const Real step = shift.cwiseAbs().maxCoeff();
+    if (static_cast<std::size_t>(id) < motion_.size()) {
+        const float decayed = motion_[id] * kMotionDecay;
+        const float capped = float(std::min<Real>(step, kFloatMax));
+        motion_[id] = std::max(decayed, step < kInf ? capped : 0.0f);
+    }
+    table_.moveBox(id, box);
+    ++moved_;
+    // Whether it left its fat box, tested here while the box is at hand (a proxy set changed
+    // since the last findPairs is rebuilt whole: nothing to note, and new ids have no fat box).
+    if (dirty_) return;
+    const bool outside = !insideFat(id, box);
+    if (outside && !escaped_flag_[id]) {
+        escaped_flag_[id] = 1;
+        escaped_.push_back(id);
+    }
+}
+
 void PackedSweepAndPrune::move(ProxyId id, const ProxyVolumes& v) { moveBox(id, v.aabb); }
 
 void PackedSweepAndPrune::moveBoxes(ProxyId first, std::span<const Aabb> boxes) {
     for (std::size_t i = 0; i < boxes.size(); ++i) {
         moveBox(first + static_cast<ProxyId>(i), boxes[i]);
-    }
-}
-
-void PackedSweepAndPrune::moveBox(ProxyId id, const Aabb& box) {
-    // How far the box moves per frame, remembered with a slow decay: the fattening margin.
-    const Vec3 shift = (box.min + box.max - table_.aabb(id).min - table_.aabb(id).max) / 2;
-    const Real step = shift.cwiseAbs().maxCoeff();
-    if (static_cast<std::size_t>(id) < motion_.size()) {
-        const float decayed = motion_[id] * kMotionDecay;
-        motion_[id] = std::isfinite(step)
-                          ? std::max(decayed, float(std::min<Real>(step, kFloatMax)))
-                          : decayed;
-    }
-    table_.moveBox(id, box);
-    ++moved_;
-    // Whether it left its fat box, tested here while the box is at hand (a proxy set changed
-    // since the last findPairs is rebuilt whole: nothing to note).
-    if (!dirty_ && !escaped_flag_[id] && !insideFat(id)) {
-        escaped_flag_[id] = 1;
-        escaped_.push_back(id);
     }
 }
 

@@ -154,7 +154,17 @@ private:
     void fatten(ProxyId id, float share, bool learn);
     /// Stores the fat box of id k from double bounds, rounded outward to float.
     void setFat(std::size_t k, Real lo_x, Real lo_y, Real lo_z, Real hi_x, Real hi_y, Real hi_z);
-    bool insideFat(ProxyId id) const;
+    bool insideFat(ProxyId id) const { return insideFat(id, table_.aabb(id)); }
+    /// Whether `box` lies inside id's fat box: every side tested, with no branch between them
+    /// (move() asks for every box of every frame).
+    bool insideFat(ProxyId id, const Aabb& box) const {
+        const auto k = static_cast<std::size_t>(id);
+        return (double(fat_.min_x[k]) <= box.min.x()) & (box.max.x() <= double(fat_.max_x[k])) &
+               (double(fat_.min_y[k]) <= box.min.y()) &
+               (box.max.y() <= -double(fat_.neg_max_y[k])) &
+               (double(fat_.min_z[k]) <= box.min.z()) &
+               (box.max.z() <= -double(fat_.neg_max_z[k]));
+    }
     void rebuild();
     /// Sorts, packs and deals the current fat boxes into bands; none stale after.
     void resnapshot(BroadPhaseCounters& counters);

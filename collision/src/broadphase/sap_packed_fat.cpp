@@ -82,13 +82,6 @@ void PackedSweepAndPrune::setFat(std::size_t k, Real lo_x, Real lo_y, Real lo_z,
     fat_.neg_max_z[k] = -roundUp(hi_z);
 }
 
-bool PackedSweepAndPrune::insideFat(ProxyId id) const {
-    const Aabb& box = table_.aabb(id);
-    const std::size_t k = static_cast<std::size_t>(id);
-    return double(fat_.min_x[k]) <= box.min.x() && box.max.x() <= double(fat_.max_x[k]) &&
-           double(fat_.min_y[k]) <= box.min.y() && box.max.y() <= -double(fat_.neg_max_y[k]) &&
-           double(fat_.min_z[k]) <= box.min.z() && box.max.z() <= -double(fat_.neg_max_z[k]);
-}
 
 std::size_t PackedSweepAndPrune::queryRange(const Lanes& lanes, std::size_t j,
                                             const float (&box)[6], bool stop_past_x,
