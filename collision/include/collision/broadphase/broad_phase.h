@@ -57,8 +57,9 @@ struct ProxyVolumes {
 };
 
 /// The volumes of a proxy known only by its box: the box, its circumscribed sphere (the centre,
-/// the half diagonal) and the box as an axis-aligned OBB. What insertBoxes() and moveBoxes()
-/// give a broad phase that decides on spheres or OBBs.
+/// the half diagonal; each rounded once, so a corner may lie outside by a rounding error) and the
+/// box as an axis-aligned OBB. What insertBoxes() and moveBoxes() give a broad phase that decides
+/// on spheres or OBBs.
 ProxyVolumes volumesOfBox(const Aabb& box);
 
 /// Cost-model counters of one findPairs call (F = Nv·Cv + Np·Cp + Nu·Cu).
