@@ -159,11 +159,12 @@ private:
     /// (move() asks for every box of every frame).
     bool insideFat(ProxyId id, const Aabb& box) const {
         const auto k = static_cast<std::size_t>(id);
-        return (double(fat_.min_x[k]) <= box.min.x()) & (box.max.x() <= double(fat_.max_x[k])) &
-               (double(fat_.min_y[k]) <= box.min.y()) &
-               (box.max.y() <= -double(fat_.neg_max_y[k])) &
-               (double(fat_.min_z[k]) <= box.min.z()) &
-               (box.max.z() <= -double(fat_.neg_max_z[k]));
+        return (int(double(fat_.min_x[k]) <= box.min.x()) &
+                int(box.max.x() <= double(fat_.max_x[k])) &
+                int(double(fat_.min_y[k]) <= box.min.y()) &
+                int(box.max.y() <= -double(fat_.neg_max_y[k])) &
+                int(double(fat_.min_z[k]) <= box.min.z()) &
+                int(box.max.z() <= -double(fat_.neg_max_z[k]))) != 0;
     }
     void rebuild();
     /// Sorts, packs and deals the current fat boxes into bands; none stale after.
