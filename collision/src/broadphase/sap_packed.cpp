@@ -67,6 +67,7 @@ void PackedSweepAndPrune::remove(ProxyId id) {
     // Whether it left its fat box, tested here while the box is at hand (a proxy set changed
     // since the last findPairs is rebuilt whole: nothing to note, and new ids have no fat box).
     if (dirty_) return;
+    if (output_ == Output::Exact) setNear(id, box);
     const bool outside = !insideFat(id, box);
     if (outside && !escaped_flag_[id]) {
         escaped_flag_[id] = 1;
@@ -205,6 +206,7 @@ void PackedSweepAndPrune::rebuild() {
     fat_centre_.resize(capacity, Vec3::Zero());
     fat_frame_.resize(capacity, 0);
     present_.clear();
+    if (output_ == Output::Exact) near_.resize(capacity);
     for (ProxyId id = 0; id < table_.capacity(); ++id) {
         if (!table_.contains(id)) {
             const std::size_t k = static_cast<std::size_t>(id);
@@ -213,6 +215,7 @@ void PackedSweepAndPrune::rebuild() {
             continue;
         }
         present_.push_back(id);
+        if (output_ == Output::Exact) setNear(id, table_.aabb(id));
         // Margins given to all boxes at once would run out at once, and again every lifetime
         // after (boxes moving steadily escape after about as many frames): each box's first
         // margin is a fraction of the full one, spread over (0, 1] by a hash of its id, so the
@@ -414,17 +417,19 @@ void PackedSweepAndPrune::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCou
         update(nullptr, counters);
         pairs.assign(candidates_.begin(), candidates_.end());
     } else if (!update(&pairs, counters)) {
-        // The exact answer: every candidate (fat boxes overlap) tested on the double AABBs.
+        // The exact answer: every candidate (fat boxes overlap) tested as the double AABBs
+        // decide (overlapsExactly).
         // Candidates are sorted, so the pairs are. Branch-free: every candidate is written, and
         // the count advances only for an overlap (about half the candidates do, so a branch
         // would be mispredicted as often as not).
-        pairs.resize(candidates_.size());
+        if (exact_.size() < candidates_.size()) exact_.resize(candidates_.size());
+        ProxyPair* exact = exact_.data();
         std::size_t count = 0;
         for (const ProxyPair& p : candidates_) {
-            pairs[count] = p;
+            exact[count] = p;
             count += static_cast<std::size_t>(overlapsExactly(p));
         }
-        pairs.resize(count);
+        pairs.assign(exact, exact + count);
     }
     counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
 }
@@ -526,6 +531,19 @@ std::string PackedSweepAndPrune::validate() const {
     for (const Entry& e : entries_) {
         if (!table_.contains(e.id)) return "entry for an absent proxy";
         if (!escaped_flag_[e.id] && !insideFat(e.id)) return "a box outside its fat box";
+        if (output_ == Output::Exact) {
+            const Aabb& box = table_.aabb(e.id);
+            const NearBox& n = near_[static_cast<std::size_t>(e.id)];
+            for (int k = 0; k < 3; ++k) {
+                // Compared as bits: a NaN bound must be copied as NaN too.
+                if (std::bit_cast<std::uint32_t>(n.lo[k]) !=
+                        std::bit_cast<std::uint32_t>(float(box.min[k])) ||
+                    std::bit_cast<std::uint32_t>(n.hi[k]) !=
+                        std::bit_cast<std::uint32_t>(float(box.max[k]))) {
+                    return "a box's float copy is not its box rounded to nearest";
+                }
+            }
+        }
     }
     for (std::size_t k = 0; k < candidates_.size(); ++k) {
         const ProxyPair& p = candidates_[k];

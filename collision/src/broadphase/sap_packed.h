@@ -22,8 +22,8 @@ namespace collision {
 /// so it is reported once. Boxes meeting more than a few bands are swept against the whole
 /// sorted list instead (so one huge box costs one sweep, not one per band). The bounds are
 /// copied into float form, each double rounded outward (minimum down, maximum up), so the float
-/// test never rejects a pair the double test accepts; every candidate is confirmed on the double
-/// AABBs. The bounds are stored one array per bound, and the sweep tests four consecutive boxes
+/// test never rejects a pair the double test accepts; every candidate is confirmed as the double
+/// AABBs decide (overlapsExactly). The bounds are stored one array per bound, and the sweep tests four consecutive boxes
 /// at once with SSE2 (x, y and z in five four-wide comparisons), leaving the sweep when one of the
 /// four starts past the box's end. The sort is an LSD radix sort on the float keys after a change
 /// of the proxy set, and an insertion sort of last frame's order otherwise (O(n + swaps) when
@@ -182,26 +182,46 @@ private:
     /// Out of line: inlined into queryEscaped, the walk's state did not stay in registers.
     template <bool kExact>
     [[gnu::noinline]] void mergeFresh(std::vector<ProxyPair>* exact_pairs);
-    /// Whether the candidate's double AABBs overlap, as Aabb::overlaps decides (closed test).
-    /// Inline: it runs once per candidate per frame.
+    /// Whether the candidate's AABBs overlap, as Aabb::overlaps decides on the double bounds
+    /// (closed test). Inline: it runs once per candidate per frame. Decided on the boxes rounded
+    /// to nearest float (near_), which rounding keeps in order (x <= y gives f(x) <= f(y)), so
+    /// f(x) < f(y) proves x < y and f(x) > f(y) proves x > y: every comparison strict on the
+    /// floats is decided there, and only a pair with some bounds equal as floats (touching to
+    /// within a float's precision, or a bound past float range, or NaN) is tested on the doubles.
     int overlapsExactly(const ProxyPair& p) const {
+#if defined(__SSE2__)
+        const NearBox& a = near_[static_cast<std::size_t>(p.a)];
+        const NearBox& b = near_[static_cast<std::size_t>(p.b)];
+        const __m128 a_lo = _mm_load_ps(a.lo);
+        const __m128 a_hi = _mm_load_ps(a.hi);
+        const __m128 b_lo = _mm_load_ps(b.lo);
+        const __m128 b_hi = _mm_load_ps(b.hi);
+        const int sure = _mm_movemask_ps(
+            _mm_and_ps(_mm_cmplt_ps(a_lo, b_hi), _mm_cmplt_ps(b_lo, a_hi)));
+        const int maybe = _mm_movemask_ps(
+            _mm_and_ps(_mm_cmple_ps(a_lo, b_hi), _mm_cmple_ps(b_lo, a_hi)));
+        if (maybe != sure) [[unlikely]] return overlapsOnDoubles(p);
+        return int(sure == 0xF);
+#else
+        return overlapsOnDoubles(p);
+#endif
+    }
+    int overlapsOnDoubles(const ProxyPair& p) const {
         const Aabb& a = table_.aabb(p.a);
         const Aabb& b = table_.aabb(p.b);
-#if defined(__SSE2__) && !defined(CDLAB_USE_FLOAT)
-        // The six comparisons as four two-wide ones, on (x, y) and (y, z) of each bound (y twice):
-        // a.min <= b.max and b.min <= a.max. cmple is false on a NaN, as the scalar <= is.
-        const __m128d lo = _mm_and_pd(
-            _mm_cmple_pd(_mm_loadu_pd(a.min.data()), _mm_loadu_pd(b.max.data())),
-            _mm_cmple_pd(_mm_loadu_pd(a.min.data() + 1), _mm_loadu_pd(b.max.data() + 1)));
-        const __m128d hi = _mm_and_pd(
-            _mm_cmple_pd(_mm_loadu_pd(b.min.data()), _mm_loadu_pd(a.max.data())),
-            _mm_cmple_pd(_mm_loadu_pd(b.min.data() + 1), _mm_loadu_pd(a.max.data() + 1)));
-        return int(_mm_movemask_pd(_mm_and_pd(lo, hi)) == 3);
-#else
         return int(a.min.x() <= b.max.x()) & int(b.min.x() <= a.max.x()) &
                int(a.min.y() <= b.max.y()) & int(b.min.y() <= a.max.y()) &
                int(a.min.z() <= b.max.z()) & int(b.min.z() <= a.max.z());
-#endif
+    }
+    /// A box's bounds rounded to nearest float, x y z and a fourth lane that always passes.
+    struct alignas(16) NearBox {
+        float lo[4];
+        float hi[4];
+    };
+    void setNear(ProxyId id, const Aabb& box) {
+        NearBox& n = near_[static_cast<std::size_t>(id)];
+        n = NearBox{{float(box.min.x()), float(box.min.y()), float(box.min.z()), 0.0f},
+                    {float(box.max.x()), float(box.max.y()), float(box.max.z()), 1.0f}};
     }
 
     Output output_;
@@ -212,6 +232,7 @@ private:
     // Fat boxes by id (absent ids NaN): the exact box grown by the margins of fatten() and
     // rounded outward; candidates_ holds every pair whose fat boxes overlap.
     Lanes fat_;
+    std::vector<NearBox> near_;  ///< by id, the exact boxes as floats (Output::Exact only)
     std::vector<float> motion_;  ///< recent largest centre step per frame, by id
     // Per id, of its current fat box: the margin on every side, the velocity it leads by, and
     // the centre and frame it was made at.
@@ -235,6 +256,10 @@ private:
     std::vector<ProxyPair> candidates_;
     std::vector<ProxyPair> fresh_;
     std::vector<ProxyPair> merged_;
+    /// The exact pairs written branch-free (every candidate written, the count advanced for an
+    /// overlap) before their copy to the caller's list: kept at its largest size, so no frame
+    /// pays to value-initialise room for every candidate in the caller's list.
+    std::vector<ProxyPair> exact_;
     bool margins_on_ = false;
     int retry_in_ = 1;
     float lo_y_ = 0;  ///< lowest min y and highest max y (float)

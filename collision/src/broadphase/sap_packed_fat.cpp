@@ -276,8 +276,8 @@ void PackedSweepAndPrune::mergeFresh(std::vector<ProxyPair>* exact_pairs) {
     ProxyPair* merged = merged_.data();
     ProxyPair* exact = nullptr;
     if constexpr (kExact) {
-        exact_pairs->resize(merged_.size());
-        exact = exact_pairs->data();
+        if (exact_.size() < merged_.size()) exact_.resize(merged_.size());
+        exact = exact_.data();
     }
     std::size_t kept = 0;
     std::size_t count = 0;
@@ -308,7 +308,7 @@ void PackedSweepAndPrune::mergeFresh(std::vector<ProxyPair>* exact_pairs) {
     }
     for (; f < n_fresh; ++f) takeFresh(fresh[f]);
     merged_.resize(kept);
-    if constexpr (kExact) exact_pairs->resize(count);
+    if constexpr (kExact) exact_pairs->assign(exact, exact + count);
     candidates_.swap(merged_);
 }
 
