@@ -6,7 +6,7 @@
 // kind, chosen by the long-double ground truth (convex_reference.h) to be separated or
 // penetrating by more than 1e-3 of their size; rows of the same name share their pairs. Timing:
 // thread CPU time of whole passes over the list divided by the pair count, the median of
-// `passes` passes (no per-call clock overhead). Accuracy: every answer's signed distance, normal
+// `passes` passes (no per-call clock overhead), cdlab's and Bullet's passes interleaved. Accuracy: every answer's signed distance, normal
 // and witness points are checked against the ground truth, relative to the pair's size; the
 // "ext" columns repeat every pair translated by 1e6 and scaled by 1e-4 and 1e4 and report the
 // largest change of the (rescaled) answer.
@@ -168,24 +168,42 @@ struct Answers {
     double us = 0;  ///< median pass, thread CPU microseconds per query
 };
 
-// query(i) answers pair i; the median of `passes` passes over all pairs is kept.
+// Times one pass over all pairs, query(i) answering pair i, into `out`.
 template <typename Query>
-Answers timeQueries(std::size_t n, int passes, Query&& query) {
-    Answers out;
-    out.answers.assign(n, ContactAnswer{});
-    std::vector<double> times;
-    for (int pass = 0; pass < std::max(passes, 1); ++pass) {
-        const double start = threadCpuMicroseconds();
-        for (std::size_t i = 0; i < n; ++i) out.answers[i] = query(i);
-        times.push_back(threadCpuMicroseconds() - start);
-    }
+double timePass(std::size_t n, Answers& out, Query&& query) {
+    const double start = threadCpuMicroseconds();
+    for (std::size_t i = 0; i < n; ++i) out.answers[i] = query(i);
+    return threadCpuMicroseconds() - start;
+}
+
+// The median pass per query, and the answers counted as failed.
+void finish(std::size_t n, std::vector<double>& times, Answers& out) {
     std::sort(times.begin(), times.end());
     const double median = times[times.size() / 2];
     out.us = n > 0 ? median / static_cast<double>(n) : 0;
     for (const ContactAnswer& a : out.answers) {
         if (!std::isfinite(a.signed_distance)) ++out.failed;
     }
-    return out;
+}
+
+// `passes` passes over all pairs of each query, interleaved (ours then theirs, then theirs then
+// ours, and so on), so that a stretch where the machine runs slow costs both the same; each
+// keeps its median pass. Without `theirs`, ours alone.
+template <typename Ours, typename Theirs>
+void timeQueries(std::size_t n, int passes, Ours&& ours, Answers& ours_out, Theirs* theirs,
+                 Answers* theirs_out) {
+    ours_out.answers.assign(n, ContactAnswer{});
+    if (theirs != nullptr) theirs_out->answers.assign(n, ContactAnswer{});
+    std::vector<double> ours_times;
+    std::vector<double> theirs_times;
+    for (int pass = 0; pass < std::max(passes, 1); ++pass) {
+        const bool ours_first = pass % 2 == 0;
+        if (ours_first) ours_times.push_back(timePass(n, ours_out, ours));
+        if (theirs != nullptr) theirs_times.push_back(timePass(n, *theirs_out, *theirs));
+        if (!ours_first) ours_times.push_back(timePass(n, ours_out, ours));
+    }
+    finish(n, ours_times, ours_out);
+    if (theirs != nullptr) finish(n, theirs_times, *theirs_out);
 }
 
 ContactAnswer cdlabQuery(const ConvexPair& p) {
@@ -281,8 +299,15 @@ Row runWorkload(const Workload& w, const PairSet& set, const BenchConvexOptions&
     row.workload = w.name;
     row.method = w.method;
     row.queries = static_cast<int>(pairs.size());
-    const Answers ours = timeQueries(pairs.size(), options.passes,
-                                     [&](std::size_t i) { return cdlabQuery(pairs[i]); });
+    // Bullet's objects are made before any pass, so its passes can be interleaved with ours.
+    std::unique_ptr<BulletConvexPeer> peer;
+    if (bulletAvailable()) peer = std::make_unique<BulletConvexPeer>(w.peer, pairs);
+    const auto our_query = [&](std::size_t i) { return cdlabQuery(pairs[i]); };
+    const auto peer_query = [&](std::size_t i) { return peer->query(i); };
+    Answers ours;
+    Answers theirs;
+    timeQueries(pairs.size(), options.passes, our_query, ours, peer ? &peer_query : nullptr,
+                &theirs);
     row.cdlab_us = ours.us;
     row.cdlab_failed = ours.failed;
     row.cdlab = accuracy(pairs, set.truth, ours.answers, options.tolerance);
@@ -295,11 +320,8 @@ Row runWorkload(const Workload& w, const PairSet& set, const BenchConvexOptions&
         variantError(pairs, ours.answers, moved, kVariants[k].factor, row.cdlab_variant_error[k],
                      row.cdlab_variant_failed);
     }
-    if (!bulletAvailable()) return row;
-    const BulletConvexPeer peer(w.peer, pairs);
-    row.peer = peer.pathName();
-    const Answers theirs =
-        timeQueries(pairs.size(), options.passes, [&](std::size_t i) { return peer.query(i); });
+    if (!peer) return row;
+    row.peer = peer->pathName();
     row.bullet_us = theirs.us;
     row.bullet_failed = theirs.failed;
     row.bullet = accuracy(pairs, set.truth, theirs.answers, options.tolerance);
@@ -377,7 +399,7 @@ void printTable(const std::vector<Row>& rows, double tolerance, std::ostream& ou
         out << std::defaultfloat << std::setw(7) << r.cdlab_failed + r.cdlab_variant_failed
             << "\n";
     }
-    out << "us: thread CPU time per query, median pass; ratio = cdlab_us / bullet_us; *_err: "
+    out << "us: thread CPU time per query, median pass (cdlab and Bullet passes interleaved); ratio = cdlab_us / bullet_us; *_err: "
            "largest |signed distance - exact| / size (exact: long-double closed forms, boxes' "
            "15-axis SAT depth or brute-force distance); wrong: Bullet answers off by more than "
         << tolerance
