@@ -148,6 +148,12 @@ Command addBenchNarrowphaseCommand(CLI::App& bench) {
     cmd->add_option("--poses", o.poses, "poses, even: half collide")->capture_default_str();
     cmd->add_option("--reps", o.reps, "repetitions per pose (fastest counts)")
         ->capture_default_str();
+    cmd->add_option("--rounds", o.rounds,
+                    "measure the methods this many times, interleaved (every other round in "
+                    "reverse order), and report each time's median over the rounds with each "
+                    "round's best ratios (a machine that runs slow for a stretch then costs a "
+                    "round, not a method)")
+        ->capture_default_str();
     cmd->add_option("--seed", o.seed, "pose seed")->capture_default_str();
     cmd->add_option("--methods", o.methods,
                     "comma-separated (default all): volume names (NAME-bu: bottom-up build; "

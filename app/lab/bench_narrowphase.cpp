@@ -236,7 +236,42 @@ struct Row {
     double refit_ms = 0;  // one tree refitted to the deformed torus (cdlab only)
     std::int32_t refit_nu = 0;
     bool refit_ok = true;  // the refitted tree's pairs equal the reference on the deformed torus
+    // Each round's times, when there were several rounds (the fields above are their medians).
+    std::vector<double> build_by_round;
+    std::vector<double> first_by_round;
+    std::vector<double> all_by_round;
 };
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+}
+
+// One row per method from every round's rows (same order): times the median over the rounds,
+// mismatches the most any round saw, the refit checked in every round; the counts and unit costs
+// are the first round's (the counts are the same in every round).
+std::vector<Row> mergeRounds(const std::vector<std::vector<Row>>& by_round) {
+    std::vector<Row> rows = by_round.front();
+    for (std::size_t m = 0; m < rows.size(); ++m) {
+        Row& row = rows[m];
+        std::vector<double> refit;
+        for (const std::vector<Row>& round : by_round) {
+            const Row& r = round[m];
+            row.build_by_round.push_back(r.build_ms);
+            row.first_by_round.push_back(r.first_us);
+            row.all_by_round.push_back(r.all_us);
+            refit.push_back(r.refit_ms);
+            row.bool_mismatches = std::max(row.bool_mismatches, r.bool_mismatches);
+            row.count_mismatches = std::max(row.count_mismatches, r.count_mismatches);
+            row.refit_ok = row.refit_ok && r.refit_ok;
+        }
+        row.build_ms = median(row.build_by_round);
+        row.first_us = median(row.first_by_round);
+        row.all_us = median(row.all_by_round);
+        row.refit_ms = median(refit);
+    }
+    return rows;
+}
 
 // The torus deformed for the refit row: radial waves around the ring and a twist about z, moving
 // vertices by up to ~20 % of the ring radius (more than a triangle's size, so leaves move).
@@ -441,8 +476,10 @@ Best bestOf(const std::vector<Row>& rows, double (*value)(const Row&)) {
 }
 
 // One line per column: cdlab's fastest volume against FCL's fastest, as a ratio (below 1:
-// cdlab faster). Printed only when both libraries ran.
-void printBest(const std::vector<Row>& rows, std::ostream& out) {
+// cdlab faster), and with several rounds each round's ratio of its own fastest. Printed only
+// when both libraries ran.
+void printBest(const std::vector<Row>& rows, const std::vector<std::vector<Row>>& by_round,
+               std::ostream& out) {
     const std::pair<const char*, double (*)(const Row&)> columns[] = {
         {"build", [](const Row& r) { return r.build_ms; }},
         {"first contact", [](const Row& r) { return r.first_us; }},
@@ -452,7 +489,15 @@ void printBest(const std::vector<Row>& rows, std::ostream& out) {
         if (!b.cdlab || !b.fcl) return;
         out << std::fixed << std::setprecision(2) << "best " << label << ": cdlab "
             << b.cdlab->method << ' ' << value(*b.cdlab) << ", FCL " << b.fcl->method << ' '
-            << value(*b.fcl) << ", ratio " << b.ratio() << '\n';
+            << value(*b.fcl) << ", ratio " << b.ratio();
+        if (by_round.size() > 1) {
+            out << " (by round:";
+            for (const std::vector<Row>& round : by_round) {
+                out << ' ' << bestOf(round, value).ratio();
+            }
+            out << ')';
+        }
+        out << '\n';
         out.unsetf(std::ios::fixed);
         out << std::setprecision(6);
     }
@@ -468,6 +513,11 @@ nlohmann::json rowsJson(const std::vector<Row>& rows) {
                          {"all_us", r.all_us},
                          {"bool_mismatches", r.bool_mismatches},
                          {"pair_mismatches", r.count_mismatches}};
+        if (!r.first_by_round.empty()) {
+            o["build_ms_by_round"] = r.build_by_round;
+            o["first_us_by_round"] = r.first_by_round;
+            o["all_us_by_round"] = r.all_by_round;
+        }
         if (r.counters) {
             o["first_nv"] = r.first_nv;
             o["first_np"] = r.first_np;
@@ -501,6 +551,10 @@ int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& ou
         err << "cdlab bench narrowphase: --reps must be >= 1\n";
         return 2;
     }
+    if (options.rounds < 1 || options.rounds > 50) {
+        err << "cdlab bench narrowphase: --rounds must be in 1..50\n";
+        return 2;
+    }
     const int target = options.large ? 100000 : options.triangles;
     if (target < 32) {
         err << "cdlab bench narrowphase: --triangles must be >= 32\n";
@@ -526,26 +580,39 @@ int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& ou
     for (const auto& a : w.answers) colliding += a.empty() ? 0 : 1;
     out << "narrowphase: two tori of " << mesh.triangles.size() << " triangles, " << n_poses
         << " poses (" << colliding << " colliding), fastest of " << options.reps
-        << " repetitions per pose\n";
+        << " repetitions per pose";
+    if (options.rounds > 1) {
+        out << ", times the median of " << options.rounds
+            << " rounds (methods in order, then in reverse, in turn)";
+    }
+    out << '\n';
 
     // The refit workload: the deformed torus as A, the reference its sweep answer at pose 0.
     const TriangleMesh deformed = deformedTorus(mesh);
     const std::vector<collision::TrianglePair> deformed_answer =
         collision::intersectMeshMeshSweep(deformed, mesh, w.poses.front());
 
-    std::vector<Row> rows;
+    std::vector<std::vector<Row>> by_round;
+    for (int round = 0; round < options.rounds; ++round) {
+        std::vector<Row> rows(names.size());
+        for (std::size_t k = 0; k < names.size(); ++k) {
+            const std::size_t m = round % 2 == 0 ? k : names.size() - 1 - k;
+            rows[m] = measureMethod(names[m], mesh, w, deformed, deformed_answer, options.reps);
+        }
+        by_round.push_back(std::move(rows));
+    }
+    const std::vector<Row> rows =
+        options.rounds > 1 ? mergeRounds(by_round) : by_round.front();
     bool cdlab_wrong = false;
-    for (const std::string& n : names) {
-        const Row row = measureMethod(n, mesh, w, deformed, deformed_answer, options.reps);
+    for (const Row& row : rows) {
         if (row.counters &&
             (row.bool_mismatches > 0 || row.count_mismatches > 0 || !row.refit_ok)) {
             cdlab_wrong = true;
         }
-        rows.push_back(row);
     }
 
     printRows(rows, out);
-    printBest(rows, out);
+    printBest(rows, by_round, out);
 
     if (options.json) {
         nlohmann::json j;
@@ -553,6 +620,7 @@ int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& ou
         j["poses"] = n_poses;
         j["colliding_poses"] = colliding;
         j["reps"] = options.reps;
+        j["rounds"] = options.rounds;
         j["seed"] = options.seed;
         j["rows"] = rowsJson(rows);
         if (!writeTextReporting(*options.json, j.dump(2) + "\n", err)) return 1;

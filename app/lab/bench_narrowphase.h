@@ -17,6 +17,10 @@ struct BenchNarrowphaseOptions {
     bool large = false;     ///< 100k-triangle tori (overrides `triangles`)
     int poses = 32;         ///< even, >= 2: half colliding, half not
     int reps = 3;  ///< repetitions per pose (and of the build, at most 3); the fastest counts
+    /// The method list measured this many times (1..50), in order then in reverse, in turn; each
+    /// time is the median over the rounds, so a stretch where the machine runs slow costs a
+    /// round, not a method.
+    int rounds = 1;
     std::uint64_t seed = 7;
     /// Method names (cdlab volume names, NAME-bu for the bottom-up build, "fcl-obbrss", ...);
     /// empty: every volume name (top-down) and every FCL type.
@@ -28,7 +32,7 @@ struct BenchNarrowphaseOptions {
 std::vector<std::string> narrowphaseBenchMethods();
 
 /// Prints one row per method: build ms (one tree), first-contact and all-pairs µs per query (mean
-/// over poses of the fastest repetition), Nv and Np per query, and answer mismatches against the
+/// over poses of the fastest repetition; with rounds, the median over the rounds), Nv and Np per query, and answer mismatches against the
 /// brute force. Exit codes: 0 success; 1 a cdlab method disagreed with the brute force, or the
 /// JSON could not be written; 2 bad options.
 int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& out,

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "bench_narrowphase.h"
 #include "cli_run.h"
@@ -143,11 +144,42 @@ TEST(NarrowphaseBench, FclRowsTakeSplitRulesAndAgreeWithBruteForce) {
     }
 }
 
+// With rounds, every method is measured once per round (in order, then in reverse) and each
+// time reported is the median of its rounds' times; answers are checked in every round.
+TEST(NarrowphaseBench, RoundsReportTheMedianOfEachRoundsTimes) {
+    const fs::path work = tempDir("rounds");
+    const fs::path json = work / "np.json";
+    const Result r = runCdlab("bench narrowphase --triangles 600 --poses 2 --reps 1 --rounds 3 "
+                              "--methods obb,aabb --json " +
+                                  json.string(),
+                              work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("median of 3 rounds"), std::string::npos) << r.out;
+    const nlohmann::json j = nlohmann::json::parse(slurp(json));
+    EXPECT_EQ(j["rounds"], 3);
+    ASSERT_EQ(j["rows"].size(), 2u);
+    for (const auto& row : j["rows"]) {
+        EXPECT_EQ(row["bool_mismatches"], 0) << row["method"];
+        EXPECT_EQ(row["pair_mismatches"], 0) << row["method"];
+        for (const char* key : {"build_ms", "first_us", "all_us"}) {
+            std::vector<double> times = row[std::string(key) + "_by_round"];
+            ASSERT_EQ(times.size(), 3u) << row["method"] << ' ' << key;
+            std::sort(times.begin(), times.end());
+            EXPECT_EQ(row[key].get<double>(), times[1]) << row["method"] << ' ' << key;
+        }
+    }
+}
+
 TEST(NarrowphaseBench, BadOptionsExitTwo) {
     const fs::path work = tempDir("bad");
     Result r = runCdlab("bench narrowphase --poses 3", work);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("--poses"), std::string::npos) << r.err;
+    for (const char* rounds : {"0", "51"}) {
+        r = runCdlab(std::string("bench narrowphase --poses 2 --rounds ") + rounds, work);
+        EXPECT_EQ(r.exit_code, 2) << rounds;
+        EXPECT_NE(r.err.find("--rounds must be in 1..50"), std::string::npos) << r.err;
+    }
     r = runCdlab("bench narrowphase --methods obb,octree --poses 2", work);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("unknown method 'octree'"), std::string::npos) << r.err;
