@@ -6,10 +6,10 @@
 // kind, chosen by the long-double ground truth (convex_reference.h) to be separated or
 // penetrating by more than 1e-3 of their size; rows of the same name share their pairs. Timing:
 // thread CPU time of whole passes over the list divided by the pair count, the median of
-// `passes` passes (no per-call clock overhead), cdlab's and Bullet's passes interleaved. Accuracy: every answer's signed distance, normal
-// and witness points are checked against the ground truth, relative to the pair's size; the
-// "ext" columns repeat every pair translated by 1e6 and scaled by 1e-4 and 1e4 and report the
-// largest change of the (rescaled) answer.
+// `passes` passes (no per-call clock overhead), cdlab's and Bullet's passes interleaved.
+// Accuracy: every answer's signed distance, normal and witness points are checked against the
+// ground truth, relative to the pair's size; the "ext" columns repeat every pair translated by
+// 1e6 and scaled by 1e-4 and 1e4 and report the largest change of the (rescaled) answer.
 #include "bench_convex.h"
 
 #include <time.h>
@@ -396,12 +396,12 @@ void printTable(const std::vector<Row>& rows, double tolerance, std::ostream& ou
                 << "n/a" << std::setw(7) << "n/a" << std::setw(11) << "n/a" << std::setw(10)
                 << maxOf(r.cdlab_variant_error) << std::setw(11) << "n/a";
         }
-        out << std::defaultfloat << std::setw(7) << r.cdlab_failed + r.cdlab_variant_failed
-            << "\n";
+        out << std::defaultfloat << std::setw(7) << r.cdlab_failed + r.cdlab_variant_failed << "\n";
     }
-    out << "us: thread CPU time per query, median pass (cdlab and Bullet passes interleaved); ratio = cdlab_us / bullet_us; *_err: "
-           "largest |signed distance - exact| / size (exact: long-double closed forms, boxes' "
-           "15-axis SAT depth or brute-force distance); wrong: Bullet answers off by more than "
+    out << "us: thread CPU time per query, median pass (cdlab and Bullet passes interleaved); "
+           "ratio = cdlab_us / bullet_us; *_err: largest |signed distance - exact| / size (exact: "
+           "long-double closed forms, boxes' 15-axis SAT depth or brute-force distance); wrong: "
+           "Bullet answers off by more than "
         << tolerance
         << " * size; bullet_nrm: largest (overlap along Bullet's normal - exact depth) / size, 0 "
            "for a valid normal; ext: largest change of answer / factor after translating by 1e6 "

@@ -32,9 +32,9 @@ struct BenchNarrowphaseOptions {
 std::vector<std::string> narrowphaseBenchMethods();
 
 /// Prints one row per method: build ms (one tree), first-contact and all-pairs µs per query (mean
-/// over poses of the fastest repetition; with rounds, the median over the rounds), Nv and Np per query, and answer mismatches against the
-/// brute force. Exit codes: 0 success; 1 a cdlab method disagreed with the brute force, or the
-/// JSON could not be written; 2 bad options.
+/// over poses of the fastest repetition; with rounds, the median over the rounds), Nv and Np per
+/// query, and answer mismatches against the brute force. Exit codes: 0 success; 1 a cdlab method
+/// disagreed with the brute force, or the JSON could not be written; 2 bad options.
 int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& out,
                         std::ostream& err);
 

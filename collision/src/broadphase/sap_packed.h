@@ -23,11 +23,12 @@ namespace collision {
 /// sorted list instead (so one huge box costs one sweep, not one per band). The bounds are
 /// copied into float form, each double rounded outward (minimum down, maximum up), so the float
 /// test never rejects a pair the double test accepts; every candidate is confirmed as the double
-/// AABBs decide (overlapsExactly). The bounds are stored one array per bound, and the sweep tests four consecutive boxes
-/// at once with SSE2 (x, y and z in five four-wide comparisons), leaving the sweep when one of the
-/// four starts past the box's end. The sort is an LSD radix sort on the float keys after a change
-/// of the proxy set, and an insertion sort of last frame's order otherwise (O(n + swaps) when
-/// motion is coherent; it falls back to the radix sort when the order changed too much).
+/// AABBs decide (overlapsExactly). The bounds are stored one array per bound, and the sweep tests
+/// four consecutive boxes at once with SSE2 (x, y and z in five four-wide comparisons), leaving
+/// the sweep when one of the four starts past the box's end. The sort is an LSD radix sort on the
+/// float keys after a change of the proxy set, and an insertion sort of last frame's order
+/// otherwise (O(n + swaps) when motion is coherent; it falls back to the radix sort when the order
+/// changed too much).
 ///
 /// Coherence (as Bullet's DBVT and Box2D's tree fatten leaves): the swept boxes are fat, the exact
 /// box grown by a margin and led in the direction it moves (fatten()), and the candidate pairs
