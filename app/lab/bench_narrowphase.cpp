@@ -23,6 +23,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "bench_broadphase_measure.h"
 #include "bvh_unit_costs.h"
 #include "collision/bvh/bvh.h"
 #include "collision/test_meshes.h"
@@ -52,12 +53,8 @@ using collision::Real;
 using collision::TriangleMesh;
 using collision::Vec3;
 
-// Thread CPU time: what another process on a shared machine takes does not count.
-double threadCpuSeconds() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
+// Thread CPU time (threadCpuSeconds): what another process on a shared machine takes does not
+// count.
 double secondsSince(double t) { return threadCpuSeconds() - t; }
 
 // A torus around local z, ring radius 1, tube radius 0.4: nu segments around the ring, nv around
@@ -241,11 +238,6 @@ struct Row {
     std::vector<double> first_by_round;
     std::vector<double> all_by_round;
 };
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-}
 
 // One row per method from every round's rows (same order): times the median over the rounds,
 // mismatches the most any round saw, the refit checked in every round; the counts and unit costs
