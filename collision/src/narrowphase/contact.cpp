@@ -203,6 +203,21 @@ template <class Routine>
     return out;
 }
 
+// contact() of two boxes in canonical order. Box-box names the manifold entry its witness points
+// repeat, so they are moved once. A function of its own: inside contactConvex, which holds every
+// pair's contactPair, GCC's growth limits left the quaternion-to-matrix conversions and the
+// finiteness checks as calls.
+[[gnu::noinline]] ContactOutput contactBoxes(const Shape& first, const Pose& pose_first,
+                                             const Shape& second, const Pose& pose_second,
+                                             bool swap) {
+    int witness_entry = -1;
+    const auto box_box = [&witness_entry](const Shape& box_a, const Shape& box_b,
+                                          const RelativePose& rel, const Ctx& ctx, Local& out) {
+        return boxBoxWitness(box_a, box_b, rel, ctx, out, witness_entry);
+    };
+    return contactPair(box_box, first, pose_first, second, pose_second, swap, witness_entry);
+}
+
 // contact() of two convex shapes (no meshes). The round closed forms are called directly, so
 // they inline and their answer reaches the world transform in registers; every other pair goes
 // through the table.
@@ -230,16 +245,8 @@ ContactOutput contactConvex(const Shape& a, const Pose& pose_a, const Shape& b,
         return contactPair(capsuleCapsule, first, pose_first, second, pose_second, swap,
                            kNoWitnessEntry);
     }
-    // Box-box names the manifold entry its witness points repeat, so they are moved once.
     if (first.type == ShapeType::Box && second.type == ShapeType::Box) {
-        int witness_entry = -1;
-        const auto box_box = [&witness_entry](const Shape& box_a, const Shape& box_b,
-                                              const RelativePose& rel, const Ctx& ctx,
-                                              Local& out) {
-            return boxBoxWitness(box_a, box_b, rel, ctx, out, witness_entry);
-        };
-        return contactPair(box_box, first, pose_first, second, pose_second, swap,
-                           witness_entry);
+        return contactBoxes(first, pose_first, second, pose_second, swap);
     }
     return contactPair(pairEntry(kContactTable, first.type, second.type), first, pose_first,
                        second, pose_second, swap, kNoWitnessEntry);
