@@ -66,6 +66,14 @@ Command addBenchBroadphaseCommand(CLI::App& bench) {
                     "(a machine that runs slow for a stretch then costs a round, not a row)")
         ->check(CLI::Range(1, kMaxBenchRounds))
         ->capture_default_str();
+    cmd->add_option("--interleave", o.interleave,
+                    "FRAMES > 0: after a first pass of each row alone (peer tuning, memory), "
+                    "time the rows --rounds times measured together: all alive at once, FRAMES "
+                    "frames each per turn (one-shot: one repetition), the order reversed every "
+                    "turn, so a slow stretch of the machine costs every row alike; 0: rounds run "
+                    "row after row")
+        ->check(CLI::Range(0, kMaxInterleaveFrames))
+        ->capture_default_str();
     cmd->add_flag("--in-process", f->in_process,
                   "do not fork per method (no per-method peak memory)");
     return {cmd, [f, cmd]() {

@@ -75,6 +75,11 @@ bool resolveBenchOptions(const BenchOptions& options, std::ostream& err,
         err << "--rounds: " << options.rounds << "; need 1 to " << kMaxBenchRounds << "\n";
         return false;
     }
+    if (options.interleave < 0 || options.interleave > kMaxInterleaveFrames) {
+        err << "--interleave: " << options.interleave << "; need 0 to " << kMaxInterleaveFrames
+            << " frames per turn\n";
+        return false;
+    }
     if (options.clock != "thread" && options.clock != "wall") {
         err << "--clock: '" << options.clock << "' is not thread or wall\n";
         return false;
@@ -169,7 +174,17 @@ int runBenchBroadphase(const BenchOptions& options, std::ostream& out, std::ostr
                "the fastest by exact_ms when that is another (--peers all prints the "
                "grid).\n";
     }
-    if (options.rounds > 1) {
+    if (options.interleave > 0) {
+        out << "Interleaved: after each table's first pass (every row alone"
+            << (tune ? ", the peers' grids swept" : "")
+            << (options.isolate ? ", peak memory" : "") << "), its rows are timed "
+            << options.rounds << (options.rounds == 1 ? " more time" : " more times")
+            << " measured together: all alive at once, " << options.interleave
+            << (options.interleave == 1 ? " frame" : " frames")
+            << " each per turn (one-shot: one repetition), the order reversed every turn; "
+               "each figure is "
+            << (options.rounds == 1 ? "that round's" : "the median over those rounds") << ".\n";
+    } else if (options.rounds > 1) {
         out << "Rounds: " << options.rounds
             << "; each table's rows run once per round, interleaved (every other round in "
                "reverse order); each figure is the median over the rounds"

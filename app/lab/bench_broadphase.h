@@ -40,9 +40,17 @@ struct BenchOptions {
     /// whole figure. Each figure is then the median over the rounds; the per-round ratios are
     /// printed beside it. The peers' tuning runs in the first round only. 1..kMaxBenchRounds.
     int rounds = 1;
+    /// > 0: after each table's first pass (every row alone: the peers' tuning, peak memory, the
+    /// check), its rows are timed `rounds` more times measured together (measureTogether): all
+    /// alive at once, each advancing this many frames per turn (one-shot: one repetition), the
+    /// order reversed every turn. A stretch in which the machine runs slow then costs every row
+    /// alike however short a row's run is. The figures are the medians over those rounds; the
+    /// first pass only chooses the rows and measures memory. 0: the rounds run row after row.
+    int interleave = 0;
 };
 
 constexpr int kMaxBenchRounds = 50;
+constexpr int kMaxInterleaveFrames = 1000;
 
 /// A small configuration for smoke tests: 200 boxes, 20 frames, both workloads, all methods.
 /// Runs in well under a second per method in Release.

@@ -76,142 +76,241 @@ void setNote(RunResult& r, const std::string& text) {
     std::snprintf(r.note, sizeof(r.note), "%s", text.c_str());
 }
 
-/// Runs one method on a private copy of the workload: insert + first query, then the frames.
-RunResult measureOneShot(const BenchMethodEntry& entry, const MovingBoxes& boxes,
-                         const std::vector<PairSummary>& reference, const BenchOptions& options);
+/// One method's moving run on a private copy of the workload, a frame at a time: create, insert
+/// and the first query (insert_ms), then each frame moveAll + findPairs (median_ms) and
+/// deliverExact (exact_ms) timed, its pairs checked against the reference untimed. measure()
+/// runs one to the end alone; measureTogether() advances several in turns.
+class MovingRun {
+public:
+    MovingRun(const BenchMethodEntry& entry, const MovingBoxes& initial,
+              const std::vector<PairSummary>& reference, const BenchOptions& options)
+        : entry_(entry), boxes_(initial), reference_(reference), options_(options),
+          clock_(frameClock(options, entry)) {
+        boxes_.volumes(volumes_);
+        times_.reserve(static_cast<std::size_t>(options.frames));
+        exact_times_.reserve(static_cast<std::size_t>(options.frames));
+    }
+
+    void start() {
+        const double t0 = clockSeconds(clock_);
+        method_ = entry_.create();
+        method_->insertAll(boxes_, volumes_);
+        method_->findPairs();
+        r_.insert_ms = 1e3 * (clockSeconds(clock_) - t0);
+        check(0);
+    }
+
+    /// Every frame run, or stopped by the budget.
+    bool done() const { return frame_ >= options_.frames || r_.budget_hit != 0; }
+
+    void frame() {
+        ++frame_;
+        boxes_.step();
+        boxes_.volumes(volumes_);
+        const double start = clockSeconds(clock_);
+        method_->moveAll(boxes_, volumes_);
+        method_->findPairs();
+        const double found = clockSeconds(clock_);
+        method_->deliverExact(boxes_);
+        const double dt = clockSeconds(clock_) - start;
+        times_.push_back(1e3 * (found - start));
+        exact_times_.push_back(1e3 * dt);
+        total_ += dt;
+        check(frame_);
+        if (options_.budget_seconds > 0 && total_ > options_.budget_seconds &&
+            frame_ < options_.frames) {
+            r_.budget_hit = 1;
+        }
+    }
+
+    /// The figures; the method is destroyed.
+    RunResult finish() {
+        r_.raw_pairs_last = method_->rawPairs();
+        r_.potentially_colliding_last = method_->potentiallyColliding();
+        method_.reset();
+        r_.frames_run = static_cast<int>(times_.size());
+        r_.median_ms = median(times_);
+        r_.exact_median_ms = median(exact_times_);
+        r_.mean_ms = times_.empty() ? 0
+                                    : std::accumulate(times_.begin(), times_.end(), 0.0) /
+                                          static_cast<double>(times_.size());
+        const std::size_t edge = std::min<std::size_t>(kEdgeFrames, times_.size());
+        r_.first_median_ms = median(std::vector<double>(times_.begin(), times_.begin() + edge));
+        r_.last_median_ms = median(std::vector<double>(times_.end() - edge, times_.end()));
+        return r_;
+    }
+
+private:
+    void check(int frame) {
+        const PairSummary got = method_->summary(boxes_);
+        r_.pairs_last = got.pairs;
+        if (got == reference_[static_cast<std::size_t>(frame)]) return;
+        if (r_.mismatched_frames++ == 0) {
+            r_.first_mismatch_frame = frame;
+            r_.expected_pairs = reference_[static_cast<std::size_t>(frame)].pairs;
+            r_.got_pairs = got.pairs;
+        }
+    }
+
+    const BenchMethodEntry& entry_;
+    MovingBoxes boxes_;
+    const std::vector<PairSummary>& reference_;
+    const BenchOptions& options_;
+    clockid_t clock_;
+    std::vector<collision::ProxyVolumes> volumes_;
+    std::unique_ptr<BenchMethod> method_;
+    std::vector<double> times_, exact_times_;
+    double total_ = 0;
+    int frame_ = 0;
+    RunResult r_;
+};
+
+/// One method's one-shot run: every repetition creates the method, inserts every box and finds
+/// the pairs of frame 0, all timed; destroying it is not. No state survives between
+/// repetitions.
+class OneShotRun {
+public:
+    OneShotRun(const BenchMethodEntry& entry, const MovingBoxes& boxes,
+               const std::vector<PairSummary>& reference, const BenchOptions& options)
+        : entry_(entry), boxes_(boxes), reference_(reference), options_(options),
+          clock_(frameClock(options, entry)), repetitions_(oneShotRepetitions(options)) {
+        boxes.volumes(volumes_);
+    }
+
+    bool done() const {
+        return static_cast<int>(times_.size()) >= repetitions_ || r_.budget_hit != 0;
+    }
+
+    void repetition() {
+        const double start = clockSeconds(clock_);
+        std::unique_ptr<BenchMethod> method = entry_.create();
+        method->insertAll(boxes_, volumes_);
+        method->findPairs();
+        const double found = clockSeconds(clock_);
+        method->deliverExact(boxes_);
+        const double dt = clockSeconds(clock_) - start;
+        times_.push_back(1e3 * (found - start));
+        exact_times_.push_back(1e3 * dt);
+        total_ += dt;
+        const PairSummary got = method->summary(boxes_);
+        r_.pairs_last = got.pairs;
+        r_.raw_pairs_last = method->rawPairs();
+        r_.potentially_colliding_last = method->potentiallyColliding();
+        if (!(got == reference_[0]) && r_.mismatched_frames++ == 0) {
+            r_.first_mismatch_frame = 0;
+            r_.expected_pairs = reference_[0].pairs;
+            r_.got_pairs = got.pairs;
+        }
+        method.reset();
+        if (options_.budget_seconds > 0 && total_ > options_.budget_seconds &&
+            static_cast<int>(times_.size()) < repetitions_) {
+            r_.budget_hit = 1;
+        }
+    }
+
+    RunResult finish() {
+        r_.insert_ms = times_.front();
+        r_.frames_run = static_cast<int>(times_.size());
+        r_.median_ms = median(times_);
+        r_.exact_median_ms = median(exact_times_);
+        r_.mean_ms = std::accumulate(times_.begin(), times_.end(), 0.0) / double(times_.size());
+        const std::size_t edge = std::min<std::size_t>(kEdgeFrames, times_.size());
+        r_.first_median_ms = median(std::vector<double>(times_.begin(), times_.begin() + edge));
+        r_.last_median_ms = median(std::vector<double>(times_.end() - edge, times_.end()));
+        return r_;
+    }
+
+private:
+    const BenchMethodEntry& entry_;
+    const MovingBoxes& boxes_;
+    const std::vector<PairSummary>& reference_;
+    const BenchOptions& options_;
+    clockid_t clock_;
+    int repetitions_;
+    std::vector<collision::ProxyVolumes> volumes_;
+    std::vector<double> times_, exact_times_;
+    double total_ = 0;
+    RunResult r_;
+};
 
 RunResult measure(const BenchMethodEntry& entry, const MovingBoxes& initial,
                   const std::vector<PairSummary>& reference, const BenchOptions& options,
                   bool one_shot) {
-    if (one_shot) return measureOneShot(entry, initial, reference, options);
-    RunResult r;
-    MovingBoxes boxes = initial;
-    std::vector<collision::ProxyVolumes> volumes;
-    boxes.volumes(volumes);
-    std::vector<double> times, exact_times;
-    times.reserve(static_cast<std::size_t>(options.frames));
-    exact_times.reserve(static_cast<std::size_t>(options.frames));
-    auto check = [&](BenchMethod& method, int frame) {
-        const PairSummary got = method.summary(boxes);
-        r.pairs_last = got.pairs;
-        if (got == reference[static_cast<std::size_t>(frame)]) return;
-        if (r.mismatched_frames++ == 0) {
-            r.first_mismatch_frame = frame;
-            r.expected_pairs = reference[static_cast<std::size_t>(frame)].pairs;
-            r.got_pairs = got.pairs;
-        }
-    };
-
+    if (one_shot) {
+        OneShotRun run(entry, initial, reference, options);
+        while (!run.done()) run.repetition();
+        return run.finish();
+    }
+    MovingRun run(entry, initial, reference, options);
     const bool peak_reset = options.isolate && resetPeakRss();
     const long rss_before = peak_reset ? statusKb("VmRSS:") : statusKb("VmHWM:");
-
-    const clockid_t clock = frameClock(options, entry);
-    const double t0 = clockSeconds(clock);
-    std::unique_ptr<BenchMethod> method = entry.create();
-    method->insertAll(boxes, volumes);
-    method->findPairs();
-    r.insert_ms = 1e3 * (clockSeconds(clock) - t0);
-    check(*method, 0);
-
-    double total = 0;
-    for (int frame = 1; frame <= options.frames; ++frame) {
-        boxes.step();
-        boxes.volumes(volumes);
-        const double start = clockSeconds(clock);
-        method->moveAll(boxes, volumes);
-        method->findPairs();
-        const double found = clockSeconds(clock);
-        method->deliverExact(boxes);
-        const double dt = clockSeconds(clock) - start;
-        times.push_back(1e3 * (found - start));
-        exact_times.push_back(1e3 * dt);
-        total += dt;
-        check(*method, frame);
-        if (options.budget_seconds > 0 && total > options.budget_seconds &&
-            frame < options.frames) {
-            r.budget_hit = 1;
-            break;
-        }
-    }
-    r.raw_pairs_last = method->rawPairs();
-    r.potentially_colliding_last = method->potentiallyColliding();
+    run.start();
+    while (!run.done()) run.frame();
     const long rss_after = statusKb("VmHWM:");
-    method.reset();
-
-    r.frames_run = static_cast<int>(times.size());
-    r.median_ms = median(times);
-    r.exact_median_ms = median(exact_times);
-    r.mean_ms = times.empty() ? 0
-                              : std::accumulate(times.begin(), times.end(), 0.0) /
-                                    static_cast<double>(times.size());
-    const std::size_t edge = std::min<std::size_t>(kEdgeFrames, times.size());
-    r.first_median_ms = median(std::vector<double>(times.begin(), times.begin() + edge));
-    r.last_median_ms = median(std::vector<double>(times.end() - edge, times.end()));
+    RunResult r = run.finish();
     if (options.isolate && rss_before >= 0 && rss_after >= 0) {
         r.peak_mb = static_cast<double>(std::max(0L, rss_after - rss_before)) / 1024.0;
     }
     return r;
 }
 
-/// One-shot: every repetition creates the method, inserts every box and finds the pairs of frame 0,
-/// all timed; destroying it is not. No state survives between repetitions.
-RunResult measureOneShot(const BenchMethodEntry& entry, const MovingBoxes& boxes,
-                         const std::vector<PairSummary>& reference, const BenchOptions& options) {
-    RunResult r;
-    std::vector<collision::ProxyVolumes> volumes;
-    boxes.volumes(volumes);
-    const int repetitions = oneShotRepetitions(options);
-    std::vector<double> times, exact_times;
-    const clockid_t clock = frameClock(options, entry);
-    double total = 0;
-    for (int rep = 0; rep < repetitions; ++rep) {
-        const double start = clockSeconds(clock);
-        std::unique_ptr<BenchMethod> method = entry.create();
-        method->insertAll(boxes, volumes);
-        method->findPairs();
-        const double found = clockSeconds(clock);
-        method->deliverExact(boxes);
-        const double dt = clockSeconds(clock) - start;
-        times.push_back(1e3 * (found - start));
-        exact_times.push_back(1e3 * dt);
-        total += dt;
-        const PairSummary got = method->summary(boxes);
-        r.pairs_last = got.pairs;
-        r.raw_pairs_last = method->rawPairs();
-        r.potentially_colliding_last = method->potentiallyColliding();
-        if (!(got == reference[0]) && r.mismatched_frames++ == 0) {
-            r.first_mismatch_frame = 0;
-            r.expected_pairs = reference[0].pairs;
-            r.got_pairs = got.pairs;
+/// Several methods measured in turns (measureTogether's body): the moving runs are created and
+/// started in `order`, then advance `turn_frames` frames each per turn, every other turn in
+/// reverse order; one-shot runs take one repetition per turn. Results in the entries' order.
+std::vector<RunResult> measureInTurns(const std::vector<const BenchMethodEntry*>& entries,
+                                      const MovingBoxes& initial,
+                                      const std::vector<PairSummary>& reference,
+                                      const BenchOptions& options, bool one_shot,
+                                      int turn_frames) {
+    std::vector<std::size_t> order(entries.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::vector<RunResult> results;
+    auto turns = [&order](auto& runs, auto&& advance) {
+        for (bool any = true; any;) {
+            any = false;
+            for (const std::size_t i : order) {
+                if (runs[i].done()) continue;
+                advance(runs[i]);
+                any = true;
+            }
+            std::reverse(order.begin(), order.end());
         }
-        method.reset();
-        if (options.budget_seconds > 0 && total > options.budget_seconds && rep + 1 < repetitions) {
-            r.budget_hit = 1;
-            break;
-        }
+    };
+    if (one_shot) {
+        std::vector<OneShotRun> runs;
+        runs.reserve(entries.size());
+        for (const BenchMethodEntry* e : entries) runs.emplace_back(*e, initial, reference, options);
+        turns(runs, [](OneShotRun& run) { run.repetition(); });
+        for (OneShotRun& run : runs) results.push_back(run.finish());
+        return results;
     }
-    r.insert_ms = times.front();
-    r.frames_run = static_cast<int>(times.size());
-    r.median_ms = median(times);
-    r.exact_median_ms = median(exact_times);
-    r.mean_ms = std::accumulate(times.begin(), times.end(), 0.0) / double(times.size());
-    const std::size_t edge = std::min<std::size_t>(kEdgeFrames, times.size());
-    r.first_median_ms = median(std::vector<double>(times.begin(), times.begin() + edge));
-    r.last_median_ms = median(std::vector<double>(times.end() - edge, times.end()));
-    return r;
+    std::vector<MovingRun> runs;
+    runs.reserve(entries.size());
+    for (const BenchMethodEntry* e : entries) runs.emplace_back(*e, initial, reference, options);
+    for (MovingRun& run : runs) run.start();
+    turns(runs, [turn_frames](MovingRun& run) {
+        for (int k = 0; k < turn_frames && !run.done(); ++k) run.frame();
+    });
+    for (MovingRun& run : runs) results.push_back(run.finish());
+    return results;
 }
 
-/// measure() in a forked child: per-method peak memory, and a crash is a row, not the end.
-RunResult measureIsolated(const BenchMethodEntry& entry, const MovingBoxes& initial,
-                          const std::vector<PairSummary>& reference, const BenchOptions& options,
-                          bool one_shot) {
-    RunResult r;
+/// `count` results made by `produce` in a forked child, so that a method's peak memory is its
+/// own and a crash is a failed row, not the end of the run. Each result is failed with the
+/// reason when the child could not run or did not report.
+template <class Produce>
+std::vector<RunResult> inChild(std::size_t count, const BenchOptions& options, Produce&& produce) {
+    std::vector<RunResult> results(count);
+    auto failAll = [&results](const std::string& why) {
+        for (RunResult& r : results) {
+            r = RunResult{};
+            r.failed = 1;
+            setNote(r, why);
+        }
+        return results;
+    };
     int fds[2];
-    if (::pipe(fds) != 0) {
-        r.failed = 1;
-        setNote(r, std::string("pipe: ") + std::strerror(errno));
-        return r;
-    }
+    if (::pipe(fds) != 0) return failAll(std::string("pipe: ") + std::strerror(errno));
     std::cout.flush();
     std::cerr.flush();
     std::fflush(nullptr);
@@ -223,24 +322,26 @@ RunResult measureIsolated(const BenchMethodEntry& entry, const MovingBoxes& init
     if (pid < 0) {
         ::close(fds[0]);
         ::close(fds[1]);
-        r.failed = 1;
-        setNote(r, std::string("fork: ") + std::strerror(errno));
-        return r;
+        return failAll(std::string("fork: ") + std::strerror(errno));
     }
     if (pid == 0) {
         ::close(fds[0]);
         // A stuck method ends with SIGALRM instead of stalling the run.
-        if (options.budget_seconds > 0)
-            ::alarm(static_cast<unsigned>(options.budget_seconds * 10 + 600));
-        RunResult child;
-        try {
-            child = measure(entry, initial, reference, options, one_shot);
-        } catch (const std::exception& e) {
-            child.failed = 1;
-            setNote(child, std::string("exception: ") + e.what());
+        if (options.budget_seconds > 0) {
+            ::alarm(static_cast<unsigned>(options.budget_seconds * 10 * static_cast<double>(count) +
+                                          600));
         }
-        const char* p = reinterpret_cast<const char*>(&child);
-        std::size_t left = sizeof(child);
+        std::vector<RunResult> child(count);
+        try {
+            child = produce();
+        } catch (const std::exception& e) {
+            for (RunResult& r : child) {
+                r.failed = 1;
+                setNote(r, std::string("exception: ") + e.what());
+            }
+        }
+        const char* p = reinterpret_cast<const char*>(child.data());
+        std::size_t left = sizeof(RunResult) * count;
         while (left > 0) {
             const ssize_t w = ::write(fds[1], p, left);
             if (w <= 0) break;
@@ -250,10 +351,11 @@ RunResult measureIsolated(const BenchMethodEntry& entry, const MovingBoxes& init
         ::_exit(left == 0 ? 0 : 1);
     }
     ::close(fds[1]);
-    char* p = reinterpret_cast<char*>(&r);
+    char* p = reinterpret_cast<char*>(results.data());
+    const std::size_t size = sizeof(RunResult) * count;
     std::size_t got = 0;
-    while (got < sizeof(r)) {
-        const ssize_t n = ::read(fds[0], p + got, sizeof(r) - got);
+    while (got < size) {
+        const ssize_t n = ::read(fds[0], p + got, size - got);
         if (n < 0 && errno == EINTR) continue;
         if (n <= 0) break;
         got += static_cast<std::size_t>(n);
@@ -262,17 +364,14 @@ RunResult measureIsolated(const BenchMethodEntry& entry, const MovingBoxes& init
     int status = 0;
     while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
     }
-    if (got != sizeof(r)) {
-        r = RunResult{};
-        r.failed = 1;
+    if (got != size) {
         if (WIFSIGNALED(status)) {
-            setNote(r, "child killed by signal " + std::to_string(WTERMSIG(status)) + " (" +
+            return failAll("child killed by signal " + std::to_string(WTERMSIG(status)) + " (" +
                            strsignal(WTERMSIG(status)) + ")");
-        } else {
-            setNote(r, "child exited with status " + std::to_string(WEXITSTATUS(status)));
         }
+        return failAll("child exited with status " + std::to_string(WEXITSTATUS(status)));
     }
-    return r;
+    return results;
 }
 
 }  // namespace
@@ -317,8 +416,28 @@ Row runMethod(const BenchMethodEntry& m, const TableRun& run, const BenchOptions
         return row;
     }
     row.result = options.isolate
-                     ? measureIsolated(m, run.workload, run.reference, options, run.one_shot)
+                     ? inChild(1, options,
+                               [&] {
+                                   return std::vector<RunResult>{measure(
+                                       m, run.workload, run.reference, options, run.one_shot)};
+                               })
+                           .front()
                      : measure(m, run.workload, run.reference, options, run.one_shot);
+    reportRun(row, m, run);
+    return row;
+}
+
+std::vector<RunResult> measureTogether(const std::vector<const BenchMethodEntry*>& entries,
+                                       const TableRun& run, int turn_frames) {
+    auto produce = [&] {
+        return measureInTurns(entries, run.workload, run.reference, run.options, run.one_shot,
+                              turn_frames);
+    };
+    return run.options.isolate ? inChild(entries.size(), run.options, produce) : produce();
+}
+
+void reportRun(const Row& row, const BenchMethodEntry& m, const TableRun& run) {
+    const int n = run.workload.size();
     const RunResult& r = row.result;
     run.err << "[" << row.workload << " N=" << n << "] " << m.name << ": ";
     if (r.failed) {
@@ -342,7 +461,6 @@ Row runMethod(const BenchMethodEntry& m, const TableRun& run, const BenchOptions
         run.out << "!!! " << msg;
         run.err << "!!! " << msg;
     }
-    return row;
 }
 
 }  // namespace app

@@ -290,6 +290,7 @@ bool writeBenchJson(const std::filesystem::path& file, const BenchOptions& optio
     doc["clock"] = options.clock;
     doc["peers"] = options.peers;
     doc["rounds"] = options.rounds;
+    doc["interleave"] = options.interleave;
     doc["rows"] = nlohmann::json::array();
     for (const Row& row : rows) doc["rows"].push_back(rowJson(row));
     return writeTextReporting(file, doc.dump(2) + "\n", err);

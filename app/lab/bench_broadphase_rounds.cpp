@@ -43,9 +43,80 @@ void combineRounds(Row& row) {
     }
 }
 
+// A row whose method is not in the registry any more: failed rather than given a figure of
+// another round.
+void failUnregistered(const TableRun& run, Row& row) {
+    row.result.failed = 1;
+    std::snprintf(row.result.note, sizeof(row.result.note), "no method named %s to run again",
+                  row.method.c_str());
+    run.failed = true;
+}
+
+// The rows' results over their rounds, or their rounds dropped when they did not run them all.
+void combineAll(std::vector<Row>& rows, int rounds) {
+    for (Row& row : rows) {
+        if (usable(row) && static_cast<int>(row.rounds.size()) == rounds) {
+            combineRounds(row);
+        } else {
+            row.rounds.clear();
+        }
+    }
+}
+
+// --interleave: the usable rows timed `rounds` times, measured together each time; these rounds
+// replace the first pass's figures. A row that fails or disagrees in a round keeps that round's
+// result and sits out the rest.
+void runTogether(const TableRun& run, std::vector<Row>& rows) {
+    const int rounds = run.options.rounds;
+    std::vector<std::size_t> ids;
+    std::vector<const BenchMethodEntry*> entries;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+        if (!usable(rows[i])) continue;
+        const BenchMethodEntry* entry = findBenchMethod(rows[i].method);
+        if (entry == nullptr) {
+            failUnregistered(run, rows[i]);
+            continue;
+        }
+        ids.push_back(i);
+        entries.push_back(entry);
+        rows[i].rounds.clear();
+    }
+    if (entries.empty()) return;
+    for (int round = 1; round <= rounds; ++round) {
+        run.err << "[" << tableName(run.workload, run.one_shot) << " N=" << run.workload.size()
+                << "] round " << round << " of " << rounds << ", " << entries.size()
+                << " rows measured together\n";
+        const std::vector<RunResult> results = measureTogether(entries, run, run.options.interleave);
+        std::vector<std::size_t> kept_ids;
+        std::vector<const BenchMethodEntry*> kept_entries;
+        for (std::size_t j = 0; j < entries.size(); ++j) {
+            Row& row = rows[ids[j]];
+            Row again = row;
+            again.result = results[j];
+            reportRun(again, *entries[j], run);
+            if (!usable(again)) {
+                row.result = again.result;
+                row.rounds.clear();
+                continue;
+            }
+            row.rounds.push_back(results[j]);
+            kept_ids.push_back(ids[j]);
+            kept_entries.push_back(entries[j]);
+        }
+        ids = std::move(kept_ids);
+        entries = std::move(kept_entries);
+        if (entries.empty()) break;
+    }
+    combineAll(rows, rounds);
+}
+
 }  // namespace
 
 void runRounds(const TableRun& run, std::vector<Row>& rows) {
+    if (run.options.interleave > 0) {
+        runTogether(run, rows);
+        return;
+    }
     const int rounds = run.options.rounds;
     if (rounds <= 1) return;
     std::vector<std::size_t> order;
@@ -64,12 +135,7 @@ void runRounds(const TableRun& run, std::vector<Row>& rows) {
             if (!usable(row)) continue;
             const BenchMethodEntry* entry = findBenchMethod(row.method);
             if (entry == nullptr) {
-                // Every row comes from a registered method; say so rather than mix a one-round
-                // figure into a table of medians.
-                row.result.failed = 1;
-                std::snprintf(row.result.note, sizeof(row.result.note),
-                              "no method named %s to run again", row.method.c_str());
-                run.failed = true;
+                failUnregistered(run, row);
                 continue;
             }
             const Row again = runMethod(*entry, run, run.options);
@@ -81,13 +147,7 @@ void runRounds(const TableRun& run, std::vector<Row>& rows) {
             row.rounds.push_back(again.result);
         }
     }
-    for (Row& row : rows) {
-        if (usable(row) && static_cast<int>(row.rounds.size()) == rounds) {
-            combineRounds(row);
-        } else {
-            row.rounds.clear();
-        }
-    }
+    combineAll(rows, rounds);
 }
 
 void setRoundRatios(std::vector<Row>& rows) {

@@ -13,6 +13,8 @@ namespace app {
 /// reference in any round keeps that round's result and so drops out of the ratios. Each row
 /// that stays usable gets its per-round results in `rounds` and, as its figures, their medians
 /// (peak memory: the largest; frames: the fewest; a budget stop in any round shows).
+/// With --interleave, instead: rounds 1..R all measured together (measureTogether), and the
+/// first pass that made `rows` gives no figure.
 void runRounds(const TableRun& run, std::vector<Row>& rows);
 
 /// Each row's ratio to the best usable peer of the same round, under each rule (rows without

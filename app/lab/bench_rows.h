@@ -83,4 +83,16 @@ inline std::string tableName(const MovingBoxes& workload, bool one_shot) {
 /// and mismatches (bench_broadphase.cpp).
 Row runMethod(const BenchMethodEntry& m, const TableRun& run, const BenchOptions& options);
 
+/// The methods measured together on a table (--interleave): each on its own copy of the
+/// workload, all alive at once, advanced `turn_frames` frames per turn (one-shot: one repetition)
+/// with the order reversed every turn, so a stretch in which the machine runs slow costs them
+/// alike. In a forked child unless the options say in-process; no peak memory. Results in the
+/// entries' order.
+std::vector<RunResult> measureTogether(const std::vector<const BenchMethodEntry*>& entries,
+                                       const TableRun& run, int turn_frames);
+
+/// Prints `row`'s progress line and any mismatch, and marks the run failed on a failure or a
+/// mismatch of one of cdlab's methods.
+void reportRun(const Row& row, const BenchMethodEntry& m, const TableRun& run);
+
 }  // namespace app
