@@ -279,7 +279,9 @@ std::vector<RunResult> measureInTurns(const std::vector<const BenchMethodEntry*>
     if (one_shot) {
         std::vector<OneShotRun> runs;
         runs.reserve(entries.size());
-        for (const BenchMethodEntry* e : entries) runs.emplace_back(*e, initial, reference, options);
+        for (const BenchMethodEntry* e : entries) {
+            runs.emplace_back(*e, initial, reference, options);
+        }
         turns(runs, [](OneShotRun& run) { run.repetition(); });
         for (OneShotRun& run : runs) results.push_back(run.finish());
         return results;

@@ -86,7 +86,8 @@ void runTogether(const TableRun& run, std::vector<Row>& rows) {
         run.err << "[" << tableName(run.workload, run.one_shot) << " N=" << run.workload.size()
                 << "] round " << round << " of " << rounds << ", " << entries.size()
                 << " rows measured together\n";
-        const std::vector<RunResult> results = measureTogether(entries, run, run.options.interleave);
+        const std::vector<RunResult> results =
+            measureTogether(entries, run, run.options.interleave);
         std::vector<std::size_t> kept_ids;
         std::vector<const BenchMethodEntry*> kept_entries;
         for (std::size_t j = 0; j < entries.size(); ++j) {

@@ -95,8 +95,8 @@ TEST(BroadphaseBenchInterleave, MovingRowsRunTheirFramesInTurnsOnTheirOwnWorkloa
     bool failed = false;
     const app::TableRun run{t.workload, t.reference, options, false, out, err, failed};
     const std::vector<app::RunResult> results = app::measureTogether({&a, &b}, run, 2);
-    const std::vector<std::string> expected{"A+", "B+", "A1", "A2", "B1", "B2", "B3",
-                                            "B4", "A3", "A4", "A5", "B5"};
+    const std::vector<std::string> expected{"A+", "B+", "A1", "A2", "B1", "B2",
+                                            "B3", "B4", "A3", "A4", "A5", "B5"};
     EXPECT_EQ(log, expected);
     ASSERT_EQ(results.size(), 2u);
     for (const app::RunResult& r : results) {
@@ -183,8 +183,9 @@ TEST(BroadphaseBenchInterleave, InterleavedRoundsAreTheRowsFigures) {
     ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
     EXPECT_NE(r.out.find("timed 3 more times measured together"), std::string::npos) << r.out;
     for (int round = 1; round <= 3; ++round) {
-        EXPECT_NE(r.err.find("] round " + std::to_string(round) + " of 3, 2 rows measured together"),
-                  std::string::npos)
+        EXPECT_NE(
+            r.err.find("] round " + std::to_string(round) + " of 3, 2 rows measured together"),
+            std::string::npos)
             << r.err;
     }
     std::ifstream in(json);
