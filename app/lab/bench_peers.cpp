@@ -111,9 +111,10 @@ public:
                 double mean_size = 0;
                 for (const collision::Vec3& h : boxes.halfExtents()) mean_size += 2 * h.mean();
                 mean_size /= n;
-                gDbvtMargin = tuning_.margin_fraction < 0
-                                  ? kBulletDefaultMargin
-                                  : btScalar(tuning_.margin_fraction * mean_size);
+                margin_ = tuning_.margin_fraction < 0
+                              ? kBulletDefaultMargin
+                              : btScalar(tuning_.margin_fraction * mean_size);
+                gDbvtMargin = margin_;
                 auto dbvt = std::make_unique<btDbvtBroadphase>();
                 dbvt->m_deferedcollide = kind_ == BulletKind::DbvtDeferred;
                 dbvt->m_prediction = btScalar(tuning_.prediction);
@@ -149,12 +150,19 @@ public:
     }
     void moveAll(const MovingBoxes& boxes,
                  std::span<const collision::ProxyVolumes> /*volumes*/) override {
+        // gDbvtMargin is a global of Bullet's, read whenever a DBVT leaf is (re)inserted: with
+        // several instances alive at once (bench broadphase --interleave), the last one made
+        // would set every one's margin. Each sets its own before its calls.
+        gDbvtMargin = margin_;
         for (std::size_t i = 0; i < proxies_.size(); ++i) {
             const collision::Aabb box = boxes.aabb(static_cast<int>(i));
             broad_phase_->setAabb(proxies_[i], lowerCorner(box), upperCorner(box), nullptr);
         }
     }
-    void findPairs() override { broad_phase_->calculateOverlappingPairs(nullptr); }
+    void findPairs() override {
+        gDbvtMargin = margin_;
+        broad_phase_->calculateOverlappingPairs(nullptr);
+    }
     PairSummary summary(const MovingBoxes& boxes) override {
         PairSummary out;
         btBroadphasePairArray& cache =
@@ -206,6 +214,7 @@ public:
 private:
     BulletKind kind_;
     BulletTuning tuning_;
+    btScalar margin_ = kBulletDefaultMargin;  ///< this DBVT's gDbvtMargin
     std::unique_ptr<btBroadphaseInterface> broad_phase_;
     std::vector<btBroadphaseProxy*> proxies_;
     std::int64_t raw_pairs_ = 0;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -168,6 +169,30 @@ TEST(BroadphaseBenchInterleave, AForkedRoundReportsEachRowAndSurvivesACrash) {
         EXPECT_EQ(r.failed, 1);
         EXPECT_NE(std::string(r.note).find("signal"), std::string::npos) << r.note;
     }
+}
+
+// Methods alive at once keep their own settings: Bullet's DBVT margin is one global of Bullet's
+// (gDbvtMargin), and two configurations measured together each hold the pair cache that margin
+// gives them alone.
+TEST(BroadphaseBenchInterleave, PeersMeasuredTogetherKeepTheirOwnSettings) {
+    const app::BenchMethodEntry* wide = app::findBenchMethod("bullet-dbvt:m0.3");
+    const app::BenchMethodEntry* narrow = app::findBenchMethod("bullet-dbvt:m0.1");
+    if (wide == nullptr || narrow == nullptr) GTEST_SKIP() << "built without Bullet";
+    const Table t = table(2000, 20);
+    app::BenchOptions options;
+    options.frames = 20;
+    options.isolate = false;
+    std::ostringstream out, err;
+    bool failed = false;
+    const app::TableRun run{t.workload, t.reference, options, false, out, err, failed};
+    const std::int64_t wide_alone = app::measureTogether({wide}, run, 5).front().raw_pairs_last;
+    const std::int64_t narrow_alone =
+        app::measureTogether({narrow}, run, 5).front().raw_pairs_last;
+    ASSERT_GT(wide_alone, narrow_alone);  // the margins differ enough to tell apart
+    const std::vector<app::RunResult> together = app::measureTogether({wide, narrow}, run, 5);
+    EXPECT_EQ(together[0].raw_pairs_last, wide_alone);
+    EXPECT_EQ(together[1].raw_pairs_last, narrow_alone);
+    for (const app::RunResult& r : together) EXPECT_EQ(r.mismatched_frames, 0);
 }
 
 // The command: after the first pass, --rounds rounds measured together; each row reports those
