@@ -186,8 +186,7 @@ TEST(BroadphaseBenchInterleave, PeersMeasuredTogetherKeepTheirOwnSettings) {
     bool failed = false;
     const app::TableRun run{t.workload, t.reference, options, false, out, err, failed};
     const std::int64_t wide_alone = app::measureTogether({wide}, run, 5).front().raw_pairs_last;
-    const std::int64_t narrow_alone =
-        app::measureTogether({narrow}, run, 5).front().raw_pairs_last;
+    const std::int64_t narrow_alone = app::measureTogether({narrow}, run, 5).front().raw_pairs_last;
     ASSERT_GT(wide_alone, narrow_alone);  // the margins differ enough to tell apart
     const std::vector<app::RunResult> together = app::measureTogether({wide, narrow}, run, 5);
     EXPECT_EQ(together[0].raw_pairs_last, wide_alone);
