@@ -255,8 +255,9 @@ RunResult measure(const BenchMethodEntry& entry, const MovingBoxes& initial,
 }
 
 /// Several methods measured in turns (measureTogether's body): the moving runs are created and
-/// started in `order`, then advance `turn_frames` frames each per turn, every other turn in
-/// reverse order; one-shot runs take one repetition per turn. Results in the entries' order.
+/// started in the entries' order, then advance `turn_frames` frames each per turn, the order
+/// reversed every turn; one-shot runs take one repetition per turn. Results in the entries'
+/// order.
 std::vector<RunResult> measureInTurns(const std::vector<const BenchMethodEntry*>& entries,
                                       const MovingBoxes& initial,
                                       const std::vector<PairSummary>& reference,
