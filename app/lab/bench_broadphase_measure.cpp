@@ -76,6 +76,36 @@ void setNote(RunResult& r, const std::string& text) {
     std::snprintf(r.note, sizeof(r.note), "%s", text.c_str());
 }
 
+/// A row's timed frames (one-shot: repetitions), ms: the pairs as held (`held`), and with the
+/// exact pairs delivered (`exact`); and the figures made from them.
+struct FrameTimes {
+    std::vector<double> held, exact;
+    double total_s = 0;  ///< with the exact pairs, s: what the budget counts
+
+    /// One frame timed from `start`: pairs found at `found`, exact pairs delivered at `end` (s).
+    void add(double start, double found, double end) {
+        held.push_back(1e3 * (found - start));
+        exact.push_back(1e3 * (end - start));
+        total_s += end - start;
+    }
+    int count() const { return static_cast<int>(held.size()); }
+    bool overBudget(const BenchOptions& options) const {
+        return options.budget_seconds > 0 && total_s > options.budget_seconds;
+    }
+    /// frames_run, the medians, the mean, and the first and last kEdgeFrames' medians.
+    void fill(RunResult& r) const {
+        r.frames_run = count();
+        r.median_ms = median(held);
+        r.exact_median_ms = median(exact);
+        r.mean_ms = held.empty() ? 0
+                                 : std::accumulate(held.begin(), held.end(), 0.0) /
+                                       static_cast<double>(held.size());
+        const std::size_t edge = std::min<std::size_t>(kEdgeFrames, held.size());
+        r.first_median_ms = median(std::vector<double>(held.begin(), held.begin() + edge));
+        r.last_median_ms = median(std::vector<double>(held.end() - edge, held.end()));
+    }
+};
+
 /// One method's moving run on a private copy of the workload, a frame at a time: create, insert
 /// and the first query (insert_ms), then each frame moveAll + findPairs (median_ms) and
 /// deliverExact (exact_ms) timed, its pairs checked against the reference untimed. measure()
@@ -84,11 +114,14 @@ class MovingRun {
 public:
     MovingRun(const BenchMethodEntry& entry, const MovingBoxes& initial,
               const std::vector<PairSummary>& reference, const BenchOptions& options)
-        : entry_(entry), boxes_(initial), reference_(reference), options_(options),
+        : entry_(entry),
+          boxes_(initial),
+          reference_(reference),
+          options_(options),
           clock_(frameClock(options, entry)) {
         boxes_.volumes(volumes_);
-        times_.reserve(static_cast<std::size_t>(options.frames));
-        exact_times_.reserve(static_cast<std::size_t>(options.frames));
+        times_.held.reserve(static_cast<std::size_t>(options.frames));
+        times_.exact.reserve(static_cast<std::size_t>(options.frames));
     }
 
     void start() {
@@ -112,13 +145,9 @@ public:
         method_->findPairs();
         const double found = clockSeconds(clock_);
         method_->deliverExact(boxes_);
-        const double dt = clockSeconds(clock_) - start;
-        times_.push_back(1e3 * (found - start));
-        exact_times_.push_back(1e3 * dt);
-        total_ += dt;
+        times_.add(start, found, clockSeconds(clock_));
         check(frame_);
-        if (options_.budget_seconds > 0 && total_ > options_.budget_seconds &&
-            frame_ < options_.frames) {
+        if (times_.overBudget(options_) && frame_ < options_.frames) {
             r_.budget_hit = 1;
         }
     }
@@ -128,15 +157,7 @@ public:
         r_.raw_pairs_last = method_->rawPairs();
         r_.potentially_colliding_last = method_->potentiallyColliding();
         method_.reset();
-        r_.frames_run = static_cast<int>(times_.size());
-        r_.median_ms = median(times_);
-        r_.exact_median_ms = median(exact_times_);
-        r_.mean_ms = times_.empty() ? 0
-                                    : std::accumulate(times_.begin(), times_.end(), 0.0) /
-                                          static_cast<double>(times_.size());
-        const std::size_t edge = std::min<std::size_t>(kEdgeFrames, times_.size());
-        r_.first_median_ms = median(std::vector<double>(times_.begin(), times_.begin() + edge));
-        r_.last_median_ms = median(std::vector<double>(times_.end() - edge, times_.end()));
+        times_.fill(r_);
         return r_;
     }
 
@@ -159,8 +180,7 @@ private:
     clockid_t clock_;
     std::vector<collision::ProxyVolumes> volumes_;
     std::unique_ptr<BenchMethod> method_;
-    std::vector<double> times_, exact_times_;
-    double total_ = 0;
+    FrameTimes times_;
     int frame_ = 0;
     RunResult r_;
 };
@@ -172,14 +192,16 @@ class OneShotRun {
 public:
     OneShotRun(const BenchMethodEntry& entry, const MovingBoxes& boxes,
                const std::vector<PairSummary>& reference, const BenchOptions& options)
-        : entry_(entry), boxes_(boxes), reference_(reference), options_(options),
-          clock_(frameClock(options, entry)), repetitions_(oneShotRepetitions(options)) {
+        : entry_(entry),
+          boxes_(boxes),
+          reference_(reference),
+          options_(options),
+          clock_(frameClock(options, entry)),
+          repetitions_(oneShotRepetitions(options)) {
         boxes.volumes(volumes_);
     }
 
-    bool done() const {
-        return static_cast<int>(times_.size()) >= repetitions_ || r_.budget_hit != 0;
-    }
+    bool done() const { return times_.count() >= repetitions_ || r_.budget_hit != 0; }
 
     void repetition() {
         const double start = clockSeconds(clock_);
@@ -188,10 +210,7 @@ public:
         method->findPairs();
         const double found = clockSeconds(clock_);
         method->deliverExact(boxes_);
-        const double dt = clockSeconds(clock_) - start;
-        times_.push_back(1e3 * (found - start));
-        exact_times_.push_back(1e3 * dt);
-        total_ += dt;
+        times_.add(start, found, clockSeconds(clock_));
         const PairSummary got = method->summary(boxes_);
         r_.pairs_last = got.pairs;
         r_.raw_pairs_last = method->rawPairs();
@@ -202,21 +221,14 @@ public:
             r_.got_pairs = got.pairs;
         }
         method.reset();
-        if (options_.budget_seconds > 0 && total_ > options_.budget_seconds &&
-            static_cast<int>(times_.size()) < repetitions_) {
+        if (times_.overBudget(options_) && times_.count() < repetitions_) {
             r_.budget_hit = 1;
         }
     }
 
     RunResult finish() {
-        r_.insert_ms = times_.front();
-        r_.frames_run = static_cast<int>(times_.size());
-        r_.median_ms = median(times_);
-        r_.exact_median_ms = median(exact_times_);
-        r_.mean_ms = std::accumulate(times_.begin(), times_.end(), 0.0) / double(times_.size());
-        const std::size_t edge = std::min<std::size_t>(kEdgeFrames, times_.size());
-        r_.first_median_ms = median(std::vector<double>(times_.begin(), times_.begin() + edge));
-        r_.last_median_ms = median(std::vector<double>(times_.end() - edge, times_.end()));
+        r_.insert_ms = times_.held.front();
+        times_.fill(r_);
         return r_;
     }
 
@@ -228,8 +240,7 @@ private:
     clockid_t clock_;
     int repetitions_;
     std::vector<collision::ProxyVolumes> volumes_;
-    std::vector<double> times_, exact_times_;
-    double total_ = 0;
+    FrameTimes times_;
     RunResult r_;
 };
 
@@ -261,8 +272,7 @@ RunResult measure(const BenchMethodEntry& entry, const MovingBoxes& initial,
 std::vector<RunResult> measureInTurns(const std::vector<const BenchMethodEntry*>& entries,
                                       const MovingBoxes& initial,
                                       const std::vector<PairSummary>& reference,
-                                      const BenchOptions& options, bool one_shot,
-                                      int turn_frames) {
+                                      const BenchOptions& options, bool one_shot, int turn_frames) {
     std::vector<std::size_t> order(entries.size());
     std::iota(order.begin(), order.end(), std::size_t{0});
     std::vector<RunResult> results;

@@ -64,22 +64,30 @@ app::BenchMethodEntry logged(const std::string& name, const std::string& inner,
     return entry;
 }
 
+// A table to measure: the uniform workload of n boxes, its reference pairs for `frames` frames,
+// and the options (`frames` frames, in-process) and streams of a run of it.
 struct Table {
+    Table(int n, int frames) : workload(app::WorkloadKind::Uniform, n, 1) {
+        app::MovingBoxes boxes = workload;
+        app::PairReference sweep;
+        reference.push_back(sweep.count(boxes));
+        for (int f = 1; f <= frames; ++f) {
+            boxes.step();
+            reference.push_back(sweep.count(boxes));
+        }
+        options.frames = frames;
+        options.isolate = false;
+    }
+    app::TableRun run(bool one_shot) {
+        return {workload, reference, options, one_shot, out, err, failed};
+    }
+
     app::MovingBoxes workload;
     std::vector<app::PairSummary> reference;
+    app::BenchOptions options;
+    std::ostringstream out, err;
+    bool failed = false;
 };
-
-Table table(int n, int frames) {
-    Table t{app::MovingBoxes(app::WorkloadKind::Uniform, n, 1), {}};
-    app::MovingBoxes boxes = t.workload;
-    app::PairReference sweep;
-    t.reference.push_back(sweep.count(boxes));
-    for (int f = 1; f <= frames; ++f) {
-        boxes.step();
-        t.reference.push_back(sweep.count(boxes));
-    }
-    return t;
-}
 
 // Moving: every method is created and filled first, then each runs its frames in turns of
 // turn_frames, the order reversed every turn, each on its own copy of the workload (every frame
@@ -88,14 +96,8 @@ TEST(BroadphaseBenchInterleave, MovingRowsRunTheirFramesInTurnsOnTheirOwnWorkloa
     std::vector<std::string> log;
     const app::BenchMethodEntry a = logged("A", "sap", log);
     const app::BenchMethodEntry b = logged("B", "hgrid", log);
-    const Table t = table(300, 5);
-    app::BenchOptions options;
-    options.frames = 5;
-    options.isolate = false;
-    std::ostringstream out, err;
-    bool failed = false;
-    const app::TableRun run{t.workload, t.reference, options, false, out, err, failed};
-    const std::vector<app::RunResult> results = app::measureTogether({&a, &b}, run, 2);
+    Table t(300, 5);
+    const std::vector<app::RunResult> results = app::measureTogether({&a, &b}, t.run(false), 2);
     const std::vector<std::string> expected{"A+", "B+", "A1", "A2", "B1", "B2",
                                             "B3", "B4", "A3", "A4", "A5", "B5"};
     EXPECT_EQ(log, expected);
@@ -107,7 +109,7 @@ TEST(BroadphaseBenchInterleave, MovingRowsRunTheirFramesInTurnsOnTheirOwnWorkloa
         EXPECT_EQ(r.pairs_last, t.reference.back().pairs);
         EXPECT_GT(r.median_ms, 0);
     }
-    EXPECT_FALSE(failed);
+    EXPECT_FALSE(t.failed);
 }
 
 // One-shot: one repetition (create, fill, find) per turn, alternating A B, B A, ...
@@ -115,14 +117,9 @@ TEST(BroadphaseBenchInterleave, OneShotRowsTakeOneRepetitionPerTurn) {
     std::vector<std::string> log;
     const app::BenchMethodEntry a = logged("A", "sap", log);
     const app::BenchMethodEntry b = logged("B", "hgrid", log);
-    const Table t = table(300, 0);
-    app::BenchOptions options;
-    options.frames = 3;
-    options.isolate = false;
-    std::ostringstream out, err;
-    bool failed = false;
-    const app::TableRun run{t.workload, t.reference, options, true, out, err, failed};
-    const std::vector<app::RunResult> results = app::measureTogether({&a, &b}, run, 7);
+    Table t(300, 0);
+    t.options.frames = 3;  // repetitions, each of frame 0
+    const std::vector<app::RunResult> results = app::measureTogether({&a, &b}, t.run(true), 7);
     const std::vector<std::string> expected{"A+", "B+", "B+", "A+", "A+", "B+"};
     EXPECT_EQ(log, expected);
     for (const app::RunResult& r : results) {
@@ -135,12 +132,9 @@ TEST(BroadphaseBenchInterleave, OneShotRowsTakeOneRepetitionPerTurn) {
 // that disagrees with the reference is reported as such, and one that crashes fails its rows
 // with the signal named instead of ending the run.
 TEST(BroadphaseBenchInterleave, AForkedRoundReportsEachRowAndSurvivesACrash) {
-    const Table t = table(200, 4);
-    app::BenchOptions options;
-    options.frames = 4;
-    std::ostringstream out, err;
-    bool failed = false;
-    const app::TableRun run{t.workload, t.reference, options, false, out, err, failed};
+    Table t(200, 4);
+    t.options.isolate = true;
+    const app::TableRun run = t.run(false);
     std::vector<std::string> unused;
     const app::BenchMethodEntry good = logged("good", "sap", unused);
     app::BenchMethodEntry wrong = logged("wrong", "sap", unused);
@@ -178,13 +172,8 @@ TEST(BroadphaseBenchInterleave, PeersMeasuredTogetherKeepTheirOwnSettings) {
     const app::BenchMethodEntry* wide = app::findBenchMethod("bullet-dbvt:m0.3");
     const app::BenchMethodEntry* narrow = app::findBenchMethod("bullet-dbvt:m0.1");
     if (wide == nullptr || narrow == nullptr) GTEST_SKIP() << "built without Bullet";
-    const Table t = table(2000, 20);
-    app::BenchOptions options;
-    options.frames = 20;
-    options.isolate = false;
-    std::ostringstream out, err;
-    bool failed = false;
-    const app::TableRun run{t.workload, t.reference, options, false, out, err, failed};
+    Table t(2000, 20);
+    const app::TableRun run = t.run(false);
     const std::int64_t wide_alone = app::measureTogether({wide}, run, 5).front().raw_pairs_last;
     const std::int64_t narrow_alone = app::measureTogether({narrow}, run, 5).front().raw_pairs_last;
     ASSERT_GT(wide_alone, narrow_alone);  // the margins differ enough to tell apart
