@@ -543,8 +543,8 @@ int runBenchNarrowphase(const BenchNarrowphaseOptions& options, std::ostream& ou
         err << "cdlab bench narrowphase: --reps must be >= 1\n";
         return 2;
     }
-    if (options.rounds < 1 || options.rounds > 50) {
-        err << "cdlab bench narrowphase: --rounds must be in 1..50\n";
+    if (options.rounds < 1 || options.rounds > kMaxBenchRounds) {
+        err << "cdlab bench narrowphase: --rounds must be in 1.." << kMaxBenchRounds << "\n";
         return 2;
     }
     const int target = options.large ? 100000 : options.triangles;

@@ -17,9 +17,9 @@ struct BenchNarrowphaseOptions {
     bool large = false;     ///< 100k-triangle tori (overrides `triangles`)
     int poses = 32;         ///< even, >= 2: half colliding, half not
     int reps = 3;  ///< repetitions per pose (and of the build, at most 3); the fastest counts
-    /// The method list measured this many times (1..50), in order then in reverse, in turn; each
-    /// time is the median over the rounds, so a stretch where the machine runs slow costs a
-    /// round, not a method.
+    /// The method list measured this many times (1..kMaxBenchRounds, bench_broadphase.h), in
+    /// order then in reverse, in turn; each time is the median over the rounds, so a stretch
+    /// where the machine runs slow costs a round, not a method.
     int rounds = 1;
     std::uint64_t seed = 7;
     /// Method names (cdlab volume names, NAME-bu for the bottom-up build, "fcl-obbrss", ...);
