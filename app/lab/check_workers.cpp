@@ -169,13 +169,6 @@ pid_t spawnWorker(const WorkerPlan& plan, std::size_t i, const fs::path& work, s
     return pid;
 }
 
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
-}
-
 SceneReport notRun(const std::string& why) {
     SceneReport r;
     r.outcome = SceneOutcome::NotRun;
@@ -190,7 +183,7 @@ SceneReport collect(const WorkerPlan& plan, const Child& c, int status, bool tim
     if (timed_out) {
         report = notRun("timed out after " + formatDouble(*plan.timeout) + " s");
     } else if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
-        report = parseWorkerReport(slurp(reportPath(work, c.index)));
+        report = parseWorkerReport(fileBytes(reportPath(work, c.index)));
         if (!report) report = notRun("the grader's report is unreadable");
     } else if (WIFSIGNALED(status)) {
         const int sig = WTERMSIG(status);
@@ -204,7 +197,7 @@ SceneReport collect(const WorkerPlan& plan, const Child& c, int status, bool tim
         report->seconds = std::chrono::duration<double>(Clock::now() - c.start).count();
     }
     report->label = plan.scenes[c.index].string();
-    report->log = slurp(logPath(work, c.index));
+    report->log = fileBytes(logPath(work, c.index));
     return *report;
 }
 

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <sstream>
 #include <string_view>
 #include <system_error>
 
@@ -10,6 +11,13 @@
 #include "render/output_file.h"
 
 namespace app {
+
+std::string fileBytes(const std::filesystem::path& file) {
+    std::ifstream f(file, std::ios::binary);
+    std::ostringstream s;
+    s << f.rdbuf();
+    return s.str();
+}
 
 namespace fs = std::filesystem;
 

@@ -1,4 +1,5 @@
-// app/lab/output_files.h -- output directories and files that are either complete or absent.
+// app/lab/output_files.h -- output directories and files that are either complete or absent, and
+// the lab's files read back whole.
 #pragma once
 
 #include <filesystem>
@@ -6,6 +7,10 @@
 #include <string>
 
 namespace app {
+
+/// The whole of `file` as bytes; empty when it cannot be read (the caller's parse then says what
+/// is missing).
+std::string fileBytes(const std::filesystem::path& file);
 
 /// Writes `text` to FILE.partial and renames it to `file`, so a file that exists is complete; an
 /// existing `file` that is not a regular file (a device, a FIFO, a link) is refused, never

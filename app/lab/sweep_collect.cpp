@@ -23,13 +23,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string fileBytes(const fs::path& file) {
-    std::ifstream f(file, std::ios::binary);
-    std::ostringstream s;
-    s << f.rdbuf();
-    return s.str();
-}
-
 // Marks every run whose timed interval overlapped another job's on the same host; true when any
 // did, or when the runs were timed on more than one host (their clocks are not comparable).
 bool markConcurrent(std::vector<JobResult>& results) {

@@ -102,13 +102,6 @@ double epochSeconds() {
         .count();
 }
 
-std::string fileBytes(const fs::path& file) {
-    std::ifstream f(file, std::ios::binary);
-    std::ostringstream s;
-    s << f.rdbuf();
-    return s.str();
-}
-
 // Measures the run `plan.repeat` times; the first repeat measures everything, the others must
 // reproduce its deterministic columns. Returns the failure, empty on success.
 std::string measureRepeats(const SweepPlan& plan, const engine::Scene& scene, JobResult& result) {

@@ -36,13 +36,6 @@ std::string utcNow() {
     return text;
 }
 
-std::string fileBytes(const fs::path& file) {
-    std::ifstream f(file, std::ios::binary);
-    std::ostringstream s;
-    s << f.rdbuf();
-    return s.str();
-}
-
 // plan.json without its id: what the id is computed over (nlohmann keeps object keys sorted, so
 // the text is canonical).
 json planContent(const SweepPlan& plan) {

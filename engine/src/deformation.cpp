@@ -9,6 +9,7 @@
 
 namespace engine {
 
+using collision::kPi;
 using collision::Real;
 using collision::Vec3;
 
@@ -55,7 +56,6 @@ Vec3 deformPoint(const Deformation& d, const Vec3& rest, Real t) {
 }
 
 Real deformSpeedBound(const Deformation& d, std::span<const Vec3> rest) {
-    constexpr Real kPi = std::numbers::pi_v<Real>;
     // Bend and twist vary with the strength k = amount s(t), s = sin^2(pi f t), whose rate
     // |ds/dt| = pi f |sin(2 pi f t)| is at most pi f.
     const Real strength_rate = kPi * d.frequency * std::abs(d.amount);

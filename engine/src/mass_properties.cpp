@@ -22,9 +22,8 @@ namespace engine {
 
 namespace {
 
+using collision::kPi;
 using collision::ShapeType;
-
-constexpr Real kPi = std::numbers::pi_v<Real>;
 
 // Signed volume below this fraction of the bounding box volume counts as "no volume": a flat or
 // open-and-cancelling surface, never a solid.

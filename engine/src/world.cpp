@@ -10,7 +10,6 @@
 #include "engine/world.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -21,16 +20,13 @@
 #include "collision/ccd/ccd.h"
 #include "collision/narrowphase/narrow_phase.h"
 #include "contact_solver.h"
+#include "stage_clock.h"
 
 namespace engine {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
+using Clock = StageClock;
 
 std::unique_ptr<collision::BroadPhase> makeBroadPhase(const std::string& name,
                                                       collision::PairOrder order) {

@@ -1,7 +1,6 @@
 // engine/src/world_deform.cpp -- the World's deforming mesh bodies (vertices moved, hierarchy
 // refitted or rebuilt every step) and self-collision of mesh bodies (their own intersecting
 // triangle pairs).
-#include <chrono>
 #include <memory>
 #include <string>
 #include <tuple>
@@ -12,16 +11,13 @@
 #include "collision/bvh/bvh.h"
 #include "collision/geometry/convex_hull.h"
 #include "engine/world.h"
+#include "stage_clock.h"
 
 namespace engine {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
+using Clock = StageClock;
 
 // Sum of every node's volume over the root's volume, for the tree's volume type (0 for an empty
 // tree or a root of zero volume). >= 1 for nested volumes; grows as a refit loosens the tree;

@@ -13,12 +13,12 @@
 namespace render {
 
 using collision::Color;
+using collision::kPi;
 using collision::Mat3;
 using collision::Pose;
 using collision::Real;
 using collision::Vec3;
 
-inline constexpr Real kPi = Real(3.14159265358979323846);
 /// sin of the smallest angle between view direction and `up` that still defines a camera roll.
 inline constexpr Real kParallelSine = Real(1e-6);
 /// Near plane never closer than this fraction of the far plane (24-bit depth stays useful).

@@ -34,11 +34,6 @@ namespace {
 
 std::string errnoText(int err) { return std::error_code(err, std::generic_category()).message(); }
 
-void removeQuietly(const fs::path& file) {
-    std::error_code ec;
-    fs::remove(file, ec);
-}
-
 // Writes to a pipe without letting SIGPIPE kill the process when the reader has died: the
 // signal is blocked in this thread for the duration, and a SIGPIPE raised by our write is
 // consumed before unblocking (the classic library-safe pattern; the process's handlers are

@@ -44,12 +44,12 @@ fs::file_type typeOf(const fs::path& path) {
     return status.type();
 }
 
+}  // namespace
+
 void removeQuietly(const fs::path& file) {
     std::error_code ec;
     fs::remove(file, ec);
 }
-
-}  // namespace
 
 void checkOutputPath(const fs::path& file) {
     const fs::file_type type = typeOf(file);

@@ -2,6 +2,8 @@
 // Everything in cdlab computes in Real (double unless built with CDLAB_USE_FLOAT).
 #pragma once
 
+#include <numbers>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -19,6 +21,9 @@ using Quat = Eigen::Quaternion<Real>;
 
 /// Relative epsilon of Real: tolerances are this times a length scale of the objects involved.
 inline constexpr Real kEpsilon = Eigen::NumTraits<Real>::epsilon();
+
+/// pi, rounded to Real.
+inline constexpr Real kPi = std::numbers::pi_v<Real>;
 
 /// A rigid transform: world = orientation * local + position. `orientation` is a unit quaternion.
 struct Pose {

@@ -65,12 +65,13 @@ Vec3 closestPointOnShape(const Shape& shape, const Pose& pose, const Vec3& q) {
 }
 
 // A witness on the shape's support feature along local `dir`: for boxes the centre of the
-// supporting face or edge (components of dir below kFeatureRelative * |dir| count as zero), so
-// a face or edge contact is not reported at one arbitrary corner; other shapes: supportPoint.
-constexpr Real kFeatureRelative = Real(1e-6);
+// supporting face or edge (components of dir below kSupportFeatureRelative * |dir| count as
+// zero), so a face or edge contact is not reported at one arbitrary corner; other shapes:
+// supportPoint.
+constexpr Real kSupportFeatureRelative = Real(1e-6);
 Vec3 featureCentreSupport(const Shape& shape, const Vec3& dir) {
     if (shape.type != ShapeType::Box) return supportPoint(shape, dir);
-    const Real eps = kFeatureRelative * dir.norm();
+    const Real eps = kSupportFeatureRelative * dir.norm();
     Vec3 p;
     for (int k = 0; k < 3; ++k) {
         p[k] = std::abs(dir[k]) <= eps

@@ -32,9 +32,8 @@ namespace collision {
 
 namespace {
 
-constexpr Real kTwoPi = Real(2 * M_PI);
-constexpr Real kHalfPi = Real(M_PI / 2);
-constexpr Real kPi = Real(M_PI);
+constexpr Real kTwoPi = 2 * kPi;
+constexpr Real kHalfPi = kPi / 2;
 
 // Rounding allowances, in units of kEpsilon times the magnitude they apply to: a handful of
 // roundings per evaluated expression, doubled.

@@ -37,7 +37,6 @@ Real mag(Interval a) { return std::max(std::abs(a.lo), std::abs(a.hi)); }
 // cos over [a, b]: the endpoint values, widened to +-1 where a multiple of pi (resp. an odd
 // multiple for -1) lies inside.
 Interval cosInterval(Real a, Real b) {
-    constexpr Real kPi = std::numbers::pi_v<Real>;
     Real lo = std::min(std::cos(a), std::cos(b));
     Real hi = std::max(std::cos(a), std::cos(b));
     const Real k_max = std::ceil(a / kPi);  // smallest k with k pi >= a
@@ -52,8 +51,7 @@ Interval cosInterval(Real a, Real b) {
     return {lo, hi};
 }
 Interval sinInterval(Real a, Real b) {
-    constexpr Real kHalfPi = std::numbers::pi_v<Real> / 2;
-    const Interval c = cosInterval(a - kHalfPi, b - kHalfPi);  // sin x = cos(x - pi/2)
+    const Interval c = cosInterval(a - kPi / 2, b - kPi / 2);  // sin x = cos(x - pi/2)
     return c;
 }
 

@@ -40,4 +40,8 @@ void checkOutputWritable(const std::filesystem::path& file);
 /// naming the file; a failure leaves neither `file` changed nor the partial file behind.
 void writeFileAtomically(const std::filesystem::path& file, std::string_view bytes);
 
+/// Removes `file` if it is there, ignoring every error: the clean-up of a partial output on a
+/// path that is already failing.
+void removeQuietly(const std::filesystem::path& file);
+
 }  // namespace render
