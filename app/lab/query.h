@@ -1,4 +1,4 @@
-// app/query_command.h -- `cdlab query`: two meshes, B at a pose in A's frame, every BVH volume
+// app/lab/query.h -- `cdlab query`: two meshes, B at a pose in A's frame, every BVH volume
 // type side by side (answer, triangle pairs, BV and triangle tests, build and query time).
 #pragma once
 

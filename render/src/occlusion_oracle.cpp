@@ -4,7 +4,6 @@
 // or behind the nearest face drawn so far, so zero samples = fully visible), then its near face
 // with GL_LESS and depth writes on. Axis-aligned boxes seen along an axis have constant depth on
 // those faces, and the side faces are edge-on, so two quads say everything.
-#define GL_GLEXT_PROTOTYPES
 #include "render/occlusion_oracle.h"
 
 #include <GL/gl.h>

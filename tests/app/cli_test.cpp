@@ -46,6 +46,39 @@ int differingPixels(const render::Image& a, const render::Image& b, int first_ro
 
 const std::string kTiny = "tests/data/tiny.yaml";
 
+// `cdlab bench` runs cdlab-bench from cdlab's own folder, with the arguments after `bench`.
+TEST(Cli, BenchRunsTheBenchExecutableBesideCdlab) {
+    const fs::path work = tempDir("bench_forward");
+    const Result help = runCdlab("bench --help", work);
+    EXPECT_EQ(help.exit_code, 0) << help.err;
+    EXPECT_NE(help.out.find("cdlab bench"), std::string::npos) << help.out;
+    EXPECT_NE(help.out.find("broadphase"), std::string::npos) << help.out;
+    const Result bad = runCdlab("bench nope", work);
+    EXPECT_EQ(bad.exit_code, 2) << bad.err;
+    EXPECT_NE(bad.err.find("subcommand"), std::string::npos) << bad.err;
+}
+
+// A cdlab without cdlab-bench beside it (the demo builds cdlab alone) says how to build the
+// benches and exits 1; the other commands are unaffected.
+TEST(Cli, BenchWithoutTheBenchExecutableSaysHowToBuildIt) {
+    const fs::path work = tempDir("bench_missing");
+    const fs::path alone = work / "cdlab";
+    fs::copy_file(CDLAB_BINARY, alone);
+    const std::string cmd = alone.string() + " bench broadphase --sizes 50 > " +
+                            (work / "out.txt").string() + " 2> " + (work / "err.txt").string();
+    const int status = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 1);
+    const std::string err = slurp(work / "err.txt");
+    EXPECT_NE(err.find((work / "cdlab-bench").string() + " is not built"), std::string::npos)
+        << err;
+    EXPECT_NE(err.find("--target cdlab-bench"), std::string::npos) << err;
+    EXPECT_EQ(slurp(work / "out.txt"), "");
+    const std::string help = alone.string() + " --help > " + (work / "help.txt").string();
+    EXPECT_EQ(std::system(help.c_str()), 0);
+    EXPECT_NE(slurp(work / "help.txt").find("bench"), std::string::npos);
+}
+
 TEST(Cli, RunWritesFramesPauseDumpsAndSummary) {
     const fs::path work = tempDir("run");
     const fs::path out = work / "out";

@@ -14,7 +14,7 @@
 
 #include "collision/bvh/bvh.h"
 #include "engine/mesh_import.h"
-#include "query_command.h"
+#include "query.h"
 
 namespace {
 

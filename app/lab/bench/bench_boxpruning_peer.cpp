@@ -1,4 +1,4 @@
-// app/lab/bench_boxpruning_peer.cpp -- Terdiman's BoxPruning17 (github.com/Pierre-Terdiman/
+// app/lab/bench/bench_boxpruning_peer.cpp -- Terdiman's BoxPruning17 (github.com/Pierre-Terdiman/
 // BoxPruning, "Box pruning revisited", 2017) as the bench row `terdiman-v17`, when configured with
 // CDLAB_BOXPRUNING_DIR. His code has no coherence: every findPairs() is a one-shot query on the
 // boxes as floats (his AABB type). The BoxPruning scene's boxes are integers, so the floats are

@@ -1,4 +1,4 @@
-// app/lab/bench_broadphase.cpp -- `cdlab bench broadphase`: runs every method on the same
+// app/lab/bench/bench_broadphase.cpp -- `cdlab bench broadphase`: runs every method on the same
 // moving-box sequence and tabulates per-frame thread CPU time, build time and peak memory. Fairness
 // invariants: every method sees bit-identical boxes in the same order (each child process rebuilds
 // the workload from the same state and steps it with the same code); the timed part of a frame is

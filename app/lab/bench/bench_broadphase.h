@@ -1,4 +1,4 @@
-// app/lab/bench_broadphase.h -- `cdlab bench broadphase`: cdlab's broad phases side by side with
+// app/lab/bench/bench_broadphase.h -- `cdlab bench broadphase`: cdlab's broad phases side by side with
 // Bullet and FCL on the same moving-box workload, in the same process image.
 #pragma once
 

@@ -1,4 +1,4 @@
-// app/lab/bench_broadphase_measure.cpp -- timing one broad-phase method on a workload: the
+// app/lab/bench/bench_broadphase_measure.cpp -- timing one broad-phase method on a workload: the
 // frame loop (moveAll + findPairs timed, then deliverExact, then the check outside the timer),
 // the one-shot repetitions, the forked child that gives per-method peak memory, and one table
 // row per method. Fairness invariants: bench_broadphase.cpp's header.

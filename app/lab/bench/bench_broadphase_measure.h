@@ -1,4 +1,4 @@
-// app/lab/bench_broadphase_measure.h -- timing one broad-phase method (runMethod, declared in
+// app/lab/bench/bench_broadphase_measure.h -- timing one broad-phase method (runMethod, declared in
 // bench_rows.h) and the clocks and counts the report shares with it.
 #pragma once
 

@@ -1,4 +1,4 @@
-// app/lab/bench_broadphase_report.cpp -- the bench's tables and JSON: each row's ratios to the
+// app/lab/bench/bench_broadphase_report.cpp -- the bench's tables and JSON: each row's ratios to the
 // best peer under both rules (pairs as held, exact pairs delivered), the fastest cdlab method
 // against the best peer, notes on stopped runs and pair caches, and the JSON rows.
 #include "bench_broadphase_report.h"

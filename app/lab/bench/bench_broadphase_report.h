@@ -1,4 +1,4 @@
-// app/lab/bench_broadphase_report.h -- `cdlab bench broadphase`'s tables and JSON.
+// app/lab/bench/bench_broadphase_report.h -- `cdlab bench broadphase`'s tables and JSON.
 #pragma once
 
 #include <filesystem>

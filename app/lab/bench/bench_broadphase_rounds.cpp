@@ -1,4 +1,4 @@
-// app/lab/bench_broadphase_rounds.cpp -- interleaved rounds of a table's rows. The machine this
+// app/lab/bench/bench_broadphase_rounds.cpp -- interleaved rounds of a table's rows. The machine this
 // bench runs on can run a process 1.4x slower for seconds to minutes at a time; run once, in
 // sequence, such a stretch lands on whole rows and moves their ratios. Run R times with the order
 // alternating (A B C, C B A, A B C, ...), each stretch costs each row at most a round or two, and

@@ -1,4 +1,4 @@
-// app/lab/bench_broadphase_rounds.h -- `cdlab bench broadphase --rounds R`: a table's rows run
+// app/lab/bench/bench_broadphase_rounds.h -- `cdlab bench broadphase --rounds R`: a table's rows run
 // again, interleaved, and each figure becomes the median over the rounds.
 #pragma once
 

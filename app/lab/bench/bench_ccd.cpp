@@ -1,4 +1,4 @@
-// app/lab/bench_ccd.cpp -- `cdlab bench ccd`: loads CCD query CSVs (8 rows per query, rational
+// app/lab/bench/bench_ccd.cpp -- `cdlab bench ccd`: loads CCD query CSVs (8 rows per query, rational
 // coordinates as numerator/denominator pairs, last column the exact ground truth), runs each
 // method on every query and tabulates correctness and time per query.
 // Rows come out sorted by (method, set, kind), so two runs compare line by line.

@@ -1,4 +1,4 @@
-// app/lab/bench_ccd.h -- `cdlab bench ccd`: the conservative and naive vertex-face / edge-edge CCD
+// app/lab/bench/bench_ccd.h -- `cdlab bench ccd`: the conservative and naive vertex-face / edge-edge CCD
 // methods (and Tight-Inclusion when built against it) on the sample queries of Wang et al. 2021 (or any directory in their CSV layout):
 // false negatives, false positives and microseconds per query, per method, query set and kind;
 // then the per-frame cost of the engine's CCD stage in the tunnelling scenes, off vs on.

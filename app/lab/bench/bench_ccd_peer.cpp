@@ -1,4 +1,4 @@
-// app/lab/bench_ccd_peer.cpp -- Tight-Inclusion behind cdlab's CcdOutput, for `cdlab bench ccd`.
+// app/lab/bench/bench_ccd_peer.cpp -- Tight-Inclusion behind cdlab's CcdOutput, for `cdlab bench ccd`.
 // Wang, Ferguson, Schneider, Jiang, Attene, Panozzo, "A Large-scale Benchmark and an
 // Inclusion-based Algorithm for Continuous Collision Detection", ACM TOG 40(5), 2021.
 #include "bench_ccd_peer.h"

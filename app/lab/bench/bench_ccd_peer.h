@@ -1,4 +1,4 @@
-// app/lab/bench_ccd_peer.h -- Tight-Inclusion (Wang et al. 2021) as a peer method of
+// app/lab/bench/bench_ccd_peer.h -- Tight-Inclusion (Wang et al. 2021) as a peer method of
 // `cdlab bench ccd`, compiled in only when CMake found an installed copy
 // (CDLAB_HAVE_TIGHT_INCLUSION); its headers stay inside bench_ccd_peer.cpp.
 #pragma once

@@ -1,4 +1,4 @@
-// app/lab/bench_convex.cpp -- `cdlab bench convex`: cdlab's convex contact query beside Bullet,
+// app/lab/bench/bench_convex.cpp -- `cdlab bench convex`: cdlab's convex contact query beside Bullet,
 // each pair family against the path Bullet itself runs for it (its dispatcher's algorithm:
 // btBoxBoxDetector for boxes, the sphere-sphere and sphere-box algorithms, the capsule cases of
 // btConvexConvexAlgorithm) and against Bullet's general GJK/EPA (bench_convex_peers.h). Each

@@ -1,4 +1,4 @@
-// app/lab/bench_convex.h -- `cdlab bench convex`: microseconds per convex contact query (GJK distance,
+// app/lab/bench/bench_convex.h -- `cdlab bench convex`: microseconds per convex contact query (GJK distance,
 // EPA depth, SAT box-box, sphere/capsule closed forms) beside the path Bullet runs for each pair
 // (its dispatcher's algorithm) and its general GJK/EPA on the same random poses, with every
 // answer's error against an exact reference.

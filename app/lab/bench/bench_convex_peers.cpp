@@ -1,4 +1,4 @@
-// app/lab/bench_convex_peers.cpp -- Bullet as the peer of `cdlab bench convex`
+// app/lab/bench/bench_convex_peers.cpp -- Bullet as the peer of `cdlab bench convex`
 // (bench_convex_peers.h). Invariant: Bullet gets the pairs' exact geometry and runs unmodified
 // library code; the dispatcher path calls processCollision as btCollisionDispatcher's
 // defaultNearCallback does (wrappers and a btManifoldResult made per call), with the result's

@@ -1,4 +1,4 @@
-// app/lab/bench_convex_peers.h -- the pairs of `cdlab bench convex` and the Bullet peers that
+// app/lab/bench/bench_convex_peers.h -- the pairs of `cdlab bench convex` and the Bullet peers that
 // answer them: Bullet's own narrow phase (the collision algorithm its default dispatcher picks
 // for the pair: btBoxBoxDetector, the sphere-sphere and sphere-box algorithms, the capsule special
 // cases of btConvexConvexAlgorithm) and its general btGjkPairDetector + EPA. Bullet's headers

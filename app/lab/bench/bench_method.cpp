@@ -1,4 +1,4 @@
-// app/lab/bench_method.cpp -- cdlab's AABB broad phases behind the benchmark interface, and the
+// app/lab/bench/bench_method.cpp -- cdlab's AABB broad phases behind the benchmark interface, and the
 // list of every benchmark method by name.
 #include "bench_method.h"
 

@@ -1,4 +1,4 @@
-// app/lab/bench_method.h -- one broad phase as the benchmarks drive it: cdlab's registry entries and
+// app/lab/bench/bench_method.h -- one broad phase as the benchmarks drive it: cdlab's registry entries and
 // the peer libraries (Bullet, FCL) behind one small interface, listed by name.
 #pragma once
 

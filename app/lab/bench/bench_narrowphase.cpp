@@ -1,4 +1,4 @@
-// app/lab/bench_narrowphase.cpp -- `cdlab bench narrowphase`. Wiring and timing only: trees and
+// app/lab/bench/bench_narrowphase.cpp -- `cdlab bench narrowphase`. Wiring and timing only: trees and
 // queries are collision/bvh.h; FCL (when CMake found it, CDLAB_HAVE_FCL) stays in this file. Same
 // inputs for every method: one torus mesh for A and B, B placed by the pose (A at the identity).
 // The reference answer per pose is cdlab's brute-force triangle loop (intersectMeshMeshBruteForce;

@@ -1,4 +1,4 @@
-// app/lab/bench_narrowphase.h -- `cdlab bench narrowphase`: mesh-mesh queries on two procedural tori
+// app/lab/bench/bench_narrowphase.h -- `cdlab bench narrowphase`: mesh-mesh queries on two procedural tori
 // over fixed random poses (half of them colliding), every cdlab BVH volume type beside FCL's
 // BVHModel types, with every answer checked against cdlab's brute-force triangle loop.
 #pragma once

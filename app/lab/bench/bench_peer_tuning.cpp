@@ -1,4 +1,4 @@
-// app/lab/bench_peer_tuning.cpp -- each peer compared at its best: every configuration of its
+// app/lab/bench/bench_peer_tuning.cpp -- each peer compared at its best: every configuration of its
 // grid runs as long as the measured run, ranked by its own median (a short trial would rank a
 // DBVT whose tree degrades over hundreds of frames by its good start).
 #include "bench_peer_tuning.h"

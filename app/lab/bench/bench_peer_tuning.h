@@ -1,4 +1,4 @@
-// app/lab/bench_peer_tuning.h -- `cdlab bench broadphase --peers tuned|all`: each peer's grid of
+// app/lab/bench/bench_peer_tuning.h -- `cdlab bench broadphase --peers tuned|all`: each peer's grid of
 // configurations run on a table, and the fastest of each chosen as the peer.
 #pragma once
 

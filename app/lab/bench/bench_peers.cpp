@@ -1,4 +1,4 @@
-// app/lab/bench_peers.cpp -- Bullet and FCL broad phases behind the benchmark interface.
+// app/lab/bench/bench_peers.cpp -- Bullet and FCL broad phases behind the benchmark interface.
 // Compiled in only when CMake found them (CDLAB_HAVE_BULLET, CDLAB_HAVE_FCL); their headers stay
 // in this file. Every peer gets the same doubles as cdlab: box i is centre_i -/+ half_i.
 //  - Bullet is driven directly (createProxy, setAabb, calculateOverlappingPairs) with its own

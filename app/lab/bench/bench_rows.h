@@ -1,4 +1,4 @@
-// app/lab/bench_rows.h -- the rows of `cdlab bench broadphase` (private to it): one method's
+// app/lab/bench/bench_rows.h -- the rows of `cdlab bench broadphase` (private to it): one method's
 // measurement, one table row, and what the methods of one table run on; shared by the bench
 // (bench_broadphase.cpp) and its peer tuning (bench_peer_tuning.cpp).
 #pragma once

@@ -1,4 +1,4 @@
-// app/lab/bench_workload.cpp -- moving-box workloads and the reference pair count.
+// app/lab/bench/bench_workload.cpp -- moving-box workloads and the reference pair count.
 // Determinism: all randomness comes from one splitmix64 stream per workload, converted to doubles
 // by hand (not by std:: distributions, whose algorithms are implementation-defined), and the
 // motion is plain double arithmetic in a fixed order, so every process that builds the same

@@ -1,4 +1,4 @@
-// app/lab/bench_workload.h -- the moving-box workloads of `cdlab bench broadphase` and of the Google
+// app/lab/bench/bench_workload.h -- the moving-box workloads of `cdlab bench broadphase` and of the Google
 // Benchmark target: N axis-aligned boxes drifting coherently in a cube, and an independent
 // reference pair count to check every broad phase against.
 #pragma once

@@ -1,4 +1,4 @@
-// app/lab/convex_reference.cpp -- the long-double ground truth of `cdlab bench convex`
+// app/lab/bench/convex_reference.cpp -- the long-double ground truth of `cdlab bench convex`
 // (convex_reference.h). Invariant: nothing here calls collision's queries; every answer comes from
 // the poses' quaternions and the shapes' dimensions through closed forms or brute force, in long
 // double (64-bit mantissa on x86-64), so its own rounding is ~1e-19 of the size, far below the

@@ -1,4 +1,4 @@
-// app/lab/convex_reference.h -- exact answers for `cdlab bench convex`, in long double and
+// app/lab/bench/convex_reference.h -- exact answers for `cdlab bench convex`, in long double and
 // independent of every library under test: the signed distance of sphere, capsule and box pairs
 // (closed forms; boxes: the 15-axis SAT depth when they overlap, the brute-force feature distance
 // when apart), the projection overlap along a given normal and a point's distance from a surface,

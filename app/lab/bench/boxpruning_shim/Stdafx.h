@@ -1,4 +1,4 @@
-// app/lab/boxpruning_shim/Stdafx.h -- what Terdiman's BoxPruning17/IceBoxPruning.cpp
+// app/lab/bench/boxpruning_shim/Stdafx.h -- what Terdiman's BoxPruning17/IceBoxPruning.cpp
 // (github.com/Pierre-Terdiman/BoxPruning, "Box pruning revisited", 2017) takes from his Windows
 // support library, written for GCC/Clang so that his file compiles with two mechanical edits
 // that app/CMakeLists.txt makes to a build-directory copy: MSVC's `_asm align 16` lines are

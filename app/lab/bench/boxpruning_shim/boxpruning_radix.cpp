@@ -1,4 +1,4 @@
-// app/lab/boxpruning_shim/boxpruning_radix.cpp -- the radix sort the BoxPruning shim declares.
+// app/lab/bench/boxpruning_shim/boxpruning_radix.cpp -- the radix sort the BoxPruning shim declares.
 // Floats become unsigned keys in the same order (sign bit flipped for positives, all bits for
 // negatives: Herf, "Radix Tricks", 2001), then four stable 8-bit counting passes.
 #include <array>

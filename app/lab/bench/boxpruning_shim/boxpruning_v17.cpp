@@ -1,4 +1,4 @@
-// app/lab/boxpruning_shim/boxpruning_v17.cpp -- boxPruningV17() over his CompleteBoxPruning.
+// app/lab/bench/boxpruning_shim/boxpruning_v17.cpp -- boxPruningV17() over his CompleteBoxPruning.
 #include "boxpruning_v17.h"
 
 #include "Stdafx.h"

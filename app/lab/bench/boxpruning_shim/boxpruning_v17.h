@@ -1,4 +1,4 @@
-// app/lab/boxpruning_shim/boxpruning_v17.h -- a plain entry to Terdiman's BoxPruning17
+// app/lab/bench/boxpruning_shim/boxpruning_v17.h -- a plain entry to Terdiman's BoxPruning17
 // CompleteBoxPruning (compiled from CDLAB_BOXPRUNING_DIR when set), for the broad-phase bench and
 // its test. Bench only: never part of the library.
 #pragma once
