@@ -20,6 +20,11 @@ Command addQueryCommand(CLI::App& cli) {
     cmd->add_option("--pose-b", query->pose_b,
                     "B's pose in A's frame: x,y,z,qw,qx,qy,qz (default identity)");
     cmd->add_flag("--json", query->json, "machine-readable output");
+    cmd->add_option("--unit-cost-tests", query->unit_cost_tests,
+                    "volume tests and refitted nodes each unit cost is timed over (triangle "
+                    "tests: half as many); fewer measure faster and less precisely")
+        ->check(CLI::Range(std::int64_t{2}, std::int64_t{1000000000}))
+        ->capture_default_str();
     cmd->add_flag("--self", query->self,
                   "self-collision of mesh A: its intersecting non-adjacent triangle pairs "
                   "through each tree against itself and the brute-force loop (exit 1 if they "

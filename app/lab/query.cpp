@@ -83,13 +83,8 @@ void writeQueryJson(std::ostream& out, const std::filesystem::path (&paths)[2],
                    {"triangles", meshes[1].triangles.size()},
                    {"import", importJson(reports[1])}};
     const auto& q = pose_b.orientation;
-    j["pose_b"] = {pose_b.position.x(),
-                   pose_b.position.y(),
-                   pose_b.position.z(),
-                   q.w(),
-                   q.x(),
-                   q.y(),
-                   q.z()};
+    j["pose_b"] = {
+        pose_b.position.x(), pose_b.position.y(), pose_b.position.z(), q.w(), q.x(), q.y(), q.z()};
     j["volumes_agree"] = agree;
     nlohmann::json results = nlohmann::json::array();
     for (const Row& r : rows) {
@@ -122,12 +117,11 @@ void writeQueryJson(std::ostream& out, const std::filesystem::path (&paths)[2],
               {"refit_nodes_timed", r.refit.nodes_timed},
               // F = Nv Cv + Np Cp for the all-pairs query, beside its measured time_us.
               {"all_pairs_model_us",
-               r.unit.measured
-                   ? nlohmann::json(1e-3 * (static_cast<double>(r.all.bv_tests) *
-                                                r.unit.bv_test_ns +
-                                            static_cast<double>(r.all.triangle_tests) *
-                                                r.unit.triangle_test_ns))
-                   : nullptr}}},
+               r.unit.measured ? nlohmann::json(1e-3 * (static_cast<double>(r.all.bv_tests) *
+                                                            r.unit.bv_test_ns +
+                                                        static_cast<double>(r.all.triangle_tests) *
+                                                            r.unit.triangle_test_ns))
+                               : nullptr}}},
         });
     }
     j["results"] = results;
@@ -159,8 +153,8 @@ void writeQueryTable(std::ostream& out, const std::filesystem::path (&paths)[2],
         } else {
             out << std::setw(8) << "-" << std::setw(8) << "-";
         }
-        out << std::setw(8) << r.refit.refit_node_ns
-            << (r.unit.triangles_from_queries ? "" : "*") << "\n";
+        out << std::setw(8) << r.refit.refit_node_ns << (r.unit.triangles_from_queries ? "" : "*")
+            << "\n";
     }
     out << "(Nv: BV tests, Np: triangle tests; build: both trees; Cv, Cp: ns per BV test and\n"
            " per triangle test, timed by replaying the all-pairs query's own tests; Cu: ns per\n"
@@ -176,8 +170,8 @@ void writeQueryTable(std::ostream& out, const std::filesystem::path (&paths)[2],
 
 // Self-collision of one mesh: every requested tree against itself beside the brute-force loop.
 int runSelfQuery(const std::vector<std::string_view>& names, const std::filesystem::path& path,
-                 const collision::TriangleMesh& mesh, bool json, std::ostream& out,
-                 std::ostream& err) {
+                 const collision::TriangleMesh& mesh, bool json, std::int64_t unit_cost_tests,
+                 std::ostream& out, std::ostream& err) {
     struct SelfRow {
         std::string_view bv;
         std::vector<collision::TrianglePair> pairs;
@@ -201,7 +195,7 @@ int runSelfQuery(const std::vector<std::string_view>& names, const std::filesyst
         row.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - b0).count();
         row.pairs = tree->intersectSelf(&row.stats);
         row.query_us = 1e6 * timePerCall([&] { (void)tree->intersectSelf(); });
-        row.refit = measureRefitUnitCost(name, mesh);
+        row.refit = measureRefitUnitCost(name, mesh, unit_cost_tests);
         agree = agree && row.pairs == brute;
         rows.push_back(std::move(row));
     }
@@ -337,7 +331,8 @@ int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err) 
             err << "warning: " << options.mesh_a.string() << ": "
                 << engine::describeImportChanges(imported.report) << "\n";
         }
-        return runSelfQuery(names, options.mesh_a, imported.mesh, options.json, out, err);
+        return runSelfQuery(names, options.mesh_a, imported.mesh, options.json,
+                            options.unit_cost_tests, out, err);
     }
     if (options.mesh_b.empty()) {
         err << "mesh_b: required (or --self for one mesh against itself)\n";
@@ -374,8 +369,9 @@ int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err) 
         row.first_us = 1e6 * timePerCall([&] { (void)a->testOverlap(*b, pose_b); });
         row.all_us = 1e6 * timePerCall([&] { (void)a->intersect(*b, pose_b); });
         // Cv and Cp: the all-pairs query's own tests replayed in batches, outside its timing.
-        row.unit = measureBvhUnitCosts(*a, *b, std::span<const collision::Pose>(&pose_b, 1));
-        row.refit = measureRefitUnitCost(name, meshes[0]);
+        row.unit = measureBvhUnitCosts(*a, *b, std::span<const collision::Pose>(&pose_b, 1),
+                                       options.unit_cost_tests, options.unit_cost_tests / 2);
+        row.refit = measureRefitUnitCost(name, meshes[0], options.unit_cost_tests);
         rows.push_back(std::move(row));
     }
     bool agree = true;

@@ -2,6 +2,7 @@
 // type side by side (answer, triangle pairs, BV and triangle tests, build and query time).
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <iosfwd>
 #include <optional>
@@ -19,6 +20,9 @@ struct QueryOptions {
     std::string pose_b;      ///< "x,y,z,qw,qx,qy,qz" (B's frame in A's); empty: identity
     bool json = false;       ///< machine-readable output on `out`
     bool self = false;       ///< self-collision of mesh_a alone (mesh_b must be empty)
+    /// Volume tests and refitted nodes each unit cost (Cv, Cu) is timed over, triangle tests (Cp)
+    /// half as many: the measurement's size, not the answer's (bvh_unit_costs.h).
+    std::int64_t unit_cost_tests = 200000;
 };
 
 /// Parses "x,y,z,qw,qx,qy,qz" into a pose (quaternion normalised). Returns nothing and sets

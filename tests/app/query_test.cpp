@@ -1,5 +1,7 @@
 // End-to-end: `cdlab query` answers for every BVH volume type side by side, agrees across types,
 // writes JSON on request, and rejects bad flags and unreadable meshes with exit code 2.
+#include "query.h"
+
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -14,7 +16,7 @@
 
 #include "collision/bvh/bvh.h"
 #include "engine/mesh_import.h"
-#include "query.h"
+#include "test_scale.h"
 
 namespace {
 
@@ -33,14 +35,22 @@ std::string readAll(const fs::path& p) {
     return s.str();
 }
 
-QueryResult runQueryCli(const std::string& args) {
+// The unit costs' timing batches, smaller at a smaller CDLAB_TEST_SCALE (the sanitizer tier): the
+// size of a measurement, which no answer depends on. At scale 1 the command's own default.
+std::string unitCostFlag() {
+    if (cdlab_test::testScale() >= 1) return "";
+    return " --unit-cost-tests " + std::to_string(cdlab_test::scaled(200000, 1000));
+}
+
+// `cdlab query ARGS`; unit_cost_flag: with unitCostFlag() after ARGS.
+QueryResult runQueryCli(const std::string& args, bool unit_cost_flag = true) {
     const fs::path dir = fs::temp_directory_path() / ("cdlab_query_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     const fs::path out = dir / "stdout.txt";
     const fs::path err = dir / "stderr.txt";
     const std::string cmd = std::string("cd ") + CDLAB_SOURCE_DIR + " && " + CDLAB_BINARY +
-                            " query " + args + " > " + out.string() + " 2> " + err.string() +
-                            " < /dev/null";
+                            " query " + args + (unit_cost_flag ? unitCostFlag() : "") + " > " +
+                            out.string() + " 2> " + err.string() + " < /dev/null";
     const int status = std::system(cmd.c_str());
     QueryResult r;
     r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -150,7 +160,8 @@ TEST(Query, BadInputExitsTwoWithAMessage) {
 // Issue "Meshes from the real world": import dropped triangles without a word. The query warns on
 // stderr with the counts and puts the import report beside each mesh in --json.
 TEST(Query, ImportChangesAreReportedOnStderrAndInJson) {
-    const fs::path dir = fs::temp_directory_path() / ("cdlab_query_import_" + std::to_string(::getpid()));
+    const fs::path dir =
+        fs::temp_directory_path() / ("cdlab_query_import_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     const fs::path near = dir / "near.obj";
     // Vertex 5 is 1e-9 from vertex 2: one vertex in float, and the sliver 2-5-4 collapses.
@@ -233,6 +244,33 @@ TEST(Query, ParsePose) {
     EXPECT_NE(error.find("zero"), std::string::npos);
     EXPECT_FALSE(app::parsePose("1,2,x,1,0,0,0", &error).has_value());
     EXPECT_FALSE(app::parsePose("1,2,inf,1,0,0,0", &error).has_value());
+}
+
+// --unit-cost-tests sizes the batches the unit costs are timed over (at least that many volume
+// tests, half as many triangle tests, that many refitted nodes); the answer does not change.
+TEST(Query, UnitCostTestsSizeTheTimedBatches) {
+    const std::string args =
+        "assets/torus.obj assets/torus.obj --bv obb --pose-b 0.5,0,0.1,1,0,0,0 --json";
+    const QueryResult small = runQueryCli(args + " --unit-cost-tests 4000", false);
+    ASSERT_EQ(small.exit_code, 0) << small.err;
+    const nlohmann::json s_row = nlohmann::json::parse(small.out)["results"][0];
+    const nlohmann::json& s = s_row["unit_costs"];
+    EXPECT_GE(s["bv_tests_timed"].get<std::int64_t>(), 4000);
+    EXPECT_LT(s["bv_tests_timed"].get<std::int64_t>(), 200000);
+    EXPECT_GE(s["triangle_tests_timed"].get<std::int64_t>(), 2000);
+    EXPECT_GE(s["refit_nodes_timed"].get<std::int64_t>(), 4000);
+    EXPECT_LT(s["refit_nodes_timed"].get<std::int64_t>(), 200000);
+    const QueryResult large = runQueryCli(args + " --unit-cost-tests 400000", false);
+    ASSERT_EQ(large.exit_code, 0) << large.err;
+    const nlohmann::json l_row = nlohmann::json::parse(large.out)["results"][0];
+    EXPECT_GE(l_row["unit_costs"]["bv_tests_timed"].get<std::int64_t>(), 400000);
+    EXPECT_EQ(l_row["triangle_pairs"], s_row["triangle_pairs"]);
+    EXPECT_GT(s_row["triangle_pair_count"].get<std::int64_t>(), 0);
+    for (const char* bad : {" --unit-cost-tests 0", " --unit-cost-tests x"}) {
+        const QueryResult r = runQueryCli(args + bad, false);
+        EXPECT_EQ(r.exit_code, 2) << bad;
+        EXPECT_NE(r.err.find("--unit-cost-tests"), std::string::npos) << bad << ": " << r.err;
+    }
 }
 
 }  // namespace
