@@ -1,6 +1,7 @@
 // app/main.cpp -- the cdlab command line: the table of commands (each registers its own flags,
 // command.h), parsing, and the last line of defence against anything a command throws.
-// `cdlab bench ...` is handed to cdlab-bench, the executable built beside this one (bench_main.cpp).
+// `cdlab bench ...` is handed to cdlab-bench, the executable built beside this one
+// (bench_main.cpp).
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -21,8 +22,8 @@
 namespace {
 
 using AddCommand = app::Command (*)(CLI::App&);
-constexpr AddCommand kCommands[] = {app::addRunCommand, app::addCheckCommand,
-                                    app::addQueryCommand, app::addSweepCommand};
+constexpr AddCommand kCommands[] = {app::addRunCommand, app::addCheckCommand, app::addQueryCommand,
+                                    app::addSweepCommand};
 
 constexpr const char* kBenchExecutable = "cdlab-bench";
 

@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 using Result = cdlab_test::CliResult;
 using cdlab_test::slurp;
 
-Result runCdlab(const std::string& args, const fs::path& work) {
+Result runBadInput(const std::string& args, const fs::path& work) {
     return cdlab_test::runCdlab(args, work, "", work);
 }
 
@@ -149,7 +149,7 @@ TEST_P(BadInput, PreciseMessageExit2NoOutput) {
     for (const auto& [name, text] : c.files) std::ofstream(work / name, std::ios::binary) << text;
 
     for (const std::string command : {"run bad.yaml --no-video --out out", "check bad.yaml"}) {
-        const Result r = runCdlab(command, work);
+        const Result r = runBadInput(command, work);
         EXPECT_EQ(r.exit_code, 2) << command << "\n" << r.err;
         EXPECT_EQ(r.err.rfind("bad.yaml:" + c.prefix, 0), 0u) << command << "\n" << r.err;
         EXPECT_NE(r.err.find(c.fragment), std::string::npos) << command << "\n" << r.err;

@@ -32,7 +32,7 @@ using Result = cdlab_test::CliResult;
 using cdlab_test::runCdlab;
 using cdlab_test::slurp;
 
-fs::path tempDir(const std::string& name) { return cdlab_test::tempDir("cdlab_bp_bench_", name); }
+fs::path bpBenchDir(const std::string& name) { return cdlab_test::tempDir("cdlab_bp_bench_", name); }
 
 // Calls visit(a, b) for every overlapping pair of the workload after `frames` steps, by testing
 // every pair of boxes with the closed interval test on each axis (touching counts): independent
@@ -76,7 +76,7 @@ TEST(BroadphaseBench, SmallRunReportsEveryMethodWithTheSamePairsInTableAndJson) 
     ASSERT_EQ(small.sizes.size(), 1u);
     ASSERT_EQ(small.workload, "both");
     const int n = small.sizes.front();
-    const fs::path work = tempDir("small");
+    const fs::path work = bpBenchDir("small");
     const fs::path json = work / "bp.json";
     const Result r =
         runCdlab("bench broadphase --sizes " + joined(small.sizes) + " --frames " +
@@ -223,7 +223,7 @@ TEST(BroadphaseBench, SmallRunReportsEveryMethodWithTheSamePairsInTableAndJson) 
 // boxes (over its 4096 threshold) it runs both lanes and must report hgrid's pairs, here on
 // the 1:10^4 size mix (--workload wide).
 TEST(BroadphaseBench, WallClockRunsTheTwoThreadMethodWithTheSamePairs) {
-    const fs::path work = tempDir("wall");
+    const fs::path work = bpBenchDir("wall");
     const fs::path json = work / "wall.json";
     const Result r = runCdlab(
         "bench broadphase --sizes 5000 --frames 4 --methods hgrid,hgrid2 "
@@ -264,7 +264,7 @@ std::int64_t boxesInSomePair(app::WorkloadKind kind, int n, std::uint64_t seed, 
 // pairs it reports the size of its potentially colliding set in the last frame, which holds every
 // box that overlaps another and no more boxes than there are.
 TEST(BroadphaseBench, CullideReportsItsPotentiallyCollidingSetAndItsClock) {
-    const fs::path work = tempDir("cullide");
+    const fs::path work = bpBenchDir("cullide");
     const fs::path json = work / "cullide.json";
     const int n = 400;
     const int frames = 3;
@@ -333,7 +333,7 @@ TEST(BroadphaseBench, TunedPeersRunTheirWholeGridAndReportTheFastestConfiguratio
         if (!m.family.empty()) grid[m.family].insert(m.name);
     }
     if (grid.empty()) GTEST_SKIP() << "built without Bullet and FCL";
-    const fs::path work = tempDir("tuned");
+    const fs::path work = bpBenchDir("tuned");
     const fs::path json = work / "tuned.json";
     const Result r = runCdlab(
         "bench broadphase --sizes 150 --frames 120 --workload uniform "
@@ -437,7 +437,7 @@ TEST(BroadphaseBench, BoxPruningWorkloadIsTerdimansScene) {
 // `--workload boxpruning` measures one-shot (create + insert + find pairs, repeated) and moving
 // tables, every method checked against the reference.
 TEST(BroadphaseBench, BoxPruningRunsOneShotAndMovingTables) {
-    const fs::path work = tempDir("boxpruning");
+    const fs::path work = bpBenchDir("boxpruning");
     const fs::path json = work / "bp.json";
     const Result r = runCdlab(
         "bench broadphase --workload boxpruning --sizes 400 --frames 4 "
@@ -468,7 +468,7 @@ TEST(BroadphaseBench, APeerThatDisagreesIsShownAndLeftOutOfTheRatios) {
         app::findBenchMethod("bullet-dbvt") == nullptr) {
         GTEST_SKIP() << "built without Bullet and FCL";
     }
-    const fs::path work = tempDir("peer_mismatch");
+    const fs::path work = bpBenchDir("peer_mismatch");
     const fs::path json = work / "bp.json";
     const Result r = runCdlab(
         "bench broadphase --workload boxpruning --sizes 400 --frames 3 "
@@ -494,7 +494,7 @@ TEST(BroadphaseBench, APeerThatDisagreesIsShownAndLeftOutOfTheRatios) {
 }
 
 TEST(BroadphaseBench, BadOptionsExitTwoBeforeAnyWork) {
-    const fs::path work = tempDir("bad");
+    const fs::path work = bpBenchDir("bad");
     Result r = runCdlab("bench broadphase --sizes 1 --frames 2", work);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("--sizes: 1 boxes"), std::string::npos) << r.err;
@@ -541,7 +541,7 @@ TEST(BroadphaseBench, RoundsInterleaveTheRowsAndReportMediansOverThem) {
         }
     }
     if (peer.empty()) GTEST_SKIP() << "built without Bullet and FCL";
-    const fs::path work = tempDir("rounds");
+    const fs::path work = bpBenchDir("rounds");
     const fs::path json = work / "rounds.json";
     const Result r = runCdlab("bench broadphase --sizes 200 --frames 6 --workload uniform "
                               "--in-process --rounds 3 --methods sap-packed," +

@@ -22,13 +22,13 @@ using Result = cdlab_test::CliResult;
 using cdlab_test::runCdlab;
 using cdlab_test::slurp;
 
-fs::path tempDir(const std::string& name) { return cdlab_test::tempDir("cdlab_ccd_bench_", name); }
+fs::path ccdBenchDir(const std::string& name) { return cdlab_test::tempDir("cdlab_ccd_bench_", name); }
 
 // From a working directory other than the repository's root, the defaults still find the query
 // sets and the tunnelling scenes (in the source tree the program was built from): the full
 // table, the tunnelling table, nothing silently dropped.
 TEST(CcdBench, DefaultsWorkOutsideTheRepositoryRoot) {
-    const fs::path work = tempDir("elsewhere");
+    const fs::path work = ccdBenchDir("elsewhere");
     const Result r = runCdlab("bench ccd --method conservative", work, "", work);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("conservative all"), std::string::npos) << r.out;
@@ -38,7 +38,7 @@ TEST(CcdBench, DefaultsWorkOutsideTheRepositoryRoot) {
 }
 
 TEST(CcdBench, UnitTestSetTableAndJsonWithNoFalseNegatives) {
-    const fs::path work = tempDir("unit");
+    const fs::path work = ccdBenchDir("unit");
     const fs::path json = work / "ccd.json";
     const Result r = runCdlab(
         "bench ccd tests/data/ccd-sample-queries/unit-tests --json " + json.string(), work);
@@ -110,7 +110,7 @@ TEST(CcdBench, UnitTestSetTableAndJsonWithNoFalseNegatives) {
 }
 
 TEST(CcdBench, MethodFilterAndBadInput) {
-    const fs::path work = tempDir("bad");
+    const fs::path work = ccdBenchDir("bad");
     const Result only =
         runCdlab("bench ccd tests/data/ccd-sample-queries/unit-tests --method naive --no-scenes",
                  work);
@@ -150,7 +150,7 @@ TEST(CcdBench, MethodFilterAndBadInput) {
 // ratio lines appear (with its own FN/FP counts); without it, asking for it is an error that
 // says what to configure, and `all` says so once on stderr and runs the rest.
 TEST(CcdBench, TightInclusionPeerWhenBuiltInElseAClearNote) {
-    const fs::path work = tempDir("peer");
+    const fs::path work = ccdBenchDir("peer");
     const std::string set = "bench ccd tests/data/ccd-sample-queries/unit-tests --no-scenes";
     const Result all = runCdlab(set, work);
     ASSERT_EQ(all.exit_code, 0) << all.err;

@@ -37,7 +37,7 @@ const std::string kTwoSpheres =
     "  - {name: b, shape: sphere, radius: 0.5, position: [1.55, 0, 0], velocity: [-1, 0, 0]}\n"
     "  - {name: c, shape: sphere, radius: 0.5, position: [0, 2.5, -2]}\n";
 
-fs::path tempDir(const std::string& name) { return cdlab_test::tempDir("cdlab_check_test_", name); }
+fs::path checkDir(const std::string& name) { return cdlab_test::tempDir("cdlab_check_test_", name); }
 
 engine::Scene parse(const std::string& text) { return engine::parseScene(text, "t.yaml", "."); }
 
@@ -53,7 +53,7 @@ const CheckRow* findRow(const std::vector<CheckRow>& rows, const std::string& fr
 }
 
 TEST(Check, ExpectationsThatHoldPass) {
-    const fs::path dir = tempDir("pass");
+    const fs::path dir = checkDir("pass");
     const engine::Scene scene =
         parse(kTwoSpheres +
               "expect:\n"
@@ -87,7 +87,7 @@ TEST(Check, ExpectationsThatHoldPass) {
 // are apart, their AABBs and bounding spheres overlap. Under the obb broad phase the frame shows
 // two green OBBs; a checker drawing the default spheres would see them yellow.
 TEST(Check, ColoursAreGradedOnTheVolumeTheBroadPhaseTests) {
-    const fs::path dir = tempDir("colours");
+    const fs::path dir = checkDir("colours");
     const engine::Scene scene = parse(
         "world: {bounds: {min: [-4, -4, -4], max: [4, 4, 4]}, frames: 2}\n"
         "broadphase: obb\n"
@@ -108,7 +108,7 @@ TEST(Check, ColoursAreGradedOnTheVolumeTheBroadPhaseTests) {
 }
 
 TEST(Check, WrongExpectationsFailWithTheReason) {
-    const fs::path dir = tempDir("fail");
+    const fs::path dir = checkDir("fail");
     // Gravity makes semi-implicit Euler drift in energy; nothing rotates.
     std::string text = kTwoSpheres;
     text.replace(text.find("frames: 25}"), 11, "frames: 25, gravity: [0, -9.81, 0]}");
@@ -142,7 +142,7 @@ TEST(Check, WrongExpectationsFailWithTheReason) {
 // through b: relative to b, a's centre goes from x = -3.1 at 2 m/s and is beyond b's box
 // (half extent 0.5) once -3.1 + 2 t > 0.5, t > 1.8 s: frame 19 (the first frame after).
 TEST(Check, TunnellingTimeOfImpactRestAndEnergyRise) {
-    const fs::path dir = tempDir("motion");
+    const fs::path dir = checkDir("motion");
     const engine::Scene off = parse(kTwoSpheres +
                                     "expect:\n"
                                     "  tunnelling:\n"
@@ -207,7 +207,7 @@ TEST(Check, TunnellingTimeOfImpactRestAndEnergyRise) {
 }
 
 TEST(Check, ShortRunsAndMissingSectionsFail) {
-    const fs::path dir = tempDir("short");
+    const fs::path dir = checkDir("short");
     std::vector<CheckRow> rows = checkScene(parse(kTwoSpheres), 25, dir);
     ASSERT_EQ(rows.size(), 1u);
     EXPECT_FALSE(rows[0].pass);
@@ -237,7 +237,7 @@ TEST(Check, ShortRunsAndMissingSectionsFail) {
 // 6-DOPs (boxes) overlap, their 26-DOPs are apart on the (1, 1, 0) slab, so the 6-DOP frame has
 // yellow and the 26-DOP frame none, though the scene draws both; a wrong expectation fails.
 TEST(Check, ColoursOfOneVolumeAlone) {
-    const fs::path dir = tempDir("volume");
+    const fs::path dir = checkDir("volume");
     const std::string diagonal =
         "world: {bounds: {min: [-4, -4, -4], max: [4, 4, 4]}, time_step: 0.1, frames: 2}\n"
         "output: {width: 160, height: 120, fps: 10}\n"
@@ -265,7 +265,7 @@ TEST(Check, ColoursOfOneVolumeAlone) {
 }
 
 TEST(Check, SameSceneSameRows) {
-    const fs::path dir = tempDir("det");
+    const fs::path dir = checkDir("det");
     const engine::Scene scene = parse(kTwoSpheres +
                                       "expect:\n  energy_drift_max: 0\n"
                                       "  colors:\n    - {frame: 3, absent: [red]}\n");
@@ -284,7 +284,7 @@ TEST(Check, SameSceneSameRows) {
 // The shipped arm (scenes/arm.yaml) with its expectations replaced: its tip first touches the
 // plate at 0.16722176 s (derived independently in the scene's comment).
 TEST(Check, ChainLinksAreGradedByTheExistingExpectations) {
-    const fs::path dir = tempDir("chain");
+    const fs::path dir = checkDir("chain");
     std::string arm = slurp(fs::path(CDLAB_SOURCE_DIR) / "scenes/arm.yaml");
     arm.erase(arm.find("expect:"));
     const std::string expect =
@@ -326,7 +326,7 @@ TEST(Check, ChainLinksAreGradedByTheExistingExpectations) {
 // --- through the binary ---
 
 TEST(CheckCli, ExitCodesAndTable) {
-    const fs::path work = tempDir("cli");
+    const fs::path work = checkDir("cli");
     const fs::path good = work / "good.yaml";
     const fs::path bad = work / "wrong.yaml";
     const fs::path broken = work / "broken.yaml";

@@ -28,7 +28,7 @@ using cdlab_test::CliResult;
 using cdlab_test::runCdlab;
 using cdlab_test::slurp;
 
-fs::path tempDir(const std::string& name) { return cdlab_test::tempDir("cdlab_check_many_", name); }
+fs::path checkManyDir(const std::string& name) { return cdlab_test::tempDir("cdlab_check_many_", name); }
 
 std::string scene(const std::string& expect, int extra = 1, const std::string& world = "") {
     std::string s =
@@ -112,7 +112,7 @@ std::string withoutTimes(std::string xml) {
 }
 
 TEST(CheckCli, SameTableAndExitCodeForEveryJobCount) {
-    const fs::path work = tempDir("jobs");
+    const fs::path work = checkManyDir("jobs");
     const Course course = makeCourse(work);
     const CliResult one = runCompared("check --keep-going -j 1" + course.all, work);
     const CliResult three = runCompared("check --keep-going -j 3" + course.all, work);
@@ -152,7 +152,7 @@ TEST(CheckCli, SameTableAndExitCodeForEveryJobCount) {
 
 // Pause dumps kept with --out: scene k in OUT/k_STEM, whichever process wrote it.
 TEST(CheckCli, ParallelPauseDumpsKeepTheirOwnFolders) {
-    const fs::path work = tempDir("dumps");
+    const fs::path work = checkManyDir("dumps");
     const Course course = makeCourse(work);
     const fs::path out = work / "dumps";
     const CliResult r = runCdlab("check -j 2 --out " + out.string() + course.loadable, work);
@@ -169,7 +169,7 @@ TEST(CheckCli, ParallelPauseDumpsKeepTheirOwnFolders) {
 
 // A scene that would run for minutes (10^7 steps) is stopped; the others are graded.
 TEST(CheckCli, TimeoutStopsOnlyTheSlowScene) {
-    const fs::path work = tempDir("timeout");
+    const fs::path work = checkManyDir("timeout");
     write(work / "good.yaml", scene(kCollide));
     write(work / "slow.yaml",
           scene("  min_bodies: 3\n", 1, ", steps_per_frame: 10, frames: 1000000"));
@@ -212,7 +212,7 @@ std::vector<pid_t> processesMentioning(const std::string& needle) {
 
 // A check killed from outside (a CI job's timeout) takes its children with it.
 TEST(CheckCli, ChildrenDieWithTheCheck) {
-    const fs::path work = tempDir("orphans");
+    const fs::path work = checkManyDir("orphans");
     const fs::path slow = work / "slow.yaml";
     write(slow, scene("  min_bodies: 3\n", 1, ", steps_per_frame: 10"));
     std::string text = slurp(slow);
@@ -245,7 +245,7 @@ TEST(CheckCli, ChildrenDieWithTheCheck) {
 }
 
 TEST(CheckCli, BadParallelFlags) {
-    const fs::path work = tempDir("flags");
+    const fs::path work = checkManyDir("flags");
     write(work / "good.yaml", scene(kCollide));
     const std::string good = " " + (work / "good.yaml").string();
     CliResult r = runCdlab("check -j -1" + good, work);
@@ -271,7 +271,7 @@ TEST(CheckCli, JunitReportSaysWhatTheTableSays) {
     if (std::system("xmllint --version > /dev/null 2>&1") != 0) {
         GTEST_SKIP() << "xmllint (Debian libxml2-utils) not installed";
     }
-    const fs::path work = tempDir("junit");
+    const fs::path work = checkManyDir("junit");
     const Course course = makeCourse(work);
     std::string odd = scene(kCollideTooEarly);
     for (std::size_t at; (at = odd.find("{a: a,")) != std::string::npos;) {
@@ -340,7 +340,7 @@ TEST(CheckCli, JunitReportSaysWhatTheTableSays) {
 // ---- the children, faked: a worker that crashes, gives up, hangs or writes nonsense ----
 
 TEST(CheckWorkers, AChildThatDiesOrHangsCostsOnlyItsRow) {
-    const fs::path work = tempDir("fake");
+    const fs::path work = checkManyDir("fake");
     const fs::path worker = work / "worker.sh";
     // argv: check --worker-result REPORT ... -- SCENE
     write(worker,

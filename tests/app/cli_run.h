@@ -56,6 +56,9 @@ inline CliResult runCdlab(const std::string& args, const std::filesystem::path& 
     return r;
 }
 
+/// The smallest scene the command-line tests run (relative to the repository).
+inline const std::string kTiny = "tests/data/tiny.yaml";
+
 /// True when ffprobe (Debian package ffmpeg) can be run.
 inline bool haveFfprobe() { return std::system("ffprobe -version > /dev/null 2>&1") == 0; }
 

@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "render/image.h"
 #include "cli_run.h"
+#include "render/image.h"
 
 namespace {
 
@@ -26,7 +26,7 @@ using Result = cdlab_test::CliResult;
 using cdlab_test::runCdlab;
 using cdlab_test::slurp;
 
-fs::path tempDir(const std::string& name) { return cdlab_test::tempDir("cdlab_cli_", name); }
+fs::path cliDir(const std::string& name) { return cdlab_test::tempDir("cdlab_cli_", name); }
 
 using cdlab_test::haveFfprobe;
 using cdlab_test::probeVideo;
@@ -44,11 +44,11 @@ int differingPixels(const render::Image& a, const render::Image& b, int first_ro
     return n;
 }
 
-const std::string kTiny = "tests/data/tiny.yaml";
+using cdlab_test::kTiny;
 
 // `cdlab bench` runs cdlab-bench from cdlab's own folder, with the arguments after `bench`.
 TEST(Cli, BenchRunsTheBenchExecutableBesideCdlab) {
-    const fs::path work = tempDir("bench_forward");
+    const fs::path work = cliDir("bench_forward");
     const Result help = runCdlab("bench --help", work);
     EXPECT_EQ(help.exit_code, 0) << help.err;
     EXPECT_NE(help.out.find("cdlab bench"), std::string::npos) << help.out;
@@ -61,7 +61,7 @@ TEST(Cli, BenchRunsTheBenchExecutableBesideCdlab) {
 // A cdlab without cdlab-bench beside it (the demo builds cdlab alone) says how to build the
 // benches and exits 1; the other commands are unaffected.
 TEST(Cli, BenchWithoutTheBenchExecutableSaysHowToBuildIt) {
-    const fs::path work = tempDir("bench_missing");
+    const fs::path work = cliDir("bench_missing");
     const fs::path alone = work / "cdlab";
     fs::copy_file(CDLAB_BINARY, alone);
     const std::string cmd = alone.string() + " bench broadphase --sizes 50 > " +
@@ -80,7 +80,7 @@ TEST(Cli, BenchWithoutTheBenchExecutableSaysHowToBuildIt) {
 }
 
 TEST(Cli, RunWritesFramesPauseDumpsAndSummary) {
-    const fs::path work = tempDir("run");
+    const fs::path work = cliDir("run");
     const fs::path out = work / "out";
     const Result r = runCdlab(
         "run " + kTiny + " --out " + out.string() + " --pause-at 0 --pause-at 3 --no-video", work);
@@ -147,7 +147,7 @@ TEST(Cli, RunWritesFramesPauseDumpsAndSummary) {
 // ffprobe, which the ffmpeg package always brings along.
 TEST(Cli, RunWritesAnH264Yuv420pVideoWithEveryFrame) {
     if (!haveFfprobe()) GTEST_SKIP() << "ffprobe not on PATH (Debian package ffmpeg)";
-    const fs::path work = tempDir("video");
+    const fs::path work = cliDir("video");
     const fs::path out = work / "out";
     const Result r = runCdlab("run " + kTiny + " --out " + out.string(), work);
     ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -172,14 +172,13 @@ TEST(Cli, RunWritesAnH264Yuv420pVideoWithEveryFrame) {
 // bad input found before any output, with the list of supported containers.
 TEST(Cli, RunWritesWebmAndGifAndRefusesUnsupportedContainers) {
     if (!haveFfprobe()) GTEST_SKIP() << "ffprobe not on PATH (Debian package ffmpeg)";
-    const fs::path work = tempDir("containers");
+    const fs::path work = cliDir("containers");
     const fs::path out = work / "out";
-    for (const auto& [name, codec] : {std::pair<std::string, std::string>{"tiny.webm", "vp9"},
-                                      {"tiny.gif", "gif"}}) {
+    for (const auto& [name, codec] :
+         {std::pair<std::string, std::string>{"tiny.webm", "vp9"}, {"tiny.gif", "gif"}}) {
         const fs::path video = work / name;
-        const Result r = runCdlab("run " + kTiny + " --out " + out.string() + " --video " +
-                                      video.string(),
-                                  work);
+        const Result r = runCdlab(
+            "run " + kTiny + " --out " + out.string() + " --video " + video.string(), work);
         ASSERT_EQ(r.exit_code, 0) << name << ": " << r.err;
         const std::map<std::string, std::string> probe = probeVideo(video, work);
         ASSERT_EQ(probe.count("error"), 0u) << probe.at("error");
@@ -187,12 +186,11 @@ TEST(Cli, RunWritesWebmAndGifAndRefusesUnsupportedContainers) {
         EXPECT_EQ(probe.count("nb_read_frames") ? probe.at("nb_read_frames") : "?", "6") << name;
     }
     const fs::path bad_out = work / "bad_out";
-    const Result r = runCdlab("run " + kTiny + " --out " + bad_out.string() + " --video " +
-                                  (work / "tiny.avi").string(),
-                              work);
+    const Result r = runCdlab(
+        "run " + kTiny + " --out " + bad_out.string() + " --video " + (work / "tiny.avi").string(),
+        work);
     EXPECT_EQ(r.exit_code, 2) << r.err;
-    EXPECT_NE(r.err.find("unsupported video container '.avi' (supported: .mp4"),
-              std::string::npos)
+    EXPECT_NE(r.err.find("unsupported video container '.avi' (supported: .mp4"), std::string::npos)
         << r.err;
     EXPECT_FALSE(fs::exists(bad_out)) << "output written before the check";
     fs::remove_all(work);
@@ -202,7 +200,7 @@ TEST(Cli, RunWritesWebmAndGifAndRefusesUnsupportedContainers) {
 // cdlab looks for ffmpeg on PATH, so an empty directory as PATH hides it; the same run with
 // --no-video succeeds, so it is the missing encoder and nothing else that stops the first run.
 TEST(Cli, MissingFfmpegIsAClearFailureBeforeAnyOutput) {
-    const fs::path work = tempDir("noffmpeg");
+    const fs::path work = cliDir("noffmpeg");
     const fs::path empty = work / "empty_path";
     fs::create_directories(empty);
     const fs::path out = work / "out";
@@ -221,11 +219,10 @@ TEST(Cli, MissingFfmpegIsAClearFailureBeforeAnyOutput) {
 }
 
 TEST(Cli, SameSceneGivesBitIdenticalFramesAndState) {
-    const fs::path work = tempDir("determinism");
+    const fs::path work = cliDir("determinism");
     for (const char* run : {"a", "b"}) {
-        const Result r = runCdlab("run " + kTiny + " --no-video --no-hud-timing --out " +
-                                      (work / run).string(),
-                                  work);
+        const Result r = runCdlab(
+            "run " + kTiny + " --no-video --no-hud-timing --out " + (work / run).string(), work);
         ASSERT_EQ(r.exit_code, 0) << r.err;
     }
     for (int f = 0; f < 6; ++f) {
@@ -241,13 +238,12 @@ TEST(Cli, SameSceneGivesBitIdenticalFramesAndState) {
 }
 
 TEST(Cli, BadSceneReportsFileLineColumnAndExits2) {
-    const fs::path work = tempDir("bad");
+    const fs::path work = cliDir("bad");
     const fs::path scene = work / "bad.yaml";
     std::ofstream(scene) << "world:\n  bounds: {min: [-1, -1, -1], max: [1, 1, 1]}\n"
                             "bodies:\n  - shape: sphere\n    radius: -2\n    position: [0, 0, 0]\n";
-    const Result r = runCdlab("run " + scene.string() + " --no-video --out " +
-                                  (work / "out").string(),
-                              work);
+    const Result r =
+        runCdlab("run " + scene.string() + " --no-video --out " + (work / "out").string(), work);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("bad.yaml:5:13: bodies[0].radius"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(work / "out" / "frame_00000.png"));
@@ -255,14 +251,12 @@ TEST(Cli, BadSceneReportsFileLineColumnAndExits2) {
 }
 
 TEST(Cli, BadFlagsExit2WithAMessage) {
-    const fs::path work = tempDir("flags");
-    Result r = runCdlab("run " + kTiny + " --broadphase nope --no-video --out " +
-                            (work / "o").string(),
-                        work);
+    const fs::path work = cliDir("flags");
+    Result r = runCdlab(
+        "run " + kTiny + " --broadphase nope --no-video --out " + (work / "o").string(), work);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("unknown broad phase 'nope'"), std::string::npos) << r.err;
-    r = runCdlab("run " + kTiny + " --pause-at 99 --no-video --out " + (work / "o").string(),
-                 work);
+    r = runCdlab("run " + kTiny + " --pause-at 99 --no-video --out " + (work / "o").string(), work);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("--pause-at 99"), std::string::npos) << r.err;
     r = runCdlab("run no/such/scene.yaml --no-video", work);
@@ -277,11 +271,11 @@ TEST(Cli, BadFlagsExit2WithAMessage) {
 }
 
 TEST(Cli, UnwritableOutputIsAClearFailure) {
-    const fs::path work = tempDir("unwritable");
+    const fs::path work = cliDir("unwritable");
     const fs::path blocker = work / "file";
     std::ofstream(blocker) << "x";
-    const Result r = runCdlab("run " + kTiny + " --no-video --out " + (blocker / "sub").string(),
-                              work);
+    const Result r =
+        runCdlab("run " + kTiny + " --no-video --out " + (blocker / "sub").string(), work);
     EXPECT_NE(r.exit_code, 0);
     EXPECT_NE(r.err.find("cannot create output directory"), std::string::npos) << r.err;
     fs::remove_all(work);
@@ -293,13 +287,12 @@ TEST(Cli, UnwritableOutputIsAClearFailure) {
 // summary.json, no video under its final or partial name).
 TEST(Cli, AFrameThatCannotBeWrittenStopsTheRun) {
     if (!haveFfprobe()) GTEST_SKIP() << "ffmpeg not on PATH (Debian package ffmpeg)";
-    const fs::path work = tempDir("frame_unwritable");
+    const fs::path work = cliDir("frame_unwritable");
     const fs::path out = work / "out";
     fs::create_directories(out / "frame_00003.png");
     const Result r = runCdlab("run " + kTiny + " --quiet --out " + out.string(), work);
     EXPECT_EQ(r.exit_code, 1);
-    EXPECT_NE(r.err.find("frame_00003.png: exists and is a directory"), std::string::npos)
-        << r.err;
+    EXPECT_NE(r.err.find("frame_00003.png: exists and is a directory"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out / "summary.json"));
     EXPECT_FALSE(fs::exists(out / "tiny.mp4"));
     EXPECT_FALSE(fs::exists(out / "tiny.partial.mp4"));
@@ -309,14 +302,13 @@ TEST(Cli, AFrameThatCannotBeWrittenStopsTheRun) {
 // --timing ends the run with one line saying where the time went, each stage named, and the
 // writers' counts: every frame's PNG written, none given to an encoder that was not asked for.
 TEST(Cli, TimingLineNamesEveryStage) {
-    const fs::path work = tempDir("timing");
-    const Result r = runCdlab("run " + kTiny + " --quiet --no-video --timing --out " +
-                                  (work / "out").string(),
-                              work);
+    const fs::path work = cliDir("timing");
+    const Result r = runCdlab(
+        "run " + kTiny + " --quiet --no-video --timing --out " + (work / "out").string(), work);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("timing: 6 frames in "), std::string::npos) << r.out;
-    for (const char* stage : {"fps", "sim ", "render ", "readback ", "waiting for writers ",
-                              "png ", "(cpu, 6 files)", "video feed ", "(cpu, 0 frames)"}) {
+    for (const char* stage : {"fps", "sim ", "render ", "readback ", "waiting for writers ", "png ",
+                              "(cpu, 6 files)", "video feed ", "(cpu, 0 frames)"}) {
         EXPECT_NE(r.out.find(stage), std::string::npos) << stage << " in " << r.out;
     }
     fs::remove_all(work);
@@ -328,7 +320,7 @@ TEST(Cli, TimingLineNamesEveryStage) {
 // FIFO, a symbolic link (to a regular file, which stays untouched too) and a directory, through
 // --video, --stats and --trace. (/dev/null itself is not used: a regression would replace it.)
 TEST(Cli, OutputPathsThatAreNotRegularFilesAreRefusedAndLeftAlone) {
-    const fs::path work = tempDir("special_outputs");
+    const fs::path work = cliDir("special_outputs");
     const fs::path fifo = work / "pipe.mp4";
     ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
     const fs::path target = work / "target.csv";
@@ -368,8 +360,8 @@ TEST(Cli, OutputPathsThatAreNotRegularFilesAreRefusedAndLeftAlone) {
     std::ofstream(victim) << "untouched";
     fs::create_directories(work / "out2");
     fs::create_symlink(victim, work / "out2" / "frame_00000.png.partial");
-    const Result r = runCdlab("run " + kTiny + " --no-video --out " + (work / "out2").string(),
-                              work);
+    const Result r =
+        runCdlab("run " + kTiny + " --no-video --out " + (work / "out2").string(), work);
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.err.find("frame_00000.png.partial: exists and is a symbolic link"),
               std::string::npos)
@@ -382,11 +374,11 @@ TEST(Cli, OutputPathsThatAreNotRegularFilesAreRefusedAndLeftAlone) {
 // .partial file beside the new summary.json. The run's own earlier outputs are cleared first;
 // files that are not cdlab's stay.
 TEST(Cli, RerunClearsTheEarlierRunsOutputsOnly) {
-    const fs::path work = tempDir("rerun");
+    const fs::path work = cliDir("rerun");
     const fs::path out = work / "out";
-    ASSERT_EQ(runCdlab("run " + kTiny + " --no-video --pause-at 5 --out " + out.string(), work)
-                  .exit_code,
-              0);
+    ASSERT_EQ(
+        runCdlab("run " + kTiny + " --no-video --pause-at 5 --out " + out.string(), work).exit_code,
+        0);
     ASSERT_TRUE(fs::exists(out / "frame_00005.png"));
     std::ofstream(out / "frame_00004.png.partial") << "killed mid-write";
     std::ofstream(out / "notes.txt") << "mine";
@@ -395,9 +387,8 @@ TEST(Cli, RerunClearsTheEarlierRunsOutputsOnly) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_TRUE(fs::exists(out / "frame_00002.png"));
     EXPECT_TRUE(fs::exists(out / "summary.json"));
-    for (const char* stale :
-         {"frame_00003.png", "frame_00005.png", "pause_5.png", "pause_5.json",
-          "frame_00004.png.partial"}) {
+    for (const char* stale : {"frame_00003.png", "frame_00005.png", "pause_5.png", "pause_5.json",
+                              "frame_00004.png.partial"}) {
         EXPECT_FALSE(fs::exists(out / stale)) << stale;
     }
     EXPECT_EQ(slurp(out / "notes.txt"), "mine");
@@ -407,7 +398,7 @@ TEST(Cli, RerunClearsTheEarlierRunsOutputsOnly) {
 // Regression: contradictory or empty flags were accepted (`--video x.mp4 --no-video` ran with no
 // video; `--broadphase ""` ran the scene's broad phase).
 TEST(Cli, ContradictoryAndEmptyFlagsExit2) {
-    const fs::path work = tempDir("flags");
+    const fs::path work = cliDir("flags");
     const std::string out = " --out " + (work / "out").string();
     Result r = runCdlab("run " + kTiny + out + " --video x.mp4 --no-video", work);
     EXPECT_EQ(r.exit_code, 2);
@@ -423,9 +414,11 @@ TEST(Cli, ContradictoryAndEmptyFlagsExit2) {
 }
 
 TEST(Cli, BroadPhaseFlagOverridesTheScene) {
-    const fs::path work = tempDir("override");
-    const Result r = runCdlab("run " + kTiny + " --broadphase sphere --no-video --frames 2 "
-                              "--pause-at 1 --out " + (work / "o").string(),
+    const fs::path work = cliDir("override");
+    const Result r = runCdlab("run " + kTiny +
+                                  " --broadphase sphere --no-video --frames 2 "
+                                  "--pause-at 1 --out " +
+                                  (work / "o").string(),
                               work);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const nlohmann::json p = nlohmann::json::parse(slurp(work / "o" / "pause_1.json"));
@@ -477,7 +470,7 @@ const std::vector<std::string> kStatsColumns = {
     "toi_iterations", "toi_events"};
 
 TEST(Cli, StatsCsvHasOneRowPerFrameAndCheckBroadphasePasses) {
-    const fs::path work = tempDir("stats");
+    const fs::path work = cliDir("stats");
     const fs::path csv = work / "stats" / "run.csv";
     const Result r = runCdlab("run " + kTiny +
                                   " --no-video --check-broadphase --draw-structure "
@@ -509,7 +502,7 @@ TEST(Cli, StatsCsvHasOneRowPerFrameAndCheckBroadphasePasses) {
 // With CCD and impulse response switched on, their stages get times of their own, and each
 // stays within the step's total.
 TEST(Cli, StatsCsvTimesTheCcdAndResponseStages) {
-    const fs::path work = tempDir("stats_stages");
+    const fs::path work = cliDir("stats_stages");
     const fs::path csv = work / "run.csv";
     const Result r = runCdlab("run " + kTiny +
                                   " --no-video --no-frames "

@@ -24,10 +24,10 @@ using Result = cdlab_test::CliResult;
 using cdlab_test::runCdlab;
 using cdlab_test::slurp;
 
-fs::path tempDir(const std::string& name) { return cdlab_test::tempDir("cdlab_convex_bench_", name); }
+fs::path convexBenchDir(const std::string& name) { return cdlab_test::tempDir("cdlab_convex_bench_", name); }
 
 TEST(ConvexBench, FewQueriesNoMismatchAndCompleteJson) {
-    const fs::path work = tempDir("smoke");
+    const fs::path work = convexBenchDir("smoke");
     const fs::path json = work / "convex.json";
     const Result r =
         runCdlab("bench convex --queries 200 --passes 1 --json " + json.string(), work);
@@ -92,7 +92,7 @@ TEST(ConvexBench, FewQueriesNoMismatchAndCompleteJson) {
 }
 
 TEST(ConvexBench, WorkloadOptionSelectsRowsByName) {
-    const fs::path work = tempDir("select");
+    const fs::path work = convexBenchDir("select");
     const fs::path json = work / "convex.json";
     const Result r = runCdlab(
         "bench convex --queries 20 --passes 1 --workload sphere-sphere --json " + json.string(),
@@ -110,7 +110,7 @@ TEST(ConvexBench, WorkloadOptionSelectsRowsByName) {
 }
 
 TEST(ConvexBench, BadOptionExitsTwo) {
-    const fs::path work = tempDir("bad");
+    const fs::path work = convexBenchDir("bad");
     const Result r = runCdlab("bench convex --queries 0", work);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("--queries"), std::string::npos) << r.err;

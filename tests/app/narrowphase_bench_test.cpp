@@ -24,10 +24,10 @@ using Result = cdlab_test::CliResult;
 using cdlab_test::runCdlab;
 using cdlab_test::slurp;
 
-fs::path tempDir(const std::string& name) { return cdlab_test::tempDir("cdlab_np_bench_", name); }
+fs::path npBenchDir(const std::string& name) { return cdlab_test::tempDir("cdlab_np_bench_", name); }
 
 TEST(NarrowphaseBench, SmallToriTableAndJsonAgreeWithBruteForce) {
-    const fs::path work = tempDir("small");
+    const fs::path work = npBenchDir("small");
     const fs::path json = work / "np.json";
     const Result r = runCdlab(
         "bench narrowphase --triangles 600 --poses 6 --reps 1 --json " + json.string(), work);
@@ -76,7 +76,7 @@ TEST(NarrowphaseBench, SmallToriTableAndJsonAgreeWithBruteForce) {
 }
 
 TEST(NarrowphaseBench, BottomUpBuildsAreCheckedToo) {
-    const fs::path work = tempDir("bu");
+    const fs::path work = npBenchDir("bu");
     const fs::path json = work / "np.json";
     const Result r = runCdlab(
         "bench narrowphase --triangles 600 --poses 4 --reps 1 --methods "
@@ -97,7 +97,7 @@ TEST(NarrowphaseBench, BottomUpBuildsAreCheckedToo) {
 // refit), and has no unit costs (null in JSON, "-" in the table, with the reason): the replay
 // times single node-pair tests, the wide tree tests four boxes at once.
 TEST(NarrowphaseBench, WideObbTreeRunsByNameAndAgreesWithBruteForce) {
-    const fs::path work = tempDir("wide");
+    const fs::path work = npBenchDir("wide");
     const fs::path json = work / "np.json";
     const Result r = runCdlab(
         "bench narrowphase --triangles 600 --poses 6 --reps 1 --methods obb4,obb --json " +
@@ -127,7 +127,7 @@ TEST(NarrowphaseBench, FclRowsTakeSplitRulesAndAgreeWithBruteForce) {
     if (std::find(names.begin(), names.end(), "fcl-obb") == names.end()) {
         GTEST_SKIP() << "built without FCL";
     }
-    const fs::path work = tempDir("fcl");
+    const fs::path work = npBenchDir("fcl");
     const fs::path json = work / "np.json";
     const Result r = runCdlab(
         "bench narrowphase --triangles 600 --poses 6 --reps 1 --methods "
@@ -147,7 +147,7 @@ TEST(NarrowphaseBench, FclRowsTakeSplitRulesAndAgreeWithBruteForce) {
 // With rounds, every method is measured once per round (in order, then in reverse) and each
 // time reported is the median of its rounds' times; answers are checked in every round.
 TEST(NarrowphaseBench, RoundsReportTheMedianOfEachRoundsTimes) {
-    const fs::path work = tempDir("rounds");
+    const fs::path work = npBenchDir("rounds");
     const fs::path json = work / "np.json";
     const Result r = runCdlab("bench narrowphase --triangles 600 --poses 2 --reps 1 --rounds 3 "
                               "--methods obb,aabb --json " +
@@ -171,7 +171,7 @@ TEST(NarrowphaseBench, RoundsReportTheMedianOfEachRoundsTimes) {
 }
 
 TEST(NarrowphaseBench, BadOptionsExitTwo) {
-    const fs::path work = tempDir("bad");
+    const fs::path work = npBenchDir("bad");
     Result r = runCdlab("bench narrowphase --poses 3", work);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("--poses"), std::string::npos) << r.err;

@@ -24,12 +24,12 @@ using Result = cdlab_test::CliResult;
 using cdlab_test::runCdlab;
 using cdlab_test::slurp;
 
-fs::path tempDir(const std::string& name) { return cdlab_test::tempDir("cdlab_order_", name); }
+fs::path orderDir(const std::string& name) { return cdlab_test::tempDir("cdlab_order_", name); }
 
 // scenes/crowd.yaml (1,500 bodies, hgrid) for 3 frames, checked against brute force every
 // step, with a trace and a pause dump: twice in found order and once sorted.
 TEST(PairOrderCli, CrowdInFoundOrderIsBitIdenticalAndWritesWhatSortedOrderWrites) {
-    const fs::path work = tempDir("crowd");
+    const fs::path work = orderDir("crowd");
     for (const char* run : {"found_a", "found_b", "sorted"}) {
         const std::string order = std::string(run).starts_with("found") ? "found" : "sorted";
         const fs::path out = work / run;
@@ -71,7 +71,7 @@ TEST(PairOrderCli, CrowdInFoundOrderIsBitIdenticalAndWritesWhatSortedOrderWrites
 }
 
 TEST(PairOrderCli, BadValuesExit2WithAMessage) {
-    const fs::path work = tempDir("bad");
+    const fs::path work = orderDir("bad");
     const std::string tiny = "tests/data/tiny.yaml";
     Result r = runCdlab(
         "run " + tiny + " --pair-order unsorted --no-video --out " + (work / "o").string(), work);
@@ -118,7 +118,7 @@ TEST(PairOrderCli, PairExpectationsHoldInFoundOrder) {
         "    - {a: t3, b: t2, frames: [0, 2], colliding: true}\n"
         "    - {a: t0, b: t2, frames: [0, 2], flagged: false}\n";
     const fs::path scenes = fs::path(CDLAB_SOURCE_DIR) / "scenes";
-    const fs::path dir = tempDir("tori");
+    const fs::path dir = orderDir("tori");
     engine::Scene scene = engine::parseScene(text, "t.yaml", scenes);
     ASSERT_EQ(scene.world.pair_order, collision::PairOrder::Found);
     for (const app::CheckRow& r : app::checkScene(scene, 3, dir)) {
@@ -136,7 +136,7 @@ TEST(PairOrderCli, PairExpectationsHoldInFoundOrder) {
 // hgrid:found in the bench: the same pairs as hgrid (checked on every frame against the
 // reference), one-shot and moving.
 TEST(PairOrderCli, BenchRowsInFoundOrderFindTheSamePairs) {
-    const fs::path work = tempDir("bench");
+    const fs::path work = orderDir("bench");
     const fs::path json = work / "bp.json";
     const Result r = runCdlab(
         "bench broadphase --workload boxpruning --sizes 3000 --frames 4 "

@@ -20,9 +20,9 @@ using cdlab_test::runCdlab;
 using cdlab_test::slurp;
 using namespace cdlab_test;
 
-const std::string kTiny = "tests/data/tiny.yaml";
+using cdlab_test::kTiny;
 
-fs::path tempDir(const std::string& name) { return cdlab_test::tempDir("cdlab_pause_", name); }
+fs::path pauseDir(const std::string& name) { return cdlab_test::tempDir("cdlab_pause_", name); }
 
 // A scene without draw.volumes (so a run draws its broad phase's volume), no HUD and no bounds,
 // seen head-on by a camera at (cx, cy, 9) looking along -z.
@@ -71,7 +71,7 @@ const Rgb kYellow = toRgb(render::stateColor(engine::BodyState::Flagged));
 // Issue "pictures that tell the truth": the pause picture coloured D's sphere yellow because its
 // AABB was flagged. The dump now lists each volume's own state, and the picture agrees.
 TEST(PausePicture, EachVolumeTakesItsOwnTestsStateInPictureAndDump) {
-    const fs::path work = tempDir("own");
+    const fs::path work = pauseDir("own");
     const fs::path scene =
         writeScene(work, "diagonal.yaml", sceneText(-1.2, -0.6, kDiagonalBodies));
     const fs::path out = work / "out";
@@ -116,7 +116,7 @@ TEST(PausePicture, EachVolumeTakesItsOwnTestsStateInPictureAndDump) {
 // while the 26-DOPs' (1, 1, 0) slab separates them. Each slab interval is a sphere's
 // [d.c - r |d|, d.c + r |d|] along the dumped direction d; k-DOPs not drawn are not dumped.
 TEST(PausePicture, DrawnKdopsAreDumpedWithTheirSlabsAndStates) {
-    const fs::path work = tempDir("kdop");
+    const fs::path work = pauseDir("kdop");
     std::string text = sceneText(-1.2, -0.6, kDiagonalBodies);
     const std::string draw = "draw: {hud: false, bounds: false, bodies: false}";
     ASSERT_NE(text.find(draw), std::string::npos);
@@ -172,7 +172,7 @@ TEST(PausePicture, DrawnKdopsAreDumpedWithTheirSlabsAndStates) {
 // The rods' AABBs and bounding spheres overlap, their OBBs do not: with obb nothing is yellow and
 // the OBB lines are green; with sphere the spheres and with sap the AABBs are yellow.
 TEST(PausePicture, FramesDrawTheVolumeTheBroadPhaseTests) {
-    const fs::path work = tempDir("default");
+    const fs::path work = pauseDir("default");
     const fs::path scene = writeScene(work, "rods.yaml", sceneText(0, 0, kRodBodies));
     const engine::CameraSettings cam = cameraAt(0, 0);
     // A point of rod1's long upper front edge, 0.7 from its middle: on its OBB, clear of its and
@@ -211,7 +211,7 @@ TEST(PausePicture, FramesDrawTheVolumeTheBroadPhaseTests) {
 // 6 frames at 10 fps); the PNG frames are not repeated; 0 holds nothing.
 TEST(PausePicture, PauseHoldAddsHoldTimesFpsVideoFrames) {
     if (!haveFfprobe()) GTEST_SKIP() << "ffprobe not on PATH (Debian package ffmpeg)";
-    const fs::path work = tempDir("hold");
+    const fs::path work = pauseDir("hold");
     struct Case {
         std::string flags;
         int video_frames;
@@ -235,7 +235,7 @@ TEST(PausePicture, PauseHoldAddsHoldTimesFpsVideoFrames) {
 }
 
 TEST(PausePicture, BadPauseHoldIsAClearErrorExit2) {
-    const fs::path work = tempDir("badhold");
+    const fs::path work = pauseDir("badhold");
     for (const std::string v : {"-1", "nan", "inf", "-inf", "1e9", "abc"}) {
         SCOPED_TRACE(v);
         const CliResult r = runCdlab("run " + kTiny + " --no-video --pause-at 1 --pause-hold " + v +
@@ -251,7 +251,7 @@ TEST(PausePicture, BadPauseHoldIsAClearErrorExit2) {
 // A mesh body's dump names its hierarchy's volume (world.mesh_bvh), the wide tree included;
 // other bodies have none.
 TEST(PausePicture, DumpNamesEachMeshBodysHierarchy) {
-    const fs::path work = tempDir("mesh_bvh");
+    const fs::path work = pauseDir("mesh_bvh");
     const std::string torus = std::string(CDLAB_SOURCE_DIR) + "/assets/torus.obj";
     const fs::path scene = writeScene(
         work, "meshes.yaml",

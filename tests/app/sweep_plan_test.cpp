@@ -30,7 +30,7 @@ namespace fs = std::filesystem;
 using cdlab_test::runCdlab;
 using cdlab_test::slurp;
 
-fs::path tempDir(const std::string& name) { return cdlab_test::tempDir("cdlab_plan_", name); }
+fs::path planDir(const std::string& name) { return cdlab_test::tempDir("cdlab_plan_", name); }
 
 // 2 broad phases x 2 time steps (one tunnels, one catches the plate) and the reference.
 const std::string kVary =
@@ -134,7 +134,7 @@ void expectSameAsOneProcess(const fs::path& dir, const fs::path& one, const fs::
 }
 
 TEST(SweepPlan, JobsRunOneByOneCollectToTheOneProcessSweep) {
-    const fs::path work = tempDir("serial");
+    const fs::path work = planDir("serial");
     const fs::path scene = sceneCopy(work);
     const fs::path one = oneProcessSweep(scene, work);
     const fs::path dir = plan(scene, work);
@@ -154,7 +154,7 @@ TEST(SweepPlan, GnuParallelRunsTheJobs) {
     if (shell("parallel --version > /dev/null 2>&1") != 0) {
         GTEST_SKIP() << "GNU Parallel not installed (Debian package parallel)";
     }
-    const fs::path work = tempDir("parallel");
+    const fs::path work = planDir("parallel");
     const fs::path scene = sceneCopy(work);
     const fs::path one = oneProcessSweep(scene, work);
     const fs::path dir = plan(scene, work);
@@ -178,7 +178,7 @@ TEST(SweepPlan, GnuParallelRunsTheJobs) {
 }
 
 TEST(SweepPlan, LocalJobsGiveTheOneProcessColumns) {
-    const fs::path work = tempDir("local");
+    const fs::path work = planDir("local");
     const fs::path scene = sceneCopy(work);
     const fs::path one = oneProcessSweep(scene, work);
     const fs::path out = work / "j2";
@@ -215,7 +215,7 @@ TEST(SweepPlan, LocalJobsGiveTheOneProcessColumns) {
 // runSweep called as a library with -j must be told which cdlab to run: its own executable is
 // not one (here it is this test binary, which would run every test again for each job).
 TEST(SweepPlan, ParallelRunsFromTheLibraryNeedTheCdlabBinary) {
-    const fs::path work = tempDir("library");
+    const fs::path work = planDir("library");
     app::SweepOptions o;
     o.scene = fs::path(CDLAB_SOURCE_DIR) / "tests/data/tunnel_small.yaml";
     o.vary = {"broadphase=sap,hgrid"};
@@ -236,7 +236,7 @@ TEST(SweepPlan, ParallelRunsFromTheLibraryNeedTheCdlabBinary) {
 
 // The Slurm array script, run by bash with the task id Slurm would give each task.
 TEST(SweepPlan, SlurmArrayScriptMapsEachTaskToItsJob) {
-    const fs::path work = tempDir("slurm");
+    const fs::path work = planDir("slurm");
     const fs::path scene = sceneCopy(work);
     const fs::path one = oneProcessSweep(scene, work);
     const fs::path dir = plan(scene, work, " --slurm");
@@ -266,7 +266,7 @@ TEST(SweepPlan, SlurmArrayScriptMapsEachTaskToItsJob) {
 // A job that never ran, and one that failed (its scene changed after planning): both are named
 // on stderr and in report.md, the other runs are still written, and collect exits 1.
 TEST(SweepPlan, MissingAndFailedJobsAreNamed) {
-    const fs::path work = tempDir("missing");
+    const fs::path work = planDir("missing");
     const fs::path scene = sceneCopy(work);
     const fs::path dir = plan(scene, work);
     const std::vector<std::string> jobs = jobLines(dir);
@@ -313,7 +313,7 @@ TEST(SweepPlan, MissingAndFailedJobsAreNamed) {
 }
 
 TEST(SweepPlan, BadInputIsExitTwoWithAClearMessage) {
-    const fs::path work = tempDir("bad");
+    const fs::path work = planDir("bad");
     const fs::path scene = sceneCopy(work);
     const fs::path dir = plan(scene, work);
     const std::vector<std::string> jobs = jobLines(dir);

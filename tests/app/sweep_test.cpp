@@ -37,7 +37,7 @@ using cdlab_test::slurp;
 
 const fs::path kScene = fs::path(CDLAB_SOURCE_DIR) / "tests/data/tunnel_small.yaml";
 
-fs::path tempDir(const std::string& name) { return cdlab_test::tempDir("cdlab_sweep_", name); }
+fs::path sweepDir(const std::string& name) { return cdlab_test::tempDir("cdlab_sweep_", name); }
 
 // A CSV file as one map per row, column name -> text.
 std::vector<std::map<std::string, std::string>> readCsv(const fs::path& file) {
@@ -96,7 +96,7 @@ TEST(Sweep, TimeStepThatTunnelsMissesTheContactAndBroadPhasesAgree) {
     app::SweepOptions o;
     o.scene = kScene;
     o.vary = {"broadphase=brute,sap,hgrid,tree", "world.time_step=0.05,0.005"};
-    o.out_dir = tempDir("tunnel");
+    o.out_dir = sweepDir("tunnel");
     const Outcome r = sweep(o);
     ASSERT_EQ(r.code, 0) << r.err;
     const auto rows = readCsv(o.out_dir / "results.csv");
@@ -139,7 +139,7 @@ TEST(Sweep, CcdStopsCountAsContactsWithTheirTimeOfImpact) {
     o.scene = kScene;
     o.vary = {"world.ccd=off,conservative_advancement", "world.time_step=0.05,0.005"};
     o.reference = {"world.ccd=conservative_advancement"};
-    o.out_dir = tempDir("ccd");
+    o.out_dir = sweepDir("ccd");
     const Outcome r = sweep(o);
     ASSERT_EQ(r.code, 0) << r.err;
     const auto rows = readCsv(o.out_dir / "results.csv");
@@ -174,7 +174,7 @@ TEST(Sweep, CcdToleranceIsSweepableAndLooserIsLessAccurate) {
     o.reference = {"world.ccd_tolerance=1e-6"};
     o.duration = 0.1;  // the first stop is at 0.0721 s
     o.report_timing = false;
-    o.out_dir = tempDir("ccd_tolerance");
+    o.out_dir = sweepDir("ccd_tolerance");
     const Outcome r = sweep(o);
     ASSERT_EQ(r.code, 0) << r.err;
     const auto rows = readCsv(o.out_dir / "results.csv");
@@ -198,7 +198,7 @@ TEST(Sweep, ReportWithoutTimingIsBitIdentical) {
     o.scene = kScene;
     o.vary = {"world.time_step=0.02,0.01"};
     o.report_timing = false;
-    o.out_dir = tempDir("det1");
+    o.out_dir = sweepDir("det1");
     ASSERT_EQ(sweep(o).code, 0);
     const std::string first = slurp(o.out_dir / "report.md");
     fs::remove_all(o.out_dir);
@@ -216,7 +216,7 @@ TEST(Sweep, MemoryPerRunIsMeasured) {
     o.scene = std::filesystem::path(CDLAB_SOURCE_DIR) / "scenes/crowd.yaml";
     o.vary = {"broadphase=sap,octree"};
     o.duration = 0.1;
-    o.out_dir = tempDir("memory");
+    o.out_dir = sweepDir("memory");
     const Outcome r = sweep(o);
     ASSERT_EQ(r.code, 0) << r.err;
     const auto rows = readCsv(o.out_dir / "results.csv");
@@ -355,7 +355,7 @@ TEST(Sweep, LateFirstContactIsNotAccurate) {
 TEST(Sweep, RepeatBelowOneIsBadInput) {
     app::SweepOptions o;
     o.scene = kScene;
-    o.out_dir = tempDir("repeat0");
+    o.out_dir = sweepDir("repeat0");
     for (int n : {0, -2}) {
         o.repeat = n;
         const Outcome r = sweep(o);
@@ -383,7 +383,7 @@ TEST(Sweep, RunAtTheReferenceTimeStepIsFlagged) {
     o.scene = kScene;
     o.vary = {"world.time_step=0.005,0.001,0.0005"};
     o.repeat = 1;
-    o.out_dir = tempDir("at_reference");
+    o.out_dir = sweepDir("at_reference");
     const Outcome r = sweep(o);
     ASSERT_EQ(r.code, 0) << r.err;
     const auto rows = readCsv(o.out_dir / "results.csv");
@@ -417,7 +417,7 @@ TEST(Sweep, RepeatsGiveMedianAndRangeAndIdenticalDeterministicColumns) {
     app::SweepOptions o;
     o.scene = kScene;
     o.vary = {"broadphase=sap,hgrid", "world.time_step=0.05,0.005"};
-    o.out_dir = tempDir("repeats");
+    o.out_dir = sweepDir("repeats");
     o.repeat = 1;
     Outcome r = sweep(o);
     ASSERT_EQ(r.code, 0) << r.err;
@@ -507,7 +507,7 @@ TEST(Sweep, ParseVaryKeepsBracketedValuesWhole) {
 TEST(Sweep, RepeatedVaryKeysAndEndlessDurationsAreBadInput) {
     app::SweepOptions o;
     o.scene = kScene;
-    o.out_dir = tempDir("repeated");
+    o.out_dir = sweepDir("repeated");
     o.vary = {"broadphase=sap", "broadphase=grid"};
     Outcome r = sweep(o);
     EXPECT_EQ(r.code, 2);
@@ -525,7 +525,7 @@ TEST(Sweep, RepeatedVaryKeysAndEndlessDurationsAreBadInput) {
 TEST(Sweep, BadInputIsExitTwoWithTheKeyNamed) {
     app::SweepOptions o;
     o.scene = kScene;
-    o.out_dir = tempDir("bad");
+    o.out_dir = sweepDir("bad");
     o.vary = {"broadphase=sap,nonesuch"};
     Outcome r = sweep(o);
     EXPECT_EQ(r.code, 2);
@@ -565,7 +565,7 @@ TEST(Sweep, FloatComparisonAgainstTheSameBuildFindsNoDifference) {
     o.scene = kScene;
     o.vary = {"world.time_step=0.01,0.005", "world.gravity=[0, -9.81, 0]"};
     o.float_binary = fs::path(CDLAB_BINARY);
-    o.out_dir = tempDir("float");
+    o.out_dir = sweepDir("float");
     const Outcome r = sweep(o);
     ASSERT_EQ(r.code, 0) << r.err;
     const auto rows = readCsv(o.out_dir / "float_vs_double.csv");
@@ -643,7 +643,7 @@ TEST(Sweep, FloatReadingStatesTheLargestDeviationEvenWhenPairsAgree) {
 }
 
 TEST(Sweep, CompareTracesFindsTheFirstDifferingFrameAndTheLargestDeviation) {
-    const fs::path dir = tempDir("traces");
+    const fs::path dir = sweepDir("traces");
     fs::create_directories(dir);
     auto write = [&](const std::string& name, const std::string& text) {
         std::ofstream(dir / name) << text;

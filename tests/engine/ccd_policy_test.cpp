@@ -14,11 +14,12 @@
 
 #include "engine/scene.h"
 #include "engine/world.h"
+#include "shipped_scenes.h"
 
 namespace engine {
 namespace {
 
-const std::filesystem::path kScenes = std::filesystem::path(CDLAB_SOURCE_DIR) / "scenes";
+using cdlab_test::kScenes;
 
 World loadWorld(const std::string& file) { return makeWorld(loadScene(kScenes / file)); }
 

@@ -25,7 +25,7 @@ namespace engine {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr Real kPi = std::numbers::pi_v<Real>;
+using collision::kPi;
 
 TEST(Deformation, ClosedForms) {
     // Bend at full strength (t = 1 / (2 f)): the x axis becomes the circle of radius 1 / k

@@ -17,7 +17,7 @@ using collision::ConvexPolytope;
 using collision::Shape;
 using collision::TriangleMesh;
 
-constexpr Real kPi = std::numbers::pi_v<Real>;
+using collision::kPi;
 
 // A box mesh with 8 shared vertices and 12 outward CCW triangles.
 TriangleMesh boxMesh(const Vec3& h, const Vec3& offset = Vec3::Zero()) {

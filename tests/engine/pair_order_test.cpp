@@ -15,6 +15,7 @@
 #include "engine/scene.h"
 #include "engine/world.h"
 #include "scene_text.h"
+#include "shipped_scenes.h"
 
 namespace engine {
 namespace {
@@ -22,7 +23,7 @@ namespace {
 using collision::PairOrder;
 using collision::ProxyPair;
 
-const std::filesystem::path kScenes = std::filesystem::path(CDLAB_SOURCE_DIR) / "scenes";
+using cdlab_test::kScenes;
 
 std::vector<ProxyPair> sortedCopy(std::span<const ProxyPair> pairs) {
     std::vector<ProxyPair> out(pairs.begin(), pairs.end());

@@ -19,12 +19,13 @@
 #include "engine/world.h"
 #include "test_scale.h"
 #include "test_mass.h"
+#include "shipped_scenes.h"
 
 namespace engine {
 namespace {
 
 using collision::Shape;
-const std::filesystem::path kScenes = std::filesystem::path(CDLAB_SOURCE_DIR) / "scenes";
+using cdlab_test::kScenes;
 
 WorldSettings impulseWorld(Real half_size) {
     WorldSettings s;

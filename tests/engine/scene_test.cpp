@@ -22,7 +22,7 @@ namespace {
 
 using namespace scene_text;
 namespace fs = std::filesystem;
-constexpr Real kPi = std::numbers::pi_v<Real>;
+using collision::kPi;
 
 TEST(Scene, FullSceneRoundTrip) {
     const Scene s = parse(kFullScene);

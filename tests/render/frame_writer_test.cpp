@@ -25,9 +25,9 @@ constexpr int kW = 64;
 constexpr int kH = 48;
 
 // A fresh directory per test.
-class TempDir : public cdlab_test::TempDir {
+class FrameWriterDir : public cdlab_test::TempDir {
 public:
-    TempDir() : cdlab_test::TempDir("cdlab_frame_writer_") {}
+    FrameWriterDir() : cdlab_test::TempDir("cdlab_frame_writer_") {}
 };
 
 // A frame with a gradient (so PNG filters have work) and a frame-specific grey level.
@@ -57,7 +57,7 @@ std::string frameName(int k) { return "frame_" + std::to_string(k) + ".png"; }
 // Eight frames through three PNG workers and a queue of two: every PNG is the file writePng
 // writes for that frame, byte for byte, whatever worker wrote it.
 TEST(FrameWriter, PngsAreTheBytesWritePngWrites) {
-    TempDir dir;
+    FrameWriterDir dir;
     fs::create_directories(dir.path() / "serial");
     {
         render::FrameWriter writer(nullptr, 3, 2);
@@ -80,7 +80,7 @@ TEST(FrameWriter, PngsAreTheBytesWritePngWrites) {
 // A PNG path that is a directory cannot be written: the writer stops, and the error, naming the
 // file, comes out of a later submit() or of finish(), never silently.
 TEST(FrameWriter, AFailedPngStopsTheWriterWithTheFileNamed) {
-    TempDir dir;
+    FrameWriterDir dir;
     fs::create_directories(dir.path() / frameName(3));
     std::string message;
     try {
@@ -98,7 +98,7 @@ TEST(FrameWriter, AFailedPngStopsTheWriterWithTheFileNamed) {
 // (decoded by ffmpeg, each frame's mean blue within H.264's loss of the grey submitted).
 TEST(FrameWriter, VideoFramesComeInSubmissionOrder) {
     if (!render::ffmpegAvailable()) GTEST_SKIP() << "ffmpeg not on PATH";
-    TempDir dir;
+    FrameWriterDir dir;
     const fs::path video = dir.path() / "order.mp4";
     const std::vector<int> greys = {0, 5, 1, 4, 2, 3};
     const std::vector<long> repeats = {1, 2, 1, 3, 1, 1};
@@ -138,7 +138,7 @@ TEST(FrameWriter, VideoFramesComeInSubmissionOrder) {
 //
 //   writer --frames--> [pipe] --x  fake "ffmpeg" (exit 3)
 TEST(FrameWriter, AnEncoderThatDiesIsAnError) {
-    TempDir dir;
+    FrameWriterDir dir;
     const cdlab_test::DeadFfmpegOnPath dead_ffmpeg(dir.path());
     std::string message;
     try {

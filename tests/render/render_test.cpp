@@ -38,9 +38,9 @@ using engine::Vec3;
 using namespace cdlab_test;
 
 // A fresh directory per test.
-class TempDir : public cdlab_test::TempDir {
+class RenderDir : public cdlab_test::TempDir {
 public:
-    TempDir() : cdlab_test::TempDir("cdlab_render_") {}
+    RenderDir() : cdlab_test::TempDir("cdlab_render_") {}
 };
 
 render::Image renderThreeSpheres(render::Renderer& renderer,
@@ -406,7 +406,7 @@ TEST(HudLine, ShowsFrameTimeBroadPhaseAndCounts) {
 // ---------------------------------------------------------------------------------------------
 
 TEST(Png, WriteThenReadRoundTripsExactly) {
-    TempDir dir;
+    RenderDir dir;
     render::Renderer renderer(kWidth, kHeight);
     render::FrameOptions options = plainOptions();
     options.hud_text = "round trip";
@@ -422,7 +422,7 @@ TEST(Png, WriteThenReadRoundTripsExactly) {
 }
 
 TEST(Png, WritingIntoAMissingDirectoryThrows) {
-    TempDir dir;
+    RenderDir dir;
     render::Image image;
     image.width = 4;
     image.height = 2;
@@ -433,7 +433,7 @@ TEST(Png, WritingIntoAMissingDirectoryThrows) {
 }
 
 TEST(Png, WritingAMalformedImageThrows) {
-    TempDir dir;
+    RenderDir dir;
     render::Image image;
     image.width = 4;
     image.height = 2;
@@ -443,7 +443,7 @@ TEST(Png, WritingAMalformedImageThrows) {
 }
 
 TEST(Png, ReadingAMissingOrBrokenFileThrows) {
-    TempDir dir;
+    RenderDir dir;
     EXPECT_THROW(render::readPng(dir.path() / "missing.png"), render::RenderError);
     const fs::path junk = dir.path() / "junk.png";
     std::ofstream(junk) << "not a png";
@@ -454,7 +454,7 @@ TEST(Png, ReadingAMissingOrBrokenFileThrows) {
 
 TEST(Video, TenFramesMakeANonEmptyMp4) {
     if (!render::ffmpegAvailable()) GTEST_SKIP() << "ffmpeg not on PATH";
-    TempDir dir;
+    RenderDir dir;
     engine::World world = makeThreeSphereWorld();
     render::Renderer renderer(kWidth, kHeight);
     const fs::path file = dir.path() / "clip.mp4";
@@ -484,7 +484,7 @@ TEST(Video, TenFramesMakeANonEmptyMp4) {
 // with its signature; an odd size is fine for GIF (no chroma subsampling).
 TEST(Video, WebmAndGifAreWritten) {
     if (!render::ffmpegAvailable()) GTEST_SKIP() << "ffmpeg not on PATH";
-    TempDir dir;
+    RenderDir dir;
     render::Renderer renderer(kWidth, kHeight);
     const render::Image frame = renderThreeSpheres(renderer);
     for (const char* name : {"clip.webm", "clip.gif", "clip.mkv", "clip.mov"}) {
@@ -512,7 +512,7 @@ TEST(Video, WebmAndGifAreWritten) {
 }
 
 TEST(Video, UnsupportedContainerIsRefusedWithTheList) {
-    TempDir dir;
+    RenderDir dir;
     try {
         render::VideoWriter video(dir.path() / "clip.avi", kWidth, kHeight, 30);
         FAIL() << "no error for .avi";
@@ -529,7 +529,7 @@ TEST(Video, UnsupportedContainerIsRefusedWithTheList) {
 
 TEST(Video, AnUnfinishedVideoLeavesNoFile) {
     if (!render::ffmpegAvailable()) GTEST_SKIP() << "ffmpeg not on PATH";
-    TempDir dir;
+    RenderDir dir;
     const fs::path file = dir.path() / "abandoned.mp4";
     {
         render::VideoWriter video(file, kWidth, kHeight, 30);
@@ -542,7 +542,7 @@ TEST(Video, AnUnfinishedVideoLeavesNoFile) {
 
 TEST(Video, OddSizeOrWrongFrameSizeThrows) {
     if (!render::ffmpegAvailable()) GTEST_SKIP() << "ffmpeg not on PATH";
-    TempDir dir;
+    RenderDir dir;
     EXPECT_THROW(render::VideoWriter(dir.path() / "odd.mp4", 161, 120, 30), render::RenderError);
     EXPECT_THROW(render::VideoWriter(dir.path() / "fps.mp4", 160, 120, 0), render::RenderError);
     render::VideoWriter video(dir.path() / "size.mp4", 160, 120, 30);
@@ -568,7 +568,7 @@ void feedPastThePipeBuffer(render::VideoWriter& video) {
 //
 //   us --frames--> [pipe] --x  fake "ffmpeg" (exit 3)
 TEST(Video, AnFfmpegThatDiesBecomesARenderError) {
-    TempDir dir;
+    RenderDir dir;
     const cdlab_test::DeadFfmpegOnPath dead_ffmpeg(dir.path());
     bool threw = false;
     try {
@@ -596,7 +596,7 @@ TEST(Video, AStalledFfmpegIsAnErrorAfterTheTimeout) {
     const std::string saved = old_path ? old_path : "";
     for (const char* script : scripts) {
         SCOPED_TRACE(script);
-        TempDir dir;
+        RenderDir dir;
         const fs::path fake = dir.path() / "ffmpeg";
         std::ofstream(fake) << script;
         fs::permissions(fake, fs::perms::owner_all);
