@@ -23,16 +23,7 @@ int runCli(int argc, char** argv) {
     bench.require_subcommand(1);
     std::vector<app::Command> commands;
     for (AddCommand add : kBenchCommands) commands.push_back(add(bench));
-    try {
-        bench.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        const int code = bench.exit(e);
-        return code == 0 ? app::kExitOk : app::kExitBadInput;
-    }
-    for (const app::Command& command : commands) {
-        if (command.cli->parsed()) return command.run();
-    }
-    return app::kExitBadInput;
+    return app::parseAndRun(bench, commands, argc, argv);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace CLI {
 class App;
@@ -27,6 +28,10 @@ struct Command {
     CLI::App* cli = nullptr;   ///< the subcommand, to ask whether it was parsed
     std::function<int()> run;  ///< runs it with the parsed flags; returns the exit code
 };
+
+/// Parses the command line into `cli` and runs the one of `commands` that was chosen. Returns its
+/// exit code, 0 after --help, kExitBadInput after CLI11's message for bad flags or no command.
+int parseAndRun(CLI::App& cli, const std::vector<Command>& commands, int argc, char** argv);
 
 Command addRunCommand(CLI::App& cli);
 Command addCheckCommand(CLI::App& cli);

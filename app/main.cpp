@@ -62,17 +62,7 @@ int runCli(int argc, char** argv) {
     cli.add_subcommand("bench",
                        "performance benchmarks beside the peers: broadphase, ccd, convex, "
                        "narrowphase (cdlab-bench, built with the tests)");
-
-    try {
-        cli.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        const int code = cli.exit(e);
-        return code == 0 ? app::kExitOk : app::kExitBadInput;
-    }
-    for (const app::Command& command : commands) {
-        if (command.cli->parsed()) return command.run();
-    }
-    return app::kExitBadInput;
+    return app::parseAndRun(cli, commands, argc, argv);
 }
 
 }  // namespace
