@@ -1,5 +1,6 @@
 // app/bench_command.cpp -- the `cdlab bench` subcommands' flags: broadphase, ccd, convex,
-// narrowphase (lab/bench_*.h).
+// narrowphase (lab/bench_*.h). A dry run stops after the flags' checks (and, for ccd, checks
+// that the folders named exist).
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <memory>
@@ -11,6 +12,7 @@
 #include "bench_convex.h"
 #include "bench_narrowphase.h"
 #include "command.h"
+#include "exit_codes.h"
 
 namespace app {
 
@@ -76,7 +78,8 @@ Command addBenchBroadphaseCommand(CLI::App& bench) {
         ->capture_default_str();
     cmd->add_flag("--in-process", f->in_process,
                   "do not fork per method (no per-method peak memory)");
-    return {cmd, [f, cmd]() {
+    return {cmd, [f, cmd](RunMode mode) {
+                if (mode == RunMode::DryRun) return kExitOk;
                 if (!f->json.empty()) f->options.json = f->json;
                 f->options.isolate = !f->in_process;
                 if (f->options.workload == "boxpruning" && cmd->count("--sizes") == 0) {
@@ -111,7 +114,13 @@ Command addBenchCcdCommand(CLI::App& bench) {
                     "folder with tunnel_sphere.yaml and tunnel_bar.yaml (default scenes): "
                     "CCD cost per frame, off vs on");
     cmd->add_flag("--no-scenes", f->no_scenes, "skip the tunnelling scenes");
-    return {cmd, [f]() {
+    return {cmd, [f](RunMode mode) {
+                if (mode == RunMode::DryRun) {
+                    std::vector<NamedInput> inputs;
+                    for (const std::string& d : f->dirs) inputs.push_back({"dirs", d});
+                    if (!f->scenes.empty()) inputs.push_back({"--scenes", f->scenes});
+                    return checkInputsExist(inputs, std::cerr);
+                }
                 BenchCcdOptions& o = f->options;
                 for (const std::string& d : f->dirs) o.dirs.emplace_back(d);
                 if (!f->json.empty()) o.json = f->json;
@@ -141,7 +150,10 @@ Command addBenchConvexCommand(CLI::App& bench) {
                     "relative tolerance for counting answers as wrong")
         ->capture_default_str();
     cmd->add_option("--json", f->json, "also write the rows as JSON to FILE");
-    return {cmd, [f]() { return runBenchConvex(f->resolved(), std::cout, std::cerr); }};
+    return {cmd, [f](RunMode mode) {
+                if (mode == RunMode::DryRun) return kExitOk;
+                return runBenchConvex(f->resolved(), std::cout, std::cerr);
+            }};
 }
 
 Command addBenchNarrowphaseCommand(CLI::App& bench) {
@@ -170,7 +182,10 @@ Command addBenchNarrowphaseCommand(CLI::App& bench) {
                     "(FCL-NAME-median, FCL-NAME-center: FCL's other split rules)")
         ->delimiter(',');
     cmd->add_option("--json", f->json, "also write the table as JSON to FILE");
-    return {cmd, [f]() { return runBenchNarrowphase(f->resolved(), std::cout, std::cerr); }};
+    return {cmd, [f](RunMode mode) {
+                if (mode == RunMode::DryRun) return kExitOk;
+                return runBenchNarrowphase(f->resolved(), std::cout, std::cerr);
+            }};
 }
 
 }  // namespace app

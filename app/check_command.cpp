@@ -54,9 +54,10 @@ Command addCheckCommand(CLI::App& cli) {
     // The child process of -j N / --timeout: one scene, its report to a file.
     cmd->add_option("--worker-result", f->worker_result)->group("");
     cmd->add_option("--worker-index", f->worker_index)->group("");
-    return {cmd, [cmd, f]() {
+    return {cmd, [cmd, f](RunMode mode) {
                 if (cmd->count("--frames") > 0) f->check.frames = f->frames;
-                if (!f->worker_result.empty()) {
+                f->check.dry_run = mode == RunMode::DryRun;
+                if (!f->worker_result.empty() && !f->check.dry_run) {
                     if (f->scenes.size() != 1 || f->out.empty()) return kExitBadInput;
                     return runCheckWorker(f->scenes.front(), f->worker_index, f->check.frames,
                                           f->out, f->worker_result);

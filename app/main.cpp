@@ -1,7 +1,7 @@
 // app/main.cpp -- the cdlab command line: the table of commands (each registers its own flags,
 // command.h), parsing, and the last line of defence against anything a command throws.
-// `cdlab bench ...` is handed to cdlab-bench, the executable built beside this one
-// (bench_main.cpp).
+// `cdlab bench ...` and `cdlab --dry-run bench ...` are handed to cdlab-bench, the executable
+// built beside this one (bench_main.cpp), which parses them.
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -28,8 +28,9 @@ constexpr AddCommand kCommands[] = {app::addRunCommand, app::addCheckCommand, ap
 constexpr const char* kBenchExecutable = "cdlab-bench";
 
 // Replaces this process by cdlab-bench from cdlab's own folder, given the arguments that follow
-// `bench`; returns only when that cannot be done, with the exit code, after saying why.
-int runBench(int argc, char** argv) {
+// `bench` (`--dry-run` first when it came before `bench`); returns only when that cannot be
+// done, with the exit code, after saying why.
+int runBench(int argc, char** argv, bool dry_run) {
     std::error_code ec;
     const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
     const std::filesystem::path bench =
@@ -43,7 +44,9 @@ int runBench(int argc, char** argv) {
         return app::kExitFailure;
     }
     std::vector<char*> args{const_cast<char*>(bench.c_str())};
-    for (int i = 2; i < argc; ++i) args.push_back(argv[i]);
+    static char dry_run_flag[] = "--dry-run";
+    if (dry_run) args.push_back(dry_run_flag);
+    for (int i = dry_run ? 3 : 2; i < argc; ++i) args.push_back(argv[i]);
     args.push_back(nullptr);
     ::execv(bench.c_str(), args.data());
     std::cerr << "cdlab bench: cannot run " << bench.string() << ": " << std::strerror(errno)
@@ -73,7 +76,10 @@ int main(int argc, char** argv) {
     // The composition root hands render's occlusion queries to the `cullide` broad phase.
     render::installOcclusionQueryOracle();
     try {
-        if (argc > 1 && std::string(argv[1]) == "bench") return runBench(argc, argv);
+        if (argc > 1 && std::string(argv[1]) == "bench") return runBench(argc, argv, false);
+        if (argc > 2 && std::string(argv[1]) == "--dry-run" && std::string(argv[2]) == "bench") {
+            return runBench(argc, argv, true);
+        }
         return runCli(argc, argv);
     } catch (const std::bad_alloc&) {
         std::cerr << "cdlab: out of memory (the scene or request needs more than this machine "

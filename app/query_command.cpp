@@ -29,7 +29,10 @@ Command addQueryCommand(CLI::App& cli) {
                   "self-collision of mesh A: its intersecting non-adjacent triangle pairs "
                   "through each tree against itself and the brute-force loop (exit 1 if they "
                   "differ)");
-    return {cmd, [query]() { return runQuery(*query, std::cout, std::cerr); }};
+    return {cmd, [query](RunMode mode) {
+                query->dry_run = mode == RunMode::DryRun;
+                return runQuery(*query, std::cout, std::cerr);
+            }};
 }
 
 }  // namespace app

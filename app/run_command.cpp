@@ -96,8 +96,9 @@ Command addRunCommand(CLI::App& cli) {
         ->take_all();
     cmd->add_option("--trace", f->trace,
                     "write every frame's body poses and confirmed pairs to FILE (JSON lines)");
-    return {cmd, [cmd, f]() {
+    return {cmd, [cmd, f](RunMode mode) {
                 RunOptions& run = f->run;
+                run.dry_run = mode == RunMode::DryRun;
                 // A flag given with an empty value ("--broadphase ''") is an error, not "unset".
                 for (const char* name :
                      {"--out", "--video", "--broadphase", "--pair-order", "--stats", "--trace"}) {

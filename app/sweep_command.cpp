@@ -33,8 +33,9 @@ struct Flags {
 };
 
 // Which of the sweep's modes the flags ask for, and the flags that do not go with it.
-int runSweepCommand(const CLI::App& cmd, Flags& f) {
+int runSweepCommand(const CLI::App& cmd, Flags& f, RunMode mode) {
     SweepOptions& sweep = f.sweep;
+    sweep.dry_run = mode == RunMode::DryRun;
     if (!f.out.empty()) sweep.out_dir = f.out;
     if (cmd.count("--duration") > 0) sweep.duration = f.duration;
     sweep.report_timing = !f.no_timing;
@@ -58,6 +59,7 @@ int runSweepCommand(const CLI::App& cmd, Flags& f) {
             std::cerr << "sweep --job: --run K is required (the job's number)\n";
             return kExitBadInput;
         }
+        if (sweep.dry_run) return checkInputsExist({{"--job", f.job}}, std::cerr);
         return sweep::runSweepJob(f.job, f.run, std::cout, std::cerr);
     }
     if (cmd.count("--run") > 0) {
@@ -65,6 +67,7 @@ int runSweepCommand(const CLI::App& cmd, Flags& f) {
         return kExitBadInput;
     }
     if (!f.collect.empty()) {
+        if (sweep.dry_run) return checkInputsExist({{"--collect", f.collect}}, std::cerr);
         sweep::CollectOptions collect;
         collect.plan = f.collect;
         collect.out_dir = f.out;
@@ -156,7 +159,7 @@ Command addSweepCommand(CLI::App& cli) {
     cmd->add_option("--collect", f->collect,
                     "merge the results of the plan in DIR into results.csv, report.md and charts "
                     "(in DIR, or --out); names every missing or failed job and exits 1");
-    return {cmd, [cmd, f]() { return runSweepCommand(*cmd, *f); }};
+    return {cmd, [cmd, f](RunMode mode) { return runSweepCommand(*cmd, *f, mode); }};
 }
 
 }  // namespace app

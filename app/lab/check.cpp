@@ -186,6 +186,10 @@ int runCheck(const CheckOptions& options, std::ostream& out, std::ostream& err) 
         err << bad << "\n";
         return kExitBadInput;
     }
+    if (options.dry_run) {
+        std::vector<engine::Scene> scenes;
+        return loadAll(options.scenes, scenes, err) ? kExitOk : kExitBadInput;
+    }
     const auto start = std::chrono::steady_clock::now();
     const bool keep_going = options.keep_going || options.junit.has_value();
     const int jobs = options.jobs == 0 ? availableCores() : options.jobs;

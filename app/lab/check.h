@@ -37,6 +37,9 @@ struct CheckOptions {
     /// The cdlab executable a child process runs (`cdlab check --worker-result ...`):
     /// /proc/self/exe from the command line. Used only when grading in child processes.
     std::filesystem::path worker_exe;
+    /// Check the options and load every scene, then return (0, or 2 for bad input) before any
+    /// scene runs or any file or folder is written (`cdlab --dry-run check ...`).
+    bool dry_run = false;
 };
 
 /// How the grading of one scene ended.

@@ -331,6 +331,7 @@ int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err) 
             err << "warning: " << options.mesh_a.string() << ": "
                 << engine::describeImportChanges(imported.report) << "\n";
         }
+        if (options.dry_run) return 0;
         return runSelfQuery(names, options.mesh_a, imported.mesh, options.json,
                             options.unit_cost_tests, out, err);
     }
@@ -354,6 +355,7 @@ int runQuery(const QueryOptions& options, std::ostream& out, std::ostream& err) 
                 << engine::describeImportChanges(reports[i]) << "\n";
         }
     }
+    if (options.dry_run) return 0;
 
     std::vector<Row> rows;
     for (const std::string_view name : names) {

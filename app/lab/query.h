@@ -23,6 +23,9 @@ struct QueryOptions {
     /// Volume tests and refitted nodes each unit cost (Cv, Cu) is timed over, triangle tests (Cp)
     /// half as many: the measurement's size, not the answer's (bvh_unit_costs.h).
     std::int64_t unit_cost_tests = 200000;
+    /// Check the flags (--bv, --pose-b, --self) and import the meshes, then return 0 before any
+    /// tree is built or query run (`cdlab --dry-run query ...`).
+    bool dry_run = false;
 };
 
 /// Parses "x,y,z,qw,qx,qy,qz" into a pose (quaternion normalised). Returns nothing and sets

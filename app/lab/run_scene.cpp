@@ -395,6 +395,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
             << "' (supported: " << render::supportedVideoExtensions() << ")\n";
         return kExitBadInput;
     }
+    if (options.dry_run) return kExitOk;
     if (want_video && !render::ffmpegAvailable()) {
         err << "ffmpeg not found on PATH: install it (apt-get install ffmpeg) or pass --no-video\n";
         return kExitFailure;

@@ -42,6 +42,9 @@ struct RunOptions {
     /// Write index.html beside the frames (run_html.h): the video, the timeline of pairs and
     /// stage times with a cursor following the video, the pause pictures with their bodies.
     bool html = false;
+    /// Check everything above (scene loaded with its overrides, flags, video container) and
+    /// return 0 before anything is written or run (`cdlab --dry-run run ...`).
+    bool dry_run = false;
 };
 
 /// Exit codes: 0 success, 1 output or runtime failure, 2 bad input (scene, flags),

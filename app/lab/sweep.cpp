@@ -253,6 +253,7 @@ int runSweep(const SweepOptions& options, std::ostream& out, std::ostream& err) 
     }
     const std::optional<sweep::SweepSetup> setup = sweep::setUpSweep(options, err);
     if (!setup) return kExitBadInput;
+    if (options.dry_run) return kExitOk;
     if (options.jobs > 1) return sweep::runPlannedLocally(options, *setup, out, err);
     const fs::path& out_dir = setup->out_dir;
     try {

@@ -54,6 +54,9 @@ struct SweepOptions {
     bool timed_concurrently = false;
     /// The runs were the jobs of a plan, each timed in a process of its own (set by collect).
     bool planned = false;
+    /// Check the options and load every run's scene (runSweep, planSweep), then return 0 before
+    /// anything is run or written (`cdlab --dry-run sweep ...`).
+    bool dry_run = false;
 };
 
 /// A run of a planned sweep that left no usable result: named on stderr and in report.md,

@@ -237,6 +237,7 @@ int planSweep(const SweepOptions& options, const fs::path& dir, bool slurm, cons
     }
     const std::optional<SweepSetup> setup = setUpSweep(options, err);
     if (!setup) return kExitBadInput;
+    if (options.dry_run) return kExitOk;
     const SweepPlan plan = makePlan(options, *setup, binary, dir);
     try {
         writePlan(plan, slurm);
