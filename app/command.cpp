@@ -15,7 +15,8 @@ namespace {
 // Holds what a stream is sent until restored: a dry run speaks only when a check fails.
 class HeldStream {
 public:
-    explicit HeldStream(std::ostream& stream) : stream_(stream), saved_(stream.rdbuf(held_.rdbuf())) {}
+    explicit HeldStream(std::ostream& stream)
+        : stream_(stream), saved_(stream.rdbuf(held_.rdbuf())) {}
     ~HeldStream() { stream_.rdbuf(saved_); }
     HeldStream(const HeldStream&) = delete;
     HeldStream& operator=(const HeldStream&) = delete;

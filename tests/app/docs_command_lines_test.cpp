@@ -203,8 +203,8 @@ TEST(DocsCommandLines, EveryDocumentedLineParses) {
     const std::vector<DocLine> lines = docAllLines();
     // The docs show every subcommand at least once in a form that can be checked, so a broken
     // extraction (nothing found) fails here rather than passing on nothing.
-    for (const char* sub : {"run ", "check ", "sweep ", "query ", "bench broadphase ",
-                                  "bench ccd ", "bench narrowphase ", "bench convex "}) {
+    for (const char* sub : {"run ", "check ", "sweep ", "query ", "bench broadphase ", "bench ccd ",
+                            "bench narrowphase ", "bench convex "}) {
         EXPECT_TRUE(std::any_of(lines.begin(), lines.end(),
                                 [&](const DocLine& d) { return d.args.rfind(sub, 0) == 0; }))
             << "no checkable `cdlab " << sub << "...` line in README.md or docs/*.md";
@@ -214,8 +214,8 @@ TEST(DocsCommandLines, EveryDocumentedLineParses) {
     fs::remove_all(work);
 }
 
-// A checker that cannot fail checks nothing: a line with a misspelt flag, a value of the wrong type,
-// a scene that does not exist or a bench flag that does not exist must each be reported.
+// A checker that cannot fail checks nothing: a line with a misspelt flag, a value of the wrong
+// type, a scene that does not exist or a bench flag that does not exist must each be reported.
 TEST(DocsCommandLines, WrongLinesAreReported) {
     const fs::path work = tempDir("cdlab_docs_", "wrong");
     const std::string text =
@@ -336,12 +336,15 @@ TEST(CliDryRun, GoodLinesRunNothingAndWriteNothing) {
 TEST(CliDryRun, BadLinesFailAsARealRunFails) {
     const fs::path work = tempDir("cdlab_dry_", "bad");
     const std::string tiny = cdlab_test::kTiny;
-    const std::vector<std::string> bad_lines = {
-        "run " + tiny + " --frmaes 2",          "run " + tiny + " --frames abc",
-        "run " + tiny + " --broadphase nope",   "run " + tiny + " --set world.frames=abc",
-        "check tests/data/no_such.yaml",        "query assets/torus.obj --self --bv nope",
-        "sweep " + tiny + " --vary nokey",      "bench broadphase --workload nope",
-        "bench ccd --reps 0"};
+    const std::vector<std::string> bad_lines = {"run " + tiny + " --frmaes 2",
+                                                "run " + tiny + " --frames abc",
+                                                "run " + tiny + " --broadphase nope",
+                                                "run " + tiny + " --set world.frames=abc",
+                                                "check tests/data/no_such.yaml",
+                                                "query assets/torus.obj --self --bv nope",
+                                                "sweep " + tiny + " --vary nokey",
+                                                "bench broadphase --workload nope",
+                                                "bench ccd --reps 0"};
     for (const std::string& args : bad_lines) {
         const cdlab_test::CliResult dry = runCdlab("--dry-run " + args, work);
         const cdlab_test::CliResult real = runCdlab(args, work);
@@ -351,9 +354,8 @@ TEST(CliDryRun, BadLinesFailAsARealRunFails) {
         EXPECT_NE(dry.err, "") << args;
     }
     // What a dry run checks beyond the parser: named inputs that a real run reads later.
-    for (const std::string& args :
-         {std::string("bench ccd tests/data/no_such_folder"),
-          std::string("sweep --collect out/no_such_plan")}) {
+    for (const std::string& args : {std::string("bench ccd tests/data/no_such_folder"),
+                                    std::string("sweep --collect out/no_such_plan")}) {
         const cdlab_test::CliResult dry = runCdlab("--dry-run " + args, work);
         EXPECT_EQ(dry.exit_code, 2) << args;
         EXPECT_NE(dry.err.find("no such file or folder"), std::string::npos) << dry.err;
