@@ -2,6 +2,8 @@
 // Pairs come out sorted because the loops run over (a, b) in lexicographic order.
 #include "broadphase/brute.h"
 
+#include <type_traits>
+
 namespace collision {
 
 std::string_view BruteForceBroadPhase::name() const {
@@ -15,13 +17,16 @@ std::string_view BruteForceBroadPhase::name() const {
 
 namespace {
 
-// Every pair of `volumes` (the present proxies' volumes, in increasing id order `ids`) tested
-// with V::overlaps, in lexicographic order. The volumes are packed first so the n^2 loop reads
+// Every pair of the present proxies `ids` (increasing) tested with V::overlaps on the volumes
+// `volume_of` gives, in lexicographic order. The volumes are packed first so the n^2 loop reads
 // contiguous memory rather than the table's sparse arrays; the tests and their order are those
 // of a loop over the table.
-template <class V>
-void allPairs(const std::vector<ProxyId>& ids, const std::vector<V>& volumes,
-              std::vector<ProxyPair>& pairs) {
+template <class VolumeOf>
+void allPairs(const std::vector<ProxyId>& ids, VolumeOf volume_of, std::vector<ProxyPair>& pairs) {
+    using V = std::decay_t<decltype(volume_of(ProxyId{}))>;
+    std::vector<V> volumes;
+    volumes.reserve(ids.size());
+    for (ProxyId id : ids) volumes.push_back(volume_of(id));
     const std::size_t n = volumes.size();
     for (std::size_t i = 0; i < n; ++i) {
         const V& a = volumes[i];
@@ -29,15 +34,6 @@ void allPairs(const std::vector<ProxyId>& ids, const std::vector<V>& volumes,
             if (a.overlaps(volumes[j])) pairs.push_back(ProxyPair{ids[i], ids[j]});
         }
     }
-}
-
-template <class V, class Get>
-void packAndTest(const ProxyTable& table, Get get, std::vector<ProxyId>& ids,
-                 std::vector<ProxyPair>& pairs) {
-    std::vector<V> volumes;
-    volumes.reserve(ids.size());
-    for (ProxyId id : ids) volumes.push_back(get(table, id));
-    allPairs(ids, volumes, pairs);
 }
 
 }  // namespace
@@ -52,16 +48,13 @@ void BruteForceBroadPhase::findPairs(std::vector<ProxyPair>& pairs,
     }
     switch (volume_) {
         case Volume::Aabb:
-            packAndTest<Aabb>(
-                table_, [](const ProxyTable& t, ProxyId id) { return t.aabb(id); }, ids, pairs);
+            allPairs(ids, [this](ProxyId id) { return table_.aabb(id); }, pairs);
             break;
         case Volume::Sphere:
-            packAndTest<BoundingSphere>(
-                table_, [](const ProxyTable& t, ProxyId id) { return t.sphere(id); }, ids, pairs);
+            allPairs(ids, [this](ProxyId id) { return table_.sphere(id); }, pairs);
             break;
         case Volume::Obb:
-            packAndTest<Obb>(
-                table_, [](const ProxyTable& t, ProxyId id) { return t.obb(id); }, ids, pairs);
+            allPairs(ids, [this](ProxyId id) { return table_.obb(id); }, pairs);
             break;
     }
     const auto m = static_cast<std::int64_t>(ids.size());
