@@ -4,7 +4,8 @@
 // world_deform.cpp).
 // Bodies are processed in id order and pairs come out of the broad phase in an order fixed by the
 // calls made to it (sorted by default; settings().pair_order), the contact solver and the CCD
-// stage take their pairs from sweeps of their own, sorted (the CCD stage sorts its events by
+// stage take theirs from instances of the same broad phase over their own boxes, sorted
+// (box_pair_finder.h; the CCD stage sorts its events by
 // (t, a, b)), so every step does the same floating-point operations in the same order: runs are
 // bit-identical, and the bodies' motion is the same in either pair order.
 #include "engine/world.h"
@@ -19,6 +20,7 @@
 #include "collision/bvh/bvh.h"
 #include "collision/ccd/ccd.h"
 #include "collision/narrowphase/narrow_phase.h"
+#include "box_pair_finder.h"
 #include "contact_solver.h"
 #include "stage_clock.h"
 
@@ -174,8 +176,12 @@ std::string_view bodyStateName(BodyState state) {
 World::World(WorldSettings settings)
     : settings_(std::move(settings)),
       broad_phase_(makeBroadPhase(settings_.broad_phase, settings_.pair_order)) {
+    if (settings_.ccd != CcdMethod::Off) {
+        ccd_finder_ = std::make_unique<BoxPairFinder>(settings_.broad_phase);
+    }
     if (settings_.response == Response::Impulse) {
         solver_ = std::make_unique<ContactSolver>();
+        response_finder_ = std::make_unique<BoxPairFinder>(settings_.broad_phase);
         // The six faces of the bounds, solid outside: -x, +x, -y, +y, -z, +z.
         for (int k = 0; k < 3; ++k) {
             for (const Real side : {Real(-1), Real(1)}) {
@@ -216,6 +222,8 @@ void World::setBroadPhase(const std::string& name) {
     broad_phase_ = makeBroadPhase(name, settings_.pair_order);
     settings_.broad_phase = name;
     proxies_inserted_ = false;
+    if (ccd_finder_) ccd_finder_->reset(name);
+    if (response_finder_) response_finder_->reset(name);
 }
 
 void World::integrate(Real dt, const Vec3& gravity) {
@@ -341,35 +349,21 @@ void World::integrateRk4(Real dt, const Vec3& gravity) {
 }
 
 void World::findResponsePairs(Real margin_fraction) {
-    // Sort-and-sweep on x over the AABBs of the last detection grown by margin_fraction times
-    // each body's bounding radius (the exact AABBs of resting bodies barely touch, and lose
-    // their pair the moment the solver lifts one by a hair). Output sorted, a < b.
+    // The AABBs of the last detection grown by margin_fraction times each body's bounding
+    // radius (the exact AABBs of resting bodies barely touch, and lose their pair the moment the
+    // solver lifts one by a hair), paired by the scene's broad phase. Output sorted, a < b.
     const std::size_t n = bodies_.size();
-    sweep_order_.clear();
     grown_.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
         const Body& b = bodies_[i];
         const Real r = b.local_bounds.sphere.center.norm() + b.local_bounds.sphere.radius;
         grown_[i].min = volumes_[i].aabb.min - Vec3::Constant(margin_fraction * r);
         grown_[i].max = volumes_[i].aabb.max + Vec3::Constant(margin_fraction * r);
-        sweep_order_.push_back(static_cast<BodyId>(i));
     }
-    std::sort(sweep_order_.begin(), sweep_order_.end(), [this](BodyId x, BodyId y) {
-        const Real ax = grown_[x].min.x(), ay = grown_[y].min.x();
-        return ax < ay || (ax == ay && x < y);
-    });
-    response_pairs_.clear();
-    for (std::size_t k = 0; k < n; ++k) {
-        const BodyId i = sweep_order_[k];
-        for (std::size_t m = k + 1; m < n; ++m) {
-            const BodyId j = sweep_order_[m];
-            if (grown_[j].min.x() > grown_[i].max.x()) break;
-            if (bodies_[i].is_static && bodies_[j].is_static) continue;
-            if (!grown_[i].overlaps(grown_[j])) continue;
-            response_pairs_.push_back({std::min(i, j), std::max(i, j)});
-        }
-    }
-    std::sort(response_pairs_.begin(), response_pairs_.end());
+    response_finder_->find(
+        grown_,
+        [this](BodyId i, BodyId j) { return !(bodies_[i].is_static && bodies_[j].is_static); },
+        response_pairs_);
     // Bodies whose grown AABB reaches a face of the bounds, by wall then body.
     wall_candidates_.clear();
     for (std::uint32_t w = 0; w < walls_.size(); ++w) {
@@ -540,6 +534,7 @@ void World::step() {
 
     if (ccd) {
         t = Clock::now();
+        checkFiniteState();  // the swept bounds go to a broad phase: finite only
         resolveContinuous();
         stats_.ccd_s = secondsSince(t);
     }

@@ -6,6 +6,7 @@
 
 #include "collision/bvh/bvh.h"
 #include "collision/ccd/ccd.h"
+#include "box_pair_finder.h"
 #include "engine/world.h"
 #include "toi_query.h"
 
@@ -42,7 +43,8 @@ Vec3 rotationBetween(const Quat& q0, const Quat& q1) {
 // so a pose stopped mid-step keeps the energy), for the other integrators the constant-axis chord
 // from start to end.
 // 1. Candidate pairs: swept bounds (AABB of the centre's segment grown by the bounding
-//    radius about the centre) overlap, at least one body moves. Sweep on x, pairs sorted.
+//    radius about the centre) overlap, at least one body moves. Found by an instance of the
+//    scene's broad phase over the swept bounds (box_pair_finder.h), pairs sorted.
 // 2. timeOfImpact per pair (never later than first contact, target gap kept). A pair that
 //    starts within the target gap is asked again with half its present gap as the target.
 //    A pair already overlapped at t = 0 is left to the discrete pipeline, and so is a pair
@@ -67,18 +69,22 @@ Vec3 rotationBetween(const Quat& q0, const Quat& q1) {
 // pose (the discrete pipeline still sees any overlap that results).
 void World::resolveContinuous() {
     buildSweeps();
-    findSweptPairs();
+    ccd_finder_->find(
+        swept_boxes_,
+        [this](BodyId i, BodyId j) {
+            return (swept_[i].moving || swept_[j].moving) && pairAllowed(i, j);
+        },
+        ccd_pairs_);
     queryTimesOfImpact();
     stopAtImpacts();
     applyImpactImpulses();
 }
 
 // Every body's sweep from its pose at the start of the step to its integrated pose, and its
-// swept bounds; `sweep_order_` sorted by the bounds' lower x.
+// swept bounds (also in `swept_boxes_`, for the pair finder).
 void World::buildSweeps() {
     const std::size_t n = bodies_.size();
     swept_.resize(n);
-    sweep_order_.clear();
     for (std::size_t i = 0; i < n; ++i) {
         const Body& b = bodies_[i];
         SweptBody& s = swept_[i];
@@ -100,7 +106,6 @@ void World::buildSweeps() {
             !b.is_static && (s.sweep.translation.squaredNorm() > 0 ||
                              s.sweep.rotation.squaredNorm() > 0 || s.sweep.spin.squaredNorm() > 0);
         if (b.kinematic) sweepLink(i, s);
-        sweep_order_.push_back(static_cast<BodyId>(i));
     }
     // A deforming body's surface also moves in its own frame, up to deform_speed over the step:
     // its swept bounds grow by that much.
@@ -110,28 +115,8 @@ void World::buildSweeps() {
         s.box.min -= Vec3::Constant(s.deform_speed);
         s.box.max += Vec3::Constant(s.deform_speed);
     }
-    std::sort(sweep_order_.begin(), sweep_order_.end(), [this](BodyId x, BodyId y) {
-        const Real ax = swept_[x].box.min.x(), ay = swept_[y].box.min.x();
-        return ax < ay || (ax == ay && x < y);
-    });
-}
-
-// Candidate pairs: swept bounds overlap and at least one body moves (sweep on x), sorted.
-void World::findSweptPairs() {
-    const std::size_t n = bodies_.size();
-    ccd_pairs_.clear();
-    for (std::size_t k = 0; k < n; ++k) {
-        const BodyId i = sweep_order_[k];
-        for (std::size_t m = k + 1; m < n; ++m) {
-            const BodyId j = sweep_order_[m];
-            if (swept_[j].box.min.x() > swept_[i].box.max.x()) break;
-            if (!swept_[i].moving && !swept_[j].moving) continue;
-            if (!swept_[i].box.overlaps(swept_[j].box)) continue;
-            if (!pairAllowed(i, j)) continue;
-            ccd_pairs_.push_back({std::min(i, j), std::max(i, j)});
-        }
-    }
-    std::sort(ccd_pairs_.begin(), ccd_pairs_.end());
+    swept_boxes_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) swept_boxes_[i] = swept_[i].box;
 }
 
 ToiEvent World::impactEvent(const collision::ProxyPair& pair, const collision::ToiOutput& out,

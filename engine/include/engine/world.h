@@ -104,8 +104,8 @@ struct WorldSettings {
     /// The order flaggedPairs() and collidingPairs() come in (scene key `pair_order`): sorted by
     /// (a, b) (default), or the broad phase's own order (collision::PairOrder::Found), which
     /// saves hgrid its final sort. Either way the same pairs, and the same list for the same run.
-    /// The motion does not depend on it: the contact solver and the CCD stage find their pairs
-    /// by sweeps of their own and sort them.
+    /// The motion does not depend on it: the contact solver and the CCD stage get their pairs
+    /// from instances of the same broad phase over boxes of their own, sorted.
     collision::PairOrder pair_order = collision::PairOrder::Sorted;
     /// Node volume of mesh bodies' hierarchies (collision::bvhVolumeNames()); scene key
     /// `world.mesh_bvh`. Read when mesh bodies are built (scene loading), not by the World.
@@ -166,6 +166,7 @@ struct StepStats {
     std::int64_t rebuilds = 0;
 };
 
+class BoxPairFinder;
 class ContactSolver;
 struct Wall;
 struct WallCandidate;
@@ -286,7 +287,6 @@ private:
     // The continuous stage (world_continuous.cpp), in its order.
     void resolveContinuous();
     void buildSweeps();
-    void findSweptPairs();
     void queryTimesOfImpact();
     void stopAtImpacts();
     void applyImpactImpulses();
@@ -347,7 +347,8 @@ private:
     std::vector<Vec3> step_rotation_;  ///< semi-implicit Euler's rotation of the step (ccd on)
     std::vector<Vec3> step_spin_;
     std::vector<SweptBody> swept_;
-    std::vector<BodyId> sweep_order_;
+    std::vector<collision::Aabb> swept_boxes_;  ///< swept_[i].box, contiguous for ccd_finder_
+    std::unique_ptr<BoxPairFinder> ccd_finder_;  ///< only with ccd on
     std::vector<collision::ProxyPair> ccd_pairs_;
     std::vector<ToiEvent> toi_events_;
     std::vector<std::vector<collision::TrianglePair>> self_pairs_;  ///< per body
@@ -366,6 +367,7 @@ private:
     void deformBody(DeformingMesh& d);       // vertices at time_, refit or rebuild, hull, bounds
     std::unique_ptr<ContactSolver> solver_;  ///< only with response: impulse
     std::vector<collision::Aabb> grown_;
+    std::unique_ptr<BoxPairFinder> response_finder_;  ///< only with response: impulse
     std::vector<collision::ProxyPair> response_pairs_;
     std::vector<Wall> walls_;  ///< the faces of the bounds, for the solver (response: impulse)
     std::vector<WallCandidate> wall_candidates_;
