@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "collision/broadphase/visibility_oracle.h"
+#include "collision/visibility_oracle.h"
 #include "engine/scene.h"
 
 namespace {

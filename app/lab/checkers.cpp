@@ -16,8 +16,9 @@
 #include "collision/broadphase/broad_phase.h"
 #include "output_files.h"
 #include "pause_dump.h"
+#include "engine/world_draw.h"
 #include "render/image.h"
-#include "render/volume_states.h"
+#include "engine/volume_overlaps.h"
 
 namespace app {
 
@@ -65,7 +66,7 @@ bool hasPair(std::span<const collision::ProxyPair> pairs, collision::PairOrder o
 std::array<long, 3> countStateColors(const render::Image& image) {
     std::array<std::array<int, 3>, 3> rgb{};
     for (int s = 0; s < 3; ++s) {
-        const collision::Color c = render::stateColor(static_cast<engine::BodyState>(s));
+        const collision::Color c = engine::stateColor(static_cast<engine::BodyState>(s));
         rgb[s] = {int(std::lround(c.r * 255)), int(std::lround(c.g * 255)),
                   int(std::lround(c.b * 255))};
     }
@@ -385,7 +386,7 @@ public:
             if (expect_[k].frame != frame) continue;
             // No HUD: its legend shows every colour whatever the state.
             render::FrameOptions options;
-            options.draw = render::drawSettingsFor(run.scene.draw, run.world);  // as cdlab run
+            options.draw = engine::drawSettingsFor(run.scene.draw, run.world);  // as cdlab run
             options.draw.hud = false;
             if (!expect_[k].volume.empty()) engine::drawOnlyVolume(options.draw, expect_[k].volume);
             counts_[k] =

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "collision/bvh/bvh.h"
-#include "render/volume_states.h"
+#include "engine/volume_overlaps.h"
 
 namespace app {
 
@@ -45,25 +45,25 @@ std::string pauseDumpJson(const engine::World& world, int frame, const engine::D
     doc["time"] = world.time();
     doc["broadphase"] = std::string(world.broadPhase().name());
     doc["broadphase_volume"] = std::string(
-        render::volumeKindName(render::broadPhaseVolume(world).value_or(render::VolumeKind::Aabb)));
+        engine::volumeKindName(engine::broadPhaseVolume(world).value_or(engine::VolumeKind::Aabb)));
     // Each kind of volume by its own overlap test, as the pause picture colours them.
-    std::array<render::VolumeOverlaps, 3> overlaps;
-    for (const render::VolumeKind kind : render::kVolumeKinds) {
-        overlaps[int(kind)] = render::volumeOverlaps(world, kind);
+    std::array<engine::VolumeOverlaps, 3> overlaps;
+    for (const engine::VolumeKind kind : engine::kVolumeKinds) {
+        overlaps[int(kind)] = engine::volumeOverlaps(world, kind);
     }
     // Each k-DOP drawn, by the slab test that colours it.
     struct KdopKind {
         int k = 6;
         std::string name;
         std::vector<collision::WorldKdop> kdops;
-        render::VolumeOverlaps overlaps;
+        engine::VolumeOverlaps overlaps;
     };
     std::vector<KdopKind> kdop_kinds;
     for (std::size_t i = 0; i < engine::kDrawnKdops.size(); ++i) {
         if (!draw.kdop[i]) continue;
         const int k = engine::kDrawnKdops[i];
-        KdopKind kind{k, "kdop" + std::to_string(k), render::worldKdops(world, k), {}};
-        kind.overlaps = render::kdopOverlaps(world, kind.kdops);
+        KdopKind kind{k, "kdop" + std::to_string(k), engine::worldKdops(world, k), {}};
+        kind.overlaps = engine::kdopOverlaps(world, kind.kdops);
         kdop_kinds.push_back(std::move(kind));
     }
     nlohmann::ordered_json bodies = nlohmann::ordered_json::array();
@@ -91,9 +91,9 @@ std::string pauseDumpJson(const engine::World& world, int frame, const engine::D
             {"state", std::string(engine::bodyStateName(world.states()[i]))},
         });
         nlohmann::ordered_json volume_states;
-        for (const render::VolumeKind kind : render::kVolumeKinds) {
+        for (const engine::VolumeKind kind : engine::kVolumeKinds) {
             const auto& states = overlaps[int(kind)].states;
-            volume_states[std::string(render::volumeKindName(kind))] = std::string(
+            volume_states[std::string(engine::volumeKindName(kind))] = std::string(
                 volumeStateName(i < states.size() ? states[i] : engine::BodyState::Apart));
         }
         for (const KdopKind& kind : kdop_kinds) {
@@ -127,8 +127,8 @@ std::string pauseDumpJson(const engine::World& world, int frame, const engine::D
     doc["flagged_pairs"] = pairs(world.flaggedPairs());
     doc["colliding_pairs"] = pairs(world.collidingPairs());
     nlohmann::ordered_json overlapping = nlohmann::ordered_json::object();
-    for (const render::VolumeKind kind : render::kVolumeKinds) {
-        overlapping[std::string(render::volumeKindName(kind))] = pairs(overlaps[int(kind)].pairs);
+    for (const engine::VolumeKind kind : engine::kVolumeKinds) {
+        overlapping[std::string(engine::volumeKindName(kind))] = pairs(overlaps[int(kind)].pairs);
     }
     for (const KdopKind& kind : kdop_kinds) overlapping[kind.name] = pairs(kind.overlaps.pairs);
     doc["overlapping_pairs"] = std::move(overlapping);

@@ -33,7 +33,7 @@
 #include "render/image.h"
 #include "render/output_file.h"
 #include "render/renderer.h"
-#include "render/volume_states.h"
+#include "engine/volume_overlaps.h"
 #include "run_html.h"
 
 namespace app {
@@ -414,7 +414,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         StageTimes stage;
         const double run_start = wallSeconds();
         render::FrameOptions frame_options;
-        frame_options.draw = render::drawSettingsFor(scene.draw, world);
+        frame_options.draw = engine::drawSettingsFor(scene.draw, world);
         frame_options.draw_structure = scene.draw.structure || options.draw_structure;
         render::FrameOptions pause_options = frame_options;
         pause_options.draw.sphere = pause_options.draw.aabb = pause_options.draw.obb = true;

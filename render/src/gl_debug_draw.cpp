@@ -17,6 +17,46 @@ int segmentsFor(const CameraFrame& cam, const Vec3& center, Real radius, Real px
     return std::clamp((n + 3) / 4 * 4, lo, hi);
 }
 
+void FrameLines::clear() {
+    frame.clear();
+    structure.clear();
+    volumes.clear();
+    outlines.clear();
+    hierarchy.clear();
+    contacts.clear();
+    structure_legend.clear();
+}
+
+void GlDebugDraw::setLayer(engine::DrawLayer layer) {
+    outlines_ = nullptr;
+    legend_ = nullptr;
+    switch (layer) {
+        case engine::DrawLayer::Frame:
+            target_ = &lines_.frame;
+            break;
+        case engine::DrawLayer::Structure:
+            target_ = &lines_.structure;
+            legend_ = &lines_.structure_legend;
+            break;
+        case engine::DrawLayer::Volumes:
+            target_ = &lines_.volumes;
+            outlines_ = &lines_.outlines;
+            break;
+        case engine::DrawLayer::Hierarchy:
+            target_ = &lines_.hierarchy;
+            break;
+        case engine::DrawLayer::Contacts:
+            target_ = &lines_.contacts;
+            break;
+    }
+}
+
+bool GlDebugDraw::mayShow(const Vec3& center, Real radius) {
+    if (!cull_ || cam_.mayShow(center, radius)) return true;
+    ++culled_;
+    return false;
+}
+
 // Three great circles, as the base does, but with as many segments as the on-screen size
 // needs (round at 4K, cheap for a thousand small spheres), plus the silhouette: the circle
 // where the view cone touches the sphere. The great circles lie a little behind the rim as

@@ -1,10 +1,12 @@
 // render/src/gl_debug_draw.h -- the vertex buffers a frame fills (eye-relative floats, in a fixed
-// order every frame) and the collision::DebugDraw that records lines into them: what the broad
-// phases, the World and the volume overlays draw through. Private to render.
+// order every frame) and the engine::WorldDraw that records lines into them, one buffer per
+// layer: what engine::drawWorld (and through it the broad phases and the World) draws through.
+// Private to render.
 #pragma once
 
 #include <GL/gl.h>
 
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -12,6 +14,7 @@
 #include "camera.h"
 #include "collision/debug_draw.h"
 #include "collision/volumes/bounding_volumes.h"
+#include "engine/world_draw.h"
 
 namespace render {
 
@@ -65,16 +68,30 @@ struct LegendEntry {
 int segmentsFor(const CameraFrame& cam, const Vec3& center, Real radius, Real px_per_segment,
                 int lo, int hi);
 
-// The DebugDraw that the broad phase and the volume overlays draw through: it records lines.
-class GlDebugDraw final : public collision::DebugDraw {
-public:
-    GlDebugDraw(const CameraFrame& cam, LineBuffer& target) : cam_(cam), target_(&target) {}
+/// The lines of one frame, a buffer per engine::DrawLayer (the volumes' sphere silhouettes in
+/// their own, drawn thinner), and the legend entries the broad phase's structure gave.
+struct FrameLines {
+    LineBuffer frame;      ///< world bounds and floor grid
+    LineBuffer structure;  ///< the broad phase's own drawing
+    LineBuffer volumes;    ///< bounding volumes, poses at impact, skeletons
+    LineBuffer outlines;   ///< bounding spheres' silhouettes
+    LineBuffer hierarchy;  ///< mesh hierarchy levels (draw.bvh_depth)
+    LineBuffer contacts;   ///< contact witnesses and normals (draw.contacts)
+    std::vector<LegendEntry> structure_legend;
 
-    /// Where lines go from now on; sphere silhouettes go to `outlines` (thinner lines) when given.
-    void setTarget(LineBuffer& target, LineBuffer* outlines = nullptr) {
-        target_ = &target;
-        outlines_ = outlines;
-    }
+    void clear();
+};
+
+// Records what engine::drawWorld draws into a frame's buffers, eye-relative.
+class GlDebugDraw final : public engine::WorldDraw {
+public:
+    /// With `cull`, volumes wholly outside the view's side planes are refused (mayShow) and
+    /// counted in `culled`.
+    GlDebugDraw(const CameraFrame& cam, FrameLines& lines, bool cull, std::int64_t& culled)
+        : cam_(cam), lines_(lines), target_(&lines.frame), cull_(cull), culled_(culled) {}
+
+    void setLayer(engine::DrawLayer layer) override;
+    bool mayShow(const Vec3& center, Real radius) override;
 
     void drawLine(const Vec3& a, const Vec3& b, const Color& color) override {
         target_->add(cam_.toEye(a), cam_.toEye(b), color);
@@ -83,9 +100,8 @@ public:
     /// Three great circles and the silhouette (gl_debug_draw.cpp).
     void drawSphere(const collision::BoundingSphere& sphere, const Color& color) override;
 
-    /// Where legend entries go from now on (nullptr: dropped).
-    void setLegend(std::vector<LegendEntry>* legend) { legend_ = legend; }
-    /// Appends the entry unless the same (label, colour) is already listed.
+    /// Appends the entry to the structure's legend unless the same (label, colour) is already
+    /// listed; dropped outside the Structure layer.
     void legend(std::string_view label, const Color& color) override;
 
 private:
@@ -93,9 +109,12 @@ private:
     void circle(const Vec3& center, const Vec3& u, const Vec3& v, int n, const Color& color);
 
     const CameraFrame& cam_;
+    FrameLines& lines_;
     LineBuffer* target_;
     LineBuffer* outlines_ = nullptr;
     std::vector<LegendEntry>* legend_ = nullptr;
+    bool cull_;
+    std::int64_t& culled_;
 };
 
 }  // namespace render

@@ -33,34 +33,34 @@ void Renderer::Impl::drawOverlays(Image& image, const FrameOptions& options) con
                             std::find(options.draw.kdop.begin(), options.draw.kdop.end(), true) !=
                                 options.draw.kdop.end();
     if (any_volume || options.draw.bvh_depth >= 0) {
-        const Color apart = stateColor(engine::BodyState::Apart);
-        const Color flagged = stateColor(engine::BodyState::Flagged);
-        const Color colliding = stateColor(engine::BodyState::Colliding);
+        const Color apart = engine::stateColor(engine::BodyState::Apart);
+        const Color flagged = engine::stateColor(engine::BodyState::Flagged);
+        const Color colliding = engine::stateColor(engine::BodyState::Colliding);
         std::vector<LegendRow> rows;
-        if (any_volume && own_tests) {
+        if (any_volume && drawn.own_tests) {
             rows.push_back({{std::nullopt, "each volume coloured by its own overlap test"}});
-            std::string drawn;
-            for (const std::string& name : drawnVolumeNames(options.draw)) {
-                drawn += (drawn.empty() ? "drawn: " : ", ") + name;
+            std::string names;
+            for (const std::string& name : engine::drawnVolumeNames(options.draw)) {
+                names += (names.empty() ? "drawn: " : ", ") + name;
             }
-            rows.push_back({{std::nullopt, drawn}});
+            rows.push_back({{std::nullopt, names}});
             rows.push_back({{apart, "apart"},
                             {flagged, "overlaps a volume of its kind"},
                             {colliding, "colliding"}});
         } else {
             std::string flagged_label = "flagged";
-            if (any_volume && tested_volume) {
+            if (any_volume && drawn.tested_volume) {
                 const char* const names[3] = {"sphere", "AABB", "OBB"};
-                flagged_label += " (" + std::string(names[int(*tested_volume)]) + " test)";
+                flagged_label += " (" + std::string(names[int(*drawn.tested_volume)]) + " test)";
             }
             rows.push_back({{apart, "apart"}, {flagged, flagged_label}, {colliding, "colliding"}});
         }
         drawLegendBlock(image, margin, height - margin - legendBlockSize(rows, scale).height, rows,
                         scale);
     }
-    if (!structure_legend.empty()) {
+    if (!lines.structure_legend.empty()) {
         std::vector<LegendRow> rows;
-        for (const LegendEntry& e : structure_legend) rows.push_back({{e.color, e.label}});
+        for (const LegendEntry& e : lines.structure_legend) rows.push_back({{e.color, e.label}});
         drawLegendBlock(image, width - margin - legendBlockSize(rows, scale).width, margin, rows,
                         scale);
     }

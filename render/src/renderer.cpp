@@ -1,6 +1,6 @@
 // render/src/renderer.cpp -- OSMesa software rendering of a World: the GL set-up, shaded
-// bodies, the line buffers drawn (built in frame_lines.cpp), the supersampled pixels read back
-// and filtered, then the overlays (overlay.cpp).
+// bodies, the overlays' line buffers (what they hold is engine::drawWorld's decision), the
+// supersampled pixels read back and filtered, then the legends and HUD (overlay.cpp).
 // Invariant: a frame is a pure function of (world state, camera, options, size). Nothing that
 // shapes a pixel reads a clock (the clock only times the stages for FrameStats), geometry is
 // generated in a fixed order, and all vertices are eye-relative, so the same state renders
@@ -73,30 +73,12 @@ void downsampleRow2x2(const std::uint8_t* r0, const std::uint8_t* r1, int width,
 
 // ---------------------------------------------------------------------------------------------
 
-collision::Color nodeColor(collision::BvhNodeState state) {
-    switch (state) {
-        case collision::BvhNodeState::Apart:
-            return stateColor(engine::BodyState::Apart);
-        case collision::BvhNodeState::Overlapping:
-            return stateColor(engine::BodyState::Flagged);
-        case collision::BvhNodeState::Confirmed:
-            return stateColor(engine::BodyState::Colliding);
-    }
-    return kContactColor;
+void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& cam,
+                                const FrameOptions& options) {
+    lines.clear();
+    GlDebugDraw debug(cam, lines, options.cull, stats.volumes_culled);
+    drawn = engine::drawWorld(world, debug, {options.draw, options.draw_structure});
 }
-
-collision::Color stateColor(engine::BodyState state) {
-    switch (state) {
-        case engine::BodyState::Apart:
-            return {0.1f, 0.85f, 0.2f, 1.0f};
-        case engine::BodyState::Flagged:
-            return {1.0f, 0.85f, 0.0f, 1.0f};
-        case engine::BodyState::Colliding:
-            return {1.0f, 0.1f, 0.1f, 1.0f};
-    }
-    return {1.0f, 0.0f, 1.0f, 1.0f};
-}
-
 
 CameraFrame Renderer::Impl::setUpCamera(const engine::World& world,
                                         const engine::CameraSettings& camera,
@@ -258,7 +240,7 @@ void Renderer::Impl::drawSelfPairs(const engine::World& world, const CameraFrame
         }
         tessellateTriangles(body.shape.mesh->vertices, hit, body.pose(), cam, triangles);
     }
-    drawTriangles(stateColor(engine::BodyState::Colliding));
+    drawTriangles(engine::stateColor(engine::BodyState::Colliding));
 }
 
 
@@ -299,8 +281,8 @@ void Renderer::Impl::drawTriangles(const collision::Color& color) {
     glDisable(GL_LIGHTING);
 }
 
-void Renderer::Impl::drawLines(const LineBuffer& lines, float width_px) {
-    if (lines.count() == 0) return;
+void Renderer::Impl::drawLines(const LineBuffer& buffer, float width_px) {
+    if (buffer.count() == 0) return;
     glDisable(GL_LIGHTING);
     glEnable(GL_BLEND);
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
@@ -308,14 +290,14 @@ void Renderer::Impl::drawLines(const LineBuffer& lines, float width_px) {
     glLineWidth(width_px * float(ss));
     glEnableClientState(GL_VERTEX_ARRAY);
     glEnableClientState(GL_COLOR_ARRAY);
-    glVertexPointer(3, GL_FLOAT, 0, lines.positions.data());
+    glVertexPointer(3, GL_FLOAT, 0, buffer.positions.data());
     // Pass 1: the parts behind a body, faint (x-ray). Pass 2: the visible parts, full colour.
     glDepthFunc(GL_GREATER);
-    glColorPointer(4, GL_FLOAT, 0, lines.faint_colors.data());
-    glDrawArrays(GL_LINES, 0, lines.count());
+    glColorPointer(4, GL_FLOAT, 0, buffer.faint_colors.data());
+    glDrawArrays(GL_LINES, 0, buffer.count());
     glDepthFunc(GL_LEQUAL);
-    glColorPointer(4, GL_FLOAT, 0, lines.colors.data());
-    glDrawArrays(GL_LINES, 0, lines.count());
+    glColorPointer(4, GL_FLOAT, 0, buffer.colors.data());
+    glDrawArrays(GL_LINES, 0, buffer.count());
     glDisableClientState(GL_COLOR_ARRAY);
     glDisableClientState(GL_VERTEX_ARRAY);
     glDepthMask(GL_TRUE);
@@ -389,12 +371,12 @@ void Renderer::render(const engine::World& world, const engine::CameraSettings& 
     im.stats = FrameStats{};
     if (options.draw.bodies) im.drawBodies(world, cam, options);
     im.buildLines(world, cam, options);
-    im.drawLines(im.frame_lines, 1.0f);
-    im.drawLines(im.structure_lines, 1.0f);
-    im.drawLines(im.outline_lines, 1.0f);
-    im.drawLines(im.volume_lines, 2.0f);
-    im.drawLines(im.bvh_lines, 1.0f);
-    im.drawLines(im.contact_lines, 2.0f);
+    im.drawLines(im.lines.frame, 1.0f);
+    im.drawLines(im.lines.structure, 1.0f);
+    im.drawLines(im.lines.outlines, 1.0f);
+    im.drawLines(im.lines.volumes, 2.0f);
+    im.drawLines(im.lines.hierarchy, 1.0f);
+    im.drawLines(im.lines.contacts, 2.0f);
     const GLenum error = glGetError();
     if (error != GL_NO_ERROR) {
         throw RenderError("OpenGL error " + std::to_string(error) + " while rendering a frame");

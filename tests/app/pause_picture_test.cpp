@@ -9,6 +9,7 @@
 #include <string>
 
 #include "cli_run.h"
+#include "engine/world_draw.h"
 #include "render/image.h"
 #include "render/pixel_checks.h"
 
@@ -63,8 +64,8 @@ engine::CameraSettings cameraAt(double cx, double cy) {
     return cam;
 }
 
-const Rgb kGreen = toRgb(render::stateColor(engine::BodyState::Apart));
-const Rgb kYellow = toRgb(render::stateColor(engine::BodyState::Flagged));
+const Rgb kGreen = toRgb(engine::stateColor(engine::BodyState::Apart));
+const Rgb kYellow = toRgb(engine::stateColor(engine::BodyState::Flagged));
 
 }  // namespace
 

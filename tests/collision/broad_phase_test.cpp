@@ -14,7 +14,7 @@
 
 #include "broadphase/hgrid.h"
 #include "collision/debug_draw.h"
-#include "collision/broadphase/visibility_oracle.h"
+#include "collision/visibility_oracle.h"
 #include "broad_phase_scenes.h"
 #include "test_random.h"
 

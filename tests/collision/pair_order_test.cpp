@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "collision/broadphase/broad_phase.h"
-#include "collision/broadphase/visibility_oracle.h"
+#include "collision/visibility_oracle.h"
 #include "test_random.h"
 
 namespace collision {

@@ -24,6 +24,7 @@
 #include "engine/scene.h"
 #include "engine/world.h"
 #include "render/image.h"
+#include "engine/world_draw.h"
 #include "render/renderer.h"
 #include "pixel_checks.h"
 #include "test_dir.h"
@@ -71,8 +72,8 @@ TEST(Renderer, SphereOutlinesTakeTheirStateColour) {
     render::Renderer renderer(kWidth, kHeight);
     const render::Image image = renderThreeSpheres(renderer);
     const engine::CameraSettings cam = headOnCamera();
-    const Rgb red = toRgb(render::stateColor(engine::BodyState::Colliding));
-    const Rgb green = toRgb(render::stateColor(engine::BodyState::Apart));
+    const Rgb red = toRgb(engine::stateColor(engine::BodyState::Colliding));
+    const Rgb green = toRgb(engine::stateColor(engine::BodyState::Apart));
 
     // Points of the bounding spheres' great circles that sit on the outline seen from +z.
     const std::vector<Vec3> red_points = {
@@ -128,7 +129,7 @@ TEST(Renderer, BodiesAreShadedGreyBlueInsideTheirOutline) {
     EXPECT_GT(c[2], c[0]);
     EXPECT_GT(c[0] + c[1] + c[2], 3 * 60) << "too dark";
     EXPECT_FALSE(close(c, toRgb(render::kBackgroundColor), 10));
-    EXPECT_FALSE(close(c, toRgb(render::stateColor(engine::BodyState::Apart)), 60));
+    EXPECT_FALSE(close(c, toRgb(engine::stateColor(engine::BodyState::Apart)), 60));
 
     render::FrameOptions no_bodies = plainOptions();
     no_bodies.draw.bodies = false;
@@ -312,7 +313,7 @@ TEST(Renderer, WorldBoundsAreDrawnAsAGreyBox) {
 TEST(Renderer, VolumeSelectionControlsWhichWireframesAppear) {
     render::Renderer renderer(kWidth, kHeight);
     const engine::CameraSettings cam = headOnCamera();
-    const Rgb green = toRgb(render::stateColor(engine::BodyState::Apart));
+    const Rgb green = toRgb(engine::stateColor(engine::BodyState::Apart));
     // The AABB corner of C lies outside its bounding sphere: green only when aabb is drawn.
     const PixelPos corner = project(cam, kWidth, kHeight, Vec3(3.6, 1, 1));
     render::FrameOptions options = plainOptions();
@@ -380,9 +381,9 @@ TEST(Renderer, RejectsNonPositiveSize) {
 }
 
 TEST(StateColor, MatchesTheDocumentedColours) {
-    EXPECT_EQ(toRgb(render::stateColor(engine::BodyState::Apart)), (Rgb{26, 217, 51}));
-    EXPECT_EQ(toRgb(render::stateColor(engine::BodyState::Flagged)), (Rgb{255, 217, 0}));
-    EXPECT_EQ(toRgb(render::stateColor(engine::BodyState::Colliding)), (Rgb{255, 26, 26}));
+    EXPECT_EQ(toRgb(engine::stateColor(engine::BodyState::Apart)), (Rgb{26, 217, 51}));
+    EXPECT_EQ(toRgb(engine::stateColor(engine::BodyState::Flagged)), (Rgb{255, 217, 0}));
+    EXPECT_EQ(toRgb(engine::stateColor(engine::BodyState::Colliding)), (Rgb{255, 26, 26}));
 }
 
 TEST(HudLine, ShowsFrameTimeBroadPhaseAndCounts) {
@@ -690,7 +691,7 @@ TEST(Renderer, HierarchyLevelNodesTakeTheirStateColour) {
     for (const auto& [level, body] : {std::pair{&la, &bodies[0]}, std::pair{&lb, &bodies[1]}}) {
         for (std::size_t k = 0; k < level->nodes.size(); ++k) {
             const collision::BvhNodeState state = level->states[k];
-            const Rgb color = toRgb(render::nodeColor(state));
+            const Rgb color = toRgb(engine::nodeColor(state));
             const collision::Obb box = collision::transformObb(level->nodes[k].box, body->pose());
             Vec3 corners[8];
             box.corners(corners);
@@ -706,14 +707,14 @@ TEST(Renderer, HierarchyLevelNodesTakeTheirStateColour) {
     EXPECT_GT(seen[0], 0);  // apart
     EXPECT_GT(seen[1], 0);  // overlapping at that level only
     EXPECT_GT(seen[2], 0);  // holding a confirmed triangle
-    EXPECT_EQ(countColor(image, toRgb(render::kContactColor)), 0);
+    EXPECT_EQ(countColor(image, toRgb(engine::kContactColor)), 0);
 
     // Off: no node is drawn, so none of the state colours appears (bodies and volumes are off).
     options.draw.bvh_depth = -1;
     const render::Image off = renderer.render(world, torusCamera(), options);
     for (const auto s : {collision::BvhNodeState::Apart, collision::BvhNodeState::Overlapping,
                          collision::BvhNodeState::Confirmed}) {
-        EXPECT_EQ(countColor(off, toRgb(render::nodeColor(s))), 0);
+        EXPECT_EQ(countColor(off, toRgb(engine::nodeColor(s))), 0);
     }
 }
 
@@ -727,7 +728,7 @@ TEST(Renderer, ContactWitnessesAreDrawnInMagentaAndFramesAreDeterministic) {
     render::FrameOptions options = plainOptions();
     options.draw.sphere = false;
     options.draw.contacts = true;
-    const Rgb magenta = toRgb(render::kContactColor);
+    const Rgb magenta = toRgb(engine::kContactColor);
     const render::Image image = renderer.render(world, torusCamera(), options);
     const auto bodies = world.bodies();
     const auto witnesses = collision::contactWitnesses(bodies[0].shape, bodies[0].pose(),
@@ -760,7 +761,7 @@ TEST(Renderer, TimeOfImpactPoseIsDrawnInBlue) {
     render::Renderer renderer(320, 180);
     render::FrameOptions options;
     options.draw = scene.draw;
-    const Rgb blue = toRgb(render::kToiColor);
+    const Rgb blue = toRgb(engine::kToiColor);
     auto countBlue = [&blue](const render::Image& image) {
         int n = 0;
         for (int y = 0; y < image.height; ++y) {
@@ -792,7 +793,7 @@ TEST(Renderer, ScreenRectIsWhereTheAabbIsDrawn) {
     options.draw.aabb = true;
     render::Renderer renderer(kWidth, kHeight);
     const render::Image image = renderer.render(world, camera, options);
-    const Rgb green = toRgb(render::stateColor(engine::BodyState::Apart));
+    const Rgb green = toRgb(engine::stateColor(engine::BodyState::Apart));
     int x0 = kWidth, y0 = kHeight, x1 = -1, y1 = -1;
     for (int y = 0; y < kHeight; ++y) {
         for (int x = 0; x < kWidth; ++x) {

@@ -10,6 +10,7 @@
 #include "collision/debug_draw.h"
 #include "engine/world.h"
 #include "pixel_checks.h"
+#include "engine/world_draw.h"
 #include "render/renderer.h"
 
 namespace {
@@ -60,10 +61,10 @@ engine::World worldWith(const std::string& broad_phase) {
 
 // The colours an overlay already gives a meaning to.
 std::vector<Rgb> meaningfulColors() {
-    return {toRgb(render::stateColor(engine::BodyState::Apart)),
-            toRgb(render::stateColor(engine::BodyState::Flagged)),
-            toRgb(render::stateColor(engine::BodyState::Colliding)), toRgb(render::kToiColor),
-            toRgb(render::kContactColor)};
+    return {toRgb(engine::stateColor(engine::BodyState::Apart)),
+            toRgb(engine::stateColor(engine::BodyState::Flagged)),
+            toRgb(engine::stateColor(engine::BodyState::Colliding)), toRgb(engine::kToiColor),
+            toRgb(engine::kContactColor)};
 }
 
 // True when `seen` is `line` laid over `under` with a coverage of at least 30 %, within 10 per

@@ -10,8 +10,9 @@
 #include "engine/scene.h"
 #include "engine/world.h"
 #include "pixel_checks.h"
+#include "engine/world_draw.h"
 #include "render/renderer.h"
-#include "render/volume_states.h"
+#include "engine/volume_overlaps.h"
 
 namespace {
 
@@ -65,9 +66,9 @@ render::FrameOptions volumesOnly(bool sphere, bool aabb, bool obb) {
     return options;
 }
 
-const Rgb kGreen = toRgb(render::stateColor(engine::BodyState::Apart));
-const Rgb kYellow = toRgb(render::stateColor(engine::BodyState::Flagged));
-const Rgb kRed = toRgb(render::stateColor(engine::BodyState::Colliding));
+const Rgb kGreen = toRgb(engine::stateColor(engine::BodyState::Apart));
+const Rgb kYellow = toRgb(engine::stateColor(engine::BodyState::Flagged));
+const Rgb kRed = toRgb(engine::stateColor(engine::BodyState::Colliding));
 
 }  // namespace
 
@@ -141,7 +142,7 @@ TEST(VolumeColors, ObbBroadPhaseDrawsObbsAndNoYellowWhenOnlyTheAabbsOverlap) {
     const engine::World obb_world = makeParallelRodsWorld("obb");
     ASSERT_EQ(obb_world.flaggedPairs().size(), 0u);
     render::FrameOptions options;
-    options.draw = render::drawSettingsFor(scene_default, obb_world);
+    options.draw = engine::drawSettingsFor(scene_default, obb_world);
     EXPECT_TRUE(options.draw.obb);
     EXPECT_FALSE(options.draw.aabb);
     EXPECT_FALSE(options.draw.sphere);
@@ -155,7 +156,7 @@ TEST(VolumeColors, ObbBroadPhaseDrawsObbsAndNoYellowWhenOnlyTheAabbsOverlap) {
 
     const engine::World sap_world = makeParallelRodsWorld("sap");
     ASSERT_EQ(sap_world.flaggedPairs().size(), 1u);
-    options.draw = render::drawSettingsFor(scene_default, sap_world);
+    options.draw = engine::drawSettingsFor(scene_default, sap_world);
     EXPECT_TRUE(options.draw.aabb);
     EXPECT_FALSE(options.draw.obb);
     EXPECT_GT(countColor(renderer.render(sap_world, cam, options), kYellow), 20);
@@ -164,7 +165,7 @@ TEST(VolumeColors, ObbBroadPhaseDrawsObbsAndNoYellowWhenOnlyTheAabbsOverlap) {
     chose_aabb.sphere = false;
     chose_aabb.aabb = true;
     chose_aabb.volumes_given = true;
-    options.draw = render::drawSettingsFor(chose_aabb, obb_world);
+    options.draw = engine::drawSettingsFor(chose_aabb, obb_world);
     EXPECT_TRUE(options.draw.aabb);
     EXPECT_FALSE(options.draw.obb);
     EXPECT_GT(countColor(renderer.render(obb_world, cam, options), kYellow), 20);
@@ -178,14 +179,14 @@ TEST(VolumeColors, DefaultVolumeIsTheOneEachBroadPhaseTests) {
         if (e.needs_render_context) continue;  // no oracle installed in render_tests
         SCOPED_TRACE(std::string(e.name));
         world.setBroadPhase(std::string(e.name));
-        const engine::DrawSettings d = render::drawSettingsFor(engine::DrawSettings{}, world);
+        const engine::DrawSettings d = engine::drawSettingsFor(engine::DrawSettings{}, world);
         EXPECT_EQ(d.sphere, e.volume == "sphere");
         EXPECT_EQ(d.aabb, e.volume == "aabb");
         EXPECT_EQ(d.obb, e.volume == "obb");
         engine::DrawSettings chosen;
         chosen.sphere = chosen.aabb = chosen.obb = true;
         chosen.volumes_given = true;
-        const engine::DrawSettings kept = render::drawSettingsFor(chosen, world);
+        const engine::DrawSettings kept = engine::drawSettingsFor(chosen, world);
         EXPECT_TRUE(kept.sphere && kept.aabb && kept.obb);
     }
     EXPECT_FALSE(engine::loadScene(fs::path(CDLAB_SOURCE_DIR) / "scenes" / "bounce.yaml")
@@ -220,9 +221,9 @@ TEST(VolumeOverlaps, EqualBruteForceForEveryKindUnderEveryBroadPhase) {
         SCOPED_TRACE(bp);
         world.setBroadPhase(bp);
         world.detect();
-        for (const render::VolumeKind kind : render::kVolumeKinds) {
-            SCOPED_TRACE(std::string(render::volumeKindName(kind)));
-            const render::VolumeOverlaps o = render::volumeOverlaps(world, kind);
+        for (const engine::VolumeKind kind : engine::kVolumeKinds) {
+            SCOPED_TRACE(std::string(engine::volumeKindName(kind)));
+            const engine::VolumeOverlaps o = engine::volumeOverlaps(world, kind);
             EXPECT_EQ(o.pairs, brute[int(kind)]);
             ASSERT_EQ(o.states.size(), volumes.size());
             std::vector<engine::BodyState> expected(volumes.size(), engine::BodyState::Apart);
@@ -233,7 +234,7 @@ TEST(VolumeOverlaps, EqualBruteForceForEveryKindUnderEveryBroadPhase) {
                 expected[p.a] = expected[p.b] = engine::BodyState::Colliding;
             }
             EXPECT_EQ(o.states, expected);
-            if (render::broadPhaseVolume(world) == kind) {
+            if (engine::broadPhaseVolume(world) == kind) {
                 EXPECT_EQ(o.states, std::vector<engine::BodyState>(world.states().begin(),
                                                                    world.states().end()));
             }
@@ -250,10 +251,10 @@ TEST(KdopOverlaps, TighterKdopsLeaveTheDiagonalPairApart) {
     using engine::BodyState;
     const std::vector<BodyState> boxes = {BodyState::Flagged, BodyState::Flagged, BodyState::Apart};
     const std::vector<BodyState> apart(3, BodyState::Apart);
-    EXPECT_EQ(render::kdopOverlaps(world, render::worldKdops(world, 6)).states, boxes);
-    EXPECT_EQ(render::kdopOverlaps(world, render::worldKdops(world, 14)).states, boxes);
-    EXPECT_EQ(render::kdopOverlaps(world, render::worldKdops(world, 18)).states, apart);
-    EXPECT_EQ(render::kdopOverlaps(world, render::worldKdops(world, 26)).states, apart);
+    EXPECT_EQ(engine::kdopOverlaps(world, engine::worldKdops(world, 6)).states, boxes);
+    EXPECT_EQ(engine::kdopOverlaps(world, engine::worldKdops(world, 14)).states, boxes);
+    EXPECT_EQ(engine::kdopOverlaps(world, engine::worldKdops(world, 18)).states, apart);
+    EXPECT_EQ(engine::kdopOverlaps(world, engine::worldKdops(world, 26)).states, apart);
 }
 
 TEST(KdopOverlaps, SweepFindsExactlyTheBruteForcePairs) {
@@ -273,7 +274,7 @@ TEST(KdopOverlaps, SweepFindsExactlyTheBruteForcePairs) {
     }
     world.detect();
     for (const int k : {6, 14, 18, 26}) {
-        const std::vector<collision::WorldKdop> kdops = render::worldKdops(world, k);
+        const std::vector<collision::WorldKdop> kdops = engine::worldKdops(world, k);
         std::vector<collision::ProxyPair> brute;
         for (std::size_t a = 0; a < kdops.size(); ++a) {
             for (std::size_t b = a + 1; b < kdops.size(); ++b) {
@@ -282,7 +283,7 @@ TEST(KdopOverlaps, SweepFindsExactlyTheBruteForcePairs) {
                 }
             }
         }
-        EXPECT_EQ(render::kdopOverlaps(world, kdops).pairs, brute) << "k=" << k;
+        EXPECT_EQ(engine::kdopOverlaps(world, kdops).pairs, brute) << "k=" << k;
         EXPECT_FALSE(brute.empty()) << "k=" << k;
     }
 }
@@ -319,12 +320,12 @@ TEST(KdopDrawing, LegendNamesEachKDrawn) {
     draw.aabb = false;
     draw.obb = false;
     draw.kdop = {true, true, false, true};
-    EXPECT_EQ(render::drawnVolumeNames(draw),
+    EXPECT_EQ(engine::drawnVolumeNames(draw),
               (std::vector<std::string>{"sphere", "6-DOP", "14-DOP", "26-DOP"}));
     draw.sphere = false;
     draw.obb = true;
     draw.kdop = {false, false, true, false};
-    EXPECT_EQ(render::drawnVolumeNames(draw), (std::vector<std::string>{"OBB", "18-DOP"}));
+    EXPECT_EQ(engine::drawnVolumeNames(draw), (std::vector<std::string>{"OBB", "18-DOP"}));
 
     // In the frame: the legend block (bottom left, clear of the bodies' volumes) is there with
     // the HUD, and its text differs between a frame drawing the 14-DOPs and one drawing the

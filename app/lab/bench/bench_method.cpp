@@ -5,7 +5,7 @@
 #include <utility>
 
 #include "collision/broadphase/loose_broad_phase.h"
-#include "collision/broadphase/visibility_oracle.h"
+#include "collision/visibility_oracle.h"
 
 namespace app {
 

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "broadphase/proxy_table.h"
-#include "collision/broadphase/visibility_oracle.h"
+#include "collision/visibility_oracle.h"
 
 namespace collision {
 

@@ -47,7 +47,7 @@ struct DrawSettings {
     /// `kdop26` in `draw.volumes`).
     std::array<bool, 4> kdop{};
     /// The scene chose its volumes with `draw.volumes`. Otherwise `cdlab run` draws the
-    /// volume its broad phase tests (render::drawSettingsFor) instead of the defaults above.
+    /// volume its broad phase tests (engine::drawSettingsFor) instead of the defaults above.
     bool volumes_given = false;
     bool bounds = true;
     bool hud = true;

@@ -4,7 +4,7 @@
 
 #include <memory>
 
-#include "collision/broadphase/visibility_oracle.h"
+#include "collision/visibility_oracle.h"
 
 namespace render {
 

@@ -7,7 +7,6 @@
 #include <optional>
 #include <string>
 
-#include "collision/bvh/bvh_level.h"
 #include "collision/debug_draw.h"
 #include "engine/scene.h"
 #include "engine/world.h"
@@ -15,27 +14,10 @@
 
 namespace render {
 
-/// Colours of the overlap states: green apart, yellow flagged, red colliding.
-collision::Color stateColor(engine::BodyState state);
-
 /// The clear colour behind everything, a dark blue-grey: exactly RGB8 (26, 28, 36).
 inline constexpr collision::Color kBackgroundColor{26 / 255.0f, 28 / 255.0f, 36 / 255.0f, 1.0f};
 /// The shaded bodies' base colour (a neutral grey-blue) before lighting.
 inline constexpr collision::Color kBodyColor{0.56f, 0.63f, 0.74f, 1.0f};
-
-/// Wireframes of the bodies at the times of impact the CCD stage acted on in the last step
-/// (World::toiEvents), and the contact normal there: blue.
-inline constexpr collision::Color kToiColor{0.25f, 0.5f, 1.0f, 1.0f};
-/// Chains' skeletons: joint origins joined by lines (with the bodies).
-inline constexpr collision::Color kSkeletonColor{0.92f, 0.92f, 0.85f, 1.0f};
-
-/// Witness points (small crosses) and normals (short segments from A's witness) of the confirmed
-/// contacts, with draw.contacts: magenta, a colour no state uses.
-inline constexpr collision::Color kContactColor{1.0f, 0.0f, 1.0f, 1.0f};
-
-/// Colour of a hierarchy node drawn with draw.bvh_depth: the state colours, Overlapping as
-/// flagged (yellow) and Confirmed as colliding (red).
-collision::Color nodeColor(collision::BvhNodeState state);
 
 /// A rectangle of a picture in pixels: x to the right and y down from the top-left corner.
 struct ScreenRect {
@@ -50,8 +32,9 @@ struct ScreenRect {
 std::optional<ScreenRect> screenRect(const engine::CameraSettings& camera, int width, int height,
                                      const collision::Vec3& min, const collision::Vec3& max);
 
-/// What one frame shows. With draw.hud and any volume (or hierarchy level) drawn, a colour legend
-/// (apart / flagged / colliding) goes bottom-left.
+/// What one frame shows: the overlays as engine::drawWorld draws them for (draw, draw_structure),
+/// and the HUD. With draw.hud and any volume (or hierarchy level) drawn, a colour legend (apart /
+/// flagged / colliding) goes bottom-left.
 struct FrameOptions {
     engine::DrawSettings draw;
     bool draw_structure = false;  ///< the broad phase's own structure (BroadPhase::draw)

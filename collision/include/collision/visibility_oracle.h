@@ -1,4 +1,4 @@
-// collision/broadphase/visibility_oracle.h -- the seam through which the `cullide` broad phase
+// collision/visibility_oracle.h -- the seam through which the `cullide` broad phase
 // asks a rasteriser which boxes are fully visible. collision defines it; render implements it
 // with OpenGL occlusion queries on its OSMesa context; the app installs that implementation.
 #pragma once

@@ -1,5 +1,6 @@
-// render/volume_states.h -- each kind of bounding volume judged by its own overlap test: which
-// volumes a picture draws by default, and the state colour of every volume it draws.
+// engine/volume_overlaps.h -- each kind of bounding volume judged by its own overlap test: which
+// volumes a picture draws by default, and the overlap state of every body's volume of each kind.
+// Computed here, by the registry's broad phases, so that a picture and a data file only read it.
 #pragma once
 
 #include <cstdint>
@@ -13,7 +14,7 @@
 #include "engine/scene.h"
 #include "engine/world.h"
 
-namespace render {
+namespace engine {
 
 /// The bounding volumes a body has (collision::ProxyVolumes).
 enum class VolumeKind : std::uint8_t { Sphere, Aabb, Obb };
@@ -25,16 +26,16 @@ std::string_view volumeKindName(VolumeKind kind);
 
 /// The volume the world's broad phase decides on (BroadPhaseEntry::volume); nullopt for a
 /// broad phase that is not in the registry.
-std::optional<VolumeKind> broadPhaseVolume(const engine::World& world);
+std::optional<VolumeKind> broadPhaseVolume(const World& world);
 
 /// The scene's draw settings with, unless the scene chose its volumes (`draw.volumes` given),
 /// exactly the volume the world's broad phase tests drawn: bounding spheres for `sphere`, OBBs
 /// for `obb`, AABBs for every AABB-based broad phase.
-engine::DrawSettings drawSettingsFor(const engine::DrawSettings& draw, const engine::World& world);
+DrawSettings drawSettingsFor(const DrawSettings& draw, const World& world);
 
 /// The volumes `draw` draws, as a legend names them: "sphere", "AABB", "OBB", then "6-DOP",
 /// "14-DOP", "18-DOP", "26-DOP" for each k-DOP drawn, in that order.
-std::vector<std::string> drawnVolumeNames(const engine::DrawSettings& draw);
+std::vector<std::string> drawnVolumeNames(const DrawSettings& draw);
 
 /// One kind of volume over all bodies, each judged by that kind's own overlap test.
 struct VolumeOverlaps {
@@ -43,7 +44,7 @@ struct VolumeOverlaps {
     /// Per body: Colliding when in a pair the narrow phase confirmed (World::collidingPairs) and
     /// whose volumes of this kind overlap; else Flagged when its volume overlaps another body's
     /// volume of this kind; else Apart.
-    std::vector<engine::BodyState> states;
+    std::vector<BodyState> states;
 };
 
 /// The overlaps of the world's volumes of `kind` at its last detect() or step(). For the kind
@@ -52,15 +53,15 @@ struct VolumeOverlaps {
 /// phase's own order, WorldSettings::pair_order); any other kind is found afresh by the registry's
 /// sorting broad phase for that volume (sap, sphere, obb: exact tests, each checked against its
 /// brute-force reference), O(n log n + pairs).
-VolumeOverlaps volumeOverlaps(const engine::World& world, VolumeKind kind);
+VolumeOverlaps volumeOverlaps(const World& world, VolumeKind kind);
 
 /// Per body, its world k-DOP of `k` (6, 14, 18, 26) at its current pose (exact support of
 /// its shape along every slab direction, collision::computeWorldKdop).
-std::vector<collision::WorldKdop> worldKdops(const engine::World& world, int k);
+std::vector<collision::WorldKdop> worldKdops(const World& world, int k);
 
 /// The overlaps of the bodies' k-DOPs (collision::WorldKdop::overlaps; touching counts), states
 /// as for volumeOverlaps: sorted on the first slab and swept, O(n log n + pairs on that axis).
-VolumeOverlaps kdopOverlaps(const engine::World& world,
+VolumeOverlaps kdopOverlaps(const World& world,
                             const std::vector<collision::WorldKdop>& kdops);
 
-}  // namespace render
+}  // namespace engine

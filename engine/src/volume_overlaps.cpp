@@ -1,13 +1,13 @@
-// render/src/volume_states.cpp -- see volume_states.h.
+// engine/src/volume_overlaps.cpp -- see volume_overlaps.h.
 // A picture never colours a volume by another volume's test: a sphere is yellow only when it
 // overlaps another body's sphere, whatever the broad phase flagged.
-#include "render/volume_states.h"
+#include "engine/volume_overlaps.h"
 
 #include <algorithm>
 #include <memory>
 #include <string>
 
-namespace render {
+namespace engine {
 
 namespace {
 
@@ -30,7 +30,7 @@ std::string_view volumeKindName(VolumeKind kind) {
     return "aabb";
 }
 
-std::optional<VolumeKind> broadPhaseVolume(const engine::World& world) {
+std::optional<VolumeKind> broadPhaseVolume(const World& world) {
     const collision::BroadPhaseEntry* entry = collision::findBroadPhase(world.broadPhase().name());
     if (entry == nullptr) return std::nullopt;
     for (const VolumeKind kind : kVolumeKinds) {
@@ -39,8 +39,8 @@ std::optional<VolumeKind> broadPhaseVolume(const engine::World& world) {
     return std::nullopt;
 }
 
-engine::DrawSettings drawSettingsFor(const engine::DrawSettings& draw, const engine::World& world) {
-    engine::DrawSettings out = draw;
+DrawSettings drawSettingsFor(const DrawSettings& draw, const World& world) {
+    DrawSettings out = draw;
     if (draw.volumes_given) return out;
     const VolumeKind kind = broadPhaseVolume(world).value_or(VolumeKind::Aabb);
     out.sphere = kind == VolumeKind::Sphere;
@@ -50,13 +50,13 @@ engine::DrawSettings drawSettingsFor(const engine::DrawSettings& draw, const eng
     return out;
 }
 
-std::vector<std::string> drawnVolumeNames(const engine::DrawSettings& draw) {
+std::vector<std::string> drawnVolumeNames(const DrawSettings& draw) {
     std::vector<std::string> out;
     if (draw.sphere) out.emplace_back("sphere");
     if (draw.aabb) out.emplace_back("AABB");
     if (draw.obb) out.emplace_back("OBB");
-    for (std::size_t i = 0; i < engine::kDrawnKdops.size(); ++i) {
-        if (draw.kdop[i]) out.push_back(std::to_string(engine::kDrawnKdops[i]) + "-DOP");
+    for (std::size_t i = 0; i < kDrawnKdops.size(); ++i) {
+        if (draw.kdop[i]) out.push_back(std::to_string(kDrawnKdops[i]) + "-DOP");
     }
     return out;
 }
@@ -64,33 +64,33 @@ std::vector<std::string> drawnVolumeNames(const engine::DrawSettings& draw) {
 namespace {
 
 /// Flagged for every body in a pair, then Colliding for those in a confirmed pair among them.
-std::vector<engine::BodyState> statesOf(const engine::World& world, std::size_t n,
+std::vector<BodyState> statesOf(const World& world, std::size_t n,
                                         const std::vector<collision::ProxyPair>& pairs) {
-    std::vector<engine::BodyState> states(n, engine::BodyState::Apart);
+    std::vector<BodyState> states(n, BodyState::Apart);
     for (const collision::ProxyPair& p : pairs) {
-        states[std::size_t(p.a)] = engine::BodyState::Flagged;
-        states[std::size_t(p.b)] = engine::BodyState::Flagged;
+        states[std::size_t(p.a)] = BodyState::Flagged;
+        states[std::size_t(p.b)] = BodyState::Flagged;
     }
     for (const collision::ProxyPair& p : world.collidingPairs()) {
         if (!std::binary_search(pairs.begin(), pairs.end(), p)) continue;
-        states[std::size_t(p.a)] = engine::BodyState::Colliding;
-        states[std::size_t(p.b)] = engine::BodyState::Colliding;
+        states[std::size_t(p.a)] = BodyState::Colliding;
+        states[std::size_t(p.b)] = BodyState::Colliding;
     }
     return states;
 }
 
 }  // namespace
 
-std::vector<collision::WorldKdop> worldKdops(const engine::World& world, int k) {
+std::vector<collision::WorldKdop> worldKdops(const World& world, int k) {
     std::vector<collision::WorldKdop> out;
     out.reserve(world.bodies().size());
-    for (const engine::Body& b : world.bodies()) {
+    for (const Body& b : world.bodies()) {
         out.push_back(collision::computeWorldKdop(b.shape, b.pose(), k));
     }
     return out;
 }
 
-VolumeOverlaps kdopOverlaps(const engine::World& world,
+VolumeOverlaps kdopOverlaps(const World& world,
                             const std::vector<collision::WorldKdop>& kdops) {
     VolumeOverlaps out;
     std::vector<std::size_t> order(kdops.size());
@@ -112,7 +112,7 @@ VolumeOverlaps kdopOverlaps(const engine::World& world,
     return out;
 }
 
-VolumeOverlaps volumeOverlaps(const engine::World& world, VolumeKind kind) {
+VolumeOverlaps volumeOverlaps(const World& world, VolumeKind kind) {
     VolumeOverlaps out;
     const auto volumes = world.volumes();
     if (broadPhaseVolume(world) == kind && world.states().size() == volumes.size()) {
@@ -138,4 +138,4 @@ VolumeOverlaps volumeOverlaps(const engine::World& world, VolumeKind kind) {
     return out;
 }
 
-}  // namespace render
+}  // namespace engine

@@ -1,0 +1,27 @@
+# cmake -DDIR=<folder> -DFORBIDDEN=<a;b> -P includes_none_of.cmake: fails, naming the file and
+# the line, when a source or header under DIR includes a header under one of the FORBIDDEN
+# include folders (e.g. collision/broadphase). Direct includes only: what the module's own code
+# asks for, not what the headers it may use bring in.
+if(NOT IS_DIRECTORY "${DIR}")
+  message(FATAL_ERROR "includes_none_of: no folder '${DIR}'")
+endif()
+file(GLOB_RECURSE sources "${DIR}/*.h" "${DIR}/*.cpp")
+list(LENGTH sources count)
+if(count EQUAL 0)
+  message(FATAL_ERROR "includes_none_of: no sources under '${DIR}'")
+endif()
+set(found "")
+foreach(source IN LISTS sources)
+  file(STRINGS "${source}" lines REGEX "^[ \t]*#[ \t]*include")
+  foreach(line IN LISTS lines)
+    foreach(folder IN LISTS FORBIDDEN)
+      if(line MATCHES "[<\"]${folder}/")
+        string(APPEND found "\n  ${source}: ${line}")
+      endif()
+    endforeach()
+  endforeach()
+endforeach()
+if(found)
+  message(FATAL_ERROR "includes a header of ${FORBIDDEN}:${found}")
+endif()
+message(STATUS "${count} files under ${DIR} include nothing of ${FORBIDDEN}")
