@@ -34,7 +34,7 @@ void BoxPairFinder::feed(std::span<const collision::Aabb> boxes) {
         }
         phase_ = entry->create();
         phase_->setPairOrder(collision::PairOrder::Sorted);
-        decides_on_boxes_ = entry->volume == "aabb";
+        decides_on_boxes_ = entry->volume == collision::VolumeKind::Aabb;
         inserted_ = 0;
     }
     const auto present = static_cast<std::ptrdiff_t>(std::min(inserted_, boxes.size()));

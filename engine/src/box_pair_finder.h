@@ -70,7 +70,7 @@ private:
 
     std::string name_;
     std::unique_ptr<collision::BroadPhase> phase_;
-    bool decides_on_boxes_ = true;  ///< the registry row's volume is "aabb"
+    bool decides_on_boxes_ = true;  ///< the registry row decides on AABBs
     std::size_t inserted_ = 0;      ///< proxies 0 .. inserted_ - 1 are present
     std::vector<collision::ProxyVolumes> scratch_;
     collision::BroadPhaseCounters counters_;

@@ -264,12 +264,8 @@ void SceneParser::parseDraw(const YAML::Node& n, Scene& scene) const {
             for (std::size_t i = 0; i < e.value.size(); ++i) {
                 const std::string ip = indexPath(p, i);
                 const std::string v = readString(e.value[i], ip);
-                if (v == "sphere") {
-                    d.sphere = true;
-                } else if (v == "aabb") {
-                    d.aabb = true;
-                } else if (v == "obb") {
-                    d.obb = true;
+                if (const auto kind = collision::volumeKindNamed(v)) {
+                    d.shows(*kind) = true;
                 } else if (const int k = kdopIndex(v); k >= 0) {
                     d.kdop[std::size_t(k)] = true;
                 } else {
@@ -291,10 +287,10 @@ namespace engine {
 
 bool drawOnlyVolume(DrawSettings& draw, std::string_view name) {
     const int k = scene_parsing::kdopIndex(std::string(name));
-    if (name != "sphere" && name != "aabb" && name != "obb" && k < 0) return false;
-    draw.sphere = name == "sphere";
-    draw.aabb = name == "aabb";
-    draw.obb = name == "obb";
+    const std::optional<collision::VolumeKind> kind = collision::volumeKindNamed(name);
+    if (!kind && k < 0) return false;
+    draw.sphere = draw.aabb = draw.obb = false;
+    if (kind) draw.shows(*kind) = true;
     draw.kdop = {};
     if (k >= 0) draw.kdop[std::size_t(k)] = true;
     return true;

@@ -18,34 +18,17 @@ constexpr std::string_view kFinder[] = {"sphere", "sap", "obb"};
 
 }  // namespace
 
-std::string_view volumeKindName(VolumeKind kind) {
-    switch (kind) {
-        case VolumeKind::Sphere:
-            return "sphere";
-        case VolumeKind::Aabb:
-            return "aabb";
-        case VolumeKind::Obb:
-            return "obb";
-    }
-    return "aabb";
-}
-
 std::optional<VolumeKind> broadPhaseVolume(const World& world) {
     const collision::BroadPhaseEntry* entry = collision::findBroadPhase(world.broadPhase().name());
     if (entry == nullptr) return std::nullopt;
-    for (const VolumeKind kind : kVolumeKinds) {
-        if (entry->volume == volumeKindName(kind)) return kind;
-    }
-    return std::nullopt;
+    return entry->volume;
 }
 
 DrawSettings drawSettingsFor(const DrawSettings& draw, const World& world) {
     DrawSettings out = draw;
     if (draw.volumes_given) return out;
-    const VolumeKind kind = broadPhaseVolume(world).value_or(VolumeKind::Aabb);
-    out.sphere = kind == VolumeKind::Sphere;
-    out.aabb = kind == VolumeKind::Aabb;
-    out.obb = kind == VolumeKind::Obb;
+    for (const VolumeKind kind : kVolumeKinds) out.shows(kind) = false;
+    out.shows(broadPhaseVolume(world).value_or(VolumeKind::Aabb)) = true;
     out.kdop = {};
     return out;
 }

@@ -71,10 +71,9 @@ void drawBounds(const collision::Aabb& b, WorldDraw& draw) {
 /// polytope its slabs bound (Klosowski et al. 1998).
 void drawVolumes(const World& world, const DrawSettings& show, WorldDraw& draw,
                  WorldDrawn& drawn) {
-    const bool shown[3] = {show.sphere, show.aabb, show.obb};
-    std::vector<BodyState> kind_states[3];
+    std::vector<BodyState> kind_states[std::size(kVolumeKinds)];
     for (const VolumeKind kind : kVolumeKinds) {
-        if (!shown[int(kind)]) continue;
+        if (!show.shows(kind)) continue;
         kind_states[int(kind)] = volumeOverlaps(world, kind).states;
         drawn.own_tests = drawn.own_tests || drawn.tested_volume != kind;
     }

@@ -461,7 +461,7 @@ TEST(BroadPhaseDifferential, FloatRoundingEdgesEqualTheReference) {
     // Per axis 6 touching neighbours and 5 apart ones; 19 overlapping neighbours near 1e7.
     ASSERT_EQ(ref.size(), 3u * 6 + 19);
     for (const BroadPhaseEntry& entry : testedBroadPhases()) {
-        if (entry.volume != "aabb") continue;
+        if (entry.volume != collision::VolumeKind::Aabb) continue;
         SCOPED_TRACE(std::string(entry.name));
         EXPECT_EQ(pairsOf(entry, volumes), ref);
     }

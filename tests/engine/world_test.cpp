@@ -210,7 +210,7 @@ TEST(World, EveryBroadPhaseGivesTheSameCollisionsOnARandomRun) {
     reference.setBroadPhase("brute");
     std::vector<World> others;
     for (const collision::BroadPhaseEntry& e : collision::broadPhaseRegistry()) {
-        if (e.volume != "aabb" || e.needs_render_context) continue;
+        if (e.volume != collision::VolumeKind::Aabb || e.needs_render_context) continue;
         others.push_back(randomWorld(5));
         others.back().setBroadPhase(std::string(e.name));
     }

@@ -180,9 +180,9 @@ TEST(VolumeColors, DefaultVolumeIsTheOneEachBroadPhaseTests) {
         SCOPED_TRACE(std::string(e.name));
         world.setBroadPhase(std::string(e.name));
         const engine::DrawSettings d = engine::drawSettingsFor(engine::DrawSettings{}, world);
-        EXPECT_EQ(d.sphere, e.volume == "sphere");
-        EXPECT_EQ(d.aabb, e.volume == "aabb");
-        EXPECT_EQ(d.obb, e.volume == "obb");
+        EXPECT_EQ(d.sphere, e.volume == collision::VolumeKind::Sphere);
+        EXPECT_EQ(d.aabb, e.volume == collision::VolumeKind::Aabb);
+        EXPECT_EQ(d.obb, e.volume == collision::VolumeKind::Obb);
         engine::DrawSettings chosen;
         chosen.sphere = chosen.aabb = chosen.obb = true;
         chosen.volumes_given = true;

@@ -94,7 +94,7 @@ private:
 std::vector<BenchMethodEntry> makeMethods() {
     std::vector<BenchMethodEntry> methods;
     for (const collision::BroadPhaseEntry& entry : collision::broadPhaseRegistry()) {
-        if (entry.volume != "aabb") continue;
+        if (entry.volume != collision::VolumeKind::Aabb) continue;
         // cullide only where a rendering context was installed (cdlab, not the bare bench).
         if (entry.needs_render_context && !collision::hasVisibilityOracleFactory()) continue;
         BenchMethodEntry m;

@@ -8,9 +8,9 @@ namespace collision {
 
 std::string_view BruteForceBroadPhase::name() const {
     switch (volume_) {
-        case Volume::Aabb: return "brute";
-        case Volume::Sphere: return "sphere-brute";
-        case Volume::Obb: return "obb-brute";
+        case VolumeKind::Aabb: return "brute";
+        case VolumeKind::Sphere: return "sphere-brute";
+        case VolumeKind::Obb: return "obb-brute";
     }
     return "brute";
 }
@@ -47,13 +47,13 @@ void BruteForceBroadPhase::findPairs(std::vector<ProxyPair>& pairs,
         if (table_.contains(id)) ids.push_back(id);
     }
     switch (volume_) {
-        case Volume::Aabb:
+        case VolumeKind::Aabb:
             allPairs(ids, [this](ProxyId id) { return table_.aabb(id); }, pairs);
             break;
-        case Volume::Sphere:
+        case VolumeKind::Sphere:
             allPairs(ids, [this](ProxyId id) { return table_.sphere(id); }, pairs);
             break;
-        case Volume::Obb:
+        case VolumeKind::Obb:
             allPairs(ids, [this](ProxyId id) { return table_.obb(id); }, pairs);
             break;
     }

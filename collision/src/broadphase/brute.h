@@ -3,6 +3,7 @@
 
 #include "broadphase/proxy_table.h"
 #include "collision/broadphase/broad_phase.h"
+#include "collision/volumes/volume_kind.h"
 
 namespace collision {
 
@@ -10,12 +11,11 @@ namespace collision {
 /// phase is compared against; never used for speed.
 class BruteForceBroadPhase : public BroadPhase {
 public:
-    enum class Volume { Aabb, Sphere, Obb };
-    explicit BruteForceBroadPhase(Volume volume)
+    explicit BruteForceBroadPhase(VolumeKind volume)
         : volume_(volume),
-          table_(volume == Volume::Aabb     ? ProxyTable::kAabb
-                 : volume == Volume::Sphere ? ProxyTable::kSphere
-                                            : ProxyTable::kObb) {}
+          table_(volume == VolumeKind::Aabb     ? ProxyTable::kAabb
+                 : volume == VolumeKind::Sphere ? ProxyTable::kSphere
+                                                : ProxyTable::kObb) {}
 
     std::string_view name() const override;
     void insert(ProxyId id, const ProxyVolumes& v) override { table_.insert(id, v); }
@@ -24,7 +24,7 @@ public:
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
 
 private:
-    Volume volume_;
+    VolumeKind volume_;
     ProxyTable table_;
 };
 

@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "collision/volumes/volume_kind.h"
 #include "engine/body.h"
 #include "engine/chain.h"
 #include "engine/world.h"
@@ -57,6 +58,18 @@ struct DrawSettings {
     int bvh_depth = -1;
     /// Witness points and normals of the confirmed contacts. Scene key `draw.contacts`.
     bool contacts = false;
+
+    /// The flag of one proxy volume kind: sphere, aabb or obb.
+    bool& shows(collision::VolumeKind kind) {
+        return kind == collision::VolumeKind::Sphere ? sphere
+               : kind == collision::VolumeKind::Aabb ? aabb
+                                                     : obb;
+    }
+    bool shows(collision::VolumeKind kind) const {
+        return kind == collision::VolumeKind::Sphere ? sphere
+               : kind == collision::VolumeKind::Aabb ? aabb
+                                                     : obb;
+    }
 };
 
 /// A frame or an inclusive frame range [first, last] of a run (frame 0 is the initial state).

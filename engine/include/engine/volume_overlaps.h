@@ -11,18 +11,15 @@
 
 #include "collision/broadphase/broad_phase.h"
 #include "collision/volumes/kdop_volume.h"
+#include "collision/volumes/volume_kind.h"
 #include "engine/scene.h"
 #include "engine/world.h"
 
 namespace engine {
 
-/// The bounding volumes a body has (collision::ProxyVolumes).
-enum class VolumeKind : std::uint8_t { Sphere, Aabb, Obb };
-inline constexpr VolumeKind kVolumeKinds[] = {VolumeKind::Sphere, VolumeKind::Aabb,
-                                              VolumeKind::Obb};
-
-/// "sphere", "aabb", "obb": the names of the registry's volume column and of `draw.volumes`.
-std::string_view volumeKindName(VolumeKind kind);
+using collision::kVolumeKinds;
+using collision::VolumeKind;
+using collision::volumeKindName;
 
 /// The volume the world's broad phase decides on (BroadPhaseEntry::volume); nullopt for a
 /// broad phase that is not in the registry.

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "collision/volumes/bounding_volumes.h"
+#include "collision/volumes/volume_kind.h"
 
 namespace collision {
 
@@ -121,7 +122,7 @@ public:
 struct BroadPhaseEntry {
     std::string_view name;
     std::string_view description;
-    std::string_view volume;     ///< "aabb", "sphere" or "obb": the volume it decides on
+    VolumeKind volume;           ///< the volume it decides on
     std::string_view reference;  ///< name of the brute-force broad phase it must equal
     std::unique_ptr<BroadPhase> (*create)();
     int threads = 1;  ///< threads it runs on (timing it by thread CPU time needs 1)
