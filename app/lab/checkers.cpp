@@ -16,9 +16,9 @@
 #include "collision/broadphase/broad_phase.h"
 #include "output_files.h"
 #include "pause_dump.h"
+#include "engine/volume_overlaps.h"
 #include "engine/world_draw.h"
 #include "render/image.h"
-#include "engine/volume_overlaps.h"
 
 namespace app {
 

@@ -25,6 +25,7 @@
 #include "broadphase_check.h"
 #include "collision/broadphase/broad_phase.h"
 #include "engine/scene.h"
+#include "engine/volume_overlaps.h"
 #include "exit_codes.h"
 #include "html_page.h"
 #include "output_files.h"
@@ -33,7 +34,6 @@
 #include "render/image.h"
 #include "render/output_file.h"
 #include "render/renderer.h"
-#include "engine/volume_overlaps.h"
 #include "run_html.h"
 
 namespace app {

@@ -9,8 +9,8 @@
 
 #include "collision/debug_draw.h"
 #include "engine/world.h"
-#include "pixel_checks.h"
 #include "engine/world_draw.h"
+#include "pixel_checks.h"
 #include "render/renderer.h"
 
 namespace {

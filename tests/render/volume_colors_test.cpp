@@ -8,11 +8,11 @@
 
 #include "collision/broadphase/broad_phase.h"
 #include "engine/scene.h"
-#include "engine/world.h"
-#include "pixel_checks.h"
-#include "engine/world_draw.h"
-#include "render/renderer.h"
 #include "engine/volume_overlaps.h"
+#include "engine/world.h"
+#include "engine/world_draw.h"
+#include "pixel_checks.h"
+#include "render/renderer.h"
 
 namespace {
 
