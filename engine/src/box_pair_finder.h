@@ -12,6 +12,7 @@
 
 #include "collision/broadphase/broad_phase.h"
 #include "engine/body.h"
+#include "engine/clone_ptr.h"
 
 namespace engine {
 
@@ -33,6 +34,8 @@ public:
     /// An instance of registry broad phase `name` (created at the first find()); throws
     /// std::invalid_argument then if the name is unknown.
     explicit BoxPairFinder(std::string name) : name_(std::move(name)) {}
+    /// A copy with the same proxies and coherence state (BroadPhase::clone).
+    std::unique_ptr<BoxPairFinder> clone() const { return std::make_unique<BoxPairFinder>(*this); }
 
     /// Drops the instance and its proxies: the next find() builds `name` from the boxes it
     /// gets (switching broad phase between steps).
@@ -69,7 +72,7 @@ private:
     void feed(std::span<const collision::Aabb> boxes);
 
     std::string name_;
-    std::unique_ptr<collision::BroadPhase> phase_;
+    ClonePtr<collision::BroadPhase> phase_;
     bool decides_on_boxes_ = true;  ///< the registry row decides on AABBs
     std::size_t inserted_ = 0;      ///< proxies 0 .. inserted_ - 1 are present
     std::vector<collision::ProxyVolumes> scratch_;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -60,6 +61,8 @@ struct ContactSolverSettings {
 /// One frame's worth of contact constraints with warm starting across frames.
 class ContactSolver {
 public:
+    /// A copy with the same warm starts and scratch (World::snapshot).
+    std::unique_ptr<ContactSolver> clone() const { return std::make_unique<ContactSolver>(*this); }
     /// Builds the constraints of the candidate `pairs` (sorted; touching, penetrating, or closer
     /// than the margin: speculative) and of the bodies near `walls` (`wall_candidates` sorted
     /// by wall, then body; each wall a static body of restitution and friction of its own) at

@@ -200,6 +200,35 @@ World::World(WorldSettings settings)
 World::~World() = default;
 World::World(World&&) noexcept = default;
 World& World::operator=(World&&) noexcept = default;
+World::World(const World&) = default;
+World& World::operator=(const World&) = default;
+
+Real WorldSnapshot::time() const { return world_ ? world_->time() : Real(0); }
+std::int64_t WorldSnapshot::steps() const { return world_ ? world_->stepCount() : 0; }
+
+WorldSnapshot World::snapshot() const {
+    auto copy = std::shared_ptr<World>(new World(*this));
+    copy->ownDeformingGeometry();
+    WorldSnapshot out;
+    out.world_ = std::move(copy);
+    return out;
+}
+
+void World::restore(const WorldSnapshot& snapshot) {
+    if (snapshot.empty()) throw std::invalid_argument("restore: the snapshot is empty");
+    *this = *snapshot.world_;
+    ownDeformingGeometry();
+}
+
+void World::ownDeformingGeometry() {
+    for (DeformingMesh& d : deforming_) {
+        d.mesh = std::make_shared<collision::TriangleMesh>(*d.mesh);
+        d.bvh = std::shared_ptr<collision::MeshBvh>(d.bvh->clone());
+        Body& body = bodies_[static_cast<std::size_t>(d.body)];
+        body.shape.mesh = d.mesh;
+        body.shape.bvh = d.bvh;
+    }
+}
 
 BodyId World::addBody(Body body) {
     const BodyId id = static_cast<BodyId>(bodies_.size());

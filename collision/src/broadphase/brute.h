@@ -1,6 +1,8 @@
 // collision/src/broadphase/brute.h -- the references: every pair tested, O(n^2).
 #pragma once
 
+#include <memory>
+
 #include "broadphase/proxy_table.h"
 #include "collision/broadphase/broad_phase.h"
 #include "collision/volumes/volume_kind.h"
@@ -18,6 +20,9 @@ public:
                                                 : ProxyTable::kObb) {}
 
     std::string_view name() const override;
+    std::unique_ptr<BroadPhase> clone() const override {
+        return std::make_unique<BruteForceBroadPhase>(*this);
+    }
     void insert(ProxyId id, const ProxyVolumes& v) override { table_.insert(id, v); }
     void remove(ProxyId id) override { table_.remove(id); }
     void move(ProxyId id, const ProxyVolumes& v) override { table_.move(id, v); }

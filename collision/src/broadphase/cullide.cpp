@@ -57,7 +57,10 @@ bool hasVisibilityOracleFactory() {
     return static_cast<bool>(factory());
 }
 
-std::unique_ptr<BroadPhase> createCullide() {
+namespace {
+
+/// An oracle from the installed factory; throws BroadPhaseUnavailable when there is none.
+std::unique_ptr<VisibilityOracle> installedOracle() {
     VisibilityOracleFactory f;
     {
         std::lock_guard<std::mutex> lock(factoryMutex());
@@ -68,7 +71,27 @@ std::unique_ptr<BroadPhase> createCullide() {
             "broad phase 'cullide' renders the bodies with OpenGL occlusion queries and needs the "
             "render module's OSMesa context; none was installed in this process");
     }
-    return std::make_unique<CullideBroadPhase>(f());
+    return f();
+}
+
+}  // namespace
+
+std::unique_ptr<BroadPhase> createCullide() {
+    return std::make_unique<CullideBroadPhase>(installedOracle());
+}
+
+CullideBroadPhase::CullideBroadPhase(const CullideBroadPhase& other)
+    : RebuildingBroadPhase(other),
+      oracle_(installedOracle()),
+      ids_(other.ids_),
+      ndc_(other.ndc_),
+      ordered_(other.ordered_),
+      forward_(other.forward_),
+      backward_(other.backward_),
+      pcs_(other.pcs_) {}
+
+std::unique_ptr<BroadPhase> CullideBroadPhase::clone() const {
+    return std::unique_ptr<BroadPhase>(new CullideBroadPhase(*this));
 }
 
 CullideBroadPhase::CullideBroadPhase(std::unique_ptr<VisibilityOracle> oracle)

@@ -18,6 +18,7 @@ public:
     explicit CullideBroadPhase(std::unique_ptr<VisibilityOracle> oracle);
 
     std::string_view name() const override { return "cullide"; }
+    std::unique_ptr<BroadPhase> clone() const override;
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
 
     /// Proxies left in the potentially colliding set by the last findPairs, ascending.
@@ -27,6 +28,8 @@ public:
     }
 
 private:
+    /// The same proxies and scratch with an oracle of its own from the installed factory.
+    CullideBroadPhase(const CullideBroadPhase& other);
     void pruneAlong(int axis, std::vector<char>& pruned);
 
     std::unique_ptr<VisibilityOracle> oracle_;

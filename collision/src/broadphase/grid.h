@@ -1,6 +1,7 @@
 // collision/src/broadphase/grid.h -- uniform grid and spatial hash.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "broadphase/cells.h"
@@ -27,6 +28,9 @@ public:
     explicit GridBroadPhase(Mode mode) : mode_(mode) {}
 
     std::string_view name() const override { return mode_ == Mode::Dense ? "grid" : "hash"; }
+    std::unique_ptr<BroadPhase> clone() const override {
+        return std::make_unique<GridBroadPhase>(*this);
+    }
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
     void draw(DebugDraw& draw, const Aabb& bounds) const override;
 

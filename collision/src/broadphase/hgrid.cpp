@@ -68,7 +68,7 @@ using YzTest = YzTestOf<Real>;
 }  // namespace
 
 HierarchicalGrid::HierarchicalGrid(bool two_threads, PairOrder order) : pair_order_(order) {
-    if (two_threads) helper_ = std::make_unique<HelperThread>();
+    if (two_threads) helper_ = HelperSlot(true);
 }
 
 HierarchicalGrid::~HierarchicalGrid() = default;

@@ -60,6 +60,9 @@ public:
     explicit HierarchicalGrid(bool two_threads = false, PairOrder order = PairOrder::Sorted);
     ~HierarchicalGrid() override;
     std::string_view name() const override { return helper_ ? "hgrid2" : "hgrid"; }
+    std::unique_ptr<BroadPhase> clone() const override {
+        return std::make_unique<HierarchicalGrid>(*this);
+    }
     void insert(ProxyId id, const ProxyVolumes& v) override;
     void insertMany(ProxyId first, std::span<const ProxyVolumes> v) override;
     void insertBoxes(ProxyId first, std::span<const Aabb> boxes) override;
@@ -181,11 +184,35 @@ private:
     int id_shift_ = 1;                    // bits per id in a packed pair key
     std::vector<Entry> entries_;
     std::vector<std::size_t> chunks_;  // flat column index where each sweep chunk starts, + end
-    std::atomic<std::size_t> next_chunk_{0};
+    /// The next sweep chunk a lane takes; a copy of the grid starts from the same count.
+    struct ChunkCounter : std::atomic<std::size_t> {
+        ChunkCounter() : std::atomic<std::size_t>(0) {}
+        ChunkCounter(const ChunkCounter& other) : std::atomic<std::size_t>(other.load()) {}
+        ChunkCounter& operator=(const ChunkCounter& other) {
+            store(other.load());
+            return *this;
+        }
+    };
+    ChunkCounter next_chunk_;
     std::array<Lane, 2> lanes_;
     int lane_count_ = 1;
     PairOrder pair_order_;
-    std::unique_ptr<HelperThread> helper_;
+    /// hgrid2's helper thread (none for hgrid): a copy of the grid gets a thread of its own.
+    struct HelperSlot {
+        std::unique_ptr<HelperThread> thread;
+        HelperSlot() = default;
+        explicit HelperSlot(bool on) : thread(on ? std::make_unique<HelperThread>() : nullptr) {}
+        HelperSlot(const HelperSlot& other) : HelperSlot(other.thread != nullptr) {}
+        HelperSlot(HelperSlot&&) noexcept = default;
+        HelperSlot& operator=(const HelperSlot& other) {
+            if (this != &other) *this = HelperSlot(other);
+            return *this;
+        }
+        HelperSlot& operator=(HelperSlot&&) noexcept = default;
+        HelperThread* operator->() const { return thread.get(); }
+        explicit operator bool() const { return thread != nullptr; }
+    };
+    HelperSlot helper_;
 };
 
 }  // namespace collision

@@ -1,6 +1,7 @@
 // collision/src/broadphase/obb.h -- OBB broad phase: an AABB sweep, then the separating axes.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "broadphase/proxy_table.h"
@@ -17,6 +18,9 @@ public:
     ObbBroadPhase() : RebuildingBroadPhase(ProxyTable::kObb) {}
 
     std::string_view name() const override { return "obb"; }
+    std::unique_ptr<BroadPhase> clone() const override {
+        return std::make_unique<ObbBroadPhase>(*this);
+    }
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
 
 private:

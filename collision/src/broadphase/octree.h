@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <vector>
 
 #include "broadphase/proxy_table.h"
@@ -18,6 +19,9 @@ namespace collision {
 class LooseOctree : public RebuildingBroadPhase {
 public:
     std::string_view name() const override { return "octree"; }
+    std::unique_ptr<BroadPhase> clone() const override {
+        return std::make_unique<LooseOctree>(*this);
+    }
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
     void draw(DebugDraw& draw, const Aabb& bounds) const override;
 

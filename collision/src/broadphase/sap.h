@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "broadphase/pair_set.h"
@@ -20,6 +21,9 @@ namespace collision {
 class SweepAndPrune : public BroadPhase {
 public:
     std::string_view name() const override { return "sap"; }
+    std::unique_ptr<BroadPhase> clone() const override {
+        return std::make_unique<SweepAndPrune>(*this);
+    }
     void insert(ProxyId id, const ProxyVolumes& v) override;
     void remove(ProxyId id) override;
     void move(ProxyId id, const ProxyVolumes& v) override;

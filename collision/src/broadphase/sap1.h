@@ -1,6 +1,7 @@
 // collision/src/broadphase/sap1.h -- single-axis sort and sweep on the axis of greatest spread.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "broadphase/proxy_table.h"
@@ -16,6 +17,9 @@ namespace collision {
 class SortAndSweep1 : public BroadPhase {
 public:
     std::string_view name() const override { return "sap1"; }
+    std::unique_ptr<BroadPhase> clone() const override {
+        return std::make_unique<SortAndSweep1>(*this);
+    }
     void insert(ProxyId id, const ProxyVolumes& v) override;
     void remove(ProxyId id) override;
     void move(ProxyId id, const ProxyVolumes& v) override;

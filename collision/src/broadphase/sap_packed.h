@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #if defined(__SSE2__)
@@ -55,6 +56,9 @@ public:
     explicit PackedSweepAndPrune(Output output = Output::Exact) : output_(output) {}
     std::string_view name() const override {
         return output_ == Output::Loose ? "sap-packed-loose" : "sap-packed";
+    }
+    std::unique_ptr<BroadPhase> clone() const override {
+        return std::make_unique<PackedSweepAndPrune>(*this);
     }
     void insert(ProxyId id, const ProxyVolumes& v) override;
     void insertMany(ProxyId first, std::span<const ProxyVolumes> v) override;

@@ -1,6 +1,7 @@
 // collision/src/broadphase/sphere.h -- bounding spheres, pruned by one sort along x.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "broadphase/proxy_table.h"
@@ -16,6 +17,9 @@ public:
     SphereBroadPhase() : RebuildingBroadPhase(ProxyTable::kSphere) {}
 
     std::string_view name() const override { return "sphere"; }
+    std::unique_ptr<BroadPhase> clone() const override {
+        return std::make_unique<SphereBroadPhase>(*this);
+    }
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
 
 private:

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -20,6 +21,9 @@ namespace collision {
 class DynamicAabbTree : public BroadPhase {
 public:
     std::string_view name() const override { return "tree"; }
+    std::unique_ptr<BroadPhase> clone() const override {
+        return std::make_unique<DynamicAabbTree>(*this);
+    }
     void insert(ProxyId id, const ProxyVolumes& v) override;
     void remove(ProxyId id) override;
     void move(ProxyId id, const ProxyVolumes& v) override;

@@ -22,6 +22,7 @@ class MeshBvhOf final : public MeshBvh {
 public:
     MeshBvhOf(const TriangleMesh& mesh, const BvhBuildOptions& options) : tree_(mesh, options) {}
     const Bvh<BV>& tree() const { return tree_; }
+    std::unique_ptr<MeshBvh> clone() const override { return std::make_unique<MeshBvhOf>(*this); }
     std::string_view volumeName() const override { return BvName<BV>::value; }
     std::int32_t nodeCount() const override {
         return static_cast<std::int32_t>(tree_.nodes().size());
@@ -98,6 +99,7 @@ class MeshBvhWide final : public MeshBvh {
 public:
     MeshBvhWide(const TriangleMesh& mesh, const BvhBuildOptions& options) : tree_(mesh, options) {}
     const WideObbTree& tree() const { return tree_; }
+    std::unique_ptr<MeshBvh> clone() const override { return std::make_unique<MeshBvhWide>(*this); }
     std::string_view volumeName() const override { return kWideObbName; }
     std::int32_t nodeCount() const override {
         return static_cast<std::int32_t>(tree_.nodes().size());

@@ -18,6 +18,7 @@
 #include "collision/volumes/bounding_volumes.h"
 #include "engine/body.h"
 #include "engine/chain.h"
+#include "engine/clone_ptr.h"
 
 namespace engine {
 
@@ -190,6 +191,25 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+class World;
+
+/// A world's whole state between two steps (World::snapshot): bodies, time and step count, the
+/// broad phase with its coherence state, the contact and continuous stages' pair finders, the
+/// solver's warm starts, the chains' clocks, the deforming meshes and their hierarchies, the last
+/// step's pairs, states, events and counters. Immutable; copies share it.
+class WorldSnapshot {
+public:
+    /// Holds nothing: World::restore refuses it.
+    WorldSnapshot() = default;
+    bool empty() const { return world_ == nullptr; }
+    Real time() const;          ///< the world's time() when taken
+    std::int64_t steps() const;  ///< the world's stepCount() when taken
+
+private:
+    friend class World;
+    std::shared_ptr<const World> world_;
+};
+
 class World {
 public:
     /// Throws std::invalid_argument when the broad phase name is unknown.
@@ -197,6 +217,15 @@ public:
     ~World();
     World(World&&) noexcept;
     World& operator=(World&&) noexcept;
+
+    /// The whole state now, between steps. restore() of it and then step() give bit-identical
+    /// states, pairs, results and counters (so frames and HUDs) to never having stopped. Costs a
+    /// copy of every body, volume, broad-phase structure and stage's scratch.
+    WorldSnapshot snapshot() const;
+    /// Puts this world in the state `snapshot` holds (taken of this world, or of another made
+    /// from the same scene: it replaces everything, settings and bodies too). Throws
+    /// std::invalid_argument for an empty snapshot.
+    void restore(const WorldSnapshot& snapshot);
 
     BodyId addBody(Body body);
     /// Adds a chain whose links are bodies already added (ChainSpec::links, each in one chain
@@ -276,6 +305,11 @@ public:
     void drawChainSkeletons(collision::DebugDraw& draw, const collision::Color& color) const;
 
 private:
+    // Copies are snapshots' business: a plain copy would share the deforming meshes, which a step
+    // changes in place (ownDeformingGeometry gives the copy its own).
+    World(const World&);
+    World& operator=(const World&);
+    void ownDeformingGeometry();
     void integrate(Real dt, const Vec3& gravity);
     void integrateExplicitEuler(Real dt, const Vec3& gravity);
     void integrateSemiImplicitEuler(Real dt, const Vec3& gravity);
@@ -303,7 +337,7 @@ private:
     std::vector<BodyState> states_;
     std::vector<collision::ProxyPair> flagged_;
     std::vector<collision::ProxyPair> colliding_;
-    std::unique_ptr<collision::BroadPhase> broad_phase_;
+    ClonePtr<collision::BroadPhase> broad_phase_;
     // Continuous stage scratch, reused across steps (no per-step allocation once warm).
     struct SweptBody {
         collision::Sweep sweep;
@@ -348,7 +382,7 @@ private:
     std::vector<Vec3> step_spin_;
     std::vector<SweptBody> swept_;
     std::vector<collision::Aabb> swept_boxes_;  ///< swept_[i].box, contiguous for ccd_finder_
-    std::unique_ptr<BoxPairFinder> ccd_finder_;  ///< only with ccd on
+    ClonePtr<BoxPairFinder> ccd_finder_;  ///< only with ccd on
     std::vector<collision::ProxyPair> ccd_pairs_;
     std::vector<ToiEvent> toi_events_;
     std::vector<std::vector<collision::TrianglePair>> self_pairs_;  ///< per body
@@ -365,9 +399,9 @@ private:
     std::vector<DeformingMesh> deforming_;
     void addDeforming(BodyId id);            // addBody of a deforming mesh body: its own geometry
     void deformBody(DeformingMesh& d);       // vertices at time_, refit or rebuild, hull, bounds
-    std::unique_ptr<ContactSolver> solver_;  ///< only with response: impulse
+    ClonePtr<ContactSolver> solver_;  ///< only with response: impulse
     std::vector<collision::Aabb> grown_;
-    std::unique_ptr<BoxPairFinder> response_finder_;  ///< only with response: impulse
+    ClonePtr<BoxPairFinder> response_finder_;  ///< only with response: impulse
     std::vector<collision::ProxyPair> response_pairs_;
     std::vector<Wall> walls_;  ///< the faces of the bounds, for the solver (response: impulse)
     std::vector<WallCandidate> wall_candidates_;

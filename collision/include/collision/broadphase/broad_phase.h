@@ -77,6 +77,10 @@ public:
 
     /// Registry name ("brute", "sphere", "sap", ...).
     virtual std::string_view name() const = 0;
+    /// A copy holding the same proxies and the same coherence state (orders, fat boxes, trees,
+    /// levels, pair order): the same calls on the two give the same pairs and counters. What
+    /// World::snapshot keeps; a copy of a broad phase running on threads gets threads of its own.
+    virtual std::unique_ptr<BroadPhase> clone() const = 0;
     /// Adds a proxy. `id` must not be present; ids need not be dense but should be small.
     virtual void insert(ProxyId id, const ProxyVolumes& volumes) = 0;
     /// Adds proxies first, first + 1, ..., one per entry of `volumes`, as insert() called for

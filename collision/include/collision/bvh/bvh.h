@@ -259,6 +259,8 @@ public:
 class MeshBvh {
 public:
     virtual ~MeshBvh() = default;
+    /// A copy of the tree (a deforming mesh's, kept by World::snapshot), refitted apart from it.
+    virtual std::unique_ptr<MeshBvh> clone() const = 0;
     virtual std::string_view volumeName() const = 0;
     virtual std::int32_t nodeCount() const = 0;
     virtual int depth() const = 0;
