@@ -21,7 +21,7 @@
 #include "collision/ccd/ccd.h"
 #include "collision/narrowphase/narrow_phase.h"
 #include "box_pair_finder.h"
-#include "contact_solver.h"
+#include "response_stage.h"
 #include "stage_clock.h"
 
 namespace engine {
@@ -180,20 +180,7 @@ World::World(WorldSettings settings)
         ccd_finder_ = std::make_unique<BoxPairFinder>(settings_.broad_phase);
     }
     if (settings_.response == Response::Impulse) {
-        solver_ = std::make_unique<ContactSolver>();
-        response_finder_ = std::make_unique<BoxPairFinder>(settings_.broad_phase);
-        // The six faces of the bounds, solid outside: -x, +x, -y, +y, -z, +z.
-        for (int k = 0; k < 3; ++k) {
-            for (const Real side : {Real(-1), Real(1)}) {
-                Wall w;
-                w.plane.normal = Vec3::Zero();
-                w.plane.normal[k] = -side;  // out of the solid, into the world
-                w.plane.offset = side < 0 ? settings_.bounds.min[k] : -settings_.bounds.max[k];
-                w.restitution = settings_.restitution;
-                w.friction = settings_.friction;
-                walls_.push_back(w);
-            }
-        }
+        response_ = std::make_unique<ResponseStage>(settings_);
     }
 }
 
@@ -201,6 +188,10 @@ World::~World() = default;
 World::World(World&&) noexcept = default;
 World& World::operator=(World&&) noexcept = default;
 World::World(const World&) = default;
+
+std::span<const collision::ProxyPair> World::pushedPairs() const {
+    return response_ ? response_->pushedPairs() : std::span<const collision::ProxyPair>{};
+}
 World& World::operator=(const World&) = default;
 
 Real WorldSnapshot::time() const { return world_ ? world_->time() : Real(0); }
@@ -252,7 +243,7 @@ void World::setBroadPhase(const std::string& name) {
     settings_.broad_phase = name;
     proxies_inserted_ = false;
     if (ccd_finder_) ccd_finder_->reset(name);
-    if (response_finder_) response_finder_->reset(name);
+    if (response_) response_->reset(name);
 }
 
 void World::integrate(Real dt, const Vec3& gravity) {
@@ -377,37 +368,6 @@ void World::integrateRk4(Real dt, const Vec3& gravity) {
     }
 }
 
-void World::findResponsePairs(Real margin_fraction) {
-    // The AABBs of the last detection grown by margin_fraction times each body's bounding
-    // radius (the exact AABBs of resting bodies barely touch, and lose their pair the moment the
-    // solver lifts one by a hair), paired by the scene's broad phase. Output sorted, a < b.
-    const std::size_t n = bodies_.size();
-    grown_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-        const Body& b = bodies_[i];
-        const Real r = b.local_bounds.sphere.center.norm() + b.local_bounds.sphere.radius;
-        grown_[i].min = volumes_[i].aabb.min - Vec3::Constant(margin_fraction * r);
-        grown_[i].max = volumes_[i].aabb.max + Vec3::Constant(margin_fraction * r);
-    }
-    response_finder_->find(
-        grown_,
-        [this](BodyId i, BodyId j) { return !(bodies_[i].is_static && bodies_[j].is_static); },
-        response_pairs_);
-    // Bodies whose grown AABB reaches a face of the bounds, by wall then body.
-    wall_candidates_.clear();
-    for (std::uint32_t w = 0; w < walls_.size(); ++w) {
-        const int k = static_cast<int>(w / 2);
-        const bool low = w % 2 == 0;
-        for (std::size_t i = 0; i < n; ++i) {
-            if (bodies_[i].is_static) continue;
-            if (low ? grown_[i].min[k] <= settings_.bounds.min[k]
-                    : grown_[i].max[k] >= settings_.bounds.max[k]) {
-                wall_candidates_.push_back({w, static_cast<BodyId>(i)});
-            }
-        }
-    }
-}
-
 void World::reflectOffBounds() {
     // The coursework's "reflect objects off the edge of the scene" (response: none): a body
     // whose exact world AABB crosses a face of the bounds while moving outward has that velocity
@@ -441,7 +401,7 @@ void World::reflectOffBounds() {
             folded = true;
         }
         if (folded) updateVolume(i);
-        if (solver_) continue;
+        if (response_) continue;
         const collision::Aabb& box = volumes_[i].aabb;
         for (int k = 0; k < 3; ++k) {
             const Real p = b.linear_momentum[k];
@@ -536,21 +496,13 @@ void World::step() {
         for (std::size_t i = 0; i < bodies_.size(); ++i) step_start_[i] = bodies_[i].pose();
     }
     const Real dt = settings_.time_step;
-    if (solver_) {
+    if (response_) {
         // Impulse response: gravity as a velocity kick, then the contact solver on the pairs
         // whose AABBs, grown by the speculative margin, overlap (touching, penetrating or close),
         // then the integrator moves the bodies with the solved velocities (no further gravity).
-        for (Body& b : bodies_) {
-            if (!b.is_static) b.linear_momentum += b.mass * settings_.gravity * dt;
-        }
-        t = Clock::now();
-        const ContactSolverSettings solver_settings;
-        findResponsePairs(solver_settings.margin_fraction);
-        solver_->solve(bodies_, response_pairs_, walls_, wall_candidates_, dt, solver_settings,
-                       pseudo_linear_, pseudo_angular_);
+        response_->solve(bodies_, volumes_, settings_, dt);
         stats_.response_s = secondsSince(t);
-        stats_.contact_points = solver_->pointCount();
-        solver_->pushedPairs(pushed_);
+        stats_.contact_points = response_->pointCount();
         t = Clock::now();
         integrate(dt, Vec3::Zero());
     } else {
@@ -567,23 +519,7 @@ void World::step() {
         resolveContinuous();
         stats_.ccd_s = secondsSince(t);
     }
-    if (solver_) {
-        // Split-impulse position correction: this step's pseudo velocities move the bodies;
-        // the momenta are not changed by them (L is only turned along with the body).
-        for (std::size_t i = 0; i < bodies_.size(); ++i) {
-            Body& b = bodies_[i];
-            if (b.is_static) continue;
-            b.position += pseudo_linear_[i] * dt;
-            const Vec3 turn = pseudo_angular_[i] * dt;
-            const Real angle = turn.norm();
-            if (angle > 0) {
-                // L turns with the body, so the correction leaves 1/2 L.I^-1 L unchanged.
-                const Quat r(Eigen::AngleAxis<Real>(angle, turn / angle));
-                b.orientation = (r * b.orientation).normalized();
-                b.angular_momentum = r * b.angular_momentum;
-            }
-        }
-    }
+    if (response_) response_->correctPositions(bodies_, dt);  // split-impulse correction
 
     checkFiniteState();
     stats_.refit_nodes = 0;

@@ -168,9 +168,7 @@ struct StepStats {
 };
 
 class BoxPairFinder;
-class ContactSolver;
-struct Wall;
-struct WallCandidate;
+class ResponseStage;
 
 /// Colours and sizes of World::drawHierarchyLevels and World::drawContacts: the caller's palette.
 struct ContactDrawStyle {
@@ -257,7 +255,7 @@ public:
     std::span<const collision::ProxyPair> collidingPairs() const { return colliding_; }
     /// Pairs the contact solver pushed apart in the last step (a positive normal impulse, which
     /// includes speculative contacts that had not touched yet), sorted; empty without response.
-    std::span<const collision::ProxyPair> pushedPairs() const { return pushed_; }
+    std::span<const collision::ProxyPair> pushedPairs() const;
     const collision::BroadPhase& broadPhase() const { return *broad_phase_; }
     const StepStats& lastStats() const { return stats_; }
     /// Times of impact acted on in the last step, sorted by (t, a, b); empty when ccd is off.
@@ -324,7 +322,6 @@ private:
     void queryTimesOfImpact();
     void stopAtImpacts();
     void applyImpactImpulses();
-    void findResponsePairs(Real margin_fraction);
     void runCollisionPipeline();
     void findSelfPairs();  // self_collision mesh bodies: self_pairs_ and stats_
     /// Derives the contact details of the colliding pairs of two convex shapes and/or of the
@@ -399,15 +396,7 @@ private:
     std::vector<DeformingMesh> deforming_;
     void addDeforming(BodyId id);            // addBody of a deforming mesh body: its own geometry
     void deformBody(DeformingMesh& d);       // vertices at time_, refit or rebuild, hull, bounds
-    ClonePtr<ContactSolver> solver_;  ///< only with response: impulse
-    std::vector<collision::Aabb> grown_;
-    ClonePtr<BoxPairFinder> response_finder_;  ///< only with response: impulse
-    std::vector<collision::ProxyPair> response_pairs_;
-    std::vector<Wall> walls_;  ///< the faces of the bounds, for the solver (response: impulse)
-    std::vector<WallCandidate> wall_candidates_;
-    std::vector<collision::ProxyPair> pushed_;
-    std::vector<Vec3> pseudo_linear_;
-    std::vector<Vec3> pseudo_angular_;
+    ClonePtr<ResponseStage> response_;  ///< only with response: impulse
     StepStats stats_;
     // contactDetails(): derived on request, dropped by the next collision pipeline run.
     mutable std::vector<collision::PairContacts> details_;
