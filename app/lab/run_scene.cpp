@@ -73,6 +73,8 @@ struct FrameStats {
     std::int64_t toi_queries = 0;
     std::int64_t toi_iterations = 0;
     std::int64_t toi_events = 0;
+    std::int64_t response_pairs = 0, response_volume_tests = 0;
+    std::int64_t ccd_pairs = 0, ccd_volume_tests = 0;
     double refit_s = 0;
     double integrate_s = 0, volumes_s = 0, broad_s = 0, narrow_s = 0, ccd_s = 0, response_s = 0,
            total_s = 0;
@@ -90,6 +92,10 @@ struct FrameStats {
         toi_queries += s.toi_queries;
         toi_iterations += s.toi_iterations;
         toi_events += s.toi_events;
+        response_pairs += s.response_pairs;
+        response_volume_tests += s.response_broad.volume_tests;
+        ccd_pairs += s.ccd_pairs;
+        ccd_volume_tests += s.ccd_broad.volume_tests;
         refit_s += s.refit_s;
         integrate_s += s.integrate_s;
         volumes_s += s.volumes_s;
@@ -105,7 +111,8 @@ constexpr const char* kStatsHeader =
     "frame,time,broadphase,bodies,flagged,colliding,volume_tests,volumes_updated,swaps,"
     "narrow_tests,triangle_tests,bv_tests,integrate_ms,volumes_ms,broadphase_ms,narrowphase_ms,"
     "ccd_ms,response_ms,step_ms,self_pairs,refit_nodes,refit_ms,refit_node_ns,rebuilds,"
-    "toi_queries,toi_iterations,toi_events\n";
+    "toi_queries,toi_iterations,toi_events,response_pairs,response_volume_tests,ccd_pairs,"
+    "ccd_volume_tests\n";
 
 // Intersecting triangle pairs within self_collision mesh bodies at the current state.
 std::int64_t selfPairCount(const engine::World& world) {
@@ -120,7 +127,7 @@ std::string statsRow(int frame, const engine::World& world, const FrameStats& f)
     char line[512];
     std::snprintf(line, sizeof line,
                   "%d,%.9g,%s,%zu,%zu,%zu,%lld,%lld,%lld,%lld,%lld,%lld,%.6f,%.6f,%.6f,%.6f,%.6f,"
-                  "%.6f,%.6f,%lld,%lld,%.6f,%.3f,%lld,%lld,%lld,%lld\n",
+                  "%.6f,%.6f,%lld,%lld,%.6f,%.3f,%lld,%lld,%lld,%lld,%lld,%lld,%lld,%lld\n",
                   frame, double(world.time()), std::string(world.broadPhase().name()).c_str(),
                   world.bodies().size(), world.flaggedPairs().size(), world.collidingPairs().size(),
                   (long long)f.broad.volume_tests, (long long)f.broad.volumes_updated,
@@ -130,7 +137,9 @@ std::string statsRow(int frame, const engine::World& world, const FrameStats& f)
                   (long long)selfPairCount(world), (long long)f.refit_nodes, 1e3 * f.refit_s,
                   f.refit_nodes > 0 ? 1e9 * f.refit_s / double(f.refit_nodes) : 0.0,
                   (long long)f.rebuilds, (long long)f.toi_queries,
-                  (long long)f.toi_iterations, (long long)f.toi_events);
+                  (long long)f.toi_iterations, (long long)f.toi_events,
+                  (long long)f.response_pairs, (long long)f.response_volume_tests,
+                  (long long)f.ccd_pairs, (long long)f.ccd_volume_tests);
     return line;
 }
 

@@ -39,6 +39,9 @@ public:
 
     /// Contact points solved in the last step.
     int pointCount() const { return solver_.pointCount(); }
+    /// The pair finder's counters and the candidate pairs of the last step.
+    const collision::BroadPhaseCounters& pairCounters() const { return finder_.counters(); }
+    std::int64_t pairCount() const { return std::int64_t(pairs_.size()); }
     /// Pairs the solver pushed apart in the last step (World::pushedPairs).
     std::span<const collision::ProxyPair> pushedPairs() const { return pushed_; }
 

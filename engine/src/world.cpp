@@ -503,6 +503,8 @@ void World::step() {
         response_->solve(bodies_, volumes_, settings_, dt);
         stats_.response_s = secondsSince(t);
         stats_.contact_points = response_->pointCount();
+        stats_.response_broad = response_->pairCounters();
+        stats_.response_pairs = response_->pairCount();
         t = Clock::now();
         integrate(dt, Vec3::Zero());
     } else {

@@ -75,6 +75,8 @@ void World::resolveContinuous() {
             return (swept_[i].moving || swept_[j].moving) && pairAllowed(i, j);
         },
         ccd_pairs_);
+    stats_.ccd_broad = ccd_finder_->counters();
+    stats_.ccd_pairs = static_cast<std::int64_t>(ccd_pairs_.size());
     queryTimesOfImpact();
     stopAtImpacts();
     applyImpactImpulses();

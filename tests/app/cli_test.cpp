@@ -467,7 +467,8 @@ const std::vector<std::string> kStatsColumns = {
     "triangle_tests", "bv_tests",     "integrate_ms",    "volumes_ms", "broadphase_ms",
     "narrowphase_ms", "ccd_ms",       "response_ms",     "step_ms",    "self_pairs",
     "refit_nodes",    "refit_ms",     "refit_node_ns",   "rebuilds",   "toi_queries",
-    "toi_iterations", "toi_events"};
+    "toi_iterations", "toi_events",   "response_pairs",  "response_volume_tests",
+    "ccd_pairs",      "ccd_volume_tests"};
 
 TEST(Cli, StatsCsvHasOneRowPerFrameAndCheckBroadphasePasses) {
     const fs::path work = cliDir("stats");

@@ -248,12 +248,22 @@ TEST(World, EveryBroadPhaseMovesBodiesTheSameWithResponseAndCcd) {
     ASSERT_GE(others.size(), 10u);
     std::int64_t contact_points = 0;
     std::int64_t toi_queries = 0;
+    std::int64_t response_pairs = 0;
+    std::int64_t ccd_pairs = 0;
     for (int i = 0; i < 120; ++i) {
         reference.step();
         contact_points += reference.lastStats().contact_points;
         toi_queries += reference.lastStats().toi_queries;
+        response_pairs += reference.lastStats().response_pairs;
+        ccd_pairs += reference.lastStats().ccd_pairs;
         for (World& w : others) {
             w.step();
+            // The stages' candidates are filtered on their own boxes: the same whichever broad
+            // phase found them (its own counters differ).
+            ASSERT_EQ(w.lastStats().response_pairs, reference.lastStats().response_pairs)
+                << w.broadPhase().name() << " step " << i;
+            ASSERT_EQ(w.lastStats().ccd_pairs, reference.lastStats().ccd_pairs)
+                << w.broadPhase().name() << " step " << i;
             // The flagged pairs, and so the states, depend on the volume the broad phase
             // decides on; the motion does not.
             for (std::size_t k = 0; k < reference.bodies().size(); ++k) {
@@ -269,6 +279,8 @@ TEST(World, EveryBroadPhaseMovesBodiesTheSameWithResponseAndCcd) {
     }
     EXPECT_GT(contact_points, 100);
     EXPECT_GT(toi_queries, 100);
+    EXPECT_GT(response_pairs, 100);
+    EXPECT_GT(ccd_pairs, 100);
 }
 
 // A running world switched to another broad phase between steps builds the new one from its

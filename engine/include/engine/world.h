@@ -157,6 +157,13 @@ struct StepStats {
     std::int64_t toi_events = 0;      ///< pairs stopped at their time of impact
     std::int64_t toi_iterations = 0;  ///< iterations (distance queries / roots) of those calls
     std::int64_t contact_points = 0;  ///< manifold points the contact solver handled
+    /// The contact and continuous stages' own instances of the scene's broad phase (over the
+    /// boxes grown by the contact margin, and over the swept bounds): their counters, and the
+    /// candidate pairs they kept (after the exact box filter). Zero for a stage that is off.
+    collision::BroadPhaseCounters response_broad;
+    std::int64_t response_pairs = 0;
+    collision::BroadPhaseCounters ccd_broad;
+    std::int64_t ccd_pairs = 0;
     /// Intersecting non-adjacent triangle pairs within self_collision mesh bodies (their
     /// traversals' node and triangle tests are in bv_tests and triangle_tests).
     std::int64_t self_pairs = 0;
