@@ -65,6 +65,23 @@ int runCli(int argc, char** argv) {
     cli.add_subcommand("bench",
                        "performance benchmarks beside the peers: broadphase, ccd, convex, "
                        "narrowphase (cdlab-bench, built with the tests)");
+    // A first word that is no command is named, with the commands there are (CLI11 would say
+    // only that a subcommand is required); so is a missing command.
+    std::string names;
+    bool known = false;
+    for (const CLI::App* sub : cli.get_subcommands({})) {
+        names += (names.empty() ? "" : ", ") + sub->get_name();
+        known = known || (argc > 1 && sub->get_name() == argv[1]);
+    }
+    if (argc < 2 || (argv[1][0] != '-' && !known)) {
+        if (argc < 2) {
+            std::cerr << "cdlab: no command given";
+        } else {
+            std::cerr << "cdlab: unknown command '" << argv[1] << "'";
+        }
+        std::cerr << " (expected one of: " << names << "); cdlab --help says what each does\n";
+        return app::kExitBadInput;
+    }
     return app::parseAndRun(cli, commands, argc, argv);
 }
 

@@ -250,6 +250,18 @@ TEST(Cli, BadSceneReportsFileLineColumnAndExits2) {
     fs::remove_all(work);
 }
 
+TEST(Cli, AnUnknownOrMissingCommandIsNamedWithTheCommandsThereAre) {
+    const fs::path work = cliDir("command");
+    Result r = runCdlab("nope scenes/coursework.yaml", work);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("unknown command 'nope'"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("run, check, query, sweep, bench"), std::string::npos) << r.err;
+    r = runCdlab("", work);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("no command given"), std::string::npos) << r.err;
+    fs::remove_all(work);
+}
+
 TEST(Cli, BadFlagsExit2WithAMessage) {
     const fs::path work = cliDir("flags");
     Result r = runCdlab(
