@@ -89,8 +89,9 @@ private:
 // Formats whose header states how many elements follow (OFF, PLY) are checked against the file's
 // size before assimp allocates for them: each element takes at least a few bytes, so a count the
 // bytes cannot hold is a lie (a 100-byte OFF claiming 2e8 vertices took assimp 5.5 GB and 16 s
-// to refuse; the same PLY in ASCII did not finish). Empty when the header is consistent or is
-// not one of these formats (assimp then judges the file alone).
+// to refuse; the same PLY in ASCII did not finish). A PLY header must also end (end_header)
+// within the 64 KiB read. Empty when the header is consistent or is not one of these formats
+// (assimp then judges the file alone).
 std::string declaredCountsError(const std::filesystem::path& file, std::uintmax_t bytes) {
     std::ifstream in(file, std::ios::binary);
     std::string head(64 * 1024, '\0');
@@ -124,6 +125,7 @@ std::string declaredCountsError(const std::filesystem::path& file, std::uintmax_
     // sum of its properties' sizes in binary (a list at least its count), two bytes each in ASCII.
     if (*magic == "ply") {
         bool binary = false;
+        bool ended = false;
         long double least = 0;
         long double elements = 0;
         long double element_count = 0;
@@ -143,7 +145,10 @@ std::string declaredCountsError(const std::filesystem::path& file, std::uintmax_
                 least += element_count * element_bytes;
                 element_count = 0;
                 element_bytes = 0;
-                if (*t == "end_header") break;
+                if (*t == "end_header") {
+                    ended = true;
+                    break;
+                }
                 tokens.next();  // name
                 const std::optional<long double> n = tokens.count();
                 if (!n) return "";
@@ -160,6 +165,12 @@ std::string declaredCountsError(const std::filesystem::path& file, std::uintmax_
                 }
                 tokens.next();  // property name
             }
+        }
+        // Without its end_header line assimp's reader never stops looking for it.
+        if (!ended) {
+            return "'" + file.string() + "' is a PLY file whose header has no end_header line" +
+                   (head.size() == 64 * 1024 ? " in its first 64 KiB" : "") +
+                   " (a truncated or corrupt file)";
         }
         return tooMany(least,
                        std::to_string(static_cast<unsigned long long>(std::min(elements, 1e19L))) +

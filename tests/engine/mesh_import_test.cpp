@@ -238,6 +238,33 @@ TEST_F(MeshImport, HeaderCountsTheFileCannotHoldAreRefusedUpFront) {
     }
 }
 
+// A PLY header that never ends (no end_header line) kept assimp's reader at 100% CPU forever:
+// refused by name before assimp reads it, whether the header is short or runs past the part read.
+TEST_F(MeshImport, APlyHeaderWithoutEndHeaderIsRefused) {
+    const std::string header =
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\nproperty list uchar int vertex_indices\n";
+    const std::string body = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    std::string long_comments;
+    while (long_comments.size() < 100 * 1024) long_comments += "comment padding the header\n";
+    const std::pair<const char*, std::string> files[] = {
+        {"open.ply", header + body},
+        {"open_long.ply", header + long_comments + body},
+    };
+    for (const auto& [name, text] : files) {
+        SCOPED_TRACE(name);
+        const MeshImportOutput out = importMesh(write(name, text), 1);
+        EXPECT_FALSE(out.ok);
+        EXPECT_NE(out.error.find(name), std::string::npos) << out.error;
+        EXPECT_NE(out.error.find("end_header"), std::string::npos) << out.error;
+    }
+    // The same file with its end_header loads.
+    const MeshImportOutput closed =
+        importMesh(write("closed.ply", header + "end_header\n" + body), 1);
+    ASSERT_TRUE(closed.ok) << closed.error;
+    EXPECT_EQ(closed.mesh.triangles.size(), 1u);
+}
+
 TEST_F(MeshImport, FilesPastTheSizeLimitAreRefusedUnread) {
     const fs::path p = write("big.obj", kCubeObj);
     fs::resize_file(p, (std::uintmax_t(256) << 20) + 1);  // sparse: nothing is written
