@@ -6,6 +6,7 @@
 // float coordinates cost against the file's coordinates read in double (mesh_text_coordinates.h).
 #include "engine/mesh_import.h"
 
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -179,9 +180,9 @@ std::string declaredCountsError(const std::filesystem::path& file, std::uintmax_
     return "";
 }
 
-// Why `file` cannot be a model file (missing, not a regular file, over the size limit, or
-// declaring more elements than it can hold), or "".
-std::string fileError(const std::filesystem::path& file) {
+// Why `file` cannot be opened as part of a model (missing, not a regular file: a FIFO or a device
+// would block or never end, over the size limit), or "". Sets `bytes` when it can be.
+std::string openError(const std::filesystem::path& file, std::uintmax_t& bytes) {
     std::error_code ec;
     if (!std::filesystem::exists(file, ec)) {
         return "cannot open '" + file.string() + "': no such file";
@@ -189,18 +190,50 @@ std::string fileError(const std::filesystem::path& file) {
     if (!std::filesystem::is_regular_file(file, ec)) {
         return "cannot open '" + file.string() + "': not a regular file";
     }
-    const std::uintmax_t bytes = std::filesystem::file_size(file, ec);
-    if (!ec && bytes > kMaxMeshFileBytes) {
+    bytes = std::filesystem::file_size(file, ec);
+    if (ec) return "cannot open '" + file.string() + "': " + ec.message();
+    if (bytes > kMaxMeshFileBytes) {
         std::string why = "'";
         why += file.string();
         why += "' has " + std::to_string(bytes) + " bytes, more than the limit of " +
                std::to_string(kMaxMeshFileBytes) + " (256 MiB) for a model file";
         return why;
     }
-    if (!ec) return declaredCountsError(file, bytes);
     return "";
-
 }
+
+// Why `file` cannot be a model file (openError, or declaring more elements than it can hold),
+// or "".
+std::string fileError(const std::filesystem::path& file) {
+    std::uintmax_t bytes = 0;
+    std::string why = openError(file, bytes);
+    return why.empty() ? declaredCountsError(file, bytes) : why;
+}
+
+// assimp's file system with the model file's rules applied to every file an importer opens (an
+// OBJ's mtllib, a glTF's buffers, an X file's textures): a FIFO, a device or a file past the size
+// limit is not opened, and the first such refusal is kept to be reported.
+class CheckedIoSystem final : public Assimp::DefaultIOSystem {
+public:
+    // Asked without opening the file (the default opens it, which blocks on a FIFO).
+    bool Exists(const char* file) const override {
+        std::error_code ec;
+        return std::filesystem::exists(file, ec);
+    }
+    Assimp::IOStream* Open(const char* file, const char* mode = "rb") override {
+        std::uintmax_t bytes = 0;
+        const std::string why = openError(file, bytes);
+        if (why.empty()) return Assimp::DefaultIOSystem::Open(file, mode);
+        std::error_code ec;
+        if (refused_.empty() && std::filesystem::exists(file, ec)) refused_ = why;
+        return nullptr;
+    }
+    /// The first file refused that exists (a missing one is assimp's to report), or "".
+    const std::string& refused() const { return refused_; }
+
+private:
+    std::string refused_;
+};
 
 // Every triangle of every mesh of `scene` into `mesh`, scaled, welding equal positions across
 // meshes too (exact comparison: the file's shared vertices are bit-identical after the same
@@ -368,6 +401,8 @@ MeshImportOutput importMesh(const std::filesystem::path& file, collision::Real s
     if (!out.error.empty()) return out;
 
     Assimp::Importer importer;
+    auto* io = new CheckedIoSystem;
+    importer.SetIOHandler(io);  // the importer owns it
     // Only positions matter: drop normals, UVs and colours before JoinIdenticalVertices so that
     // vertices split at normal seams are joined again, and drop point and line primitives.
     importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS,
@@ -413,6 +448,10 @@ MeshImportOutput importMesh(const std::filesystem::path& file, collision::Real s
         return out;
     } catch (...) {
         out.error = "assimp failed";
+        return out;
+    }
+    if (!io->refused().empty()) {
+        out.error = file.string() + " refers to a file that cannot be read: " + io->refused();
         return out;
     }
     if (scene == nullptr) {

@@ -2,6 +2,7 @@
 #include "engine/mesh_import.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <array>
@@ -263,6 +264,34 @@ TEST_F(MeshImport, APlyHeaderWithoutEndHeaderIsRefused) {
         importMesh(write("closed.ply", header + "end_header\n" + body), 1);
     ASSERT_TRUE(closed.ok) << closed.error;
     EXPECT_EQ(closed.mesh.triangles.size(), 1u);
+}
+
+// Files a model refers to (an OBJ's mtllib here) obey the model file's rules: a FIFO blocked the
+// import forever, /dev/zero and a sparse file past the size limit were read whole. Each is refused
+// unopened, naming the model and the file; a readable material file changes nothing.
+TEST_F(MeshImport, FilesAModelRefersToAreCheckedLikeTheModel) {
+    const fs::path fifo = write("fifo.mtl", "");
+    fs::remove(fifo);
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    const fs::path zero = dir_ / "zero.mtl";
+    fs::create_symlink("/dev/zero", zero);
+    const fs::path big = write("big.mtl", "newmtl m\n");
+    fs::resize_file(big, (std::uintmax_t(256) << 20) + 1);  // sparse
+    for (const fs::path& ref : {fifo, zero, big}) {
+        SCOPED_TRACE(ref.filename().string());
+        const fs::path obj = write("with_" + ref.stem().string() + ".obj",
+                                   "mtllib " + ref.filename().string() + "\n" +
+                                       std::string(kCubeObj));
+        const MeshImportOutput out = importMesh(obj, 1);
+        EXPECT_FALSE(out.ok);
+        EXPECT_NE(out.error.find(obj.string()), std::string::npos) << out.error;
+        EXPECT_NE(out.error.find(ref.string()), std::string::npos) << out.error;
+    }
+    write("plain.mtl", "newmtl m\nKd 1 0 0\n");
+    const MeshImportOutput plain =
+        importMesh(write("with_plain.obj", "mtllib plain.mtl\n" + std::string(kCubeObj)), 1);
+    ASSERT_TRUE(plain.ok) << plain.error;
+    EXPECT_EQ(plain.mesh.triangles.size(), 12u);
 }
 
 TEST_F(MeshImport, FilesPastTheSizeLimitAreRefusedUnread) {
