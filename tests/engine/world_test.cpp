@@ -229,6 +229,20 @@ TEST(World, EveryBroadPhaseGivesTheSameCollisionsOnARandomRun) {
     EXPECT_GT(frames_with_collisions, 10);
 }
 
+// Every body's position, orientation and momenta bit-identical in the two worlds; the first body
+// that differs is named.
+::testing::AssertionResult sameMotion(const World& got, const World& want) {
+    for (std::size_t k = 0; k < want.bodies().size(); ++k) {
+        const Body& a = got.bodies()[k];
+        const Body& b = want.bodies()[k];
+        if (!(a.position == b.position && a.orientation.coeffs() == b.orientation.coeffs() &&
+              a.linear_momentum == b.linear_momentum && a.angular_momentum == b.angular_momentum)) {
+            return ::testing::AssertionFailure() << "body " << k << " moved differently";
+        }
+    }
+    return ::testing::AssertionSuccess();
+}
+
 // The contact solver and the continuous stage take their pairs from instances of the scene's
 // broad phase (grown AABBs, swept bounds), filtered on the boxes themselves: whichever broad
 // phase runs, including those deciding on spheres or OBBs, the motion is bit-identical to the
@@ -266,15 +280,7 @@ TEST(World, EveryBroadPhaseMovesBodiesTheSameWithResponseAndCcd) {
                 << w.broadPhase().name() << " step " << i;
             // The flagged pairs, and so the states, depend on the volume the broad phase
             // decides on; the motion does not.
-            for (std::size_t k = 0; k < reference.bodies().size(); ++k) {
-                const Body& got = w.bodies()[k];
-                const Body& want = reference.bodies()[k];
-                ASSERT_TRUE(got.position == want.position &&
-                            got.orientation.coeffs() == want.orientation.coeffs() &&
-                            got.linear_momentum == want.linear_momentum &&
-                            got.angular_momentum == want.angular_momentum)
-                    << w.broadPhase().name() << " step " << i << " body " << k;
-            }
+            ASSERT_TRUE(sameMotion(w, reference)) << w.broadPhase().name() << " step " << i;
         }
     }
     EXPECT_GT(contact_points, 100);
@@ -326,15 +332,7 @@ TEST(World, SwitchingBroadPhaseBetweenStepsKeepsPairsExactAndMotionUnchanged) {
             std::sort(got.begin(), got.end());
             ASSERT_EQ(got, want) << entry->name << " step " << i;
             flagged += std::int64_t(got.size());
-            for (std::size_t k = 0; k < reference.bodies().size(); ++k) {
-                const Body& a = switched.bodies()[k];
-                const Body& b = reference.bodies()[k];
-                ASSERT_TRUE(a.position == b.position &&
-                            a.orientation.coeffs() == b.orientation.coeffs() &&
-                            a.linear_momentum == b.linear_momentum &&
-                            a.angular_momentum == b.angular_momentum)
-                    << entry->name << " step " << i << " body " << k;
-            }
+            ASSERT_TRUE(sameMotion(switched, reference)) << entry->name << " step " << i;
         }
         EXPECT_GT(flagged, 90);  // pairs to compare on most steps
     }
