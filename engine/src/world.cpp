@@ -23,6 +23,7 @@
 #include "box_pair_finder.h"
 #include "response_stage.h"
 #include "stage_clock.h"
+#include "world_records.h"
 
 namespace engine {
 

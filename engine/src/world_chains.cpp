@@ -19,6 +19,7 @@
 #include "collision/debug_draw.h"
 #include "engine/world.h"
 #include "toi_query.h"
+#include "world_records.h"
 
 namespace engine {
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "engine/world.h"
+#include "world_records.h"
 
 namespace engine {
 

@@ -9,6 +9,7 @@
 #include "box_pair_finder.h"
 #include "engine/world.h"
 #include "toi_query.h"
+#include "world_records.h"
 
 namespace engine {
 

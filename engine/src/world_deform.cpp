@@ -12,6 +12,7 @@
 #include "collision/geometry/convex_hull.h"
 #include "engine/world.h"
 #include "stage_clock.h"
+#include "world_records.h"
 
 namespace engine {
 

@@ -176,6 +176,11 @@ struct StepStats {
 
 class BoxPairFinder;
 class ResponseStage;
+// The World's private per-body records (engine/src/world_records.h).
+struct SweptBody;
+struct LinkOf;
+struct ChainState;
+struct DeformingMesh;
 
 /// Colours and sizes of World::drawHierarchyLevels and World::drawContacts: the caller's palette.
 struct ContactDrawStyle {
@@ -342,15 +347,6 @@ private:
     std::vector<collision::ProxyPair> flagged_;
     std::vector<collision::ProxyPair> colliding_;
     ClonePtr<collision::BroadPhase> broad_phase_;
-    // Continuous stage scratch, reused across steps (no per-step allocation once warm).
-    struct SweptBody {
-        collision::Sweep sweep;
-        collision::Aabb box;    ///< swept bounds over the step
-        Real radius = 0;        ///< bounding radius about the centre of mass
-        Real deform_speed = 0;  ///< m per step: deformation's bound on any point's speed
-        Real clamp_t = 1;       ///< earliest accepted time of impact
-        bool moving = false;
-    };
     // Chains (world_chains.cpp): links to their frames at the end of the step, the parent-child
     // pairs dropped, the links' swept bounds and articulated times of impact, halting.
     void moveChains();
@@ -366,16 +362,6 @@ private:
     /// if it is a link of a chain moving in this step, else zero.
     Vec3 linkPointVelocity(BodyId id, const Vec3& point, Real s) const;
     void poseChain(std::size_t c, Real t);  ///< the links of chain c at its time t
-    struct LinkOf {
-        int chain = -1;
-        int link = -1;
-    };
-    struct ChainState {
-        Real clock = 0;       ///< s, the time the links are posed at
-        Real step_start = 0;  ///< s, the clock at the start of the step
-        bool halted = false;
-        bool moved = false;  ///< the clock advanced in this step
-    };
     std::vector<ChainSpec> chains_;
     std::vector<ChainState> chain_state_;
     std::vector<LinkOf> link_of_;        ///< per body; shorter than bodies_ past the last link
@@ -384,22 +370,12 @@ private:
     std::vector<Pose> step_start_;
     std::vector<Vec3> step_rotation_;  ///< semi-implicit Euler's rotation of the step (ccd on)
     std::vector<Vec3> step_spin_;
-    std::vector<SweptBody> swept_;
+    std::vector<SweptBody> swept_;  ///< continuous stage scratch, reused across steps
     std::vector<collision::Aabb> swept_boxes_;  ///< swept_[i].box, contiguous for ccd_finder_
     ClonePtr<BoxPairFinder> ccd_finder_;  ///< only with ccd on
     std::vector<collision::ProxyPair> ccd_pairs_;
     std::vector<ToiEvent> toi_events_;
     std::vector<std::vector<collision::TrianglePair>> self_pairs_;  ///< per body
-    /// A deforming mesh body's own geometry: rest vertices, the current mesh and hierarchy (the
-    /// body's shape points at them), and the hierarchy's volume ratio at its last build.
-    struct DeformingMesh {
-        BodyId body = 0;
-        std::vector<Vec3> rest;
-        std::shared_ptr<collision::TriangleMesh> mesh;
-        std::shared_ptr<collision::MeshBvh> bvh;
-        Real built_ratio = 0;
-        Real speed_bound = 0;  ///< m/s, deformSpeedBound of the rest vertices
-    };
     std::vector<DeformingMesh> deforming_;
     void addDeforming(BodyId id);            // addBody of a deforming mesh body: its own geometry
     void deformBody(DeformingMesh& d);       // vertices at time_, refit or rebuild, hull, bounds
