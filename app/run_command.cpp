@@ -47,6 +47,7 @@ Command addRunCommand(CLI::App& cli) {
         bool quiet = false;
         std::vector<std::string> set;
         std::string trace;
+        std::string events;
     };
     auto f = std::make_shared<Flags>();
     CLI::App* cmd = cli.add_subcommand("run", "simulate a scene, write PNG frames and a video");
@@ -66,6 +67,10 @@ Command addRunCommand(CLI::App& cli) {
                     "video holds the picture for --pause-hold seconds")
         ->expected(1)
         ->take_all();
+    cmd->add_option("--events", f->events,
+                    "FILE: follow this events track (a YAML mapping with 'events:', as a scene's "
+                    "own) instead of the scene's: play, pause, step, seek, show/hide layers, "
+                    "switch the broad phase, select a body, move the camera, dump, wait");
     cmd->add_option("--pause-hold", f->run.pause_hold_s,
                     "seconds each pause picture stays on screen in the video, as in a live "
                     "demo (default 2; 0: no hold); the PNG frames are not repeated");
@@ -101,7 +106,8 @@ Command addRunCommand(CLI::App& cli) {
                 run.dry_run = mode == RunMode::DryRun;
                 // A flag given with an empty value ("--broadphase ''") is an error, not "unset".
                 for (const char* name :
-                     {"--out", "--video", "--broadphase", "--pair-order", "--stats", "--trace"}) {
+                     {"--out", "--video", "--broadphase", "--pair-order", "--stats", "--trace",
+                      "--events"}) {
                     if (cmd->count(name) > 0 && cmd->get_option(name)->as<std::string>().empty()) {
                         std::cerr << name << ": must not be empty\n";
                         return kExitBadInput;
@@ -113,6 +119,7 @@ Command addRunCommand(CLI::App& cli) {
                 if (!f->broad_phase.empty()) run.broad_phase = f->broad_phase;
                 if (!f->pair_order.empty()) run.pair_order = f->pair_order;
                 if (!f->stats.empty()) run.stats_csv = f->stats;
+                if (!f->events.empty()) run.events = f->events;
                 for (const std::string& kv : f->set) {
                     const std::size_t eq = kv.find('=');
                     if (eq == std::string::npos || eq == 0) {

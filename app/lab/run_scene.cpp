@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
+#include <stdexcept>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -24,6 +25,7 @@
 
 #include "broadphase_check.h"
 #include "collision/broadphase/broad_phase.h"
+#include "demo/demo_session.h"
 #include "engine/scene.h"
 #include "engine/volume_overlaps.h"
 #include "exit_codes.h"
@@ -241,6 +243,16 @@ std::vector<std::optional<render::ScreenRect>> bodyRects(const engine::World& wo
     return rects;
 }
 
+// --check-broadphase found a step whose pairs differ from the reference: what() is the report.
+struct BroadPhaseMismatch : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+// A step failed (engine::SimulationError): what() is "frame F: what went wrong".
+struct StepFailure : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
 std::string frameName(int frame) {
     char name[32];
     std::snprintf(name, sizeof name, "frame_%05d.png", frame);
@@ -254,7 +266,7 @@ namespace {
 // The scene with the command line's overrides applied, and the pause frames; an error message
 // and kExitBadInput when anything is wrong with the input (before any output is written).
 int loadRunScene(const RunOptions& options, std::ostream& err, engine::Scene& scene,
-                 std::set<int>& pauses) {
+                 std::set<int>& pauses, std::vector<engine::DemoEvent>& events) {
     try {
         scene = engine::loadScene(options.scene, options.overrides);
     } catch (const engine::SceneError& e) {
@@ -291,6 +303,23 @@ int loadRunScene(const RunOptions& options, std::ostream& err, engine::Scene& sc
         options.pause_hold_s > kMaxPauseHoldSeconds) {
         err << "--pause-hold " << options.pause_hold_s << ": must be a number of seconds from 0 "
             << "(no hold) to " << kMaxPauseHoldSeconds << "\n";
+        return kExitBadInput;
+    }
+    // The track: the scene's own, or --events FILE's instead; checked against the frame count
+    // the run has (--frames may have changed it).
+    try {
+        if (options.events) {
+            if (!scene.events.empty()) {
+                err << "note: --events " << options.events->string()
+                    << " replaces the scene's own events: track\n";
+            }
+            events = engine::loadEvents(*options.events, scene);
+        } else {
+            events = scene.events;
+            engine::checkEventTrack(events, scene.frames, options.scene.string());
+        }
+    } catch (const engine::SceneError& e) {
+        err << e.what() << "\n";
         return kExitBadInput;
     }
     pauses = std::set<int>(options.pause_at.begin(), options.pause_at.end());
@@ -333,7 +362,7 @@ struct RunTotals {
 
 std::string summaryJson(const RunOptions& options, const engine::Scene& scene,
                         const engine::World& world, const RunTotals& totals, bool want_video,
-                        const fs::path& video_path) {
+                        const fs::path& video_path, std::size_t events) {
     nlohmann::ordered_json summary;
     summary["scene"] = options.scene.string();
     summary["broadphase"] = scene.world.broad_phase;
@@ -350,6 +379,10 @@ std::string summaryJson(const RunOptions& options, const engine::Scene& scene,
         world.stepCount() > 0 ? 1e3 * totals.step_seconds / double(world.stepCount()) : 0.0;
     summary["video"] = want_video ? video_path.string() : "";
     summary["checked_broadphase"] = options.check_broad_phase;
+    if (events > 0) {
+        summary["events"] = events;
+        summary["final_broadphase"] = std::string(world.broadPhase().name());
+    }
     return summary.dump(1) + "\n";
 }
 
@@ -393,7 +426,10 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
     // 1. Everything that can be wrong with the input is found before any output is written.
     engine::Scene scene;
     std::set<int> pauses;
-    if (const int code = loadRunScene(options, err, scene, pauses); code != kExitOk) return code;
+    std::vector<engine::DemoEvent> events;
+    if (const int code = loadRunScene(options, err, scene, pauses, events); code != kExitOk) {
+        return code;
+    }
     const fs::path out_dir =
         options.out_dir.empty() ? fs::path("out") / scene.name : options.out_dir;
     const bool want_video = !options.no_video;
@@ -412,7 +448,8 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
 
     try {
         prepareOutputs(options, out_dir, want_video, video_path);
-        engine::World world = engine::makeWorld(scene);
+        DemoSession session(scene, options.draw_structure);
+        const engine::World& world = session.world();
         render::Renderer renderer(scene.output.width, scene.output.height);
         std::unique_ptr<render::VideoWriter> video;
         if (want_video) {
@@ -422,11 +459,6 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         render::FrameWriter writer(std::move(video), pngThreads(), kQueueFrames);
         StageTimes stage;
         const double run_start = wallSeconds();
-        render::FrameOptions frame_options;
-        frame_options.draw = engine::drawSettingsFor(scene.draw, world);
-        frame_options.draw_structure = scene.draw.structure || options.draw_structure;
-        render::FrameOptions pause_options = frame_options;
-        pause_options.draw.sphere = pause_options.draw.aabb = pause_options.draw.obb = true;
         // Each pause picture is held this many video frames after its frame.
         const long hold_frames = std::lround(options.pause_hold_s * scene.output.fps);
 
@@ -440,59 +472,90 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         ProgressBar progress(options.progress && ::isatty(STDERR_FILENO), scene.frames);
         RunTotals totals;
         RunPage page = runPage(options, scene, world, hold_frames);
-        for (int frame = 0; frame < scene.frames; ++frame) {
-            FrameStats frame_stats;
-            auto checkStep = [&](int step) -> bool {
-                if (!checker) return true;
-                const std::string report = checker->check(world);
-                if (report.empty()) return true;
-                err << "check-broadphase: MISMATCH at frame " << frame << ", step " << step
-                    << ", t=" << world.time() << " s\n"
+        FrameStats frame_stats;  // the steps since the last frame shown
+        frame_stats.add(world.lastStats());
+        if (checker) {
+            if (const std::string report = checker->check(world); !report.empty()) {
+                err << "check-broadphase: MISMATCH at frame 0, step 0, t=" << world.time()
+                    << " s\n"
                     << report;
-                return false;
-            };
-            if (frame == 0) {
-                frame_stats.add(world.lastStats());
-                if (!checkStep(0)) return kExitCheckFailed;
-            } else {
-                const double sim_start = wallSeconds();
-                for (int s = 0; s < scene.steps_per_frame; ++s) {
-                    try {
-                        world.step();
-                    } catch (const engine::SimulationError& e) {
-                        // No summary.json: the run is incomplete, and says so.
-                        err << "error: " << options.scene.string() << ": frame " << frame << ": "
-                            << e.what() << "\n";
-                        return kExitFailure;
-                    }
-                    frame_stats.add(world.lastStats());
-                    totals.step_seconds += world.lastStats().total_s;
-                    if (!checkStep(static_cast<int>(world.stepCount()))) return kExitCheckFailed;
-                }
-                stage.sim_s += wallSeconds() - sim_start;
+                return kExitCheckFailed;
             }
+        }
+        session.on_step = [&](const engine::World& w) {
+            frame_stats.add(w.lastStats());
+            totals.step_seconds += w.lastStats().total_s;
+            if (!checker) return;
+            const std::string report = checker->check(w);
+            if (report.empty()) return;
+            std::ostringstream what;
+            what << "check-broadphase: MISMATCH at frame " << session.frame() + 1 << ", step "
+                 << w.stepCount() << ", t=" << w.time() << " s\n"
+                 << report;
+            throw BroadPhaseMismatch(what.str());
+        };
+        // Runs `simulate` (steps of the session), with its time counted as the simulation's.
+        auto simulate = [&](const auto& steps) {
+            const double sim_start = wallSeconds();
+            try {
+                steps();
+            } catch (const engine::SimulationError& e) {
+                throw StepFailure("frame " + std::to_string(session.frame() + 1) + ": " +
+                                  e.what());
+            }
+            stage.sim_s += wallSeconds() - sim_start;
+        };
+        auto hudText = [&](bool paused) {
+            if (!session.view().draw.hud) return std::string();
+            std::string text = render::hudLine(world, session.frame(),
+                                               options.hud_timing && !paused);
+            if (paused) text = "PAUSED  " + text;
+            if (session.view().selected) {
+                text += "\n" + selectionLine(world, *session.view().selected);
+            }
+            return text;
+        };
+        std::set<int> frames_written;
+        int newest_frame = -1;   // the furthest frame reached so far
+        double video_credit = 0;  // video frames owed at the current speed
+        // The current frame as the run shows it: its rows, its PNG, its video frames, and the
+        // pause picture when --pause-at asks for it.
+        auto showFrame = [&]() {
+            const int frame = session.frame();
             if (options.stats_csv) stats_text += statsRow(frame, world, frame_stats);
             if (options.trace) trace_text += traceLine(frame, world);
-            if (options.html) page.frames.push_back(pageFrame(frame, world, frame_stats));
+            if (options.html && frame > newest_frame) {
+                page.frames.push_back(pageFrame(frame, world, frame_stats));
+            }
+            newest_frame = std::max(newest_frame, frame);
+            frame_stats = FrameStats{};
             totals.flagged += static_cast<std::int64_t>(world.flaggedPairs().size());
             totals.colliding += static_cast<std::int64_t>(world.collidingPairs().size());
             totals.self_pairs += selfPairCount(world);
-            frame_options.hud_text =
-                scene.draw.hud ? render::hudLine(world, frame, options.hud_timing) : "";
-            if (!options.no_frames || want_video) {
+            video_credit += 1.0 / session.view().speed;
+            const long copies = std::lround(std::floor(video_credit + 1e-9));
+            video_credit -= double(copies);
+            const bool png = !options.no_frames;
+            if (png || (want_video && copies > 0)) {
+                render::FrameOptions frame_options = session.frameOptions();
+                frame_options.hud_text = hudText(!session.playing());
                 std::shared_ptr<render::Image> image = writer.blankFrame();
-                renderer.render(world, scene.camera, frame_options, *image);
+                renderer.render(world, session.camera(), frame_options, *image);
                 stage.add(renderer.lastFrameStats());
                 const double wait_start = wallSeconds();
-                writer.submit(std::move(image),
-                              options.no_frames ? fs::path() : out_dir / frameName(frame), 1);
+                writer.submit(std::move(image), png ? out_dir / frameName(frame) : fs::path(),
+                              copies);
                 stage.wait_s += wallSeconds() - wait_start;
+                if (png) frames_written.insert(frame);
             }
             if (pauses.count(frame)) {
+                // Every proxy volume, each coloured by its own overlap test.
+                render::FrameOptions pause_options = session.frameOptions();
+                pause_options.draw.sphere = pause_options.draw.aabb = pause_options.draw.obb = true;
                 pause_options.hud_text = "PAUSED  " + render::hudLine(world, frame, false);
                 const std::string stem = "pause_" + std::to_string(frame);
                 auto pause_image = std::make_shared<const render::Image>(
-                    renderer.render(world, scene.camera, pause_options));
+                    renderer.render(world, session.camera(), pause_options));
                 writer.submit(std::move(pause_image), out_dir / (stem + ".png"), hold_frames);
                 std::string dump = pauseDumpJson(world, frame, pause_options.draw);
                 writeTextAtomically(out_dir / (stem + ".json"), dump);
@@ -501,6 +564,47 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
                 }
             }
             progress.update(frame + 1);
+        };
+        // An event's dump: the current view, paused, as pause_F.png and pause_F.json.
+        auto dumpFrame = [&]() {
+            const int frame = session.frame();
+            render::FrameOptions dump_options = session.frameOptions();
+            dump_options.hud_text = hudText(true);
+            const std::string stem = "pause_" + std::to_string(frame);
+            render::writePng(out_dir / (stem + ".png"),
+                             renderer.render(world, session.camera(), dump_options));
+            std::string dump = pauseDumpJson(world, frame, dump_options.draw);
+            writeTextAtomically(out_dir / (stem + ".json"), dump);
+            if (options.html) page.pauses.push_back({frame, std::move(dump), bodyRects(world, scene)});
+        };
+        // An event's wait: the current picture held in the video.
+        auto holdFrame = [&](double seconds) {
+            const long copies = std::lround(seconds * scene.output.fps);
+            if (!want_video || copies == 0) return;
+            render::FrameOptions hold_options = session.frameOptions();
+            hold_options.hud_text = hudText(!session.playing());
+            auto image = std::make_shared<const render::Image>(
+                renderer.render(world, session.camera(), hold_options));
+            writer.submit(std::move(image), fs::path(), copies);
+        };
+
+        showFrame();
+        std::size_t next = 0;  // the next event of the track
+        for (;;) {
+            while (next < events.size() && events[next].frame == session.frame()) {
+                const engine::DemoEvent& e = events[next++];
+                std::string problem;
+                simulate([&] { problem = session.apply(e.commands, showFrame); });
+                if (!problem.empty()) throw std::logic_error("events: " + problem);
+                if (e.commands.dump) dumpFrame();
+                if (e.commands.wait_s > 0) holdFrame(double(e.commands.wait_s));
+            }
+            // A track that ends paused ends the run there (checkEventTrack: nothing follows).
+            if (!session.playing()) break;
+            bool moved = false;
+            simulate([&] { moved = session.advance(); });
+            if (!moved) break;
+            showFrame();
         }
         writer.finish();
         if (options.timing) {
@@ -511,23 +615,41 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         if (options.html) writeRunPage(std::move(page), out_dir, want_video, video_path);
 
         writeTextAtomically(out_dir / "summary.json",
-                            summaryJson(options, scene, world, totals, want_video, video_path));
+                            summaryJson(options, scene, world, totals, want_video, video_path,
+                                        events.size()));
 
-        out << "wrote " << (options.no_frames ? 0 : scene.frames) << " frames to "
-            << out_dir.string();
+        out << "wrote " << frames_written.size() << " frames to " << out_dir.string();
         if (want_video) out << " and " << video_path.string();
         if (options.html) out << ", the page " << (out_dir / "index.html").string();
         out << " (" << world.bodies().size() << " bodies, " << world.stepCount() << " steps, "
             << scene.world.broad_phase
             << (scene.world.pair_order == collision::PairOrder::Found ? ", pairs in found order"
                                                                       : "")
-            << (options.check_broad_phase ? ", every step checked" : "") << ")\n";
+            << (options.check_broad_phase ? ", every step checked" : "");
+        if (!events.empty()) {
+            out << ", " << events.size() << " events";
+            if (world.broadPhase().name() != scene.world.broad_phase) {
+                out << ", ending on " << world.broadPhase().name();
+            }
+        }
+        out << ")\n";
+        if (!session.playing() && session.frame() < session.lastFrame()) {
+            out << "note: the events track ended paused at frame " << session.frame()
+                << ": the run stops there\n";
+        }
         const double scale = double(engine::videoTimeScale(scene));
         if (want_video && std::abs(scale - 1.0) > 1e-9) {
             // A scene may ask for slow motion; say so, so that nobody reads it as real time.
             out << "note: one second of video shows " << scale
                 << " s of simulated time (time_step x steps_per_frame x fps)\n";
         }
+    } catch (const BroadPhaseMismatch& e) {
+        err << e.what();
+        return kExitCheckFailed;
+    } catch (const StepFailure& e) {
+        // No summary.json: the run is incomplete, and says so.
+        err << "error: " << options.scene.string() << ": " << e.what() << "\n";
+        return kExitFailure;
     } catch (const render::RenderError& e) {
         err << "error: " << e.what() << "\n";
         return kExitFailure;

@@ -24,6 +24,8 @@ struct RunOptions {
     std::optional<std::string> broad_phase;  ///< overrides the scene's broad phase
     std::optional<std::string> pair_order;   ///< overrides the scene's pair_order
     std::vector<int> pause_at;               ///< frames to dump
+    /// An events track (engine/demo_commands.h) to follow instead of the scene's own `events:`.
+    std::optional<std::filesystem::path> events;
     /// Seconds each pause picture stays on screen in the video (repeated at the video's fps),
     /// as a live demo holds its pause; 0 = not held. Finite, 0..kMaxPauseHoldSeconds.
     double pause_hold_s = 2.0;

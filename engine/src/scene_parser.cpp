@@ -315,7 +315,7 @@ Vec3 SceneParser::readVec3(const YAML::Node& n, const std::string& path) const {
     return v;
 }
 
-Scene SceneParser::parse(const std::string& text) {
+YAML::Node SceneParser::loadDocument(const std::string& text) const {
     YAML::Node root;
     try {
         root = YAML::Load(text);
@@ -326,14 +326,6 @@ Scene SceneParser::parse(const std::string& text) {
     } catch (const YAML::Exception& e) {
         fail(e.mark, "malformed YAML", e.msg);
     }
-    applyOverrides(root);
-    Scene scene;
-    scene.name = fs::path(file_).stem().string();
-    if (!root.IsMap()) {
-        fail(root, "scene",
-             "expected a mapping with keys: world, broadphase, pair_order, output, camera, draw, "
-             "bodies, chains, expect");
-    }
     // The first document parsed, so the probe's parser (the same one) cannot throw before it
     // reaches the second.
     if (const std::optional<DocumentProbe::Second> second = DocumentProbe::secondDocument(text)) {
@@ -341,12 +333,25 @@ Scene SceneParser::parse(const std::string& text) {
             fail(second->start, "malformed YAML",
                  "text the YAML parser cannot place in the document");
         fail(second->start, "scene",
-             "a second YAML document: a scene file holds exactly one (remove the '---' or '...' "
+             "a second YAML document: a file holds exactly one (remove the '---' or '...' "
              "and what follows, or merge it into the first)");
+    }
+    return root;
+}
+
+Scene SceneParser::parse(const std::string& text) {
+    YAML::Node root = loadDocument(text);
+    applyOverrides(root);
+    Scene scene;
+    scene.name = fs::path(file_).stem().string();
+    if (!root.IsMap()) {
+        fail(root, "scene",
+             "expected a mapping with keys: world, broadphase, pair_order, output, camera, draw, "
+             "bodies, chains, expect, events");
     }
     const std::vector<Entry> es = entries(root, "",
                                           {"world", "broadphase", "pair_order", "output", "camera",
-                                           "draw", "bodies", "chains", "expect"});
+                                           "draw", "bodies", "chains", "expect", "events"});
     // The output's frame rate first: the world's default time step is derived from it.
     if (const Entry* output = find(es, "output")) parseOutput(output->value, scene);
     parseWorld(require(es, "world", root, "").value, scene);
@@ -405,6 +410,7 @@ Scene SceneParser::parse(const std::string& text) {
         }
     }
     if (const Entry* e = find(es, "expect")) parseExpect(*e, scene);
+    if (const Entry* e = find(es, "events")) parseEvents(*e, scene);
     scene.notes = std::move(notes_);
     return scene;
 }

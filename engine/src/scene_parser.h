@@ -148,12 +148,17 @@ struct PreparedShape {
 
 class SceneParser {
     friend class ExpectReader;  // scene_expect.cpp: reads through fail() and the typed reads
+    friend class EventReader;   // scene_events.cpp: the same
 
 public:
     SceneParser(std::string display_name, fs::path base_dir)
         : file_(std::move(display_name)), base_dir_(std::move(base_dir)) {}
 
     Scene parse(const std::string& text);
+    /// A document whose one key is `events:`, read against `scene` (scene_events.cpp).
+    std::vector<DemoEvent> parseEventsDocument(const std::string& text, const Scene& scene) const;
+    /// A document holding one set of commands (a mapping), read against `scene`.
+    DemoCommands parseCommandsDocument(const std::string& text, const Scene& scene) const;
     void setOverrides(std::vector<SceneOverride> overrides) { overrides_ = std::move(overrides); }
 
 private:
@@ -214,6 +219,10 @@ private:
     [[noreturn]] void failFlatMesh(ShapeType type, const std::string& hull_error,
                                    const collision::TriangleMesh& mesh, const fs::path& resolved,
                                    const Entry& file_entry, const std::string& path) const;
+    /// `events:` (after the bodies and the frame count, which it refers to).
+    void parseEvents(const Entry& entry, Scene& scene) const;
+    /// Any document's root, with the parser's care for malformed YAML (scene_parser.cpp).
+    YAML::Node loadDocument(const std::string& text) const;
     /// `expect:` (after the bodies, whose names it refers to).
     void parseExpect(const Entry& entry, Scene& scene) const;
     /// `chains:` (scene_chains.cpp, after the bodies): each link becomes a kinematic body

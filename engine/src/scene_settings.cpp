@@ -244,13 +244,15 @@ void SceneParser::parseDraw(const YAML::Node& n, Scene& scene) const {
     DrawSettings& d = scene.draw;
     for (const Entry& e :
          entries(n, path,
-                 {"bodies", "volumes", "bounds", "hud", "structure", "bvh_depth", "contacts"})) {
+                 {"bodies", "volumes", "bounds", "hud", "structure", "bvh_depth", "contacts",
+                  "labels"})) {
         const std::string p = childPath(path, e.key);
         if (e.key == "bodies") d.bodies = readBool(e.value, p);
         if (e.key == "bounds") d.bounds = readBool(e.value, p);
         if (e.key == "hud") d.hud = readBool(e.value, p);
         if (e.key == "structure") d.structure = readBool(e.value, p);
         if (e.key == "contacts") d.contacts = readBool(e.value, p);
+        if (e.key == "labels") d.labels = readBool(e.value, p);
         if (e.key == "bvh_depth") {
             d.bvh_depth = readInt(e.value, p);
             if (d.bvh_depth < -1) fail(e.value, p, "must be >= 0, or -1 for off");

@@ -130,6 +130,14 @@ void drawImpacts(const World& world, WorldDraw& draw) {
     }
 }
 
+/// The selected body's AABB, and each other proxy volume shown of it, in kSelectColor.
+void drawSelection(const World& world, BodyId id, const DrawSettings& show, WorldDraw& draw) {
+    const collision::ProxyVolumes& v = world.volumes()[static_cast<std::size_t>(id)];
+    draw.drawAabb(v.aabb, kSelectColor);
+    if (show.sphere) draw.drawSphere(v.sphere, kSelectColor);
+    if (show.obb) draw.drawObb(v.obb, kSelectColor);
+}
+
 }  // namespace
 
 WorldDrawn drawWorld(const World& world, WorldDraw& draw, const DrawOptions& options) {
@@ -161,6 +169,11 @@ WorldDrawn drawWorld(const World& world, WorldDraw& draw, const DrawOptions& opt
     if (options.draw.contacts) {
         draw.setLayer(DrawLayer::Contacts);
         world.drawContacts(draw, style);
+    }
+    if (options.selected && *options.selected >= 0 &&
+        static_cast<std::size_t>(*options.selected) < world.volumes().size()) {
+        draw.setLayer(DrawLayer::Selection);
+        drawSelection(world, *options.selected, options.draw, draw);
     }
     return drawn;
 }

@@ -24,6 +24,7 @@ void FrameLines::clear() {
     outlines.clear();
     hierarchy.clear();
     contacts.clear();
+    selection.clear();
     structure_legend.clear();
 }
 
@@ -47,6 +48,9 @@ void GlDebugDraw::setLayer(engine::DrawLayer layer) {
             break;
         case engine::DrawLayer::Contacts:
             target_ = &lines_.contacts;
+            break;
+        case engine::DrawLayer::Selection:
+            target_ = &lines_.selection;
             break;
     }
 }

@@ -77,6 +77,7 @@ struct FrameLines {
     LineBuffer outlines;   ///< bounding spheres' silhouettes
     LineBuffer hierarchy;  ///< mesh hierarchy levels (draw.bvh_depth)
     LineBuffer contacts;   ///< contact witnesses and normals (draw.contacts)
+    LineBuffer selection;  ///< the selected body's volumes, drawn last and widest
     std::vector<LegendEntry> structure_legend;
 
     void clear();

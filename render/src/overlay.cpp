@@ -1,6 +1,7 @@
 // render/src/overlay.cpp -- what is written over the read-back pixels: the state legend, the
 // broad phase's structure legend and the HUD text (hudLine).
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -12,6 +13,29 @@
 namespace render {
 
 using collision::Color;
+
+void Renderer::Impl::drawLabels(Image& image, const engine::World& world,
+                                const engine::CameraSettings& camera,
+                                const FrameOptions& options) const {
+    const int scale = height >= 1440 ? 2 : 1;
+    const font::Rgb label_color{236, 238, 242};
+    const font::Rgb selected_color{255, 255, 255};
+    const auto volumes = world.volumes();
+    const auto bodies = world.bodies();
+    for (std::size_t i = 0; i < volumes.size() && i < bodies.size(); ++i) {
+        const bool selected = options.selected && std::size_t(*options.selected) == i;
+        if (!options.draw.labels && !selected) continue;
+        const std::optional<ScreenRect> rect =
+            screenRect(camera, width, height, volumes[i].aabb.min, volumes[i].aabb.max);
+        if (!rect) continue;
+        const int s = selected ? scale + 1 : scale;
+        const std::string& name = bodies[i].name;
+        const int w = font::textWidth(name, s);
+        const int x = int(std::lround(0.5 * (rect->x0 + rect->x1))) - w / 2;
+        const int y = std::max(0, int(std::lround(rect->y0)) - font::textHeight(name, s) - 2 * s);
+        font::drawText(image, x, y, name, s, selected ? selected_color : label_color);
+    }
+}
 
 void Renderer::Impl::drawOverlays(Image& image, const FrameOptions& options) const {
     // Text is pixel art: integer scale, 2x from 720p, 3x from 1440p.

@@ -77,7 +77,7 @@ void Renderer::Impl::buildLines(const engine::World& world, const CameraFrame& c
                                 const FrameOptions& options) {
     lines.clear();
     GlDebugDraw debug(cam, lines, options.cull, stats.volumes_culled);
-    drawn = engine::drawWorld(world, debug, {options.draw, options.draw_structure});
+    drawn = engine::drawWorld(world, debug, {options.draw, options.draw_structure, options.selected});
 }
 
 CameraFrame Renderer::Impl::setUpCamera(const engine::World& world,
@@ -377,6 +377,7 @@ void Renderer::render(const engine::World& world, const engine::CameraSettings& 
     im.drawLines(im.lines.volumes, 2.0f);
     im.drawLines(im.lines.hierarchy, 1.0f);
     im.drawLines(im.lines.contacts, 2.0f);
+    im.drawLines(im.lines.selection, 3.0f);
     const GLenum error = glGetError();
     if (error != GL_NO_ERROR) {
         throw RenderError("OpenGL error " + std::to_string(error) + " while rendering a frame");
@@ -384,6 +385,7 @@ void Renderer::render(const engine::World& world, const engine::CameraSettings& 
     glFinish();
     const auto drawn = std::chrono::steady_clock::now();
     im.readPixels(image);
+    if (options.draw.labels || options.selected) im.drawLabels(image, world, camera, options);
     im.drawOverlays(image, options);
     const auto read = std::chrono::steady_clock::now();
     im.stats.draw_s = std::chrono::duration<double>(drawn - start).count();

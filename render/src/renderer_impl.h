@@ -52,6 +52,9 @@ struct Renderer::Impl {
     void drawLines(const LineBuffer& buffer, float width_px);
     void readPixels(Image& image);
     void drawOverlays(Image& image, const FrameOptions& options) const;
+    /// Body names above their boxes' pictures (draw.labels), the selected body's always.
+    void drawLabels(Image& image, const engine::World& world, const engine::CameraSettings& camera,
+                    const FrameOptions& options) const;
 };
 
 }  // namespace render

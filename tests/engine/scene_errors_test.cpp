@@ -50,7 +50,7 @@ TEST(SceneErrors, BodyNamesAreUnique) {
 TEST(SceneErrors, UnknownKeysAtEveryLevel) {
     EXPECT_SCENE_ERROR("wrld:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n", "1:1: wrld: ",
                        "unknown key 'wrld' (expected one of: world, broadphase, pair_order, "
-                       "output, camera, draw, bodies, chains, expect)");
+                       "output, camera, draw, bodies, chains, expect, events)");
     EXPECT_SCENE_ERROR(withBody("  - shape: sphere\n    radus: 0.5\n    position: [0, 0, 0]\n"),
                        "5:5: bodies[0].radus: ", "unknown key 'radus' (expected one of: name,");
     EXPECT_SCENE_ERROR("world:\n  bounds: {min: [0,0,0], max: [1,1,1]}\n  gravty: [0,0,0]\n",
@@ -163,7 +163,7 @@ TEST(SceneErrors, DrawBvhDepthAndContactsAreValidated) {
               "test.yaml:4:18: draw.contacts: expected true or false, got '1.5'");
     EXPECT_EQ(sceneErrorOf(kHeader + "draw: {contact: true}\n"),
               "test.yaml:4:8: draw.contact: unknown key 'contact' (expected one of: bodies, "
-              "volumes, bounds, hud, structure, bvh_depth, contacts)");
+              "volumes, bounds, hud, structure, bvh_depth, contacts, labels)");
 }
 
 TEST(SceneErrors, UnknownNamesListTheChoices) {

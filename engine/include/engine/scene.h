@@ -12,6 +12,7 @@
 
 #include "collision/volumes/volume_kind.h"
 #include "engine/body.h"
+#include "engine/demo_commands.h"
 #include "engine/chain.h"
 #include "engine/world.h"
 
@@ -58,6 +59,8 @@ struct DrawSettings {
     int bvh_depth = -1;
     /// Witness points and normals of the confirmed contacts. Scene key `draw.contacts`.
     bool contacts = false;
+    /// Each body's name beside its centre. Scene key `draw.labels`.
+    bool labels = false;
 
     /// The flag of one proxy volume kind: sphere, aabb or obb.
     bool& shows(collision::VolumeKind kind) {
@@ -188,6 +191,8 @@ struct Scene {
     /// `chains:` (links in `bodies`, see ChainSpec::links).
     std::vector<ChainSpec> chains;
     Expectations expect;  ///< `expect:` (self-grading), empty when absent
+    /// `events:`: a scripted demo (demo_commands.h), applied by `cdlab run` as the frames come.
+    std::vector<DemoEvent> events;
     /// What loading assumed or changed that the user should know, one line each,
     /// "FILE:LINE:COL: path: what" (an open mesh's mass properties from its hull, triangles an
     /// import dropped): the commands print them on stderr. Not errors: the scene loaded.

@@ -32,11 +32,15 @@ inline constexpr collision::Color kContactColor{1.0f, 0.0f, 1.0f, 1.0f};
 /// The world bounds' box and the floor grid on its bottom face.
 inline constexpr collision::Color kBoundsColor{0.74f, 0.76f, 0.82f, 1.0f};
 inline constexpr collision::Color kGridColor{0.22f, 0.24f, 0.29f, 1.0f};
+/// The selected body's volumes (DrawOptions::selected): white, a colour no state uses.
+inline constexpr collision::Color kSelectColor{1.0f, 1.0f, 1.0f, 1.0f};
 
 /// What a picture of a world shows. Plain data: it may change from one frame to the next.
 struct DrawOptions {
     DrawSettings draw;       ///< layers and volumes (the scene's `draw:`)
     bool structure = false;  ///< the broad phase's own structure (BroadPhase::draw)
+    /// One body highlighted: its AABB and every volume shown of it drawn again in kSelectColor.
+    std::optional<BodyId> selected;
 };
 
 /// The groups of lines drawWorld draws, in this order; a renderer may give each its own buffer
@@ -47,6 +51,7 @@ enum class DrawLayer {
     Volumes,    ///< bounding volumes, poses at impact, chain skeletons
     Hierarchy,  ///< mesh hierarchy levels
     Contacts,   ///< contact witnesses and normals
+    Selection,  ///< the selected body's volumes, over everything else
 };
 
 /// The DebugDraw that drawWorld draws through: told which layer the lines that follow belong to,

@@ -38,6 +38,8 @@ std::optional<ScreenRect> screenRect(const engine::CameraSettings& camera, int w
 struct FrameOptions {
     engine::DrawSettings draw;
     bool draw_structure = false;  ///< the broad phase's own structure (BroadPhase::draw)
+    /// One body highlighted (engine::DrawOptions::selected) and named beside it.
+    std::optional<engine::BodyId> selected;
     std::string hud_text;         ///< the HUD line, top-left; empty = none
     /// Leave out bodies and volumes wholly outside the view's side planes. Changes no pixel;
     /// false draws everything (the reference the tests compare against).
