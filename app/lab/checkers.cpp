@@ -295,10 +295,10 @@ public:
     void observeFrame(CheckRun& run, int frame) override {
         for (const int f : frames_) {
             if (f != frame) continue;
-            // The same dump `cdlab run --pause-at` writes: every volume drawn, plus the JSON.
+            // The same dump `cdlab run --pause-at` writes: its picture, plus the JSON.
             render::FrameOptions options;
-            options.draw = run.scene.draw;
-            options.draw.sphere = options.draw.aabb = options.draw.obb = true;
+            options.draw = pauseDrawSettings(engine::drawSettingsFor(run.scene.draw, run.world),
+                                             run.scene.draw.volumes_given);
             options.hud_text = "PAUSED  " + render::hudLine(run.world, frame, false);
             const std::string stem = "pause_" + std::to_string(frame);
             render::writePng(run.dump_dir / (stem + ".png"),

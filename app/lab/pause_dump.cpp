@@ -135,4 +135,9 @@ std::string pauseDumpJson(const engine::World& world, int frame, const engine::D
     return doc.dump(1) + "\n";
 }
 
+engine::DrawSettings pauseDrawSettings(engine::DrawSettings frame_draw, bool volumes_chosen) {
+    if (!volumes_chosen) frame_draw.sphere = frame_draw.aabb = frame_draw.obb = true;
+    return frame_draw;
+}
+
 }  // namespace app

@@ -19,4 +19,9 @@ namespace app {
 /// (collision::bvhVolumeNames()). Numbers are printed to round-trip.
 std::string pauseDumpJson(const engine::World& world, int frame, const engine::DrawSettings& draw);
 
+/// What a `--pause-at` picture draws over the frame's view `frame_draw`: the volumes the frames
+/// draw when they were chosen (`volumes_chosen`: the scene's draw.volumes, or a show/hide), else
+/// the three proxy volumes (sphere, AABB and OBB) side by side, each coloured by its own test.
+engine::DrawSettings pauseDrawSettings(engine::DrawSettings frame_draw, bool volumes_chosen);
+
 }  // namespace app

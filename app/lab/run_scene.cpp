@@ -549,9 +549,10 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
                 if (png) frames_written.insert(frame);
             }
             if (pauses.count(frame)) {
-                // Every proxy volume, each coloured by its own overlap test.
+                // The volumes chosen, or every proxy volume, each coloured by its own test.
                 render::FrameOptions pause_options = session.frameOptions();
-                pause_options.draw.sphere = pause_options.draw.aabb = pause_options.draw.obb = true;
+                pause_options.draw =
+                    pauseDrawSettings(pause_options.draw, session.view().volumes_chosen);
                 pause_options.hud_text = "PAUSED  " + render::hudLine(world, frame, false);
                 const std::string stem = "pause_" + std::to_string(frame);
                 auto pause_image = std::make_shared<const render::Image>(

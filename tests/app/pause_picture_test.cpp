@@ -69,8 +69,8 @@ const Rgb kYellow = toRgb(engine::stateColor(engine::BodyState::Flagged));
 
 }  // namespace
 
-// Issue "pictures that tell the truth": the pause picture coloured D's sphere yellow because its
-// AABB was flagged. The dump now lists each volume's own state, and the picture agrees.
+// Each volume is coloured by its own test: D's sphere stays green though its AABB is flagged,
+// and the dump lists each volume's own state, as the picture shows it.
 TEST(PausePicture, EachVolumeTakesItsOwnTestsStateInPictureAndDump) {
     const fs::path work = pauseDir("own");
     const fs::path scene =
@@ -109,6 +109,33 @@ TEST(PausePicture, EachVolumeTakesItsOwnTestsStateInPictureAndDump) {
     // The frames of the run (no draw.volumes, broad phase sap) draw the AABBs, yellow.
     const render::Image frame = render::readPng(out / "frame_00001.png");
     EXPECT_TRUE(colorNear(frame, corner, kYellow));
+    fs::remove_all(work);
+}
+
+// A scene that chose its volumes gets them, and only them, in the pause picture too: with
+// draw.volumes [aabb] the green sphere outline of the test above is gone, the yellow box corner
+// stays; the dump still lists every volume's state.
+TEST(PausePicture, ChosenVolumesAreTheOnesThePausePictureDraws) {
+    const fs::path work = pauseDir("chosen");
+    const fs::path scene =
+        writeScene(work, "diagonal.yaml", sceneText(-1.2, -0.6, kDiagonalBodies));
+    const fs::path out = work / "out";
+    const CliResult r = runCdlab("run " + scene.string() +
+                                     " --no-video --pause-at 1 --set 'draw.volumes=[aabb]' --out " +
+                                     out.string(),
+                                 work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const render::Image pause = render::readPng(out / "pause_1.png");
+    const engine::CameraSettings cam = cameraAt(-1.2, -0.6);
+    const Real k = Real(0.8) * std::sqrt(Real(0.5));
+    for (const Vec3& p : {Vec3(-1.2 - k, -0.6 - k, 0), Vec3(-1.2 - k, -0.6 + k, 0)}) {
+        const PixelPos px = project(cam, pause.width, pause.height, p);
+        EXPECT_FALSE(colorNear(pause, px, kGreen, 1)) << "a sphere drawn at " << px.x << "," << px.y;
+    }
+    EXPECT_TRUE(colorNear(pause, project(cam, pause.width, pause.height, Vec3(-2.0, -1.4, 0.8)),
+                          kYellow));
+    const nlohmann::json dump = nlohmann::json::parse(slurp(out / "pause_1.json"));
+    EXPECT_EQ(dump["bodies"][0]["volume_states"]["sphere"], "apart");
     fs::remove_all(work);
 }
 
