@@ -240,11 +240,14 @@ BodyId World::addBody(Body body) {
 }
 
 void World::setBroadPhase(const std::string& name) {
+    const bool detected = proxies_inserted_;
     broad_phase_ = makeBroadPhase(name, settings_.pair_order);
     settings_.broad_phase = name;
     proxies_inserted_ = false;
     if (ccd_finder_) ccd_finder_->reset(name);
     if (response_) response_->reset(name);
+    // The pairs, states and structure of the current state are the new broad phase's at once.
+    if (detected) detect();
 }
 
 void World::integrate(Real dt, const Vec3& gravity) {

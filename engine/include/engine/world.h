@@ -251,8 +251,10 @@ public:
     void step();
     /// Recomputes volumes, pairs and states at the current state, without moving anything.
     void detect();
-    /// Replaces the broad phase (state kept; it writes in settings().pair_order); throws
-    /// std::invalid_argument on an unknown name.
+    /// Replaces the broad phase (state kept; it writes in settings().pair_order) and, once the
+    /// world has been detected, detects again on the current state, so flaggedPairs(), states()
+    /// and the structure drawn are the new broad phase's; throws std::invalid_argument on an
+    /// unknown name.
     void setBroadPhase(const std::string& name);
 
     const WorldSettings& settings() const { return settings_; }
