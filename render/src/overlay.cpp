@@ -85,8 +85,10 @@ void Renderer::Impl::drawOverlays(Image& image, const FrameOptions& options) con
     if (!lines.structure_legend.empty()) {
         std::vector<LegendRow> rows;
         for (const LegendEntry& e : lines.structure_legend) rows.push_back({{e.color, e.label}});
-        drawLegendBlock(image, width - margin - legendBlockSize(rows, scale).width, margin, rows,
-                        scale);
+        // Right-aligned; a block wider than the frame starts at the left margin instead, so its
+        // swatches stay on screen and only the ends of its longest lines are cut.
+        const int left = std::max(margin, width - margin - legendBlockSize(rows, scale).width);
+        drawLegendBlock(image, left, margin, rows, scale);
     }
 }
 

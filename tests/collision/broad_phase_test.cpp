@@ -234,13 +234,22 @@ TEST(BroadPhaseDifferential, HierarchicalGridKeepsFewHugeAmongManySmallNearLinea
 // +-2048, half extents 0-127 from MSVC's rand(), seed 42): the largest extent of all but 17 boxes
 // is over 32, an eighth of the largest, so those 17 would make a level of their own and visit
 // the one holding the rest as guests, whose columns would then be swept with a list of their
-// own members. That pass costs more than the hierarchy saves: one level is planned.
+// own members. That pass costs more than the hierarchy saves: one level is planned, and the
+// legend says why. hgrid-levels keeps Mirtich's hierarchy (cells halving per level) on the same
+// boxes, with the same pairs.
 TEST(BroadPhaseDifferential, HierarchicalGridPlansOneLevelForTerdimansScene) {
     struct LevelCount : DebugDraw {
         void drawLine(const Vec3&, const Vec3&, const Color&) override {}
         void drawAabb(const Aabb&, const Color&) override {}
-        void legend(std::string_view, const Color&) override { ++levels; }
+        void legend(std::string_view label, const Color&) override {
+            if (label.starts_with("hgrid level ")) {
+                ++levels;
+            } else {
+                notes.emplace_back(label);
+            }
+        }
         int levels = 0;
+        std::vector<std::string> notes;
     };
     std::uint32_t state = 42;
     const auto msvcRand = [&state] {
@@ -249,6 +258,7 @@ TEST(BroadPhaseDifferential, HierarchicalGridPlansOneLevelForTerdimansScene) {
     };
     std::unique_ptr<BroadPhase> grid = findBroadPhase("hgrid")->create();
     std::unique_ptr<BroadPhase> ref = findBroadPhase("brute")->create();
+    std::vector<ProxyVolumes> grid_volumes;
     for (int i = 0; i < 10000; ++i) {
         Vec3 c, e;
         for (int k = 0; k < 3; ++k) c[k] = Real((msvcRand() & 4095) - 2048);
@@ -257,6 +267,7 @@ TEST(BroadPhaseDifferential, HierarchicalGridPlansOneLevelForTerdimansScene) {
         v.aabb = Aabb{c - e, c + e};
         grid->insert(i, v);
         ref->insert(i, v);
+        grid_volumes.push_back(v);
     }
     std::vector<ProxyPair> pairs, ref_pairs;
     BroadPhaseCounters counters, ref_counters;
@@ -268,6 +279,20 @@ TEST(BroadPhaseDifferential, HierarchicalGridPlansOneLevelForTerdimansScene) {
     LevelCount draw;
     grid->draw(draw, Aabb{Vec3::Constant(-2175), Vec3::Constant(2175)});
     EXPECT_EQ(draw.levels, 1);
+    ASSERT_EQ(draw.notes.size(), 1u);
+    EXPECT_TRUE(draw.notes[0].starts_with("one level, not 2 by size: est. ")) << draw.notes[0];
+
+    std::unique_ptr<BroadPhase> levels = findBroadPhase("hgrid-levels")->create();
+    for (int i = 0; i < 10000; ++i) levels->insert(i, grid_volumes[std::size_t(i)]);
+    std::vector<ProxyPair> level_pairs;
+    BroadPhaseCounters level_counters;
+    levels->findPairs(level_pairs, level_counters);
+    EXPECT_EQ(level_pairs, ref_pairs);
+    EXPECT_EQ(levels->validate(), "");
+    LevelCount level_draw;
+    levels->draw(level_draw, Aabb{Vec3::Constant(-2175), Vec3::Constant(2175)});
+    EXPECT_GE(level_draw.levels, 5);  // extents 2 to 254: cells halving from 254
+    EXPECT_TRUE(level_draw.notes.empty());
 }
 
 TEST(BroadPhaseDifferential, LatticeSceneReallyTouches) {

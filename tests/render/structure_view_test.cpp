@@ -17,8 +17,8 @@ namespace {
 
 using namespace cdlab_test;
 
-const std::vector<std::string> kDrawing = {"grid", "hash", "hgrid", "sap",
-                                           "sap1", "tree", "octree"};
+const std::vector<std::string> kDrawing = {"grid", "hash",   "hgrid",  "hgrid-levels", "sap",
+                                           "sap1", "tree",   "octree", "sphere",       "obb"};
 
 // Bounds that frame the three spheres closely, so diagrams along their edges are in view of
 // structureCamera().
@@ -141,6 +141,22 @@ TEST(StructureView, EachBroadPhaseDrawsItsStructureInItsOwnColours) {
         EXPECT_GE(structure_coloured, 10)
             << "of " << differing << " changed pixels, too few in the structure's "
             << recorded.colors.size() << " colours";
+    }
+}
+
+// A broad phase without a structure of its own says so in the legend rather than drawing
+// nothing silently: the references, how many pairs they test.
+TEST(StructureView, BroadPhasesWithoutAStructureSaySoInTheLegend) {
+    for (const std::string name : {"brute", "sphere-brute", "obb-brute"}) {
+        SCOPED_TRACE(name);
+        const engine::World world = worldWith(name);
+        RecordingDraw recorded;
+        world.broadPhase().draw(recorded, world.settings().bounds);
+        EXPECT_TRUE(recorded.segments.empty());
+        ASSERT_EQ(recorded.labels.size(), 1u);
+        EXPECT_EQ(recorded.labels[0], name +
+                                          ": no structure: every pair of its 3 proxies is tested "
+                                          "(3 pairs)");
     }
 }
 

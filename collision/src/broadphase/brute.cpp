@@ -2,7 +2,11 @@
 // Pairs come out sorted because the loops run over (a, b) in lexicographic order.
 #include "broadphase/brute.h"
 
+#include <cstdio>
+#include <string>
 #include <type_traits>
+
+#include "collision/debug_draw.h"
 
 namespace collision {
 
@@ -61,6 +65,15 @@ void BruteForceBroadPhase::findPairs(std::vector<ProxyPair>& pairs,
     counters.volume_tests += m * (m - 1) / 2;
     counters.volumes_updated += table_.count();
     counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
+}
+
+void BruteForceBroadPhase::draw(DebugDraw& draw, const Aabb& /*bounds*/) const {
+    const long long n = table_.count();
+    char label[128];
+    std::snprintf(label, sizeof label,
+                  "%s: no structure: every pair of its %lld proxies is tested (%lld pairs)",
+                  std::string(name()).c_str(), n, n * (n - 1) / 2);
+    draw.legend(label, kStructurePalette[0]);
 }
 
 }  // namespace collision

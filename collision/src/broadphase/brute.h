@@ -27,6 +27,8 @@ public:
     void remove(ProxyId id) override { table_.remove(id); }
     void move(ProxyId id, const ProxyVolumes& v) override { table_.move(id, v); }
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
+    /// No lines: a legend line saying every pair is tested, and how many pairs that is.
+    void draw(DebugDraw& draw, const Aabb& bounds) const override;
 
 private:
     VolumeKind volume_;

@@ -67,7 +67,10 @@ using YzTest = YzTestOf<Real>;
 
 }  // namespace
 
-HierarchicalGrid::HierarchicalGrid(bool two_threads, PairOrder order) : pair_order_(order) {
+HierarchicalGrid::HierarchicalGrid(bool two_threads, PairOrder order, LevelPlan plan)
+    : level_plan_(plan),
+      level_bits_(plan == LevelPlan::Hierarchy ? 1 : kLevelBits),
+      pair_order_(order) {
     if (two_threads) helper_ = HelperSlot(true);
 }
 
@@ -492,6 +495,18 @@ void HierarchicalGrid::draw(DebugDraw& draw, const Aabb& /*bounds*/) const {
                       double(lv.cell));
         draw.legend(label, color);
     }
+    // Why there is one level, when there is.
+    if (level_count_ != 1) return;
+    char why[160];
+    if (size_levels_ <= 1) {
+        std::snprintf(why, sizeof why, "one level: every proxy within %dx of the largest extent",
+                      1 << level_bits_);
+    } else {
+        std::snprintf(why, sizeof why,
+                      "one level, not %d by size: est. %.3g tests vs %.3g (hgrid-levels keeps them)",
+                      size_levels_, one_level_estimate_, hierarchy_estimate_);
+    }
+    draw.legend(why, structureColor(0));
 }
 
 std::string HierarchicalGrid::validate() const {

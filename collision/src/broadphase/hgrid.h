@@ -55,11 +55,19 @@ public:
     /// few per cent at 10k). One lane only: with two (hgrid2, from kTwoLaneMinimum proxies) the
     /// pairs come sorted, since which lane sweeps which columns varies from run to run.
     using PairOrder = collision::PairOrder;
+    /// How the levels are planned each frame: the cheaper estimate of the level hierarchy (cells
+    /// 2^kLevelBits apart) and of one level holding everything ("hgrid"), or always the
+    /// hierarchy with cells halving per level ("hgrid-levels": Mirtich's own factor, a level per
+    /// size class, to be seen and measured as TR-97-23 describes it).
+    enum class LevelPlan { Cheaper, Hierarchy };
     /// `two_threads`: count, scatter and sweep split between this thread and a helper thread
     /// (from kTwoLaneMinimum proxies); the pairs are the same either way.
-    explicit HierarchicalGrid(bool two_threads = false, PairOrder order = PairOrder::Sorted);
+    explicit HierarchicalGrid(bool two_threads = false, PairOrder order = PairOrder::Sorted,
+                              LevelPlan plan = LevelPlan::Cheaper);
     ~HierarchicalGrid() override;
-    std::string_view name() const override { return helper_ ? "hgrid2" : "hgrid"; }
+    std::string_view name() const override {
+        return helper_ ? "hgrid2" : level_plan_ == LevelPlan::Hierarchy ? "hgrid-levels" : "hgrid";
+    }
     std::unique_ptr<BroadPhase> clone() const override {
         return std::make_unique<HierarchicalGrid>(*this);
     }
@@ -149,7 +157,7 @@ private:
     static constexpr std::uint8_t kZeroSize = 0xff;  // level_of_ mark: any level will do
     static double planLevels(const std::array<std::size_t, kMaxLevels>& members,
                              const std::array<Real, kMaxLevels>& extent_sum, int level_count,
-                             Real top, const Bounds& bounds, Plan& plan);
+                             int level_bits, Real top, const Bounds& bounds, Plan& plan);
     Extents gatherBoxes();
     // Steps of findPairs, in order (hgrid_order.cpp, hgrid_levels.cpp, hgrid.cpp).
     void chooseLevels(Real top, const Extents& x);
@@ -169,6 +177,12 @@ private:
     int level_count_ = 0;
     int finest_ = 0;     // the finest level with members; zero-size boxes join it
     bool flat_ = false;  // every box at level 0 (planLevels found that cheaper)
+    LevelPlan level_plan_ = LevelPlan::Cheaper;
+    int level_bits_ = kLevelBits;  // cells shrink by 2^level_bits_ per level
+    // The last plan, for draw(): the size levels the proxies span, and the estimated sweep
+    // costs of their hierarchy and of one level (0 when not planned).
+    int size_levels_ = 0;
+    double hierarchy_estimate_ = 0, one_level_estimate_ = 0;
     Real origin_y_ = 0, origin_z_ = 0;
     std::array<Level, kMaxLevels> levels_;
     std::vector<std::uint32_t> order_;   // present proxies by (min x, id)

@@ -26,10 +26,11 @@ inline int floorLog2(Real x) {
 }  // namespace
 
 void HierarchicalGrid::levelLane(Lane& lane, Real top) {
-    // Level k has cells s_top / 8^k; a box goes to the finest level whose cells hold its
-    // extent. Zero-size boxes fit anywhere: marked here, they join the finest level in use.
-    std::array<Real, kMaxLevels> base_cell;  // s_top / 8^k
-    for (int k = 0; k < kMaxLevels; ++k) base_cell[k] = std::ldexp(top, -kLevelBits * k);
+    // Level k has cells s_top / 2^(level_bits k) (8^k for hgrid); a box goes to the finest
+    // level whose cells hold its extent. Zero-size boxes fit anywhere: marked here, they join
+    // the finest level in use.
+    std::array<Real, kMaxLevels> base_cell;
+    for (int k = 0; k < kMaxLevels; ++k) base_cell[k] = std::ldexp(top, -level_bits_ * k);
     lane.extent_sum.fill(0);
     lane.members.fill(0);
     lane.zero_size = 0;
@@ -41,7 +42,7 @@ void HierarchicalGrid::levelLane(Lane& lane, Real top) {
             ++lane.zero_size;
             continue;
         }
-        int k = std::min(floorLog2(top / e) / kLevelBits, kMaxLevels - 1);
+        int k = std::min(floorLog2(top / e) / level_bits_, kMaxLevels - 1);
         while (k > 0 && base_cell[k] < e) --k;  // guard: cell >= extent
         level_of_[p] = static_cast<std::uint8_t>(k);
         lane.extent_sum[k] += e;
@@ -52,7 +53,7 @@ void HierarchicalGrid::levelLane(Lane& lane, Real top) {
 
 double HierarchicalGrid::planLevels(const std::array<std::size_t, kMaxLevels>& members,
                                     const std::array<Real, kMaxLevels>& extent_sum, int level_count,
-                                    Real top, const Bounds& b, Plan& plan) {
+                                    int level_bits, Real top, const Bounds& b, Plan& plan) {
     // Column grids: cells at least the level's own s_top / 8^k and twice its members' mean
     // extent (columns much wider than the boxes cost more candidates, much narrower ones more
     // entries per box: on the bench's uniform workload 1.11 ms/frame at the level's cell, 1.04
@@ -71,7 +72,7 @@ double HierarchicalGrid::planLevels(const std::array<std::size_t, kMaxLevels>& m
         const std::size_t entries = lv.members + guests;
         const Real limit = std::max<Real>(64, 2 * Real(entries));
         const Real mean = extent_sum[k] / Real(lv.members);
-        lv.cell = std::max(std::ldexp(top, -kLevelBits * k), kCellPerExtent * mean) *
+        lv.cell = std::max(std::ldexp(top, -level_bits * k), kCellPerExtent * mean) *
                   (1 + std::ldexp(Real(1), -20));
         for (;;) {
             lv.inv_cell = 1 / lv.cell;
@@ -139,16 +140,20 @@ void HierarchicalGrid::chooseLevels(Real top, const Extents& x) {
     const Bounds bounds{x.lo_y, x.hi_y, x.lo_z, x.hi_z, x.hi_c - x.lo_c};
     Plan levels_plan, flat_plan;
     const double levels_cost =
-        planLevels(members, extent_sum, level_count_, top, bounds, levels_plan);
+        planLevels(members, extent_sum, level_count_, level_bits_, top, bounds, levels_plan);
     flat_ = false;
-    if (level_count_ > 1) {
+    size_levels_ = level_count_;
+    hierarchy_estimate_ = levels_cost;
+    one_level_estimate_ = 0;
+    if (level_count_ > 1 && level_plan_ == LevelPlan::Cheaper) {
         std::array<std::size_t, kMaxLevels> one{};
         std::array<Real, kMaxLevels> one_sum{};
         for (int k = 0; k < level_count_; ++k) {
             one[0] += members[k];
             one_sum[0] += extent_sum[k];
         }
-        flat_ = planLevels(one, one_sum, 1, top, bounds, flat_plan) <= levels_cost;
+        one_level_estimate_ = planLevels(one, one_sum, 1, level_bits_, top, bounds, flat_plan);
+        flat_ = one_level_estimate_ <= levels_cost;
     }
     if (flat_) level_count_ = 1;
     const Plan& plan = flat_ ? flat_plan : levels_plan;

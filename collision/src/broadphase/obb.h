@@ -22,6 +22,9 @@ public:
         return std::make_unique<ObbBroadPhase>(*this);
     }
     void findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters& counters) override;
+    /// The sweep's sorted x-intervals as a 1-D interval diagram along the bounds' front bottom
+    /// edge (interval_diagram.h), those of proxies in an overlapping pair marked.
+    void draw(DebugDraw& draw, const Aabb& bounds) const override;
 
 private:
     struct Item {

@@ -2,6 +2,10 @@
 // The scene loader, the CLI and the differential tests all read this table.
 #include "collision/broadphase/broad_phase.h"
 
+#include <string>
+
+#include "collision/debug_draw.h"
+
 #include "broadphase/brute.h"
 #include "broadphase/cullide.h"
 #include "broadphase/grid.h"
@@ -36,6 +40,10 @@ void BroadPhase::moveBoxes(ProxyId first, std::span<const Aabb> boxes) {
     for (std::size_t i = 0; i < boxes.size(); ++i) {
         move(first + static_cast<ProxyId>(i), volumesOfBox(boxes[i]));
     }
+}
+
+void BroadPhase::draw(DebugDraw& draw, const Aabb& /*bounds*/) const {
+    draw.legend(std::string(name()) + ": no structure of its own to draw", kStructurePalette[0]);
 }
 
 namespace {
@@ -75,6 +83,14 @@ const BroadPhaseEntry kRegistry[] = {
      VolumeKind::Aabb, "brute",
      []() -> std::unique_ptr<BroadPhase> { return std::make_unique<HierarchicalGrid>(true); }, 2,
      false, /*found_order=*/true},
+    {"hgrid-levels",
+     "hgrid always on its level hierarchy, a level per size class (never planned down to one)",
+     VolumeKind::Aabb, "brute",
+     []() -> std::unique_ptr<BroadPhase> {
+         return std::make_unique<HierarchicalGrid>(false, PairOrder::Sorted,
+                                                   HierarchicalGrid::LevelPlan::Hierarchy);
+     },
+     1, false, /*found_order=*/true},
     {"tree", "dynamic AABB tree: fat leaves, SAH insertion, rotations", VolumeKind::Aabb, "brute",
      []() -> std::unique_ptr<BroadPhase> { return std::make_unique<DynamicAabbTree>(); }},
     {"octree", "loose octree (k = 2)", VolumeKind::Aabb, "brute",

@@ -3,6 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
+
+#include "broadphase/interval_diagram.h"
+#include "collision/debug_draw.h"
 
 namespace collision {
 
@@ -39,6 +44,26 @@ void SphereBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
     }
     std::sort(pairs.begin(), pairs.end());
     counters.pairs_flagged += static_cast<std::int64_t>(pairs.size());
+}
+
+void SphereBroadPhase::draw(DebugDraw& draw, const Aabb& bounds) const {
+    // The intervals findPairs swept, in its order; marked where the sphere test accepts a pair.
+    std::vector<DiagramInterval> intervals;
+    intervals.reserve(items_.size());
+    for (const Item& it : items_) intervals.push_back(DiagramInterval{it.lo, it.hi, false});
+    for (std::size_t i = 0; i < items_.size(); ++i) {
+        const BoundingSphere& si = table_.sphere(items_[i].id);
+        for (std::size_t j = i + 1; j < items_.size() && items_[j].lo <= items_[i].hi; ++j) {
+            if (si.overlaps(table_.sphere(items_[j].id))) {
+                intervals[i].marked = intervals[j].marked = true;
+            }
+        }
+    }
+    const Color& color = kStructurePalette[0];
+    const Color& marked = kStructurePalette[1];
+    drawIntervalDiagram(draw, bounds, 0, intervals, color, marked);
+    draw.legend("sphere x-intervals, sorted and swept, " + intervalDiagramPlace(0), color);
+    draw.legend("interval of a sphere that overlaps another", marked);
 }
 
 }  // namespace collision

@@ -113,8 +113,9 @@ public:
     /// Draws the broad phase's own structure (cells, intervals, nodes) as it was at the last
     /// findPairs, in kStructurePalette colours, and names each colour with DebugDraw::legend.
     /// `bounds` is the box the picture frames (the world bounds): what has no place in space of
-    /// its own (SAP's intervals on each axis) is laid out along its edges. Default: nothing.
-    virtual void draw(DebugDraw& /*draw*/, const Aabb& /*bounds*/) const {}
+    /// its own (SAP's intervals on each axis) is laid out along its edges. Default: no lines,
+    /// and a legend line saying the broad phase has no structure of its own to draw.
+    virtual void draw(DebugDraw& draw, const Aabb& bounds) const;
     /// Proxies the last findPairs kept in a potentially colliding set before pairing them
     /// (CULLIDE's visibility pruning), or -1 for a method that keeps no such set.
     virtual std::int64_t potentiallyCollidingSize() const { return -1; }
