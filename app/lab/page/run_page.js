@@ -230,10 +230,13 @@
     return dl;
   }
 
-  function pairList(title, pairs, select) {
+  // A button per pair, named by its bodies ("ball7\u2013ball8"; a body without a name by its id).
+  function pairList(title, pairs, bodies, select) {
     const p = text('p', title + ': ' + (pairs.length ? '' : 'none'), 'pairs');
+    const name = function (id) { return (bodies[id] && bodies[id].name) || String(id); };
     pairs.forEach(function (pair) {
-      const b = text('button', pair[0] + '\u2013' + pair[1], 'pair');
+      const b = text('button', name(pair[0]) + '\u2013' + name(pair[1]), 'pair');
+      b.title = 'bodies ' + pair[0] + ' and ' + pair[1];
       b.addEventListener('click', function () { select(pair); });
       p.appendChild(b);
     });
@@ -358,15 +361,18 @@
         const row = body.querySelector('tr[data-body="' + id + '"]');
         if (row) row.classList.add('highlight');
       });
-      detail.replaceChildren(bodyDetail(dump.bodies[pair[0]]), bodyDetail(dump.bodies[pair[1]]));
+      detail.replaceChildren(bodyDetail(dump.bodies[pair[0]], kdops),
+                             bodyDetail(dump.bodies[pair[1]], kdops));
       outline(pair);
     };
-    side.appendChild(pairList('confirmed pairs', dump.colliding_pairs, select));
-    side.appendChild(pairList('flagged pairs', dump.flagged_pairs, select));
-    side.appendChild(detail);
+    side.appendChild(pairList('confirmed pairs', dump.colliding_pairs, dump.bodies, select));
+    side.appendChild(pairList('flagged pairs', dump.flagged_pairs, dump.bodies, select));
+    // The detail below the table: as it grows or shrinks (one body, a pair) the rows stay where
+    // they are, so the row under the pointer stays the one shown.
     const scroll = text('div', undefined, 'table-scroll');
     scroll.appendChild(table);
     side.appendChild(scroll);
+    side.appendChild(detail);
     grid.appendChild(side);
     article.appendChild(grid);
     table.dataset.rendered = '1';
