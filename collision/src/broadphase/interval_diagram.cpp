@@ -83,4 +83,12 @@ void drawIntervalDiagram(DebugDraw& draw, const Aabb& bounds, int axis,
     }
 }
 
+void drawSweepDiagram(DebugDraw& draw, const Aabb& bounds, int axis,
+                      std::span<const DiagramInterval> intervals, const std::string& what,
+                      const std::string& marked_what) {
+    drawIntervalDiagram(draw, bounds, axis, intervals, kStructurePalette[0], kStructurePalette[1]);
+    draw.legend(what, kStructurePalette[0]);
+    draw.legend(marked_what, kStructurePalette[1]);
+}
+
 }  // namespace collision

@@ -2,8 +2,10 @@
 // interval diagram per axis along the edges of the world bounds (SAP and sap1 draw with it).
 #pragma once
 
+#include <cstddef>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "collision/debug_draw.h"
 
@@ -31,5 +33,27 @@ std::string intervalDiagramPlace(int axis);
 void drawIntervalDiagram(DebugDraw& draw, const Aabb& bounds, int axis,
                          std::span<const DiagramInterval> intervals, const Color& color,
                          const Color& marked_color);
+
+/// The intervals a sorted sweep meets: item i's [lo(i), hi(i)], items in ascending lo; i and
+/// each later j whose lo is at most hi(i) are marked when `accepts(i, j)` (the broad phase's own
+/// pair test). The same sweep as the broad phase's findPairs, repeated for drawing only.
+template <class Lo, class Hi, class Accepts>
+std::vector<DiagramInterval> sweptIntervals(std::size_t n, Lo lo, Hi hi, Accepts accepts) {
+    std::vector<DiagramInterval> intervals;
+    intervals.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) intervals.push_back(DiagramInterval{lo(i), hi(i), false});
+    for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t j = i + 1; j < n && intervals[j].lo <= intervals[i].hi; ++j) {
+            if (accepts(i, j)) intervals[i].marked = intervals[j].marked = true;
+        }
+    }
+    return intervals;
+}
+
+/// drawIntervalDiagram in the structure palette's first two colours, with a legend line for
+/// each: `what` the intervals are, `marked_what` the marked ones.
+void drawSweepDiagram(DebugDraw& draw, const Aabb& bounds, int axis,
+                      std::span<const DiagramInterval> intervals, const std::string& what,
+                      const std::string& marked_what);
 
 }  // namespace collision

@@ -48,26 +48,17 @@ void ObbBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounters&
 void ObbBroadPhase::draw(DebugDraw& draw, const Aabb& bounds) const {
     // The enclosing boxes' x-intervals findPairs swept; marked where the separating-axis test
     // accepts a pair.
-    std::vector<DiagramInterval> intervals;
-    intervals.reserve(items_.size());
-    for (const Item& it : items_) {
-        intervals.push_back(DiagramInterval{it.box.min.x(), it.box.max.x(), false});
-    }
-    for (std::size_t i = 0; i < items_.size(); ++i) {
-        const Item& a = items_[i];
-        for (std::size_t j = i + 1; j < items_.size() && items_[j].box.min.x() <= a.box.max.x();
-             ++j) {
+    const std::vector<DiagramInterval> intervals = sweptIntervals(
+        items_.size(), [&](std::size_t i) { return items_[i].box.min.x(); },
+        [&](std::size_t i) { return items_[i].box.max.x(); },
+        [&](std::size_t i, std::size_t j) {
+            const Item& a = items_[i];
             const Item& b = items_[j];
-            if (a.box.overlaps(b.box) && table_.obb(a.id).overlaps(table_.obb(b.id))) {
-                intervals[i].marked = intervals[j].marked = true;
-            }
-        }
-    }
-    const Color& color = kStructurePalette[0];
-    const Color& marked = kStructurePalette[1];
-    drawIntervalDiagram(draw, bounds, 0, intervals, color, marked);
-    draw.legend("obb: OBBs' x-extents, sorted and swept, " + intervalDiagramPlace(0), color);
-    draw.legend("interval of an OBB that overlaps another", marked);
+            return a.box.overlaps(b.box) && table_.obb(a.id).overlaps(table_.obb(b.id));
+        });
+    drawSweepDiagram(draw, bounds, 0, intervals,
+                     "obb: OBBs' x-extents, sorted and swept, " + intervalDiagramPlace(0),
+                     "interval of an OBB that overlaps another");
 }
 
 }  // namespace collision

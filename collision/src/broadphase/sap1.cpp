@@ -109,25 +109,17 @@ void SortAndSweep1::draw(DebugDraw& draw, const Aabb& bounds) const {
     // The one sorted list as a 1-D interval diagram along an edge of the bounds; the intervals
     // of proxies whose AABBs overlap another's marked (the sweep of findPairs, repeated).
     if (axis_ < 0) return;
-    std::vector<DiagramInterval> intervals;
-    intervals.reserve(items_.size());
-    for (const Item& it : items_) intervals.push_back(DiagramInterval{it.lo, it.hi, false});
-    for (std::size_t i = 0; i < items_.size(); ++i) {
-        const Aabb& box = table_.aabb(items_[i].id);
-        for (std::size_t j = i + 1; j < items_.size() && items_[j].lo <= items_[i].hi; ++j) {
-            if (box.overlaps(table_.aabb(items_[j].id))) {
-                intervals[i].marked = intervals[j].marked = true;
-            }
-        }
-    }
-    const Color& color = kStructurePalette[0];
-    const Color& marked = kStructurePalette[1];
-    drawIntervalDiagram(draw, bounds, axis_, intervals, color, marked);
+    const std::vector<DiagramInterval> intervals = sweptIntervals(
+        items_.size(), [&](std::size_t i) { return items_[i].lo; },
+        [&](std::size_t i) { return items_[i].hi; },
+        [&](std::size_t i, std::size_t j) {
+            return table_.aabb(items_[i].id).overlaps(table_.aabb(items_[j].id));
+        });
     const char* const axis_names[3] = {"x", "y", "z"};
-    draw.legend(std::string("sap1 intervals on ") + axis_names[axis_] +
-                    " (the sort axis), sorted, " + intervalDiagramPlace(axis_),
-                color);
-    draw.legend("interval of a proxy in an overlapping pair", marked);
+    drawSweepDiagram(draw, bounds, axis_, intervals,
+                     std::string("sap1 intervals on ") + axis_names[axis_] +
+                         " (the sort axis), sorted, " + intervalDiagramPlace(axis_),
+                     "interval of a proxy in an overlapping pair");
 }
 
 std::string SortAndSweep1::validate() const {

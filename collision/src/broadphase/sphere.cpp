@@ -48,22 +48,15 @@ void SphereBroadPhase::findPairs(std::vector<ProxyPair>& pairs, BroadPhaseCounte
 
 void SphereBroadPhase::draw(DebugDraw& draw, const Aabb& bounds) const {
     // The intervals findPairs swept, in its order; marked where the sphere test accepts a pair.
-    std::vector<DiagramInterval> intervals;
-    intervals.reserve(items_.size());
-    for (const Item& it : items_) intervals.push_back(DiagramInterval{it.lo, it.hi, false});
-    for (std::size_t i = 0; i < items_.size(); ++i) {
-        const BoundingSphere& si = table_.sphere(items_[i].id);
-        for (std::size_t j = i + 1; j < items_.size() && items_[j].lo <= items_[i].hi; ++j) {
-            if (si.overlaps(table_.sphere(items_[j].id))) {
-                intervals[i].marked = intervals[j].marked = true;
-            }
-        }
-    }
-    const Color& color = kStructurePalette[0];
-    const Color& marked = kStructurePalette[1];
-    drawIntervalDiagram(draw, bounds, 0, intervals, color, marked);
-    draw.legend("sphere x-intervals, sorted and swept, " + intervalDiagramPlace(0), color);
-    draw.legend("interval of a sphere that overlaps another", marked);
+    const std::vector<DiagramInterval> intervals = sweptIntervals(
+        items_.size(), [&](std::size_t i) { return items_[i].lo; },
+        [&](std::size_t i) { return items_[i].hi; },
+        [&](std::size_t i, std::size_t j) {
+            return table_.sphere(items_[i].id).overlaps(table_.sphere(items_[j].id));
+        });
+    drawSweepDiagram(draw, bounds, 0, intervals,
+                     "sphere x-intervals, sorted and swept, " + intervalDiagramPlace(0),
+                     "interval of a sphere that overlaps another");
 }
 
 }  // namespace collision
