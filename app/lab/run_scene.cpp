@@ -18,6 +18,7 @@
 #include <optional>
 #include <set>
 #include <stdexcept>
+#include <span>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -161,13 +162,24 @@ std::string traceLine(int frame, const engine::World& world) {
     }
     line["positions"] = std::move(positions);
     line["orientations_wxyz"] = std::move(orientations);
-    // Sorted, so that the trace does not depend on the pair order (world.pair_order).
-    std::vector<collision::ProxyPair> sorted(world.collidingPairs().begin(),
-                                             world.collidingPairs().end());
-    std::sort(sorted.begin(), sorted.end());
-    nlohmann::json pairs = nlohmann::json::array();
-    for (const collision::ProxyPair& p : sorted) pairs.push_back({p.a, p.b});
-    line["colliding_pairs"] = std::move(pairs);
+    // Sorted, so that the trace does not depend on the pair order (world.pair_order); by id,
+    // and by the bodies' names for a reader who wants to find a pair again.
+    const auto& bodies = world.bodies();
+    auto pairLists = [&](std::span<const collision::ProxyPair> list, const char* ids,
+                         const char* names) {
+        std::vector<collision::ProxyPair> sorted(list.begin(), list.end());
+        std::sort(sorted.begin(), sorted.end());
+        nlohmann::json by_id = nlohmann::json::array();
+        nlohmann::json by_name = nlohmann::json::array();
+        for (const collision::ProxyPair& p : sorted) {
+            by_id.push_back({p.a, p.b});
+            by_name.push_back({bodies[p.a].name, bodies[p.b].name});
+        }
+        line[ids] = std::move(by_id);
+        line[names] = std::move(by_name);
+    };
+    pairLists(world.collidingPairs(), "colliding_pairs", "colliding_names");
+    pairLists(world.flaggedPairs(), "flagged_pairs", "flagged_names");
     return line.dump() + "\n";
 }
 
@@ -505,19 +517,23 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
             }
             stage.sim_s += wallSeconds() - sim_start;
         };
-        auto hudText = [&](bool paused) {
-            if (!session.view().draw.hud) return std::string();
-            std::string text = render::hudLine(world, session.frame(),
-                                               options.hud_timing && !paused);
-            if (paused) text = "PAUSED  " + text;
-            if (session.view().selected) {
-                text += "\n" + selectionLine(world, *session.view().selected);
-            }
-            return text;
-        };
+        auto hudText = [&](bool paused) { return session.hudText(paused, options.hud_timing); };
         std::set<int> frames_written;
         int newest_frame = -1;   // the furthest frame reached so far
         double video_credit = 0;  // video frames owed at the current speed
+        // A frame's PNG waits until the run leaves the frame: the picture after the events at
+        // that frame, which is the one a live session last showed of it.
+        struct PendingPng {
+            std::shared_ptr<const render::Image> image;
+            int frame = 0;
+        };
+        std::optional<PendingPng> pending_png;
+        auto flushPng = [&]() {
+            if (!pending_png) return;
+            writer.submit(std::move(pending_png->image), out_dir / frameName(pending_png->frame),
+                          0);
+            pending_png.reset();
+        };
         // The current frame as the run shows it: its rows, its PNG, its video frames, and the
         // pause picture when --pause-at asks for it.
         auto showFrame = [&]() {
@@ -543,10 +559,13 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
                 renderer.render(world, session.camera(), frame_options, *image);
                 stage.add(renderer.lastFrameStats());
                 const double wait_start = wallSeconds();
-                writer.submit(std::move(image), png ? out_dir / frameName(frame) : fs::path(),
-                              copies);
+                flushPng();
+                if (want_video && copies > 0) writer.submit(image, fs::path(), copies);
                 stage.wait_s += wallSeconds() - wait_start;
-                if (png) frames_written.insert(frame);
+                if (png) {
+                    pending_png = PendingPng{std::move(image), frame};
+                    frames_written.insert(frame);
+                }
             }
             if (pauses.count(frame)) {
                 // The volumes chosen, or every proxy volume, each coloured by its own test.
@@ -592,6 +611,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         showFrame();
         std::size_t next = 0;  // the next event of the track
         for (;;) {
+            bool applied = false;
             while (next < events.size() && events[next].frame == session.frame()) {
                 const engine::DemoEvent& e = events[next++];
                 std::string problem;
@@ -599,6 +619,14 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
                 if (!problem.empty()) throw std::logic_error("events: " + problem);
                 if (e.commands.dump) dumpFrame();
                 if (e.commands.wait_s > 0) holdFrame(double(e.commands.wait_s));
+                applied = true;
+            }
+            // The frame's PNG is its picture after its events (a changed view, a pause).
+            if (applied && pending_png && pending_png->frame == session.frame()) {
+                render::FrameOptions frame_options = session.frameOptions();
+                frame_options.hud_text = hudText(!session.playing());
+                pending_png->image = std::make_shared<const render::Image>(
+                    renderer.render(world, session.camera(), frame_options));
             }
             // A track that ends paused ends the run there (checkEventTrack: nothing follows).
             if (!session.playing()) break;
@@ -607,6 +635,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
             if (!moved) break;
             showFrame();
         }
+        flushPng();
         writer.finish();
         if (options.timing) {
             out << timingLine(scene.frames, wallSeconds() - run_start, stage, writer.times());

@@ -422,4 +422,74 @@ void checkEventTrack(const std::vector<DemoEvent>& events, int frames,
     }
 }
 
+namespace {
+
+void emitReal(YAML::Emitter& out, Real v) { out << v; }
+
+void emitCommands(YAML::Emitter& out, const DemoCommands& c, const Scene& scene) {
+    auto name = [&](const std::optional<BodyId>& id) {
+        return id ? scene.bodies[std::size_t(*id)].name : std::string("none");
+    };
+    auto layers = [&](const char* key, const std::vector<DemoLayer>& list) {
+        if (list.empty()) return;
+        out << YAML::Key << key << YAML::Value << YAML::BeginSeq;
+        for (const DemoLayer l : list) out << std::string(demoLayerName(l));
+        out << YAML::EndSeq;
+    };
+    auto pair = [&](const char* key, const std::array<Real, 2>& v) {
+        out << YAML::Key << key << YAML::Value << YAML::BeginSeq;
+        emitReal(out, v[0]);
+        emitReal(out, v[1]);
+        out << YAML::EndSeq;
+    };
+    if (c.broad_phase) out << YAML::Key << "broadphase" << YAML::Value << *c.broad_phase;
+    layers("show", c.show);
+    layers("hide", c.hide);
+    if (c.select) out << YAML::Key << "select" << YAML::Value << name(*c.select);
+    if (c.camera) {
+        out << YAML::Key << "camera" << YAML::Value << YAML::BeginMap;
+        if (c.camera->reset) out << YAML::Key << "reset" << YAML::Value << true;
+        if (c.camera->orbit) pair("orbit", *c.camera->orbit);
+        if (c.camera->zoom) {
+            out << YAML::Key << "zoom" << YAML::Value;
+            emitReal(out, *c.camera->zoom);
+        }
+        if (c.camera->pan) pair("pan", *c.camera->pan);
+        if (c.camera->follow) out << YAML::Key << "follow" << YAML::Value << name(*c.camera->follow);
+        out << YAML::EndMap;
+    }
+    if (c.speed) {
+        out << YAML::Key << "speed" << YAML::Value;
+        emitReal(out, *c.speed);
+    }
+    if (c.playing) out << YAML::Key << (*c.playing ? "play" : "pause") << YAML::Value << true;
+    if (c.step) out << YAML::Key << "step" << YAML::Value << *c.step;
+    if (c.seek) {
+        out << YAML::Key << "seek" << YAML::Value << YAML::BeginMap << YAML::Key << "frame"
+            << YAML::Value << *c.seek << YAML::EndMap;
+    }
+    if (c.dump) out << YAML::Key << "dump" << YAML::Value << true;
+    if (c.wait_s > 0) {
+        out << YAML::Key << "wait" << YAML::Value;
+        emitReal(out, c.wait_s);
+    }
+}
+
+}  // namespace
+
+std::string eventsYaml(const std::vector<DemoEvent>& events, const Scene& scene) {
+    YAML::Emitter out;
+    // Every digit a Real needs, so a track read back gives the same values bit for bit.
+    out.SetFloatPrecision(9);
+    out.SetDoublePrecision(17);
+    out << YAML::BeginMap << YAML::Key << "events" << YAML::Value << YAML::BeginSeq;
+    for (const DemoEvent& e : events) {
+        out << YAML::Flow << YAML::BeginMap << YAML::Key << "frame" << YAML::Value << e.frame;
+        emitCommands(out, e.commands, scene);
+        out << YAML::EndMap;
+    }
+    out << YAML::EndSeq << YAML::EndMap;
+    return std::string(out.c_str()) + "\n";
+}
+
 }  // namespace engine

@@ -1,7 +1,9 @@
 // render/src/frame_writer.cpp -- see render/frame_writer.h.
 // Invariants: each queue holds at most queue_frames entries (the producer blocks, memory stays
 // bounded); the video thread is the only one that writes to the encoder, and it takes frames in
-// submission order, so the video is the same whatever the timing; the first failure is kept and
+// submission order, so the video is the same whatever the timing; two PNGs of the same file are
+// written one after the other in submission order, so the last one submitted is the file's (a
+// frame seen twice, stepping back); the first failure is kept and
 // every later submit() or finish() reports it, so a run never ends looking complete when a frame
 // was lost.
 #include "render/frame_writer.h"
@@ -13,6 +15,7 @@
 #include <deque>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <system_error>
 #include <thread>
@@ -122,6 +125,9 @@ struct FrameWriter::Impl {
     mutable std::mutex mutex;  ///< guards everything below
     std::optional<std::string> failure;
     FrameWriterTimes times;
+    /// The files a worker is writing now: a later job for one of them waits its turn.
+    std::set<std::filesystem::path> writing;
+    std::condition_variable written;
 
     void fail(const std::string& message) {
         {
@@ -139,16 +145,33 @@ struct FrameWriter::Impl {
     void pngWorker() {
         ::pthread_setname_np(::pthread_self(), "cdlab-png");
         while (std::optional<PngJob> job = png_queue.pop()) {
+            {
+                // Jobs leave the queue in submission order: one that finds its file being
+                // written came later, and waits for the earlier one to finish.
+                std::unique_lock<std::mutex> lock(mutex);
+                written.wait(lock, [&] { return writing.count(job->file) == 0; });
+                writing.insert(job->file);
+            }
             const double t0 = threadCpuSeconds();
+            std::string error;
             try {
                 writePng(job->file, *job->image);
             } catch (const std::exception& e) {
-                fail(e.what());
+                error = e.what();
+            }
+            {
+                std::lock_guard<std::mutex> lock(mutex);
+                writing.erase(job->file);
+                if (error.empty()) {
+                    times.png_cpu_s += threadCpuSeconds() - t0;
+                    ++times.png_files;
+                }
+            }
+            written.notify_all();
+            if (!error.empty()) {
+                fail(error);
                 return;
             }
-            std::lock_guard<std::mutex> lock(mutex);
-            times.png_cpu_s += threadCpuSeconds() - t0;
-            ++times.png_files;
         }
     }
 

@@ -513,6 +513,46 @@ TEST(Cli, StatsCsvHasOneRowPerFrameAndCheckBroadphasePasses) {
     fs::remove_all(work);
 }
 
+// Every frame's line of --trace lists the flagged and the confirmed pairs, by id and by the
+// bodies' names: at a pause frame, the same lists as the pause dump's.
+TEST(Cli, TraceListsEachFramesFlaggedAndCollidingPairsByIdAndName) {
+    const fs::path work = cliDir("trace_pairs");
+    const Result r = runCdlab("run scenes/coursework.yaml --no-video --no-frames --frames 60 "
+                              "--pause-at 20 --pause-at 59 --trace " +
+                                  (work / "trace.jsonl").string() + " --out " +
+                                  (work / "o").string(),
+                              work);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::vector<nlohmann::json> lines;
+    std::istringstream in(slurp(work / "trace.jsonl"));
+    for (std::string text; std::getline(in, text);) lines.push_back(nlohmann::json::parse(text));
+    ASSERT_EQ(lines.size(), 60u);
+    std::size_t flagged = 0;
+    for (const int frame : {20, 59}) {
+        const nlohmann::json& line = lines[std::size_t(frame)];
+        EXPECT_EQ(line["frame"], frame);
+        const nlohmann::json p =
+            nlohmann::json::parse(slurp(work / "o" / ("pause_" + std::to_string(frame) + ".json")));
+        for (const char* kind : {"flagged", "colliding"}) {
+            const std::string ids = std::string(kind) + "_pairs";
+            const std::string names = std::string(kind) + "_names";
+            EXPECT_EQ(line[ids], p[ids]) << kind << " at frame " << frame;
+            ASSERT_EQ(line[names].size(), line[ids].size()) << kind;
+            for (std::size_t i = 0; i < line[ids].size(); ++i) {
+                for (const int end : {0, 1}) {
+                    const int id = line[ids][i][end];
+                    EXPECT_EQ(line[names][i][end], p["bodies"][std::size_t(id)]["name"])
+                        << kind << " pair " << i << " at frame " << frame;
+                }
+            }
+        }
+        flagged += line["flagged_pairs"].size();
+    }
+    // The coursework scene flags pairs at those frames, or the comparison above proves little.
+    EXPECT_GT(flagged, 0u);
+    fs::remove_all(work);
+}
+
 // With CCD and impulse response switched on, their stages get times of their own, and each
 // stays within the step's total.
 TEST(Cli, StatsCsvTimesTheCcdAndResponseStages) {

@@ -151,6 +151,48 @@ TEST(DemoCommands, EventsFilesAndLiveCommandsAreReadAgainstTheScene) {
               0u);
 }
 
+// A track written out (a live session's log) reads back to the same commands: every command,
+// numbers to the last bit, a body whose name needs quoting.
+TEST(DemoCommands, ATrackWrittenOutReadsBackTheSame) {
+    const Scene scene = scene_text::parse(
+        kDemoScene + "  - {name: 'odd: [name]', shape: sphere, radius: 0.25, position: [0, 3, 0]}\n" +
+        "events:\n"
+        "  - {frame: 3, pause: true, show: [obb, labels], hide: sphere, wait: 1.5}\n"
+        "  - {frame: 3, broadphase: hgrid, select: 'odd: [name]', dump: true}\n"
+        "  - {frame: 3, camera: {orbit: [0.1, -10.3], zoom: 1.1, pan: [1e-7, 0.5], follow: ball}}\n"
+        "  - {frame: 3, step: -2, speed: 0.3}\n"
+        "  - {frame: 1, play: true}\n"
+        "  - {at: 0.5, seek: {time: 0.2}, camera: {reset: true, follow: none}, select: none}\n");
+    const std::string text = eventsYaml(scene.events, scene);
+    const std::vector<DemoEvent> back = parseEvents(text, "log.yaml", scene);
+    ASSERT_EQ(back.size(), scene.events.size()) << text;
+    EXPECT_EQ(eventsYaml(back, scene), text);
+    for (std::size_t i = 0; i < back.size(); ++i) {
+        SCOPED_TRACE(i);
+        const DemoCommands& a = scene.events[i].commands;
+        const DemoCommands& b = back[i].commands;
+        EXPECT_EQ(back[i].frame, scene.events[i].frame);
+        EXPECT_EQ(b.broad_phase, a.broad_phase);
+        EXPECT_EQ(b.show, a.show);
+        EXPECT_EQ(b.hide, a.hide);
+        EXPECT_EQ(b.select, a.select);
+        EXPECT_EQ(b.speed, a.speed);
+        EXPECT_EQ(b.playing, a.playing);
+        EXPECT_EQ(b.step, a.step);
+        EXPECT_EQ(b.seek, a.seek);
+        EXPECT_EQ(b.dump, a.dump);
+        EXPECT_EQ(b.wait_s, a.wait_s);
+        ASSERT_EQ(b.camera.has_value(), a.camera.has_value());
+        if (!a.camera) continue;
+        EXPECT_EQ(b.camera->reset, a.camera->reset);
+        EXPECT_EQ(b.camera->orbit, a.camera->orbit);
+        EXPECT_EQ(b.camera->zoom, a.camera->zoom);
+        EXPECT_EQ(b.camera->pan, a.camera->pan);
+        EXPECT_EQ(b.camera->follow, a.camera->follow);
+    }
+    EXPECT_EQ(back[1].commands.select, std::optional<std::optional<BodyId>>(BodyId(2)));
+}
+
 TEST(DemoCommands, LayerNamesRoundTrip) {
     for (int i = 0; i <= int(DemoLayer::Hud); ++i) {
         EXPECT_EQ(findDemoLayer(demoLayerName(DemoLayer(i))), DemoLayer(i));

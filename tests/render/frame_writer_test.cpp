@@ -77,6 +77,34 @@ TEST(FrameWriter, PngsAreTheBytesWritePngWrites) {
     }
 }
 
+// A file submitted twice (a frame seen again after stepping back) holds the second picture,
+// even when the first is slower to compress and another worker takes the second: a large noisy
+// frame, then a small one, to each of six files through four workers.
+TEST(FrameWriter, AFileSubmittedTwiceHoldsTheLastPicture) {
+    FrameWriterDir dir;
+    auto large = std::make_shared<render::Image>();
+    large->width = 1024;
+    large->height = 768;
+    large->rgb.resize(std::size_t(large->width) * large->height * 3);
+    std::uint32_t noise = 12345;
+    for (std::uint8_t& v : large->rgb) {
+        noise = noise * 1664525u + 1013904223u;
+        v = std::uint8_t(noise >> 24);
+    }
+    {
+        render::FrameWriter writer(nullptr, 4, 8);
+        for (int k = 0; k < 6; ++k) {
+            writer.submit(large, dir.path() / frameName(k), 0);
+            writer.submit(testFrame(k), dir.path() / frameName(k), 0);
+        }
+        writer.finish();
+        EXPECT_EQ(writer.times().png_files, 12);
+    }
+    for (int k = 0; k < 6; ++k) {
+        EXPECT_EQ(render::readPng(dir.path() / frameName(k)).rgb, testFrame(k)->rgb) << k;
+    }
+}
+
 // A PNG path that is a directory cannot be written: the writer stops, and the error, naming the
 // file, comes out of a later submit() or of finish(), never silently.
 TEST(FrameWriter, AFailedPngStopsTheWriterWithTheFileNamed) {

@@ -33,6 +33,14 @@ render::FrameOptions DemoSession::frameOptions() const {
     return options;
 }
 
+std::string DemoSession::hudText(bool paused, bool timing) const {
+    if (!view_.draw.hud) return {};
+    std::string text = render::hudLine(world_, frame_, timing && !paused);
+    if (paused) text = "PAUSED  " + text;
+    if (view_.selected) text += "\n" + selectionLine(world_, *view_.selected);
+    return text;
+}
+
 void DemoSession::keepSnapshot() {
     if (frame_ % interval_ != 0 || snapshots_.count(frame_)) return;
     snapshots_.emplace(frame_, world_.snapshot());

@@ -57,6 +57,10 @@ public:
     engine::CameraSettings camera() const;
     /// What a frame of the current view shows (HUD text left empty).
     render::FrameOptions frameOptions() const;
+    /// The HUD of the current frame ("" when the hud layer is hidden): "PAUSED  " when
+    /// `paused`, the frame's figures (the step time only when `timing` and not paused), and the
+    /// selected body's line.
+    std::string hudText(bool paused, bool timing) const;
 
     /// Called after every world step the session takes (going forward or re-simulating after a
     /// restore): counters, checks. May throw, which leaves the session at the frame before.

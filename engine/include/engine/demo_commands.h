@@ -111,6 +111,11 @@ std::vector<DemoEvent> parseEvents(const std::string& yaml_text, const std::stri
 DemoCommands parseDemoCommands(const std::string& text, const std::string& display_name,
                                const Scene& scene);
 
+/// `events` as the text of an events file (`events:` and one flow mapping per entry, `frame: F`
+/// first, bodies by name, every digit of each number), which parseEvents reads back to the same
+/// commands. An empty list gives `events: []`, which is no track (parseEvents refuses it).
+std::string eventsYaml(const std::vector<DemoEvent>& events, const Scene& scene);
+
 /// Walks a track's frames as a run plays it (play moves one frame at a time, step and seek jump,
 /// each entry applied once, in order) and throws SceneError at the first entry the run never
 /// reaches (its frame left behind by a jump, or ahead of a pause nothing ends) or whose step
