@@ -22,8 +22,9 @@
 namespace {
 
 using AddCommand = app::Command (*)(CLI::App&);
-constexpr AddCommand kCommands[] = {app::addRunCommand, app::addCheckCommand, app::addQueryCommand,
-                                    app::addSweepCommand};
+constexpr AddCommand kCommands[] = {app::addRunCommand,   app::addCheckCommand,
+                                    app::addQueryCommand, app::addSweepCommand,
+                                    app::addServeCommand};
 
 constexpr const char* kBenchExecutable = "cdlab-bench";
 

@@ -13,7 +13,9 @@ std::string_view chartJs();
 std::string_view runPageJs();
 /// The script of a sweep's report.html (app/lab/page/sweep_page.js).
 std::string_view sweepPageJs();
-/// The style sheet of both pages (app/lab/page/page.css).
+/// The script of `cdlab serve`'s page (app/lab/page/serve_page.js).
+std::string_view servePageJs();
+/// The style sheet of every page (app/lab/page/page.css).
 std::string_view pageCss();
 
 }  // namespace app

@@ -140,4 +140,15 @@ engine::DrawSettings pauseDrawSettings(engine::DrawSettings frame_draw, bool vol
     return frame_draw;
 }
 
+std::vector<std::optional<render::ScreenRect>> bodyRects(const engine::World& world,
+                                                         const engine::CameraSettings& camera,
+                                                         int width, int height) {
+    std::vector<std::optional<render::ScreenRect>> rects;
+    rects.reserve(world.volumes().size());
+    for (const collision::ProxyVolumes& v : world.volumes()) {
+        rects.push_back(render::screenRect(camera, width, height, v.aabb.min, v.aabb.max));
+    }
+    return rects;
+}
+
 }  // namespace app

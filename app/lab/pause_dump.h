@@ -1,10 +1,13 @@
 // app/lab/pause_dump.h -- the data file written at a pause: every body's bounding volumes and state.
 #pragma once
 
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "engine/scene.h"
 #include "engine/world.h"
+#include "render/renderer.h"
 
 namespace app {
 
@@ -23,5 +26,11 @@ std::string pauseDumpJson(const engine::World& world, int frame, const engine::D
 /// draw when they were chosen (`volumes_chosen`: the scene's draw.volumes, or a show/hide), else
 /// the three proxy volumes (sphere, AABB and OBB) side by side, each coloured by its own test.
 engine::DrawSettings pauseDrawSettings(engine::DrawSettings frame_draw, bool volumes_chosen);
+
+/// Where each body's AABB shows in a width x height picture taken with `camera` (the rectangle
+/// a page outlines, and picks the body by); none for a body behind the eye.
+std::vector<std::optional<render::ScreenRect>> bodyRects(const engine::World& world,
+                                                         const engine::CameraSettings& camera,
+                                                         int width, int height);
 
 }  // namespace app

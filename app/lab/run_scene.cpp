@@ -244,17 +244,6 @@ RunPageFrame pageFrame(int frame, const engine::World& world, const FrameStats& 
     return row;
 }
 
-// Where each body's AABB shows in the run's pictures (index.html outlines a body there).
-std::vector<std::optional<render::ScreenRect>> bodyRects(const engine::World& world,
-                                                         const engine::Scene& scene) {
-    std::vector<std::optional<render::ScreenRect>> rects;
-    for (const collision::ProxyVolumes& v : world.volumes()) {
-        rects.push_back(render::screenRect(scene.camera, scene.output.width, scene.output.height,
-                                           v.aabb.min, v.aabb.max));
-    }
-    return rects;
-}
-
 // --check-broadphase found a step whose pairs differ from the reference: what() is the report.
 struct BroadPhaseMismatch : std::runtime_error {
     using std::runtime_error::runtime_error;
@@ -580,7 +569,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
                 std::string dump = pauseDumpJson(world, frame, pause_options.draw);
                 writeTextAtomically(out_dir / (stem + ".json"), dump);
                 if (options.html) {
-                    page.pauses.push_back({frame, std::move(dump), bodyRects(world, scene)});
+                    page.pauses.push_back({frame, std::move(dump), bodyRects(world, session.camera(), scene.output.width, scene.output.height)});
                 }
             }
             progress.update(frame + 1);
@@ -595,7 +584,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
                              renderer.render(world, session.camera(), dump_options));
             std::string dump = pauseDumpJson(world, frame, dump_options.draw);
             writeTextAtomically(out_dir / (stem + ".json"), dump);
-            if (options.html) page.pauses.push_back({frame, std::move(dump), bodyRects(world, scene)});
+            if (options.html) page.pauses.push_back({frame, std::move(dump), bodyRects(world, session.camera(), scene.output.width, scene.output.height)});
         };
         // An event's wait: the current picture held in the video.
         auto holdFrame = [&](double seconds) {
@@ -611,22 +600,27 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         showFrame();
         std::size_t next = 0;  // the next event of the track
         for (;;) {
-            bool applied = false;
             while (next < events.size() && events[next].frame == session.frame()) {
                 const engine::DemoEvent& e = events[next++];
                 std::string problem;
-                simulate([&] { problem = session.apply(e.commands, showFrame); });
+                int shown = 0;  // frames the event's step or seek showed
+                simulate([&] {
+                    problem = session.apply(e.commands, [&] {
+                        showFrame();
+                        ++shown;
+                    });
+                });
                 if (!problem.empty()) throw std::logic_error("events: " + problem);
+                // An event that stayed on its frame changed its picture (a view, a pause): the
+                // frame's PNG is the picture after it, as a live session shows it.
+                if (shown == 0 && pending_png && pending_png->frame == session.frame()) {
+                    render::FrameOptions frame_options = session.frameOptions();
+                    frame_options.hud_text = hudText(!session.playing());
+                    pending_png->image = std::make_shared<const render::Image>(
+                        renderer.render(world, session.camera(), frame_options));
+                }
                 if (e.commands.dump) dumpFrame();
                 if (e.commands.wait_s > 0) holdFrame(double(e.commands.wait_s));
-                applied = true;
-            }
-            // The frame's PNG is its picture after its events (a changed view, a pause).
-            if (applied && pending_png && pending_png->frame == session.frame()) {
-                render::FrameOptions frame_options = session.frameOptions();
-                frame_options.hud_text = hudText(!session.playing());
-                pending_png->image = std::make_shared<const render::Image>(
-                    renderer.render(world, session.camera(), frame_options));
             }
             // A track that ends paused ends the run there (checkEventTrack: nothing follows).
             if (!session.playing()) break;

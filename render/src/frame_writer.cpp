@@ -15,7 +15,8 @@
 #include <deque>
 #include <mutex>
 #include <optional>
-#include <set>
+#include <cstdint>
+#include <map>
 #include <string>
 #include <system_error>
 #include <thread>
@@ -92,6 +93,13 @@ private:
 struct PngJob {
     std::shared_ptr<const Image> image;
     fs::path file;
+    std::uint64_t turn = 0;  ///< its place among the jobs for the same file, from 0
+};
+
+// The jobs for one file: how many were submitted, how many are written.
+struct FileTurns {
+    std::uint64_t issued = 0;
+    std::uint64_t written = 0;
 };
 
 struct VideoJob {
@@ -125,8 +133,9 @@ struct FrameWriter::Impl {
     mutable std::mutex mutex;  ///< guards everything below
     std::optional<std::string> failure;
     FrameWriterTimes times;
-    /// The files a worker is writing now: a later job for one of them waits its turn.
-    std::set<std::filesystem::path> writing;
+    /// The files with jobs not yet written: a job writes its file only once every job
+    /// submitted for it before has.
+    std::map<fs::path, FileTurns> turns;
     std::condition_variable written;
 
     void fail(const std::string& message) {
@@ -134,6 +143,7 @@ struct FrameWriter::Impl {
             std::lock_guard<std::mutex> lock(mutex);
             if (!failure) failure = message;
         }
+        written.notify_all();
         png_queue.abort();
         video_queue.abort();
     }
@@ -146,11 +156,13 @@ struct FrameWriter::Impl {
         ::pthread_setname_np(::pthread_self(), "cdlab-png");
         while (std::optional<PngJob> job = png_queue.pop()) {
             {
-                // Jobs leave the queue in submission order: one that finds its file being
-                // written came later, and waits for the earlier one to finish.
+                // Workers take jobs in submission order but may finish them in any: a job
+                // waits until the earlier jobs for its file are written (or the writer failed).
                 std::unique_lock<std::mutex> lock(mutex);
-                written.wait(lock, [&] { return writing.count(job->file) == 0; });
-                writing.insert(job->file);
+                written.wait(lock, [&] {
+                    return failure.has_value() || turns[job->file].written == job->turn;
+                });
+                if (failure) return;
             }
             const double t0 = threadCpuSeconds();
             std::string error;
@@ -161,7 +173,8 @@ struct FrameWriter::Impl {
             }
             {
                 std::lock_guard<std::mutex> lock(mutex);
-                writing.erase(job->file);
+                FileTurns& t = turns[job->file];
+                if (++t.written == t.issued) turns.erase(job->file);
                 if (error.empty()) {
                     times.png_cpu_s += threadCpuSeconds() - t0;
                     ++times.png_files;
@@ -246,7 +259,14 @@ void FrameWriter::submit(std::shared_ptr<const Image> image, const fs::path& png
     if (im.finished) throw RenderError("frame writer: submit() after finish()");
     im.throwIfFailed();
     bool queued = true;
-    if (!png_file.empty()) queued = im.png_queue.push(PngJob{image, png_file});
+    if (!png_file.empty()) {
+        std::uint64_t turn = 0;
+        {
+            std::lock_guard<std::mutex> lock(im.mutex);
+            turn = im.turns[png_file].issued++;
+        }
+        queued = im.png_queue.push(PngJob{image, png_file, turn});
+    }
     if (queued && im.video && video_repeats > 0) {
         queued = im.video_queue.push(VideoJob{std::move(image), video_repeats});
     }

@@ -136,6 +136,15 @@ bool encodePng(const Image& image, std::string& bytes, std::string& message) {
 
 }  // namespace
 
+std::string pngBytes(const Image& image) {
+    checkImage(image, "a PNG in memory");
+    std::string bytes;
+    bytes.reserve(image.rgb.size() / 8);
+    std::string message;
+    if (!encodePng(image, bytes, message)) throw RenderError("cannot encode PNG: " + message);
+    return bytes;
+}
+
 void writePng(const fs::path& file, const Image& image) {
     checkImage(image, file.c_str());
     std::string bytes;

@@ -266,6 +266,7 @@ TEST(DocsCommandLines, EveryFlagIsOnItsCommandsPage) {
         {"check", "docs/check.md"},
         {"sweep", "docs/sweep.md"},
         {"query", "docs/query.md"},
+        {"serve", "docs/serve.md"},
         {"bench broadphase", "docs/bench.md"},
         {"bench ccd", "docs/bench.md"},
         {"bench convex", "docs/bench.md"},

@@ -100,6 +100,28 @@ void DemoSession::show(engine::DemoLayer layer, bool on) {
     if (layer <= DemoLayer::Kdop26) view_.volumes_chosen = true;
 }
 
+bool DemoSession::shows(engine::DemoLayer layer) const {
+    using engine::DemoLayer;
+    const engine::DrawSettings& d = view_.draw;
+    switch (layer) {
+        case DemoLayer::Sphere: return d.sphere;
+        case DemoLayer::Aabb: return d.aabb;
+        case DemoLayer::Obb: return d.obb;
+        case DemoLayer::Kdop6: return d.kdop[0];
+        case DemoLayer::Kdop14: return d.kdop[1];
+        case DemoLayer::Kdop18: return d.kdop[2];
+        case DemoLayer::Kdop26: return d.kdop[3];
+        case DemoLayer::Hierarchy: return d.bvh_depth >= 0;
+        case DemoLayer::Structure: return view_.structure;
+        case DemoLayer::Contacts: return d.contacts;
+        case DemoLayer::Labels: return d.labels;
+        case DemoLayer::Bounds: return d.bounds;
+        case DemoLayer::Bodies: return d.bodies;
+        case DemoLayer::Hud: return d.hud;
+    }
+    return false;
+}
+
 void DemoSession::moveCamera(const engine::CameraCommand& c) {
     if (c.reset) {
         view_.camera = scene_.camera;

@@ -53,6 +53,8 @@ public:
     int lastFrame() const { return scene_.frames - 1; }
     bool playing() const { return playing_; }
     const DemoView& view() const { return view_; }
+    /// Whether the current view shows `layer` (what show/hide last set, or the scene's draw).
+    bool shows(engine::DemoLayer layer) const;
     /// The camera of the current frame: the view's, moved to look at the followed body.
     engine::CameraSettings camera() const;
     /// What a frame of the current view shows (HUD text left empty).

@@ -1,7 +1,8 @@
 # app/lab/page/embed_assets.cmake -- run by the build (cmake -P): writes page_assets.cpp, which
 # holds the pages' scripts and style sheet as string literals so that cdlab inlines them into
 # index.html and report.html and the pages open from disk without a network.
-# Inputs: OUT (the .cpp to write), CHART_JS (Chart.js's UMD build), RUN_JS, SWEEP_JS, CSS.
+# Inputs: OUT (the .cpp to write), CHART_JS (Chart.js's UMD build), RUN_JS, SWEEP_JS, SERVE_JS,
+# CSS.
 # Each file goes into one raw string literal; a file that holds the literal's delimiter, or a
 # closing script tag (it would end the page's <script> element early), stops the build.
 set(_delimiter "cdlab_asset")
@@ -12,7 +13,8 @@ string(APPEND _text "#include \"page_assets.h\"\n\n#include <initializer_list>\n
   "    std::string text;\n"
   "    for (const std::string_view part : parts) text += part;\n"
   "    return text;\n}\n\n}  // namespace\n")
-foreach(_pair "chartJs;CHART_JS" "runPageJs;RUN_JS" "sweepPageJs;SWEEP_JS" "pageCss;CSS")
+foreach(_pair "chartJs;CHART_JS" "runPageJs;RUN_JS" "sweepPageJs;SWEEP_JS" "servePageJs;SERVE_JS"
+    "pageCss;CSS")
   list(GET _pair 0 _function)
   list(GET _pair 1 _variable)
   set(_file "${${_variable}}")

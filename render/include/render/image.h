@@ -29,6 +29,9 @@ struct Image {
 /// Writes an 8-bit RGB PNG (libpng). Writes to a temporary name and renames, so a file that
 /// exists is complete. Throws RenderError.
 void writePng(const std::filesystem::path& file, const Image& image);
+/// The bytes writePng writes for `image`, in memory (a live session's frames). Throws
+/// RenderError.
+std::string pngBytes(const Image& image);
 /// Reads an 8-bit RGB or RGBA PNG (for tests and tools). Throws RenderError.
 Image readPng(const std::filesystem::path& file);
 

@@ -1,0 +1,310 @@
+// app/lab/serve/serve_http.cpp -- see serve_http.h.
+// cpp-httplib (Debian's libcpp-httplib-dev 0.11): a thread pool answering requests, each handler
+// touching the session only through LiveSession's thread-safe calls, so a slow or vanished
+// client holds one pool thread for at most its timeouts and never the simulation.
+#include "serve/serve_http.h"
+
+#include <httplib.h>
+#include <pthread.h>
+#include <signal.h>
+
+#include <atomic>
+#include <charconv>
+#include <functional>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "collision/broadphase/broad_phase.h"
+#include "engine/demo_commands.h"
+#include "engine/scene.h"
+#include "exit_codes.h"
+#include "html_page.h"
+#include "output_files.h"
+#include "page_assets.h"
+#include "serve/live_session.h"
+
+namespace app {
+
+namespace {
+
+constexpr std::size_t kMaxRequestBytes = 64 * 1024;
+constexpr auto kLongPoll = std::chrono::seconds(2);
+
+void jsonAnswer(httplib::Response& res, int status, const nlohmann::ordered_json& body) {
+    res.status = status;
+    res.set_header("Cache-Control", "no-store");
+    res.set_content(body.dump(), "application/json");
+}
+
+void errorAnswer(httplib::Response& res, int status, const std::string& what) {
+    jsonAnswer(res, status, {{"ok", false}, {"error", what}});
+}
+
+// A query parameter that must be an unsigned integer, or none; false when it is malformed
+// (the answer is then written).
+bool unsignedParam(const httplib::Request& req, httplib::Response& res, const char* name,
+                   std::optional<std::uint64_t>& value) {
+    if (!req.has_param(name)) return true;
+    const std::string text = req.get_param_value(name);
+    std::uint64_t v = 0;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (ec != std::errc() || end != text.data() + text.size() || text.empty()) {
+        errorAnswer(res, 400, std::string("query parameter '") + name +
+                                  "': expected a whole number >= 0");
+        return false;
+    }
+    value = v;
+    return true;
+}
+
+std::string servePage(const engine::Scene& scene, const std::string& scene_name) {
+    nlohmann::ordered_json data;
+    data["scene"] = scene_name;
+    data["width"] = scene.output.width;
+    data["height"] = scene.output.height;
+    data["fps"] = scene.output.fps;
+    nlohmann::ordered_json layers = nlohmann::ordered_json::array();
+    for (int i = 0; i <= int(engine::DemoLayer::Hud); ++i) {
+        layers.push_back(std::string(engine::demoLayerName(engine::DemoLayer(i))));
+    }
+    data["layers"] = std::move(layers);
+    nlohmann::ordered_json phases = nlohmann::ordered_json::array();
+    for (const collision::BroadPhaseEntry& e : collision::broadPhaseRegistry()) {
+        phases.push_back(e.name);
+    }
+    data["broadphases"] = std::move(phases);
+    std::string page = html::pageStart("cdlab serve: " + scene_name);
+    page += "<header><h1>cdlab serve: " + html::escape(scene_name) +
+            "</h1><p class=\"note\">A live session: every picture is drawn by the off-screen "
+            "renderer; the commands below are the ones a scene's events track and POST "
+            "/api/command take.</p></header>\n";
+    page += "<main id=\"live\"></main>\n";
+    page += html::jsonScript("serve-data", data.dump());
+    page += html::pageEnd(servePageJs());
+    return page;
+}
+
+// SIGINT and SIGTERM, blocked in every thread and awaited by one, which stops the server.
+class StopSignals {
+public:
+    StopSignals() {
+        sigemptyset(&set_);
+        sigaddset(&set_, SIGINT);
+        sigaddset(&set_, SIGTERM);
+        pthread_sigmask(SIG_BLOCK, &set_, &saved_);
+    }
+    ~StopSignals() {
+        if (waiter_.joinable()) {
+            // Wakes the waiter if no signal came, without stopping what is gone by now.
+            closing_ = true;
+            if (!signalled_) pthread_kill(waiter_.native_handle(), SIGTERM);
+            waiter_.join();
+        }
+        pthread_sigmask(SIG_SETMASK, &saved_, nullptr);
+    }
+    StopSignals(const StopSignals&) = delete;
+    StopSignals& operator=(const StopSignals&) = delete;
+
+    void onSignal(std::function<void(int)> stop) {
+        waiter_ = std::thread([this, stop = std::move(stop)] {
+            int sig = 0;
+            if (sigwait(&set_, &sig) == 0) {
+                signalled_ = true;
+                if (!closing_) stop(sig);
+            }
+        });
+    }
+
+private:
+    sigset_t set_{};
+    sigset_t saved_{};
+    std::thread waiter_;
+    std::atomic<bool> signalled_{false};
+    std::atomic<bool> closing_{false};
+};
+
+bool isLoopback(const std::string& host) {
+    return host == "127.0.0.1" || host == "localhost" || host == "::1";
+}
+
+}  // namespace
+
+int serveScene(const ServeOptions& options, std::ostream& out, std::ostream& err) {
+    engine::Scene scene;
+    try {
+        scene = engine::loadScene(options.scene, options.overrides);
+    } catch (const engine::SceneError& e) {
+        err << e.what() << "\n";
+        return kExitBadInput;
+    }
+    for (const std::string& note : scene.notes) err << note << "\n";
+    if (options.broad_phase) {
+        if (collision::findBroadPhase(*options.broad_phase) == nullptr) {
+            err << "--broadphase: unknown broad phase '" << *options.broad_phase
+                << "' (expected one of: " << collision::broadPhaseNames() << ")\n";
+            return kExitBadInput;
+        }
+        scene.world.broad_phase = *options.broad_phase;
+    }
+    if (options.port < 0 || options.port > 65535) {
+        err << "--port " << options.port << ": expected 0..65535 (0: any free port)\n";
+        return kExitBadInput;
+    }
+    if (options.host.empty()) {
+        err << "--host: must not be empty\n";
+        return kExitBadInput;
+    }
+    if (options.dry_run) return kExitOk;
+
+    const std::string scene_name = options.scene.stem().string();
+    const std::filesystem::path out_dir =
+        options.out_dir.empty() ? std::filesystem::path("out") / scene_name : options.out_dir;
+    LiveOptions live;
+    live.structure = options.draw_structure;
+    live.paused = options.paused;
+    live.dump_dir = out_dir;
+    live.log_file = options.session_log.value_or(out_dir / "session.yaml");
+    std::string replay = "cdlab run " + options.scene.string() + " --events " +
+                         live.log_file->string() + " --no-hud-timing";
+    if (options.broad_phase) replay += " --broadphase " + *options.broad_phase;
+    for (const engine::SceneOverride& o : options.overrides) {
+        replay += " --set '" + o.key + "=" + o.value + "'";
+    }
+    if (options.draw_structure) replay += " --draw-structure";
+    live.log_comment = {"A cdlab serve session of " + options.scene.string() + ". Replay it with:",
+                        "  " + replay};
+
+    std::unique_ptr<LiveSession> session;
+    StopSignals signals;  // before any thread starts, so every thread inherits the mask
+    try {
+        prepareOutputDir(out_dir);
+        if (live.log_file->has_parent_path()) prepareOutputDir(live.log_file->parent_path());
+        session = std::make_unique<LiveSession>(scene, live);
+    } catch (const std::exception& e) {
+        err << "cdlab serve: " << e.what() << "\n";
+        return kExitFailure;
+    }
+
+    httplib::Server server;
+    server.set_payload_max_length(kMaxRequestBytes);
+    server.set_read_timeout(5, 0);
+    server.set_write_timeout(5, 0);
+    server.set_keep_alive_timeout(5);
+    const std::string page = servePage(scene, scene_name);
+    LiveSession& s = *session;
+
+    server.Get("/", [&](const httplib::Request&, httplib::Response& res) {
+        res.set_header("Cache-Control", "no-store");
+        res.set_content(page, "text/html; charset=utf-8");
+    });
+    // Browsers ask for an icon; there is none (204), and no error is logged for it.
+    server.Get("/favicon.ico", [](const httplib::Request&, httplib::Response& res) {
+        res.status = 204;
+    });
+    server.Post("/api/command", [&](const httplib::Request& req, httplib::Response& res) {
+        const LiveAnswer a = s.command(req.body);
+        if (a.ok) {
+            jsonAnswer(res, 200, {{"ok", true}, {"at_frame", a.at_frame}, {"frame", a.frame}});
+            return;
+        }
+        const int status = a.error.rfind("busy:", 0) == 0                    ? 429
+                           : a.error.rfind("the session has stopped", 0) == 0 ? 503
+                                                                              : 400;
+        jsonAnswer(res, status, {{"ok", false}, {"error", a.error}, {"frame", a.frame}});
+    });
+    // The newest picture, or one newer than ?after, or the one of ?version.
+    const auto picked = [&](const httplib::Request& req, httplib::Response& res)
+        -> std::shared_ptr<const LiveFrame> {
+        std::optional<std::uint64_t> after, version;
+        if (!unsignedParam(req, res, "after", after) ||
+            !unsignedParam(req, res, "version", version)) {
+            return nullptr;
+        }
+        std::shared_ptr<const LiveFrame> f;
+        if (version) f = s.frameAt(*version);
+        if (!f) f = s.frame(after, kLongPoll);
+        if (!f) errorAnswer(res, 503, "no picture yet");
+        return f;
+    };
+    server.Get("/api/frame.png", [&](const httplib::Request& req, httplib::Response& res) {
+        const auto f = picked(req, res);
+        if (!f) return;
+        res.set_header("Cache-Control", "no-store");
+        res.set_header("X-Cdlab-Frame", std::to_string(f->frame));
+        res.set_header("X-Cdlab-Version", std::to_string(f->version));
+        res.set_content(f->png, "image/png");
+    });
+    server.Get("/api/state.json", [&](const httplib::Request& req, httplib::Response& res) {
+        const auto f = picked(req, res);
+        if (!f) return;
+        res.set_header("Cache-Control", "no-store");
+        res.set_content(f->state, "application/json");
+    });
+    server.Get("/api/session.yaml", [&](const httplib::Request&, httplib::Response& res) {
+        res.set_header("Cache-Control", "no-store");
+        res.set_content(s.logYaml(), "text/yaml; charset=utf-8");
+    });
+    server.Get("/api/timeline.json", [&](const httplib::Request& req, httplib::Response& res) {
+        std::optional<std::uint64_t> from;
+        if (!unsignedParam(req, res, "from", from)) return;
+        res.set_header("Cache-Control", "no-store");
+        res.set_content(s.timelineJson(std::size_t(from.value_or(0))), "application/json");
+    });
+    server.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
+        if (!res.body.empty()) return;
+        const std::string what = res.status == 404 ? "no such page: " + req.method + " " + req.path
+                                 : res.status == 413 ? "request larger than 64 KiB"
+                                                     : "HTTP " + std::to_string(res.status);
+        errorAnswer(res, res.status, what);
+    });
+    server.set_exception_handler(
+        [](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
+            std::string what = "internal error";
+            try {
+                if (ep) std::rethrow_exception(ep);
+            } catch (const std::exception& e) {
+                what += std::string(": ") + e.what();
+            } catch (...) {
+            }
+            errorAnswer(res, 500, what);
+        });
+
+    int port = options.port;
+    if (port == 0) {
+        port = server.bind_to_any_port(options.host);
+    } else if (!server.bind_to_port(options.host, port)) {
+        port = -1;
+    }
+    if (port <= 0) {
+        err << "cdlab serve: cannot listen on " << options.host << ":" << options.port
+            << " (in use, or not an address of this machine)\n";
+        return kExitFailure;
+    }
+    if (!isLoopback(options.host)) {
+        err << "cdlab serve: WARNING: listening on " << options.host
+            << ", not only this machine: anyone who reaches it can drive the session and see "
+               "its frames\n";
+    }
+    signals.onSignal([&](int) { server.stop(); });
+    const std::string shown_host =
+        options.host.find(':') != std::string::npos ? "[" + options.host + "]" : options.host;
+    out << "cdlab serve: http://" << shown_host << ":" << port << "/ (Ctrl-C stops; session log "
+        << live.log_file->string() << ")" << std::endl;
+    const bool listened = server.listen_after_bind();
+    session->stop();
+    const std::string failure = session->failure();
+    if (!failure.empty()) {
+        err << "cdlab serve: the session stopped: " << failure << "\n";
+        return kExitFailure;
+    }
+    if (!listened) {
+        err << "cdlab serve: the server stopped with an error\n";
+        return kExitFailure;
+    }
+    out << "cdlab serve: stopped; session log " << live.log_file->string() << "\n" << "replay: "
+        << replay << "\n";
+    return kExitOk;
+}
+
+}  // namespace app
