@@ -159,7 +159,7 @@ TEST(Query, BadInputExitsTwoWithAMessage) {
     EXPECT_NE(r.err.find("no/such/mesh.obj"), std::string::npos) << r.err;
 }
 
-// Issue "Meshes from the real world": import dropped triangles without a word. The query warns on
+// Import once dropped triangles without a word. The query warns on
 // stderr with the counts and puts the import report beside each mesh in --json.
 TEST(Query, ImportChangesAreReportedOnStderrAndInJson) {
     const fs::path dir =

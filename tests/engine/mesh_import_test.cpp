@@ -386,7 +386,7 @@ struct FarGrid {
     }
 };
 
-// Issue "Meshes from the real world": a fine grid near 1e6 lost 2,686 of 3,732 triangles in
+// A fine grid near 1e6 lost 2,686 of 3,732 triangles in
 // assimp's float coordinates, silently. An OBJ is read in double as well, so the importer hands
 // assimp its text recentred on the mesh: every triangle is kept, the coordinates come back to
 // float's precision relative to the mesh's size, and there is nothing to warn about.

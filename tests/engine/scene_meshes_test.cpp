@@ -135,7 +135,7 @@ std::string openCubeObj() {
     return text;
 }
 
-// Issue "Meshes from the real world": `shape: mesh` refused every mesh that is not closed
+// `shape: mesh` once refused every mesh that is not closed
 // ("mesh is not closed", exit 2), although collision only uses its triangles. An open box
 //        +  +   <- no lid
 //        |  |

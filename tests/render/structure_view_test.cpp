@@ -160,7 +160,7 @@ TEST(StructureView, BroadPhasesWithoutAStructureSaySoInTheLegend) {
     }
 }
 
-// Issue "pictures that tell the truth": SAP drew its x intervals in red and its y intervals in
+// SAP once drew its x intervals in red and its y intervals in
 // green, the colours of a colliding and of an apart volume. No structure colour may be a state
 // colour, the time-of-impact blue or the contact magenta, nor blend over the background into one.
 TEST(StructureView, PaletteNeverLooksLikeAStateToiOrContactColour) {

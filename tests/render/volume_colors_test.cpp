@@ -94,7 +94,7 @@ TEST(VolumeColors, FlaggedButNotTouchingAabbsAreYellow) {
     EXPECT_FALSE(colorNear(image, f_edge, kYellow));
 }
 
-// Issue "pictures that tell the truth": the pause picture drew D's and E's spheres yellow
+// The pause picture once drew D's and E's spheres yellow
 // because their AABBs were flagged. Drawn together, each volume takes its own test's colour:
 // the spheres (apart as spheres) green, the AABBs and OBBs (overlapping) yellow.
 TEST(VolumeColors, SphereStaysGreenWhenOnlyTheAabbsOverlap) {
