@@ -58,6 +58,7 @@ Command addCheckCommand(CLI::App& cli);
 Command addQueryCommand(CLI::App& cli);
 Command addSweepCommand(CLI::App& cli);
 Command addServeCommand(CLI::App& cli);
+Command addReplayCommand(CLI::App& cli);
 /// The `bench` subcommands, registered on `cdlab bench`.
 Command addBenchBroadphaseCommand(CLI::App& bench);
 Command addBenchCcdCommand(CLI::App& bench);

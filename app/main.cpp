@@ -24,7 +24,7 @@ namespace {
 using AddCommand = app::Command (*)(CLI::App&);
 constexpr AddCommand kCommands[] = {app::addRunCommand,   app::addCheckCommand,
                                     app::addQueryCommand, app::addSweepCommand,
-                                    app::addServeCommand};
+                                    app::addServeCommand, app::addReplayCommand};
 
 constexpr const char* kBenchExecutable = "cdlab-bench";
 

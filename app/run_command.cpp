@@ -47,6 +47,7 @@ Command addRunCommand(CLI::App& cli) {
         bool quiet = false;
         std::vector<std::string> set;
         std::string trace;
+        std::string record;
         std::string events;
     };
     auto f = std::make_shared<Flags>();
@@ -100,13 +101,19 @@ Command addRunCommand(CLI::App& cli) {
         ->expected(1)
         ->take_all();
     cmd->add_option("--trace", f->trace,
-                    "write every frame's body poses and confirmed pairs to FILE (JSON lines)");
+                    "write every frame's body poses and flagged and confirmed pairs to FILE "
+                    "(JSON lines)");
+    cmd->add_option("--record", f->record,
+                    "write a recording to FILE: every frame's body states, pairs and state "
+                    "hash, for `cdlab serve --replay FILE` (shown without simulating) and "
+                    "`cdlab replay FILE --check` (simulated again, compared frame by frame)")
+        ->type_name("FILE");
     return {cmd, [cmd, f](RunMode mode) {
                 RunOptions& run = f->run;
                 run.dry_run = mode == RunMode::DryRun;
                 // A flag given with an empty value ("--broadphase ''") is an error, not "unset".
                 for (const char* name :
-                     {"--out", "--video", "--broadphase", "--pair-order", "--stats", "--trace",
+                     {"--out", "--video", "--broadphase", "--pair-order", "--stats", "--trace", "--record",
                       "--events"}) {
                     if (cmd->count(name) > 0 && cmd->get_option(name)->as<std::string>().empty()) {
                         std::cerr << name << ": must not be empty\n";
@@ -129,6 +136,7 @@ Command addRunCommand(CLI::App& cli) {
                     run.overrides.push_back({kv.substr(0, eq), kv.substr(eq + 1)});
                 }
                 if (!f->trace.empty()) run.trace = f->trace;
+                if (!f->record.empty()) run.record = f->record;
                 run.hud_timing = !f->no_timing;
                 run.progress = !f->quiet;
                 return runScene(run, std::cout, std::cerr);

@@ -19,12 +19,18 @@ Command addServeCommand(CLI::App& cli) {
         std::string session;
         std::string broad_phase;
         std::vector<std::string> set;
+        std::string replay;
     };
     auto f = std::make_shared<Flags>();
     CLI::App* cmd = cli.add_subcommand(
         "serve", "run a scene live behind a local web page and HTTP API: play, pause, step, "
                  "seek, show/hide layers, switch the broad phase, select, move the camera, dump");
-    cmd->add_option("scene", f->serve.scene, "scene file (YAML)")->required();
+    cmd->add_option("scene", f->serve.scene,
+                    "scene file (YAML); with --replay, the recording's scene if it has moved");
+    cmd->add_option("--replay", f->replay,
+                    "show the frames of a recording (run --record FILE) without simulating: "
+                    "scrub, step back and forth, change layers and camera, dump any frame")
+        ->type_name("FILE");
     cmd->add_option("--host", f->serve.host,
                     "address to listen on (default 127.0.0.1, this machine only; any other is "
                     "said loudly: whoever reaches it can drive the session)");
@@ -49,12 +55,18 @@ Command addServeCommand(CLI::App& cli) {
     return {cmd, [cmd, f](RunMode mode) {
                 ServeOptions& serve = f->serve;
                 serve.dry_run = mode == RunMode::DryRun;
-                for (const char* name : {"--out", "--session", "--broadphase", "--host"}) {
+                for (const char* name :
+                     {"--out", "--session", "--broadphase", "--host", "--replay"}) {
                     if (cmd->count(name) > 0 && cmd->get_option(name)->as<std::string>().empty()) {
                         std::cerr << name << ": must not be empty\n";
                         return kExitBadInput;
                     }
                 }
+                if (f->replay.empty() && serve.scene.empty()) {
+                    std::cerr << "serve: a scene file, or --replay RECORDING, is required\n";
+                    return kExitBadInput;
+                }
+                if (!f->replay.empty()) serve.replay = f->replay;
                 if (!f->out_dir.empty()) serve.out_dir = f->out_dir;
                 if (!f->session.empty()) serve.session_log = f->session;
                 if (!f->broad_phase.empty()) serve.broad_phase = f->broad_phase;

@@ -33,6 +33,7 @@
 #include "html_page.h"
 #include "output_files.h"
 #include "pause_dump.h"
+#include "replay/run_recorder.h"
 #include "render/frame_writer.h"
 #include "render/image.h"
 #include "render/output_file.h"
@@ -323,6 +324,12 @@ int loadRunScene(const RunOptions& options, std::ostream& err, engine::Scene& sc
         err << e.what() << "\n";
         return kExitBadInput;
     }
+    if (options.record) {
+        if (const std::string why = recordRefusal(scene, events); !why.empty()) {
+            err << "--record " << options.record->string() << ": " << why << "\n";
+            return kExitBadInput;
+        }
+    }
     pauses = std::set<int>(options.pause_at.begin(), options.pause_at.end());
     for (int f : pauses) {
         if (f < 0 || f >= scene.frames) {
@@ -344,11 +351,11 @@ void prepareOutputs(const RunOptions& options, const fs::path& out_dir, bool wan
     if (options.stats_csv && options.stats_csv->has_parent_path()) {
         prepareOutputDir(options.stats_csv->parent_path());
     }
-    if (options.trace && options.trace->has_parent_path()) {
-        prepareOutputDir(options.trace->parent_path());
+    for (const auto& file : {options.trace, options.record}) {
+        if (file && file->has_parent_path()) prepareOutputDir(file->parent_path());
+        if (file) render::checkOutputWritable(*file);
     }
     if (options.stats_csv) render::checkOutputWritable(*options.stats_csv);
-    if (options.trace) render::checkOutputWritable(*options.trace);
     if (want_video) render::checkOutputWritable(video_path);
     clearPreviousRun(out_dir);
 }
@@ -447,10 +454,24 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         return kExitFailure;
     }
 
+    std::optional<RunRecorder> recorder;
+    // A run that stops early still ends its recording, saying why, so frames up to there can be
+    // viewed.
+    auto endRecording = [&](const std::string& why) {
+        try {
+            if (recorder) recorder->finish(why);
+        } catch (const engine::RecordingError& e) {
+            err << "error: " << e.what() << "\n";
+        }
+    };
     try {
         prepareOutputs(options, out_dir, want_video, video_path);
         DemoSession session(scene, options.draw_structure);
         const engine::World& world = session.world();
+        if (options.record) {
+            recorder.emplace(*options.record,
+                             recordingHeader(options.scene, options.overrides, scene), world);
+        }
         render::Renderer renderer(scene.output.width, scene.output.height);
         std::unique_ptr<render::VideoWriter> video;
         if (want_video) {
@@ -484,6 +505,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
             }
         }
         session.on_step = [&](const engine::World& w) {
+            if (recorder) recorder->observe(w);
             frame_stats.add(w.lastStats());
             totals.step_seconds += w.lastStats().total_s;
             if (!checker) return;
@@ -631,6 +653,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         }
         flushPng();
         writer.finish();
+        if (recorder) recorder->finish();
         if (options.timing) {
             out << timingLine(scene.frames, wallSeconds() - run_start, stage, writer.times());
         }
@@ -657,6 +680,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
             }
         }
         out << ")\n";
+        if (recorder) out << recorder->summary() << "\n";
         if (!session.playing() && session.frame() < session.lastFrame()) {
             out << "note: the events track ended paused at frame " << session.frame()
                 << ": the run stops there\n";
@@ -668,20 +692,25 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
                 << " s of simulated time (time_step x steps_per_frame x fps)\n";
         }
     } catch (const BroadPhaseMismatch& e) {
+        endRecording("stopped: the broad phase differed from its reference");
         err << e.what();
         return kExitCheckFailed;
     } catch (const StepFailure& e) {
         // No summary.json: the run is incomplete, and says so.
+        endRecording(std::string("stopped: ") + e.what());
         err << "error: " << options.scene.string() << ": " << e.what() << "\n";
         return kExitFailure;
     } catch (const render::RenderError& e) {
+        endRecording(std::string("stopped: ") + e.what());
         err << "error: " << e.what() << "\n";
         return kExitFailure;
     } catch (const std::bad_alloc&) {
+        endRecording("stopped: out of memory");
         err << "error: out of memory: this scene needs more memory than the machine can allocate "
                "(fewer bodies, fewer volumes drawn, or --no-frames --no-video)\n";
         return kExitFailure;
     } catch (const std::exception& e) {
+        endRecording(std::string("stopped: ") + e.what());
         err << "error: " << e.what() << "\n";
         return kExitFailure;
     }

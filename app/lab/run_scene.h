@@ -41,6 +41,8 @@ struct RunOptions {
     /// sorted by (a, b) whatever the pair order (`cdlab sweep --float-binary` compares a float
     /// build's trace with the double one's).
     std::optional<std::filesystem::path> trace;
+    /// Write a recording (engine/recording.h) of every frame the run reaches, in frame order.
+    std::optional<std::filesystem::path> record;
     /// Write index.html beside the frames (run_html.h): the video, the timeline of pairs and
     /// stage times with a cursor following the video, the pause pictures with their bodies.
     bool html = false;

@@ -19,6 +19,31 @@ DemoSession::DemoSession(const engine::Scene& scene, bool structure)
     keepSnapshot();
 }
 
+DemoSession::DemoSession(const engine::Scene& scene, bool structure,
+                         const engine::Recording& recording)
+    : DemoSession(scene, structure) {
+    recording_ = &recording;
+    snapshots_.clear();
+    placeRecorded(0);
+}
+
+void DemoSession::placeRecorded(int frame) {
+    const engine::RecordedFrame f = recording_->frame(frame);
+    if (!broad_phase_chosen_ && f.broad_phase != broad_phase_) {
+        world_.setBroadPhase(f.broad_phase);
+        broad_phase_ = f.broad_phase;
+        if (!view_.volumes_chosen) view_.draw = engine::drawSettingsFor(scene_.draw, world_);
+    }
+    world_.place(f.state, f.counters);
+    if (world_.stateHash() != f.state_hash) {
+        throw engine::RecordingError(
+            recording_->file().string() + ": frame " + std::to_string(frame) +
+            ": the recorded state, placed and detected, does not hash to its recorded hash (a "
+            "recording of another build of cdlab, whose detection differs)");
+    }
+    frame_ = frame;
+}
+
 engine::CameraSettings DemoSession::camera() const {
     if (!view_.follow) return view_.camera;
     return render::lookAtPoint(view_.camera,
@@ -53,6 +78,10 @@ void DemoSession::keepSnapshot() {
 
 bool DemoSession::advance() {
     if (frame_ >= lastFrame()) return false;
+    if (recording_) {
+        placeRecorded(frame_ + 1);
+        return true;
+    }
     for (int s = 0; s < scene_.steps_per_frame; ++s) {
         world_.step();
         if (on_step) on_step(world_);
@@ -65,6 +94,10 @@ bool DemoSession::advance() {
 void DemoSession::goTo(int frame) {
     if (frame < 0 || frame > lastFrame()) {
         throw std::out_of_range("frame " + std::to_string(frame) + " is outside the run");
+    }
+    if (recording_) {
+        if (frame != frame_) placeRecorded(frame);
+        return;
     }
     if (frame < frame_) {
         // The nearest snapshot at or before `frame` (frame 0's is always kept).
@@ -155,6 +188,7 @@ std::string DemoSession::apply(const engine::DemoCommands& c,
         }
     }
 
+    if (c.broad_phase) broad_phase_chosen_ = true;
     if (c.broad_phase && *c.broad_phase != broad_phase_) {
         world_.setBroadPhase(*c.broad_phase);
         broad_phase_ = *c.broad_phase;

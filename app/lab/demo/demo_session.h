@@ -9,6 +9,9 @@
 // World steps are deterministic, so a frame reached again is bit-identical to its first visit
 // (the same state hash), unless the broad phase was switched in between with pair_order: found,
 // where the pairs' order, and so the motion, follows the broad phase.
+//
+// A session of a recording (engine/recording.h) never steps: every frame it reaches is the
+// recorded one placed in the world (World::place), checked against its recorded state hash.
 #pragma once
 
 #include <functional>
@@ -17,6 +20,7 @@
 #include <string>
 
 #include "engine/demo_commands.h"
+#include "engine/recording.h"
 #include "engine/scene.h"
 #include "engine/world.h"
 #include "render/renderer.h"
@@ -45,12 +49,20 @@ public:
     /// phase's structure). `scene` must outlive the session. Throws what engine::makeWorld
     /// throws.
     DemoSession(const engine::Scene& scene, bool structure);
+    /// The frames of `recording` (of `scene`: replay/run_recorder.h loadRecordedScene), shown
+    /// without simulating; both must outlive the session. Each frame shows the broad phase
+    /// recorded for it until a command chooses one. Throws engine::RecordingError for a frame
+    /// that cannot be read or whose placed state does not hash to the recorded hash (a
+    /// recording of another build's detection).
+    DemoSession(const engine::Scene& scene, bool structure, const engine::Recording& recording);
+    /// A session of a recording.
+    bool replaying() const { return recording_ != nullptr; }
 
     const engine::Scene& scene() const { return scene_; }
     const engine::World& world() const { return world_; }
     int frame() const { return frame_; }
-    /// The last frame a session can reach: scene().frames - 1.
-    int lastFrame() const { return scene_.frames - 1; }
+    /// The last frame a session can reach: scene().frames - 1, or a recording's last.
+    int lastFrame() const { return recording_ ? recording_->frames() - 1 : scene_.frames - 1; }
     bool playing() const { return playing_; }
     const DemoView& view() const { return view_; }
     /// Whether the current view shows `layer` (what show/hide last set, or the scene's draw).
@@ -87,6 +99,7 @@ public:
 
 private:
     void keepSnapshot();
+    void placeRecorded(int frame);
     void show(engine::DemoLayer layer, bool on);
     void moveCamera(const engine::CameraCommand& c);
 
@@ -98,6 +111,8 @@ private:
     std::string broad_phase_;  ///< the broad phase chosen, re-installed after a restore
     std::map<int, engine::WorldSnapshot> snapshots_;
     int interval_ = 8;
+    const engine::Recording* recording_ = nullptr;
+    bool broad_phase_chosen_ = false;  ///< a command chose the broad phase (replay)
 };
 
 /// "selected NAME (sphere): colliding with A, B; flagged with C" for the HUD: the body's pairs of

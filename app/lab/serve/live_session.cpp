@@ -193,7 +193,11 @@ void LiveSession::loop(std::promise<void>& started) {
     std::optional<DemoSession> session;
     std::optional<render::Renderer> renderer;
     try {
-        session.emplace(scene_, options_.structure);
+        if (options_.replay) {
+            session.emplace(scene_, options_.structure, *options_.replay);
+        } else {
+            session.emplace(scene_, options_.structure);
+        }
         renderer.emplace(scene_.output.width, scene_.output.height);
     } catch (...) {
         started.set_exception(std::current_exception());

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "engine/demo_commands.h"
+#include "engine/recording.h"
 #include "engine/scene.h"
 
 namespace app {
@@ -59,6 +60,9 @@ struct LiveOptions {
     /// Commands waiting at most; more are refused as "busy" (a client flooding the session
     /// cannot grow its memory or delay the others' frames without bound).
     std::size_t max_queued = 64;
+    /// Show this recording's frames instead of simulating (DemoSession of a recording); it must
+    /// outlive the session and is read by the session thread alone.
+    const engine::Recording* replay = nullptr;
     /// Comment lines (without '#') at the head of the log file: how to replay it.
     std::vector<std::string> log_comment;
 };

@@ -17,7 +17,9 @@
 
 #include "collision/broadphase/broad_phase.h"
 #include "engine/demo_commands.h"
+#include "engine/recording.h"
 #include "engine/scene.h"
+#include "replay/run_recorder.h"
 #include "exit_codes.h"
 #include "html_page.h"
 #include "output_files.h"
@@ -132,9 +134,27 @@ bool isLoopback(const std::string& host) {
 
 int serveScene(const ServeOptions& options, std::ostream& out, std::ostream& err) {
     engine::Scene scene;
+    std::optional<engine::Recording> recording;
+    std::filesystem::path scene_file = options.scene;
     try {
-        scene = engine::loadScene(options.scene, options.overrides);
+        if (options.replay) {
+            if (options.broad_phase || !options.overrides.empty()) {
+                err << "--replay: --broadphase and --set do not apply: the recording holds its "
+                       "run's broad phase and scene values\n";
+                return kExitBadInput;
+            }
+            recording = engine::Recording::open(*options.replay);
+            const std::optional<std::filesystem::path> moved =
+                options.scene.empty() ? std::nullopt : std::optional(options.scene);
+            scene = loadRecordedScene(*recording, moved);
+            scene_file = moved.value_or(recording->header().scene);
+        } else {
+            scene = engine::loadScene(options.scene, options.overrides);
+        }
     } catch (const engine::SceneError& e) {
+        err << e.what() << "\n";
+        return kExitBadInput;
+    } catch (const engine::RecordingError& e) {
         err << e.what() << "\n";
         return kExitBadInput;
     }
@@ -157,7 +177,7 @@ int serveScene(const ServeOptions& options, std::ostream& out, std::ostream& err
     }
     if (options.dry_run) return kExitOk;
 
-    const std::string scene_name = options.scene.stem().string();
+    const std::string scene_name = scene_file.stem().string();
     const std::filesystem::path out_dir =
         options.out_dir.empty() ? std::filesystem::path("out") / scene_name : options.out_dir;
     LiveOptions live;
@@ -165,14 +185,23 @@ int serveScene(const ServeOptions& options, std::ostream& out, std::ostream& err
     live.paused = options.paused;
     live.dump_dir = out_dir;
     live.log_file = options.session_log.value_or(out_dir / "session.yaml");
-    std::string replay = "cdlab run " + options.scene.string() + " --events " +
+    live.replay = recording ? &*recording : nullptr;
+    std::string replay = "cdlab run " + scene_file.string() + " --events " +
                          live.log_file->string() + " --no-hud-timing";
+    if (recording) {
+        replay += " --broadphase " + recording->header().broad_phase + " --frames " +
+                  std::to_string(recording->frames());
+    }
     if (options.broad_phase) replay += " --broadphase " + *options.broad_phase;
-    for (const engine::SceneOverride& o : options.overrides) {
+    for (const engine::SceneOverride& o :
+         recording ? recording->header().overrides : options.overrides) {
         replay += " --set '" + o.key + "=" + o.value + "'";
     }
     if (options.draw_structure) replay += " --draw-structure";
-    live.log_comment = {"A cdlab serve session of " + options.scene.string() + ". Replay it with:",
+    live.log_comment = {"A cdlab serve session of " +
+                            (recording ? "the recording " + recording->file().string()
+                                       : scene_file.string()) +
+                            ". Replay it with:",
                         "  " + replay};
 
     std::unique_ptr<LiveSession> session;

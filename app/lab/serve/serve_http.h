@@ -1,4 +1,4 @@
-// app/lab/serve/serve_http.h -- `cdlab serve SCENE`: a live session (live_session.h) behind a
+// app/lab/serve/serve_http.h -- `cdlab serve SCENE` (or `--replay RECORDING`): a live session (live_session.h) behind a
 // local web server (cpp-httplib, Debian's libcpp-httplib-dev) with a page to drive it and a
 // plain HTTP API for scripts:
 //
@@ -40,6 +40,9 @@ struct ServeOptions {
     bool draw_structure = false;  ///< draw the broad phase's structure
     std::optional<std::string> broad_phase;  ///< overrides the scene's broad phase
     std::vector<engine::SceneOverride> overrides;
+    /// Show this recording (`cdlab run --record`) instead of simulating: its scene is the one it
+    /// names, or `scene` when given (one moved since); --broadphase and --set are refused.
+    std::optional<std::filesystem::path> replay;
     bool dry_run = false;
 };
 

@@ -201,6 +201,31 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+/// What a step changes of one body, and all World::stateHash reads of it besides the overlap
+/// states.
+struct BodyMotion {
+    Vec3 position = Vec3::Zero();
+    Quat orientation = Quat::Identity();
+    Vec3 linear_momentum = Vec3::Zero();
+    Vec3 angular_momentum = Vec3::Zero();
+};
+
+/// A chain's clock: World::chainTime and chainHalted.
+struct ChainClock {
+    Real time = 0;
+    bool halted = false;
+};
+
+/// The part of a world's state that shows it as it was (World::state, World::place): time,
+/// bodies' motion, chains' clocks. What a recording keeps of a frame (engine/recording.h); not
+/// enough to step on from (broad-phase coherence, solver warm starts are not in it).
+struct WorldState {
+    Real time = 0;
+    std::int64_t steps = 0;
+    std::vector<BodyMotion> bodies;
+    std::vector<ChainClock> chains;
+};
+
 class World;
 
 /// A world's whole state between two steps (World::snapshot): bodies, time and step count, the
@@ -236,6 +261,18 @@ public:
     /// from the same scene: it replaces everything, settings and bodies too). Throws
     /// std::invalid_argument for an empty snapshot.
     void restore(const WorldSnapshot& snapshot);
+
+    /// Time, step count, every body's motion and every chain's clock now.
+    WorldState state() const;
+    /// Shows `state` (taken of a world made from the same scene): puts its time, motion and
+    /// clocks in place, moves deforming meshes to its time, detects, and then reports `reported`
+    /// as the last step's statistics (the recorded step's counters, which a HUD shows). Volumes,
+    /// pairs, overlap states and contacts are then those of the recorded state, so stateHash()
+    /// is its hash. A deforming mesh's hierarchy is refitted from wherever it was, so its nodes
+    /// may differ from the recorded run's (its triangles, hull and pairs do not). Stepping on
+    /// from a placed world is not the recorded run's continuation. Throws std::invalid_argument
+    /// when the body or chain count is not this world's.
+    void place(const WorldState& state, const StepStats& reported);
 
     BodyId addBody(Body body);
     /// Adds a chain whose links are bodies already added (ChainSpec::links, each in one chain
