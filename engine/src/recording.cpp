@@ -210,6 +210,19 @@ std::string frameBytes(const RecordedFrame& f) {
     }
     putPairs(out, f.flagged);
     putPairs(out, f.colliding);
+    put(out, static_cast<std::uint32_t>(f.impacts.size()));
+    for (const ToiEvent& e : f.impacts) {
+        put(out, static_cast<std::uint32_t>(e.a));
+        put(out, static_cast<std::uint32_t>(e.b));
+        put(out, e.t);
+        for (const Pose& p : {e.pose_a, e.pose_b}) {
+            putVec(out, p.position);
+            out.append(reinterpret_cast<const char*>(p.orientation.coeffs().data()), 32);
+        }
+        putVec(out, e.point);
+        putVec(out, e.normal);
+        put(out, static_cast<std::uint8_t>(e.failed ? 1 : 0));
+    }
     StepStats counters = f.counters;
     for (int i = 0; i < kCounters; ++i) put(out, *counterFields(counters, i));
     return out;
@@ -225,6 +238,7 @@ RecordedFrame recordFrame(const World& world, int frame) {
     f.state = world.state();
     f.flagged.assign(world.flaggedPairs().begin(), world.flaggedPairs().end());
     f.colliding.assign(world.collidingPairs().begin(), world.collidingPairs().end());
+    f.impacts.assign(world.toiEvents().begin(), world.toiEvents().end());
     StepStats s = world.lastStats();
     for (int i = 0; i < kCounters; ++i) *counterFields(f.counters, i) = *counterFields(s, i);
     return f;
@@ -426,6 +440,24 @@ RecordedFrame Recording::frame(int k) const {
             p.b = static_cast<collision::ProxyId>(c.get<std::uint32_t>());
             if (!(p.a < p.b) || std::size_t(p.b) >= n) c.fail("a pair of bodies it does not have");
         }
+    }
+    f.impacts.resize(c.count(177, "times of impact"));
+    for (ToiEvent& e : f.impacts) {
+        e.a = static_cast<BodyId>(c.get<std::uint32_t>());
+        e.b = static_cast<BodyId>(c.get<std::uint32_t>());
+        if (e.a == e.b || std::uint32_t(e.a) >= n || std::uint32_t(e.b) >= n) {
+            c.fail("an impact of bodies it does not have");
+        }
+        e.t = c.real("an impact's time");
+        for (Pose* p : {&e.pose_a, &e.pose_b}) {
+            p->position = c.vec("an impact's pose");
+            const Real x = c.real("an impact's pose"), y = c.real("an impact's pose"),
+                       z = c.real("an impact's pose"), w = c.real("an impact's pose");
+            p->orientation = Quat(w, x, y, z);
+        }
+        e.point = c.vec("an impact's point");
+        e.normal = c.vec("an impact's normal");
+        e.failed = c.get<std::uint8_t>() != 0;
     }
     for (int i = 0; i < kCounters; ++i) *counterFields(f.counters, i) = c.get<std::int64_t>();
     c.end();

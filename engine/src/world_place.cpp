@@ -21,7 +21,8 @@ WorldState World::state() const {
     return out;
 }
 
-void World::place(const WorldState& state, const StepStats& reported) {
+void World::place(const WorldState& state, std::span<const ToiEvent> impacts,
+                  const std::optional<StepStats>& reported) {
     if (state.bodies.size() != bodies_.size() || state.chains.size() != chain_state_.size()) {
         throw std::invalid_argument(
             "place: a state of " + std::to_string(state.bodies.size()) + " bodies and " +
@@ -45,9 +46,9 @@ void World::place(const WorldState& state, const StepStats& reported) {
         chain_state_[c].halted = state.chains[c].halted;
     }
     for (DeformingMesh& d : deforming_) deformBody(d);
-    toi_events_.clear();
     detect();
-    stats_ = reported;
+    if (reported) stats_ = *reported;
+    toi_events_.assign(impacts.begin(), impacts.end());
 }
 
 }  // namespace engine

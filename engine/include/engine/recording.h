@@ -6,7 +6,8 @@
 // state hash differs. The byte layout (version 1) is in docs/recording.md.
 //
 // Cost: 104 bytes per body per frame (13 doubles: position, orientation, both momenta, every
-// bit, so a placed state has the recorded hash), 8 per pair, 9 per chain, about 150 per frame.
+// bit, so a placed state has the recorded hash), 8 per pair, 9 per chain, 177 per time of
+// impact of the frame's last step, about 150 per frame.
 //
 // A recording is read with the care of a scene file: a file that is not one, of a newer version,
 // cut short (no end record: the run was stopped), with a frame whose checksum, counts or values
@@ -60,6 +61,7 @@ struct RecordedFrame {
     WorldState state;
     std::vector<collision::ProxyPair> flagged;    ///< World::flaggedPairs, in its order
     std::vector<collision::ProxyPair> colliding;  ///< World::collidingPairs
+    std::vector<ToiEvent> impacts;                ///< World::toiEvents of the last step
     StepStats counters;
 };
 

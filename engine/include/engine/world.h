@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -265,14 +266,17 @@ public:
     /// Time, step count, every body's motion and every chain's clock now.
     WorldState state() const;
     /// Shows `state` (taken of a world made from the same scene): puts its time, motion and
-    /// clocks in place, moves deforming meshes to its time, detects, and then reports `reported`
-    /// as the last step's statistics (the recorded step's counters, which a HUD shows). Volumes,
-    /// pairs, overlap states and contacts are then those of the recorded state, so stateHash()
-    /// is its hash. A deforming mesh's hierarchy is refitted from wherever it was, so its nodes
+    /// clocks in place, moves deforming meshes to its time, detects, and then reports `impacts`
+    /// as the last step's times of impact and `reported`, when given, as its statistics (else
+    /// the detection's): the recorded step's events and counters, which a frame and a HUD show.
+    /// Volumes, pairs, overlap states and contacts are then those of the recorded state with
+    /// this world's broad phase, so stateHash() is the recorded hash when it is the recorded
+    /// broad phase (or one testing the same volume kind). A deforming mesh's hierarchy is refitted from wherever it was, so its nodes
     /// may differ from the recorded run's (its triangles, hull and pairs do not). Stepping on
     /// from a placed world is not the recorded run's continuation. Throws std::invalid_argument
     /// when the body or chain count is not this world's.
-    void place(const WorldState& state, const StepStats& reported);
+    void place(const WorldState& state, std::span<const ToiEvent> impacts = {},
+               const std::optional<StepStats>& reported = std::nullopt);
 
     BodyId addBody(Body body);
     /// Adds a chain whose links are bodies already added (ChainSpec::links, each in one chain
