@@ -22,6 +22,7 @@ Command addCheckCommand(CLI::App& cli) {
         double timeout = 0;
         std::string out;
         std::string junit;
+        std::string events;
         std::string worker_result;
         std::size_t worker_index = 0;
     };
@@ -32,6 +33,11 @@ Command addCheckCommand(CLI::App& cli) {
         "table (scenes in command-line order), exit 0 all pass, 1 any failure, 2 bad input");
     cmd->add_option("scenes", f->scenes, "scene files (YAML)")->required();
     cmd->add_option("--frames", f->frames, "frames to run (overrides expect.frames and the scene)");
+    cmd->add_option("--events", f->events,
+                    "run each scene through this events track instead of its own events:, as "
+                    "'cdlab run --events' plays it, and grade the file's expect: (else the "
+                    "scene's) on that run")
+        ->type_name("FILE");
     cmd->add_option("--out", f->out,
                     "keep pause dumps in DIR, scene k (from 0) in DIR/k_STEM (default: a "
                     "temporary folder, removed)");
@@ -56,11 +62,12 @@ Command addCheckCommand(CLI::App& cli) {
     cmd->add_option("--worker-index", f->worker_index)->group("");
     return {cmd, [cmd, f](RunMode mode) {
                 if (cmd->count("--frames") > 0) f->check.frames = f->frames;
+                if (cmd->count("--events") > 0) f->check.events = f->events;
                 f->check.dry_run = mode == RunMode::DryRun;
                 if (!f->worker_result.empty() && !f->check.dry_run) {
                     if (f->scenes.size() != 1 || f->out.empty()) return kExitBadInput;
                     return runCheckWorker(f->scenes.front(), f->worker_index, f->check.frames,
-                                          f->out, f->worker_result);
+                                          f->out, f->worker_result, f->check.events);
                 }
                 for (const std::string& sc : f->scenes) f->check.scenes.emplace_back(sc);
                 if (cmd->count("--timeout") > 0) f->check.timeout = f->timeout;

@@ -1,6 +1,7 @@
 // app/lab/check.cpp -- `cdlab check`: runs each scene once and grades it with the checkers of
 // its `expect:` section (checkers.h), which all watch that single run: frame 0 is the initial
-// state, frame k is after k * steps_per_frame steps. Rows come out in a fixed order (the order of
+// state, frame k is after k * steps_per_frame steps; a scene with an events track runs through
+// it as `cdlab run` plays it (demo_playback.h). Rows come out in a fixed order (the order of
 // makeCheckers, then file order), and scenes in command-line order whichever process graded them
 // and whenever it finished, so two checks of the same scenes print the same table.
 #include "check.h"
@@ -20,6 +21,8 @@
 #include "check_workers.h"
 #include "checkers.h"
 #include "checkers_step.h"
+#include "demo/demo_playback.h"
+#include "demo/demo_session.h"
 #include "exit_codes.h"
 #include "junit_report.h"
 #include "output_files.h"
@@ -56,12 +59,11 @@ std::string badOption(const CheckOptions& options) {
 
 // Loads every scene before any runs, printing the loader's notes and errors in command-line
 // order; false when any scene is bad.
-bool loadAll(const std::vector<fs::path>& files, std::vector<engine::Scene>& scenes,
-             std::ostream& err) {
+bool loadAll(const CheckOptions& options, std::vector<engine::Scene>& scenes, std::ostream& err) {
     bool bad = false;
-    for (const fs::path& file : files) {
+    for (const fs::path& file : options.scenes) {
         try {
-            scenes.push_back(engine::loadScene(file));
+            scenes.push_back(loadCheckScene(file, options.events, options.frames));
             for (const std::string& note : scenes.back().notes) err << note << "\n";
         } catch (const engine::SceneError& e) {
             err << e.what() << "\n";
@@ -111,6 +113,42 @@ void printTable(const std::vector<SceneReport>& reports, std::ostream& out) {
     out << "\n";
 }
 
+// checkScene of a scene with events: the run through the track on a session of `frames` frames.
+// The checkers see each step as it is taken, with the frame it leads to and the time it started
+// at (recorded by step count the first time, so a re-simulated step gets the same bits), each
+// frame shown and each entry applied.
+std::vector<CheckRow> checkThroughEvents(const engine::Scene& scene, int frames,
+                                         const fs::path& dump_dir) {
+    engine::Scene run_scene = scene;
+    run_scene.frames = frames;
+    engine::checkEventTrack(run_scene.events, frames, scene.name);
+    DemoSession session(run_scene, false);
+    const engine::World& world = session.world();
+    CheckRun run(run_scene, world, frames, dump_dir, &session);
+    const std::vector<std::unique_ptr<Checker>> checkers = makeCheckers(run_scene, world);
+    std::vector<double> time_after_step{double(world.time())};  // by step count
+    for (const auto& c : checkers) c->observeStep(run, 0, std::nullopt);
+    session.on_step = [&](const engine::World& w) {
+        const auto k = std::size_t(w.stepCount());
+        if (time_after_step.size() <= k) time_after_step.resize(k + 1);
+        time_after_step[k] = double(w.time());
+        for (const auto& c : checkers) c->observeStep(run, session.frame() + 1, time_after_step[k - 1]);
+    };
+    DemoPlaybackHooks hooks;
+    hooks.frame_shown = [&] {
+        run.markShown(session.frame());
+        for (const auto& c : checkers) c->observeFrame(run, session.frame());
+    };
+    hooks.event_applied = [&](const engine::DemoEvent& e) {
+        for (const auto& c : checkers) c->observeEvent(run, session.frame(), e.commands);
+    };
+    playDemo(session, run_scene.events, hooks);
+    std::vector<CheckRow> rows;
+    for (const auto& c : checkers) c->report(run, rows);
+    if (rows.empty()) rows.push_back({"expect", false, "states no expectation"});
+    return rows;
+}
+
 }  // namespace
 
 std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames, const fs::path& dump_dir) {
@@ -119,6 +157,7 @@ std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames, const f
         rows.push_back({"expect", false, "the scene has no 'expect:' section"});
         return rows;
     }
+    if (!scene.events.empty()) return checkThroughEvents(scene, frames, dump_dir);
     engine::World world = engine::makeWorld(scene);
     CheckRun run(scene, world, frames, dump_dir);
     const std::vector<std::unique_ptr<Checker>> checkers = makeCheckers(scene, world);
@@ -164,20 +203,39 @@ SceneReport gradeScene(const engine::Scene& scene, std::size_t index, std::optio
     return report;
 }
 
+engine::Scene loadCheckScene(const fs::path& file, const std::optional<fs::path>& events,
+                             std::optional<int> frames) {
+    engine::Scene scene = engine::loadScene(file);
+    if (!events) return scene;
+    if (frames) scene.frames = *frames;
+    engine::EventTrack track = engine::loadEventTrack(*events, scene);
+    scene.events = std::move(track.events);
+    if (track.expect.present) {
+        scene.expect = std::move(track.expect);
+    } else {
+        engine::requireGradableThroughEvents(scene.expect, file.string());
+    }
+    return scene;
+}
+
+std::string sceneLabel(const fs::path& file, const std::optional<fs::path>& events) {
+    return events ? file.string() + " --events " + events->string() : file.string();
+}
+
 SceneReport gradeSceneFile(const fs::path& file, std::size_t index, std::optional<int> frames,
-                           const fs::path& dump_root) {
+                           const fs::path& dump_root, const std::optional<fs::path>& events) {
     std::optional<engine::Scene> scene;
     try {
-        scene = engine::loadScene(file);
+        scene = loadCheckScene(file, events, frames);
     } catch (const engine::SceneError& e) {
         SceneReport report;
-        report.label = file.string();
+        report.label = sceneLabel(file, events);
         report.outcome = SceneOutcome::NotLoaded;
         report.rows = {{"load", false, e.what()}};
         return report;
     }
     SceneReport report = gradeScene(*scene, index, frames, dump_root);
-    report.label = file.string();
+    report.label = sceneLabel(file, events);
     return report;
 }
 
@@ -188,7 +246,7 @@ int runCheck(const CheckOptions& options, std::ostream& out, std::ostream& err) 
     }
     if (options.dry_run) {
         std::vector<engine::Scene> scenes;
-        return loadAll(options.scenes, scenes, err) ? kExitOk : kExitBadInput;
+        return loadAll(options, scenes, err) ? kExitOk : kExitBadInput;
     }
     const auto start = std::chrono::steady_clock::now();
     const bool keep_going = options.keep_going || options.junit.has_value();
@@ -207,7 +265,7 @@ int runCheck(const CheckOptions& options, std::ostream& out, std::ostream& err) 
     // Without keep_going every scene is loaded before any runs: bad input stops the whole check.
     std::vector<engine::Scene> scenes;
     if (!keep_going) {
-        if (!loadAll(options.scenes, scenes, err)) return kExitBadInput;
+        if (!loadAll(options, scenes, err)) return kExitBadInput;
         if (in_children) scenes.clear();  // each child loads its own
     }
 
@@ -223,8 +281,8 @@ int runCheck(const CheckOptions& options, std::ostream& out, std::ostream& err) 
 
     std::vector<SceneReport> reports;
     if (in_children) {
-        WorkerPlan plan{options.worker_exe, options.scenes, options.frames,
-                        dump_root,          jobs,           options.timeout};
+        WorkerPlan plan{options.worker_exe, options.scenes, options.frames, dump_root,
+                        jobs,               options.timeout, options.events};
         try {
             reports = gradeInWorkers(plan);
         } catch (const render::RenderError& e) {
@@ -234,10 +292,11 @@ int runCheck(const CheckOptions& options, std::ostream& out, std::ostream& err) 
     } else {
         for (std::size_t i = 0; i < options.scenes.size(); ++i) {
             if (keep_going) {
-                reports.push_back(gradeSceneFile(options.scenes[i], i, options.frames, dump_root));
+                reports.push_back(gradeSceneFile(options.scenes[i], i, options.frames, dump_root,
+                                                 options.events));
             } else {
                 reports.push_back(gradeScene(scenes[i], i, options.frames, dump_root));
-                reports.back().label = options.scenes[i].string();
+                reports.back().label = sceneLabel(options.scenes[i], options.events);
             }
         }
     }

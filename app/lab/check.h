@@ -1,7 +1,9 @@
 // app/lab/check.h -- `cdlab check`: runs scenes headless and grades them against their
 // `expect:` sections (engine/scene.h), printing a pass/fail table with a reason per failure and,
 // on request, a JUnit XML report (junit_report.h). Scenes are graded one after the other in
-// this process, or several at once in child processes (check_workers.h).
+// this process, or several at once in child processes (check_workers.h). A scene with an events
+// track (its own `events:`, or `--events FILE` with that file's `expect:`) is graded on the run
+// through the track, played as `cdlab run` plays it (demo/demo_playback.h).
 #pragma once
 
 #include <cstddef>
@@ -19,6 +21,9 @@ namespace app {
 struct CheckOptions {
     std::vector<std::filesystem::path> scenes;
     std::optional<int> frames;  ///< overrides expect.frames and the scene's frame count
+    /// An events file each scene's run follows instead of its own `events:` (as `cdlab run
+    /// --events`); its `expect:`, when it has one, replaces the scene's (loadCheckScene).
+    std::optional<std::filesystem::path> events;
     /// Where pause dumps are written; default: a temporary folder removed afterwards. Scene k
     /// (from 0, command-line order) writes into `k_STEM`, so two scenes of the same file name
     /// never share a folder.
@@ -63,7 +68,12 @@ struct SceneReport {
 /// Runs `scene` for `frames` frames (frame 0 = initial state) and grades every expectation.
 /// Renders only for `colors` and `pause_dumps`; pause dumps go to `dump_dir`. A scene without an
 /// `expect:` section gets one failing row. Deterministic: same scene -> same rows (except paths).
-/// Throws render::RenderError when rendering or writing fails.
+/// A scene with `events` is run through them on a DemoSession of `frames` frames, as `cdlab run`
+/// plays them: every step taken (re-simulated ones after stepping back too) and every frame
+/// shown (as often as shown) reach the checkers; frames the track never shows fail the
+/// expectations on them; dumps are the track's `dump: true` entries.
+/// Throws render::RenderError when rendering or writing fails, engine::SceneError when the
+/// track does not fit `frames`.
 std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames,
                                  const std::filesystem::path& dump_dir);
 
@@ -73,10 +83,24 @@ std::vector<CheckRow> checkScene(const engine::Scene& scene, int frames,
 SceneReport gradeScene(const engine::Scene& scene, std::size_t index, std::optional<int> frames,
                        const std::filesystem::path& dump_root);
 
-/// Loads `file` and grades it as gradeScene; a file that does not load is a NotLoaded report
-/// (its message in the "load" row), never an exception.
+/// The scene a check grades: `file` as loaded; with `events`, that file's track in place of the
+/// scene's `events:` (read against the scene, its frames set to `frames` first, as `cdlab run
+/// --frames N --events FILE` reads it) and its `expect:` in place of the scene's, or, when the
+/// file has none, the scene's graded through the track (refused where it cannot be:
+/// engine::requireGradableThroughEvents). Throws engine::SceneError.
+engine::Scene loadCheckScene(const std::filesystem::path& file,
+                             const std::optional<std::filesystem::path>& events,
+                             std::optional<int> frames);
+
+/// The table's name of a scene: the file as given, and " --events FILE" when one is given.
+std::string sceneLabel(const std::filesystem::path& file,
+                       const std::optional<std::filesystem::path>& events);
+
+/// Loads `file` (loadCheckScene) and grades it as gradeScene; a file that does not load is a
+/// NotLoaded report (its message in the "load" row), never an exception.
 SceneReport gradeSceneFile(const std::filesystem::path& file, std::size_t index,
-                           std::optional<int> frames, const std::filesystem::path& dump_root);
+                           std::optional<int> frames, const std::filesystem::path& dump_root,
+                           const std::optional<std::filesystem::path>& events = std::nullopt);
 
 /// Exit codes: 0 every expectation of every scene passed, 1 any failed (or could not run, or
 /// the JUnit report could not be written), 2 bad input (a bad flag, or a scene that does not

@@ -132,6 +132,10 @@ pid_t spawnWorker(const WorkerPlan& plan, std::size_t i, const fs::path& work, s
         args.push_back("--frames");
         args.push_back(std::to_string(*plan.frames));
     }
+    if (plan.events) {
+        args.push_back("--events");
+        args.push_back(plan.events->string());
+    }
     args.push_back("--");  // a scene named "-x.yaml" is still a scene
     args.push_back(plan.scenes[i].string());
     std::vector<char*> argv;
@@ -196,7 +200,7 @@ SceneReport collect(const WorkerPlan& plan, const Child& c, int status, bool tim
     if (report->outcome == SceneOutcome::NotRun && report->seconds == 0) {
         report->seconds = std::chrono::duration<double>(Clock::now() - c.start).count();
     }
-    report->label = plan.scenes[c.index].string();
+    report->label = sceneLabel(plan.scenes[c.index], plan.events);
     report->log = fileBytes(logPath(work, c.index));
     return *report;
 }
@@ -252,8 +256,9 @@ std::optional<SceneReport> parseWorkerReport(const std::string& text) {
 }
 
 int runCheckWorker(const fs::path& scene, std::size_t index, std::optional<int> frames,
-                   const fs::path& dump_root, const fs::path& result) {
-    SceneReport report = gradeSceneFile(scene, index, frames, dump_root);
+                   const fs::path& dump_root, const fs::path& result,
+                   const std::optional<fs::path>& events) {
+    SceneReport report = gradeSceneFile(scene, index, frames, dump_root, events);
     try {
         writeTextAtomically(result, formatWorkerReport(report));
     } catch (const render::RenderError& e) {
@@ -281,7 +286,7 @@ std::vector<SceneReport> gradeInWorkers(const WorkerPlan& plan) {
             const pid_t pid = spawnWorker(plan, next, work, error);
             if (pid < 0) {
                 reports[next] = notRun(error);
-                reports[next].label = plan.scenes[next].string();
+                reports[next].label = sceneLabel(plan.scenes[next], plan.events);
             } else {
                 running.push_back({pid, next, Clock::now()});
             }

@@ -142,6 +142,106 @@ private:
     std::vector<ExtraBroadPhase> extra_;
 };
 
+// ---- the world's own broad phase, whichever is in use, equal to its reference ----
+// Grades what the run shows: the pairs the world's broad phase flagged, after every step and
+// on the state it re-detects when an events entry switches to it. The reference is fed the
+// world's volumes (after a restore too: a jump back is one more move) and loses the pairs the
+// world never flags (World::pairAllowed), as the world's list does.
+class BroadPhaseInUseChecker final : public Checker {
+public:
+    explicit BroadPhaseInUseChecker(const std::vector<std::string>& names) : listed_(names) {}
+    void observeStep(CheckRun& run, int frame, std::optional<double>) override {
+        grade(run.world, frame);
+    }
+    void observeEvent(CheckRun& run, int frame, const engine::DemoCommands& commands) override {
+        if (commands.broad_phase) grade(run.world, frame);
+    }
+    void report(const CheckRun&, std::vector<CheckRow>& rows) const override {
+        for (const std::string& name : listed_) {
+            const collision::BroadPhaseEntry* entry = collision::findBroadPhase(name);
+            CheckRow r{"broad phase " + name + " equals " + std::string(entry->reference) +
+                           " on every step it is in use",
+                       false, ""};
+            const InUse* u = find(name);
+            if (u == nullptr) {
+                r.reason = "never in use (the run used: " + usedList() + ")";
+            } else {
+                r.pass = u->first_mismatch.empty();
+                r.reason = u->first_mismatch;
+            }
+            rows.push_back(r);
+        }
+        for (const InUse& u : used_) {
+            if (std::find(listed_.begin(), listed_.end(), u.name) != listed_.end()) continue;
+            rows.push_back({"broad phase " + u.name + " in use is listed", false,
+                            "in use from frame " + std::to_string(u.first_frame) +
+                                " but not in expect.broadphases_in_use, so not graded"});
+        }
+    }
+
+private:
+    struct InUse {
+        std::string name;
+        int first_frame = 0;
+        std::unique_ptr<collision::BroadPhase> reference;
+        std::string reference_name;
+        std::vector<collision::ProxyPair> pairs;
+        std::size_t inserted = 0;
+        std::string first_mismatch;  // empty while they agree
+    };
+
+    const InUse* find(const std::string& name) const {
+        for (const InUse& u : used_) {
+            if (u.name == name) return &u;
+        }
+        return nullptr;
+    }
+    InUse* find(const std::string& name) {
+        for (InUse& u : used_) {
+            if (u.name == name) return &u;
+        }
+        return nullptr;
+    }
+    std::string usedList() const {
+        std::string list;
+        for (const InUse& u : used_) list += (list.empty() ? "" : ", ") + u.name;
+        return list;
+    }
+    void grade(const engine::World& world, int frame) {
+        const std::string name(world.broadPhase().name());
+        InUse* u = find(name);
+        if (u == nullptr) {
+            const collision::BroadPhaseEntry* entry = collision::findBroadPhase(name);
+            InUse fresh;
+            fresh.name = name;
+            fresh.first_frame = frame;
+            fresh.reference_name = std::string(entry->reference);
+            fresh.reference = collision::findBroadPhase(entry->reference)->create();
+            used_.push_back(std::move(fresh));
+            u = &used_.back();
+        }
+        if (!u->first_mismatch.empty()) return;  // report the first mismatch only
+        feed(*u->reference, u->inserted, world.volumes());
+        collision::BroadPhaseCounters ignored;
+        u->reference->findPairs(u->pairs, ignored);
+        u->pairs.erase(std::remove_if(u->pairs.begin(), u->pairs.end(),
+                                      [&](const collision::ProxyPair& p) {
+                                          return !world.pairAllowed(engine::BodyId(p.a),
+                                                                    engine::BodyId(p.b));
+                                      }),
+                       u->pairs.end());
+        std::string report = describePairMismatch(name, u->reference_name, world.flaggedPairs(),
+                                                  u->pairs, world.bodies());
+        if (report.empty()) return;
+        std::replace(report.begin(), report.end(), '\n', ';');
+        u->first_mismatch = "differs at frame " + std::to_string(frame) + ", step " +
+                            std::to_string(world.stepCount()) + ": " + report;
+    }
+
+    std::vector<std::string> listed_;
+    std::vector<InUse> used_;  // in the order the run first used them
+};
+
 // ---- energy drift and rise, relative to the initial energy, on every step ----
 class EnergyChecker final : public Checker {
 public:
@@ -309,6 +409,10 @@ private:
 
 std::unique_ptr<Checker> makeBroadPhaseChecker(const std::vector<std::string>& names) {
     return std::make_unique<BroadPhaseAgreementChecker>(names);
+}
+
+std::unique_ptr<Checker> makeBroadPhaseInUseChecker(const std::vector<std::string>& names) {
+    return std::make_unique<BroadPhaseInUseChecker>(names);
 }
 
 std::unique_ptr<Checker> makeEnergyChecker(const engine::Expectations& ex,

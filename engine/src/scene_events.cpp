@@ -296,15 +296,17 @@ void SceneParser::parseEvents(const Entry& entry, Scene& scene) const {
     checkEventTrack(scene.events, scene.frames, file_);
 }
 
-std::vector<DemoEvent> SceneParser::parseEventsDocument(const std::string& text,
-                                                        const Scene& scene) const {
+EventTrack SceneParser::parseEventsDocument(const std::string& text, const Scene& scene) const {
     const YAML::Node root = loadDocument(text);
     if (!root.IsMap()) fail(root, "events", "expected a mapping with the key: events");
-    const std::vector<Entry> es = entries(root, "", {"events"});
+    const std::vector<Entry> es = entries(root, "", {"events", "expect"});
     const Entry& track = require(es, "events", root, "");
-    std::vector<DemoEvent> events = EventReader(*this, scene).readTrack(track.value, "events");
-    checkEventTrack(events, scene.frames, file_);
-    return events;
+    EventTrack out;
+    out.events = EventReader(*this, scene).readTrack(track.value, "events");
+    checkEventTrack(out.events, scene.frames, file_);
+    // What the run through this track must show, read as a scene's own section is.
+    if (const Entry* e = find(es, "expect")) parseExpect(*e, scene, out.expect, true);
+    return out;
 }
 
 DemoCommands SceneParser::parseCommandsDocument(const std::string& text, const Scene& scene) const {
@@ -332,14 +334,23 @@ auto runEventParser(const std::string& display_name, Parse&& parse) {
 
 }  // namespace
 
-std::vector<DemoEvent> parseEvents(const std::string& yaml_text, const std::string& display_name,
-                                   const Scene& scene) {
+EventTrack parseEventTrack(const std::string& yaml_text, const std::string& display_name,
+                           const Scene& scene) {
     const scene_parsing::SceneParser parser(display_name, ".");
     return runEventParser(display_name,
                           [&] { return parser.parseEventsDocument(yaml_text, scene); });
 }
 
+std::vector<DemoEvent> parseEvents(const std::string& yaml_text, const std::string& display_name,
+                                   const Scene& scene) {
+    return parseEventTrack(yaml_text, display_name, scene).events;
+}
+
 std::vector<DemoEvent> loadEvents(const std::filesystem::path& file, const Scene& scene) {
+    return loadEventTrack(file, scene).events;
+}
+
+EventTrack loadEventTrack(const std::filesystem::path& file, const Scene& scene) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(file, ec)) {
         throw SceneError(file.string() + ":1:1: events: cannot open the file (" +
@@ -356,7 +367,7 @@ std::vector<DemoEvent> loadEvents(const std::filesystem::path& file, const Scene
     std::ostringstream text;
     text << in.rdbuf();
     if (!in.good() && !in.eof()) throw SceneError(file.string() + ":1:1: events: cannot read the file");
-    return parseEvents(text.str(), file.string(), scene);
+    return parseEventTrack(text.str(), file.string(), scene);
 }
 
 DemoCommands parseDemoCommands(const std::string& text, const std::string& display_name,

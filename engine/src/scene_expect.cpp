@@ -91,7 +91,8 @@ public:
     void rest(const Entry& e, const std::string& p, Expectations& ex) const;
     void selfCollision(const Entry& e, const std::string& p, Expectations& ex,
                        const Scene& scene) const;
-    void broadPhases(const Entry& e, const std::string& p, Expectations& ex) const;
+    /// `broadphases` and `broadphases_in_use`: registry names.
+    void broadPhases(const Entry& e, const std::string& p, std::vector<std::string>& names) const;
     void pauseDumps(const Entry& e, const std::string& p, Expectations& ex) const;
     void pairs(const Entry& e, const std::string& p, Expectations& ex) const;
     void colors(const Entry& e, const std::string& p, Expectations& ex) const;
@@ -194,7 +195,8 @@ void ExpectReader::selfCollision(const Entry& e, const std::string& p, Expectati
     }
 }
 
-void ExpectReader::broadPhases(const Entry& e, const std::string& p, Expectations& ex) const {
+void ExpectReader::broadPhases(const Entry& e, const std::string& p,
+                               std::vector<std::string>& names) const {
         const std::vector<YAML::Node> list = readList(e.value, p);
         for (std::size_t i = 0; i < list.size(); ++i) {
             const std::string name = p_.readString(list[i], indexPath(p, i));
@@ -203,7 +205,13 @@ void ExpectReader::broadPhases(const Entry& e, const std::string& p, Expectation
                      "unknown broad phase '" + name +
                          "' (expected one of: " + collision::broadPhaseNames() + ")");
             }
-            ex.broad_phases.push_back(name);
+            // `broadphases` always refused nothing here; a name listed twice in the list of
+            // those in use would grade one broad phase under two rows.
+            if (e.key == "broadphases_in_use" &&
+                std::find(names.begin(), names.end(), name) != names.end()) {
+                p_.fail(list[i], indexPath(p, i), "'" + name + "' is listed twice");
+            }
+            names.push_back(name);
         }
 }
 
@@ -313,22 +321,22 @@ void ExpectReader::colors(const Entry& e, const std::string& p, Expectations& ex
 // phase names in the registry, colour names, contradictory pair states, and that the section
 // states at least one expectation (an empty one would pass `cdlab check` having checked
 // nothing).
-void SceneParser::parseExpect(const Entry& entry, Scene& scene) const {
+void SceneParser::parseExpect(const Entry& entry, const Scene& scene, Expectations& ex,
+                              bool through_events) const {
     const YAML::Node& n = entry.value;
     const std::string path = "expect";
-    Expectations& ex = scene.expect;
     ex.present = true;
     const std::string kinds =
-        "min_bodies, min_moving_rotating, broadphases, energy_drift_max, energy_rise_max, "
-        "pause_dumps, pairs, colors, tunnelling, toi, rest, self_collision";
+        "min_bodies, min_moving_rotating, broadphases, broadphases_in_use, energy_drift_max, "
+        "energy_rise_max, pause_dumps, pairs, colors, tunnelling, toi, rest, self_collision";
     if (n.IsNull() || (n.IsMap() && n.size() == 0)) {
         fail(entry.key_node, path, "states no expectation (give at least one of: " + kinds + ")");
     }
     const std::vector<Entry> es =
         entries(n, path,
-                {"frames", "min_bodies", "min_moving_rotating", "broadphases", "energy_drift_max",
-                 "energy_rise_max", "pause_dumps", "pairs", "colors", "tunnelling", "toi", "rest",
-                 "self_collision"});
+                {"frames", "min_bodies", "min_moving_rotating", "broadphases",
+                 "broadphases_in_use", "energy_drift_max", "energy_rise_max", "pause_dumps",
+                 "pairs", "colors", "tunnelling", "toi", "rest", "self_collision"});
     // The run length first: every frame below must lie inside it.
     if (const Entry* f = find(es, "frames")) {
         const int v = readInt(f->value, childPath(path, "frames"));
@@ -358,7 +366,9 @@ void SceneParser::parseExpect(const Entry& entry, Scene& scene) const {
         } else if (e.key == "self_collision") {
             reader.selfCollision(e, p, ex, scene);
         } else if (e.key == "broadphases") {
-            reader.broadPhases(e, p, ex);
+            reader.broadPhases(e, p, ex.broad_phases);
+        } else if (e.key == "broadphases_in_use") {
+            reader.broadPhases(e, p, ex.broad_phases_in_use);
         } else if (e.key == "pause_dumps") {
             reader.pauseDumps(e, p, ex);
         } else if (e.key == "pairs") {
@@ -370,12 +380,27 @@ void SceneParser::parseExpect(const Entry& entry, Scene& scene) const {
     // `frames` alone sets the run length and checks nothing.
     const bool states_something =
         ex.min_bodies || ex.min_moving_rotating || !ex.broad_phases.empty() ||
-        ex.energy_drift_max || ex.energy_rise_max || !ex.pause_dumps.empty() || !ex.pairs.empty() ||
+        !ex.broad_phases_in_use.empty() || ex.energy_drift_max || ex.energy_rise_max || !ex.pause_dumps.empty() || !ex.pairs.empty() ||
         !ex.colors.empty() || !ex.tunnelling.empty() || !ex.toi.empty() || !ex.rest.empty() ||
         !ex.self_collision.empty();
     if (!states_something) {
         fail(entry.key_node, path, "states no expectation (give at least one of: " + kinds + ")");
     }
+    if (through_events) requireGradableThroughEvents(ex, file_);
 }
 
 }  // namespace engine::scene_parsing
+
+namespace engine {
+
+void requireGradableThroughEvents(const Expectations& expect, const std::string& display_name) {
+    if (expect.colors.empty()) return;
+    const ColorExpectation& c = expect.colors.front();
+    throw SceneError(display_name + ":" + std::to_string(c.line) + ":" +
+                     std::to_string(c.column) +
+                     ": expect.colors[0]: not graded in a run through an events track (its "
+                     "picture is the view the track sets: volumes shown, camera, selection); "
+                     "grade colours in a scene's expect: without events");
+}
+
+}  // namespace engine

@@ -409,7 +409,9 @@ Scene SceneParser::parse(const std::string& text) {
                      " a step may flag (spread them over a larger repeat.region, or use fewer)");
         }
     }
-    if (const Entry* e = find(es, "expect")) parseExpect(*e, scene);
+    if (const Entry* e = find(es, "expect")) {
+        parseExpect(*e, scene, scene.expect, find(es, "events") != nullptr);
+    }
     if (const Entry* e = find(es, "events")) parseEvents(*e, scene);
     scene.notes = std::move(notes_);
     return scene;

@@ -155,8 +155,9 @@ public:
         : file_(std::move(display_name)), base_dir_(std::move(base_dir)) {}
 
     Scene parse(const std::string& text);
-    /// A document whose one key is `events:`, read against `scene` (scene_events.cpp).
-    std::vector<DemoEvent> parseEventsDocument(const std::string& text, const Scene& scene) const;
+    /// A document with the key `events:` and an optional `expect:`, read against `scene`
+    /// (scene_events.cpp).
+    EventTrack parseEventsDocument(const std::string& text, const Scene& scene) const;
     /// A document holding one set of commands (a mapping), read against `scene`.
     DemoCommands parseCommandsDocument(const std::string& text, const Scene& scene) const;
     void setOverrides(std::vector<SceneOverride> overrides) { overrides_ = std::move(overrides); }
@@ -223,8 +224,11 @@ private:
     void parseEvents(const Entry& entry, Scene& scene) const;
     /// Any document's root, with the parser's care for malformed YAML (scene_parser.cpp).
     YAML::Node loadDocument(const std::string& text) const;
-    /// `expect:` (after the bodies, whose names it refers to).
-    void parseExpect(const Entry& entry, Scene& scene) const;
+    /// `expect:` of `scene` or of an events file played on it (after the bodies, whose names
+    /// it refers to) into `ex`. `through_events`: the run follows an events track, which
+    /// refuses what such a run cannot grade (requireGradableThroughEvents).
+    void parseExpect(const Entry& entry, const Scene& scene, Expectations& ex,
+                     bool through_events) const;
     /// `chains:` (scene_chains.cpp, after the bodies): each link becomes a kinematic body
     /// appended to scene.bodies, named uniquely among all bodies (`names`: body name -> path).
     void parseChains(const Entry& entry, Scene& scene);

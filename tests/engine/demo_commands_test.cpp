@@ -130,7 +130,7 @@ TEST(DemoCommands, EventsFilesAndLiveCommandsAreReadAgainstTheScene) {
         return "";
     };
     EXPECT_EQ(errorOf([&] { parseEvents("event: []\n", "demo.yaml", scene); }),
-              "demo.yaml:1:1: event: unknown key 'event' (expected one of: events)");
+              "demo.yaml:1:1: event: unknown key 'event' (expected one of: events, expect)");
     EXPECT_EQ(errorOf([&] { parseEvents("events: [{frame: 1, dump: true}]\n---\n", "demo.yaml", scene); })
                   .rfind("demo.yaml:2:1: scene: a second YAML document", 0),
               0u);

@@ -39,7 +39,7 @@ TEST(SceneExpect, AbsentMeansNotPresent) {
 TEST(SceneExpect, EmptyExpectationsAreAnError) {
     const std::string what =
         "states no expectation (give at least one of: min_bodies, "
-        "min_moving_rotating, broadphases, energy_drift_max, "
+        "min_moving_rotating, broadphases, broadphases_in_use, energy_drift_max, "
         "energy_rise_max, pause_dumps, pairs, colors, tunnelling, toi, rest, self_collision)";
     EXPECT_SCENE_ERROR(kScene, "7:1: expect: ", what);
     EXPECT_SCENE_ERROR(kScene.substr(0, kScene.size() - 1) + " {}\n", "7:1: expect: ", what);

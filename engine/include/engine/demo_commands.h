@@ -97,8 +97,10 @@ inline constexpr double kMaxDemoWaitSeconds = 3600;
 inline constexpr std::size_t kMaxDemoEvents = 10000;
 inline constexpr double kMinDemoSpeed = 1.0 / 16, kMaxDemoSpeed = 16;
 
-/// Reads an events file (a mapping whose one key is `events:`, as a scene's own track) against
+/// Reads an events file (a mapping with the key `events:`, as a scene's own track, and an
+/// optional `expect:` that `cdlab check --events` grades: engine::loadEventTrack) against
 /// `scene` (its frames, bodies and timing) and checks the track as a whole (checkEventTrack).
+/// The `expect:` section is validated too, and then left out of the answer.
 /// Throws SceneError "FILE:LINE:COL: events[i].key: what".
 std::vector<DemoEvent> loadEvents(const std::filesystem::path& file, const Scene& scene);
 /// The same from text.

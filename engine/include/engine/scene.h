@@ -164,6 +164,11 @@ struct Expectations {
     std::optional<int> min_bodies;
     std::optional<int> min_moving_rotating;  ///< bodies displaced and rotated by the last frame
     std::vector<std::string> broad_phases;   ///< each must equal its brute reference every step
+    /// The broad phases the run itself uses (the scene's, then each an events track switches
+    /// to): each must be in use at some point and equal its brute reference on every state it
+    /// detects (every step while it is in use, and the state it re-detects when switched to);
+    /// one the run uses that is not listed fails a row of its own. `expect.broadphases_in_use`.
+    std::vector<std::string> broad_phases_in_use;
     std::optional<Real> energy_drift_max;    ///< max |E(t) - E(0)| / |E(0)|, E kinetic+potential
     std::optional<Real> energy_rise_max;     ///< max (E(t) - E(0)) / |E(0)|: energy never grows
     std::vector<int> pause_dumps;            ///< frames whose pause PNG + JSON must be written
@@ -198,6 +203,29 @@ struct Scene {
     /// import dropped): the commands print them on stderr. Not errors: the scene loaded.
     std::vector<std::string> notes;
 };
+
+/// An events file as `cdlab check --events` reads it: the track and, when the file has one, its
+/// own `expect:` section, read against the scene the track plays on (its bodies and frames) with
+/// the scene loader's care. A file's `expect:` states what the run through the track must show.
+struct EventTrack {
+    std::vector<DemoEvent> events;
+    Expectations expect;  ///< `present` false when the file has no `expect:`
+};
+
+/// Reads an events file (keys `events:` and, optionally, `expect:`) against `scene`, as
+/// loadEvents does, and its `expect:` as a scene's (graded through the track, so it may not
+/// hold `colors`: requireGradableThroughEvents). Throws SceneError "FILE:LINE:COL: key: what".
+EventTrack loadEventTrack(const std::filesystem::path& file, const Scene& scene);
+/// The same from text.
+EventTrack parseEventTrack(const std::string& yaml_text, const std::string& display_name,
+                           const Scene& scene);
+
+/// Throws SceneError "FILE:LINE:COL: expect.colors[i]: ..." when `expect` states something that
+/// a run through an events track cannot grade: `colors` count the state colours of a picture,
+/// and a track's picture is the view its commands set (volumes shown and hidden, the camera, a
+/// selected body drawn white), so the count would grade the walkthrough's camera work and not
+/// the bodies' states. `display_name` is the file the expectations came from.
+void requireGradableThroughEvents(const Expectations& expect, const std::string& display_name);
 
 /// Simulated seconds per second of the scene's video: time_step * steps_per_frame * fps
 /// (1 = real time; below 1, slow motion).
