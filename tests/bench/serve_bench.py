@@ -6,26 +6,46 @@
   - command -> changed frame: from sending a command (show/hide a layer, alternately) to having
     the PNG of the picture it changed, while paused and while playing; median and p95.
 
-    serve_bench.py CDLAB SCENE [--seconds S] [--commands N] [--set KEY=VALUE ...]
+    serve_bench.py CDLAB SCENE [--seconds S] [--commands N] [--keep-alive] [--set KEY=VALUE ...]
 
 Prints one line per figure; the scene's own size and frame rate apply unless --set changes them.
+Each request opens a connection of its own unless --keep-alive sends them all over one kept-alive
+connection, as a browser does.
 """
 import argparse
+import http.client
 import json
 import signal
 import statistics
 import subprocess
 import threading
 import time
+import urllib.parse
 import urllib.request
+
+# The one connection every request goes over with --keep-alive; None: a connection per request.
+kept_alive = None
+
+
+def kept_alive_request(method, address, body=None):
+    parts = urllib.parse.urlsplit(address)
+    target = parts.path + ("?" + parts.query if parts.query else "")
+    kept_alive.request(method, target, body=body)
+    r = kept_alive.getresponse()
+    return r.read(), r.headers
 
 
 def get(address):
+    if kept_alive:
+        return kept_alive_request("GET", address)
     with urllib.request.urlopen(address, timeout=30) as r:
         return r.read(), r.headers
 
 
 def post(url, body):
+    if kept_alive:
+        return json.loads(kept_alive_request("POST", url + "api/command",
+                                             json.dumps(body).encode())[0])
     request = urllib.request.Request(url + "api/command", data=json.dumps(body).encode(),
                                      method="POST")
     with urllib.request.urlopen(request, timeout=30) as r:
@@ -61,11 +81,13 @@ def p95(values):
 
 
 def main():
+    global kept_alive
     parser = argparse.ArgumentParser()
     parser.add_argument("cdlab")
     parser.add_argument("scene")
     parser.add_argument("--seconds", type=float, default=5)
     parser.add_argument("--commands", type=int, default=60)
+    parser.add_argument("--keep-alive", action="store_true")
     parser.add_argument("--set", action="append", default=[])
     args = parser.parse_args()
     command = [args.cdlab, "serve", args.scene, "--port", "0", "--paused", "--out",
@@ -75,6 +97,9 @@ def main():
     server = subprocess.Popen(command, stdout=subprocess.PIPE, text=True)
     try:
         url = server.stdout.readline().split()[2]
+        if args.keep_alive:
+            parts = urllib.parse.urlsplit(url)
+            kept_alive = http.client.HTTPConnection(parts.hostname, parts.port, timeout=30)
         paused = latencies(url, args.commands)
         post(url, {"play": True})
         fps = follow(url, args.seconds)
