@@ -220,6 +220,12 @@ int serveScene(const ServeOptions& options, std::ostream& out, std::ostream& err
     server.set_read_timeout(5, 0);
     server.set_write_timeout(5, 0);
     server.set_keep_alive_timeout(5);
+    // cpp-httplib writes a header and a small body in two sends, and Nagle's algorithm holds the
+    // second until the client acknowledges the first: 41 ms on every command answer over a
+    // kept-alive connection (tests/bench/http_servers). And 0.11 closes a kept-alive connection
+    // after 5 requests, so a watching page reconnects behind whatever holds the pool.
+    server.set_tcp_nodelay(true);
+    server.set_keep_alive_max_count(std::size_t(1) << 20);
     const std::string page = servePage(scene, scene_name);
     LiveSession& s = *session;
 

@@ -14,8 +14,10 @@
 //   GET  /api/session.yaml      every command applied so far with its frame: an events track
 //   GET  /api/timeline.json     frames reached, from ?from=K on
 //
-// Nothing a request carries names a file; bodies over 64 KiB are refused (413), a client that
-// stops reading is dropped after 5 s, commands beyond the queue's bound are "busy".
+// Nothing a request carries names a file; bodies over 64 KiB are refused (413), a client silent
+// for 5 s is dropped, commands beyond the queue's bound are "busy". Answers go out without
+// Nagle's delay (TCP_NODELAY) and a kept-alive connection serves any number of requests
+// (docs/serve.md: "Why cpp-httplib").
 #pragma once
 
 #include <filesystem>
