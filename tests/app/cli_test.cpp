@@ -256,7 +256,7 @@ TEST(Cli, AnUnknownOrMissingCommandIsNamedWithTheCommandsThereAre) {
     Result r = runCdlab("nope scenes/coursework.yaml", work);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("unknown command 'nope'"), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find("run, check, query, sweep, serve, bench"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("run, check, query, sweep, serve, replay, bench"), std::string::npos) << r.err;
     r = runCdlab("", work);
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("no command given"), std::string::npos) << r.err;

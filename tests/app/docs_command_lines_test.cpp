@@ -100,15 +100,17 @@ std::vector<DocLine> docCommandLines(const std::string& file, const std::string&
     return found;
 }
 
-// What `--out P` and `--plan P` name: folders an earlier line of a document writes, which a
-// later one (`--collect P`) may read.
+// What `--out P`, `--plan P` and `--record P` name: folders and files an earlier line of a
+// document writes, which a later one (`--collect P`, `replay P`) may read.
 std::vector<std::string> docProducedFolders(const std::string& args) {
     std::vector<std::string> out;
     std::istringstream words(args);
     std::string word;
     std::string previous;
     while (words >> word) {
-        if (previous == "--out" || previous == "--plan") out.push_back(word);
+        if (previous == "--out" || previous == "--plan" || previous == "--record") {
+            out.push_back(word);
+        }
         previous = word;
     }
     return out;
@@ -267,6 +269,7 @@ TEST(DocsCommandLines, EveryFlagIsOnItsCommandsPage) {
         {"sweep", "docs/sweep.md"},
         {"query", "docs/query.md"},
         {"serve", "docs/serve.md"},
+        {"replay", "docs/recording.md"},
         {"bench broadphase", "docs/bench.md"},
         {"bench ccd", "docs/bench.md"},
         {"bench convex", "docs/bench.md"},

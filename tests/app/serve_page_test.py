@@ -16,6 +16,7 @@ import signal
 import subprocess
 import sys
 import time
+import urllib.parse
 import urllib.request
 from pathlib import Path
 
@@ -165,6 +166,28 @@ def main():
         for a, b in s["flagged_pairs"][:20]:
             check("%s \u2013 %s" % (names[a], names[b]) in shown,
                   "the second tab lists the flagged pair %s-%s by name" % (names[a], names[b]))
+
+        # A click on a pair shows its history, the ranges /api/pair.json gives; a click on a
+        # range seeks to its first frame.
+        rows = other.find_elements(By.CSS_SELECTOR, "#flagged-pairs li.pair-row")
+        if check(rows, "the flagged pairs are rows to click (%d pairs)" % len(s["flagged_pairs"])):
+            a, b = [names[k] for k in s["flagged_pairs"][0]]
+            rows[0].click()
+            WebDriverWait(other, 10).until(
+                lambda d: d.find_element(By.ID, "pair-history").is_displayed())
+            shown = other.find_element(By.ID, "pair-history").text
+            query = urllib.parse.urlencode({"a": a, "b": b})
+            h = json.loads(get(url + "api/pair.json?" + query))
+            check("pair %s \u2013 %s" % (a, b) in shown, "the history names the pair: " + shown)
+            buttons = other.find_elements(By.CSS_SELECTOR, "#pair-history .flagged-ranges button")
+            texts = [("%d" % f if f == l else "%d\u2013%d" % (f, l)) for f, l in h["flagged"]]
+            check([x.text for x in buttons] == texts,
+                  "the page's ranges %s are the API's %s" % ([x.text for x in buttons], texts))
+            if buttons:
+                buttons[0].click()
+                WebDriverWait(other, 10).until(
+                    lambda d: state(url)["frame"] == h["flagged"][0][0])
+                settled(other, url, "seek from a pair's history")
 
         # Playing, one tab closed mid-stream: the other keeps receiving pictures.
         main_tab.find_element(By.ID, "cmd-play").click()

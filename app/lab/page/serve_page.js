@@ -1,7 +1,8 @@
 // app/lab/page/serve_page.js -- the page of `cdlab serve`: the live picture (the off-screen
 // renderer's PNG), a control for every demo command (each sent as one POST /api/command), the
-// HUD, the current frame's flagged and confirmed pairs by body name, the selected body, and a
-// timeline of pairs per frame growing as the session plays. Every name shown goes in as text,
+// HUD, the current frame's flagged and confirmed pairs by body name (a click on one shows the
+// frames it was flagged and confirmed in), the selected body, and a timeline of pairs per frame
+// growing as the session plays. Every name shown goes in as text,
 // never as markup.
 (function () {
   "use strict";
@@ -27,11 +28,12 @@
   const message = el("p", { id: "message", class: "hint", role: "status" });
   const controls = el("div", { id: "controls" });
   const pairs = el("div", { id: "pairs" });
+  const history = el("div", { id: "pair-history", class: "detail", hidden: "" });
   const selected = el("div", { id: "selected", class: "detail", hidden: "" });
   const chartBox = el("div", { class: "chart-box" }, [el("canvas", { id: "timeline" })]);
   root.appendChild(el("div", { class: "pause-grid" }, [
     pictureBox,
-    el("div", { class: "pause-side" }, [controls, message, hud, selected, pairs]),
+    el("div", { class: "pause-side" }, [controls, message, hud, selected, history, pairs]),
   ]));
   root.appendChild(el("h2", { text: "Pairs per frame" }));
   root.appendChild(chartBox);
@@ -132,9 +134,37 @@
   });
 
   // --- what the state shows -------------------------------------------------------------------
+  // One pair's history: the frame ranges it was flagged and confirmed in, each a link to seek.
+  async function showHistory(a, b) {
+    try {
+      const r = await fetch("/api/pair.json?a=" + encodeURIComponent(a) + "&b=" +
+                            encodeURIComponent(b));
+      const h = await r.json();
+      if (!r.ok) throw new Error(h.error);
+      const ranges = (list) => list.length === 0 ? [document.createTextNode("never")] :
+        list.map(([first, last]) => el("button", {
+          type: "button", class: "range", text: first === last ? String(first) : first + "\u2013" + last,
+          onclick: () => send({ seek: { frame: first } }) }));
+      history.replaceChildren(
+        el("h3", { text: "pair " + h.a + " \u2013 " + h.b }),
+        el("p", { class: "hint", text: "frames 0.." + (h.frames - 1) + " " +
+                                        (data.replay ? "of the recording" : "reached so far") }),
+        el("dl", {}, [
+          el("dt", { text: "flagged in frames" }), el("dd", { class: "flagged-ranges" }, ranges(h.flagged)),
+          el("dt", { text: "confirmed in frames" }), el("dd", { class: "colliding-ranges" }, ranges(h.colliding)),
+        ]));
+      history.hidden = false;
+    } catch (e) {
+      message.textContent = "no history: " + e.message;
+      message.className = "missing";
+    }
+  }
+
   function pairList(title, list, id) {
     const names = (p) => state.bodies[p[0]].name + " \u2013 " + state.bodies[p[1]].name;
-    const items = list.slice(0, 200).map((p) => el("li", { text: names(p) }));
+    const items = list.slice(0, 200).map((p) => el("li", {
+      text: names(p), class: "pair-row", title: "the frames this pair was flagged and confirmed in",
+      onclick: () => showHistory(state.bodies[p[0]].name, state.bodies[p[1]].name) }));
     const more = list.length > 200 ? [el("li", { text: "and " + (list.length - 200) + " more" })]
                                    : [];
     return el("div", { id: id }, [el("h3", { text: title + " (" + list.length + ")" }),

@@ -108,6 +108,10 @@ int replayRecording(const ReplayOptions& options, std::ostream& out, std::ostrea
         err << "--frames: must be >= 1\n";
         return kExitBadInput;
     }
+    if (std::error_code ec; !std::filesystem::exists(options.recording, ec)) {
+        err << "recording " << options.recording.string() << ": no such file or folder\n";
+        return kExitBadInput;
+    }
     std::optional<engine::Recording> recording;
     engine::Scene scene;
     try {

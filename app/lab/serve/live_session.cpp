@@ -179,6 +179,33 @@ std::string LiveSession::timelineJson(std::size_t from) const {
     return rows.dump();
 }
 
+std::string LiveSession::pairHistoryJson(const std::string& a, const std::string& b) const {
+    auto find = [&](const std::string& name) {
+        for (std::size_t i = 0; i < scene_.bodies.size(); ++i) {
+            if (scene_.bodies[i].name == name) return collision::ProxyId(i);
+        }
+        throw std::invalid_argument("no body named '" + name + "' in the scene");
+    };
+    const collision::ProxyId ia = find(a), ib = find(b);
+    if (ia == ib) throw std::invalid_argument("a pair is of two bodies, not '" + a + "' twice");
+    PairHistory::Ranges r;
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        r = history_.of(ia, ib);
+    }
+    auto ranges = [](const std::vector<std::pair<int, int>>& list) {
+        nlohmann::ordered_json out = nlohmann::ordered_json::array();
+        for (const auto& [first, last] : list) out.push_back({first, last});
+        return out;
+    };
+    nlohmann::ordered_json j = {{"a", a},
+                                {"b", b},
+                                {"frames", r.frames},
+                                {"flagged", ranges(r.flagged)},
+                                {"colliding", ranges(r.colliding)}};
+    return j.dump();
+}
+
 std::string LiveSession::failure() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return failure_;
@@ -205,7 +232,32 @@ void LiveSession::loop(std::promise<void>& started) {
     }
     double step_ms = 0;  // the world steps since the last frame reached
     int newest = -1;     // the furthest frame reached
-    session->on_step = [&](const engine::World& w) { step_ms += 1e3 * w.lastStats().total_s; };
+    // Every frame's pairs the first time the simulation reaches it (a seek steps through frames
+    // it does not show), or a recording's, all of them, read once.
+    const auto keepPairs = [&](const engine::World& w, int frame) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        history_.add(frame, w.flaggedPairs(), w.collidingPairs());
+    };
+    if (options_.replay) {
+        try {
+            for (int k = 0; k < options_.replay->frames(); ++k) {
+                const engine::RecordedFrame f = options_.replay->frame(k);
+                std::lock_guard<std::mutex> lock(mutex_);
+                history_.add(k, f.flagged, f.colliding);
+            }
+        } catch (...) {
+            started.set_exception(std::current_exception());
+            return;
+        }
+    } else {
+        keepPairs(session->world(), 0);
+    }
+    session->on_step = [&](const engine::World& w) {
+        step_ms += 1e3 * w.lastStats().total_s;
+        if (w.stepCount() % scene_.steps_per_frame == 0) {
+            keepPairs(w, int(w.stepCount() / scene_.steps_per_frame));
+        }
+    };
     const auto reached = [&] {
         if (session->frame() > newest) {
             newest = session->frame();

@@ -29,6 +29,7 @@
 #include "engine/demo_commands.h"
 #include "engine/recording.h"
 #include "engine/scene.h"
+#include "serve/pair_history.h"
 
 namespace app {
 
@@ -103,6 +104,13 @@ public:
     /// {frame, time, flagged, colliding, step_ms}; at most 10,000 rows per call.
     std::string timelineJson(std::size_t from) const;
 
+    /// One pair's history, as JSON: {"a", "b", "frames", "flagged": [[first, last], ...],
+    /// "colliding": [...]}, the frames (ranges, inclusive) it was flagged and confirmed in among
+    /// frames 0..frames-1: those the simulation has reached so far, or every frame of a
+    /// recording. Throws std::invalid_argument naming a body that is not in the scene, or a
+    /// pair of one body with itself.
+    std::string pairHistoryJson(const std::string& a, const std::string& b) const;
+
     /// The first error that stopped the session thread (a step that failed), or "".
     std::string failure() const;
 
@@ -138,6 +146,7 @@ private:
     std::deque<std::shared_ptr<const LiveFrame>> held_;  ///< the last kHeldFrames published
     std::vector<engine::DemoEvent> log_;
     std::vector<TimelineRow> timeline_;
+    PairHistory history_;
     std::string failure_;
     bool stopping_ = false;
 

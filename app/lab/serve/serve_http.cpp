@@ -60,9 +60,12 @@ bool unsignedParam(const httplib::Request& req, httplib::Response& res, const ch
     return true;
 }
 
-std::string servePage(const engine::Scene& scene, const std::string& scene_name) {
+// `replay`: the recording shown, or "" for a live simulation.
+std::string servePage(const engine::Scene& scene, const std::string& scene_name,
+                      const std::string& replay) {
     nlohmann::ordered_json data;
     data["scene"] = scene_name;
+    data["replay"] = replay.empty() ? nlohmann::ordered_json() : nlohmann::ordered_json(replay);
     data["width"] = scene.output.width;
     data["height"] = scene.output.height;
     data["fps"] = scene.output.fps;
@@ -78,9 +81,12 @@ std::string servePage(const engine::Scene& scene, const std::string& scene_name)
     data["broadphases"] = std::move(phases);
     std::string page = html::pageStart("cdlab serve: " + scene_name);
     page += "<header><h1>cdlab serve: " + html::escape(scene_name) +
-            "</h1><p class=\"note\">A live session: every picture is drawn by the off-screen "
-            "renderer; the commands below are the ones a scene's events track and POST "
-            "/api/command take.</p></header>\n";
+            "</h1><p class=\"note\">" +
+            (replay.empty() ? std::string("A live session")
+                            : "A replay of the recording " + html::escape(replay) +
+                                  ", shown without simulating") +
+            ": every picture is drawn by the off-screen renderer; the commands below are the "
+            "ones a scene's events track and POST /api/command take.</p></header>\n";
     page += "<main id=\"live\"></main>\n";
     page += html::jsonScript("serve-data", data.dump());
     page += html::pageEnd(servePageJs());
@@ -141,6 +147,10 @@ int serveScene(const ServeOptions& options, std::ostream& out, std::ostream& err
             if (options.broad_phase || !options.overrides.empty()) {
                 err << "--replay: --broadphase and --set do not apply: the recording holds its "
                        "run's broad phase and scene values\n";
+                return kExitBadInput;
+            }
+            if (std::error_code ec; !std::filesystem::exists(*options.replay, ec)) {
+                err << "--replay " << options.replay->string() << ": no such file or folder\n";
                 return kExitBadInput;
             }
             recording = engine::Recording::open(*options.replay);
@@ -226,7 +236,8 @@ int serveScene(const ServeOptions& options, std::ostream& out, std::ostream& err
     // after 5 requests, so a watching page reconnects behind whatever holds the pool.
     server.set_tcp_nodelay(true);
     server.set_keep_alive_max_count(std::size_t(1) << 20);
-    const std::string page = servePage(scene, scene_name);
+    const std::string page =
+        servePage(scene, scene_name, recording ? recording->file().filename().string() : "");
     LiveSession& s = *session;
 
     server.Get("/", [&](const httplib::Request&, httplib::Response& res) {
@@ -285,6 +296,19 @@ int serveScene(const ServeOptions& options, std::ostream& out, std::ostream& err
         if (!unsignedParam(req, res, "from", from)) return;
         res.set_header("Cache-Control", "no-store");
         res.set_content(s.timelineJson(std::size_t(from.value_or(0))), "application/json");
+    });
+    server.Get("/api/pair.json", [&](const httplib::Request& req, httplib::Response& res) {
+        if (!req.has_param("a") || !req.has_param("b")) {
+            errorAnswer(res, 400, "pair.json: give the two bodies' names, ?a=NAME&b=NAME");
+            return;
+        }
+        try {
+            res.set_header("Cache-Control", "no-store");
+            res.set_content(s.pairHistoryJson(req.get_param_value("a"), req.get_param_value("b")),
+                            "application/json");
+        } catch (const std::invalid_argument& e) {
+            errorAnswer(res, 400, std::string("pair.json: ") + e.what());
+        }
     });
     server.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
         if (!res.body.empty()) return;

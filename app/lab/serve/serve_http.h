@@ -13,6 +13,7 @@
 //                               the view, HUD, body rectangles and version (?after=V as above)
 //   GET  /api/session.yaml      every command applied so far with its frame: an events track
 //   GET  /api/timeline.json     frames reached, from ?from=K on
+//   GET  /api/pair.json         ?a=NAME&b=NAME: the frames that pair was flagged and confirmed in
 //
 // Nothing a request carries names a file; bodies over 64 KiB are refused (413), a client silent
 // for 5 s is dropped, commands beyond the queue's bound are "busy". Answers go out without
