@@ -39,7 +39,8 @@ std::string_view volumeStateName(engine::BodyState state) {
 
 }  // namespace
 
-std::string pauseDumpJson(const engine::World& world, int frame, const engine::DrawSettings& draw) {
+std::string pauseDumpJson(const engine::World& world, int frame, const engine::DrawSettings& draw,
+                          bool compact) {
     nlohmann::ordered_json doc;
     doc["frame"] = frame;
     doc["time"] = world.time();
@@ -132,7 +133,7 @@ std::string pauseDumpJson(const engine::World& world, int frame, const engine::D
     }
     for (const KdopKind& kind : kdop_kinds) overlapping[kind.name] = pairs(kind.overlaps.pairs);
     doc["overlapping_pairs"] = std::move(overlapping);
-    return doc.dump(1) + "\n";
+    return compact ? doc.dump() : doc.dump(1) + "\n";
 }
 
 engine::DrawSettings pauseDrawSettings(engine::DrawSettings frame_draw, bool volumes_chosen) {

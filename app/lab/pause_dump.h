@@ -19,8 +19,10 @@ namespace app {
 /// "kdopK": {"k", "min", "max"} (its k / 2 slab intervals, slab i along
 /// "kdop_slab_directions"["kdopK"][i], unnormalised), and "kdopK" joins "volume_states" and
 /// "overlapping_pairs". A mesh body has "mesh_bvh": the volume name of its hierarchy
-/// (collision::bvhVolumeNames()). Numbers are printed to round-trip.
-std::string pauseDumpJson(const engine::World& world, int frame, const engine::DrawSettings& draw);
+/// (collision::bvhVolumeNames()). Numbers are printed to round-trip. Indented one space a level
+/// with a final newline (the file's form), or `compact`: one object on one line, no newline.
+std::string pauseDumpJson(const engine::World& world, int frame, const engine::DrawSettings& draw,
+                          bool compact = false);
 
 /// What a `--pause-at` picture draws over the frame's view `frame_draw`: the volumes the frames
 /// draw when they were chosen (`volumes_chosen`: the scene's draw.volumes, or a show/hide), else

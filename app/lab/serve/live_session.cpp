@@ -165,6 +165,9 @@ std::string LiveSession::logYaml() const {
 }
 
 std::string LiveSession::timelineJson(std::size_t from) const {
+    const auto nullable = [](double ms) {
+        return ms < 0 ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(ms);
+    };
     constexpr std::size_t kMaxRows = 10000;
     nlohmann::ordered_json rows = nlohmann::ordered_json::array();
     std::lock_guard<std::mutex> lock(mutex_);
@@ -174,7 +177,10 @@ std::string LiveSession::timelineJson(std::size_t from) const {
                         {"time", r.time},
                         {"flagged", r.flagged},
                         {"colliding", r.colliding},
-                        {"step_ms", r.step_ms}});
+                        {"step_ms", r.step_ms},
+                        {"render_ms", nullable(r.render_ms)},
+                        {"png_ms", nullable(r.png_ms)},
+                        {"state_ms", nullable(r.state_ms)}});
     }
     return rows.dump();
 }
@@ -276,14 +282,30 @@ void LiveSession::loop(std::promise<void>& started) {
         f->playing = session->playing();
         render::FrameOptions frame_options = session->frameOptions();
         frame_options.hud_text = session->hudText(!session->playing(), false);
-        f->png = render::pngBytes(renderer->render(session->world(), session->camera(),
-                                                   frame_options));
-        nlohmann::ordered_json state = nlohmann::ordered_json::parse(
-            pauseDumpJson(session->world(), f->frame, frame_options.draw));
-        state["session"] = viewJson(*session);
-        state["session"]["version"] = f->version;
-        f->state = state.dump();
+        const Clock::time_point t0 = Clock::now();
+        const render::Image image =
+            renderer->render(session->world(), session->camera(), frame_options);
+        const Clock::time_point t1 = Clock::now();
+        f->png = render::pngBytes(image);
+        const Clock::time_point t2 = Clock::now();
+        // The pause dump with "session" as its last member, spliced into the dump's compact
+        // text rather than parsed and printed again.
+        nlohmann::ordered_json view = viewJson(*session);
+        view["version"] = f->version;
+        f->state = pauseDumpJson(session->world(), f->frame, frame_options.draw, true);
+        f->state.pop_back();
+        f->state += ",\"session\":" + view.dump() + "}";
+        const Clock::time_point t3 = Clock::now();
         std::lock_guard<std::mutex> lock(mutex_);
+        if (!timeline_.empty() && timeline_.back().frame == f->frame &&
+            timeline_.back().render_ms < 0) {
+            const auto ms = [](Clock::duration d) {
+                return std::chrono::duration<double, std::milli>(d).count();
+            };
+            timeline_.back().render_ms = ms(t1 - t0);
+            timeline_.back().png_ms = ms(t2 - t1);
+            timeline_.back().state_ms = ms(t3 - t2);
+        }
         held_.push_back(f);
         if (held_.size() > kHeldFrames) held_.pop_front();
         latest_ = std::move(f);

@@ -101,7 +101,9 @@ public:
     std::string logYaml() const;
 
     /// The timeline rows of frames first reached from index `from` on, as a JSON array of
-    /// {frame, time, flagged, colliding, step_ms}; at most 10,000 rows per call.
+    /// {frame, time, flagged, colliding, step_ms, render_ms, png_ms, state_ms} (the world steps
+    /// that reached the frame; drawing its first picture, encoding it, its state JSON; null
+    /// until published); at most 10,000 rows per call.
     std::string timelineJson(std::size_t from) const;
 
     /// One pair's history, as JSON: {"a", "b", "frames", "flagged": [[first, last], ...],
@@ -129,6 +131,11 @@ private:
         std::size_t flagged = 0;
         std::size_t colliding = 0;
         double step_ms = 0;
+        /// What the frame's first picture cost: drawing it, encoding the PNG, the state JSON
+        /// (negative until it is published).
+        double render_ms = -1;
+        double png_ms = -1;
+        double state_ms = -1;
     };
 
     void loop(std::promise<void>& started);
