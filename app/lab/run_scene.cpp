@@ -26,6 +26,7 @@
 
 #include "broadphase_check.h"
 #include "collision/broadphase/broad_phase.h"
+#include "demo/demo_playback.h"
 #include "demo/demo_session.h"
 #include "engine/scene.h"
 #include "engine/volume_overlaps.h"
@@ -374,25 +375,17 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
             if (recorder) recorder->observe(w);
             frame_stats.add(w.lastStats());
             totals.step_seconds += w.lastStats().total_s;
+            stage.sim_s += w.lastStats().total_s;
             if (!checker) return;
+            const double check_start = wallSeconds();
             const std::string report = checker->check(w);
+            stage.sim_s += wallSeconds() - check_start;
             if (report.empty()) return;
             std::ostringstream what;
             what << "check-broadphase: MISMATCH at frame " << session.frame() + 1 << ", step "
                  << w.stepCount() << ", t=" << w.time() << " s\n"
                  << report;
             throw BroadPhaseMismatch(what.str());
-        };
-        // Runs `simulate` (steps of the session), with its time counted as the simulation's.
-        auto simulate = [&](const auto& steps) {
-            const double sim_start = wallSeconds();
-            try {
-                steps();
-            } catch (const engine::SimulationError& e) {
-                throw StepFailure("frame " + std::to_string(session.frame() + 1) + ": " +
-                                  e.what());
-            }
-            stage.sim_s += wallSeconds() - sim_start;
         };
         auto hudText = [&](bool paused) { return session.hudText(paused, options.hud_timing); };
         std::set<int> frames_written;
@@ -485,37 +478,28 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
             writer.submit(std::move(image), fs::path(), copies);
         };
 
-        showFrame();
-        std::size_t next = 0;  // the next event of the track
-        for (;;) {
-            while (next < events.size() && events[next].frame == session.frame()) {
-                const engine::DemoEvent& e = events[next++];
-                std::string problem;
-                int shown = 0;  // frames the event's step or seek showed
-                simulate([&] {
-                    problem = session.apply(e.commands, [&] {
-                        showFrame();
-                        ++shown;
-                    });
-                });
-                if (!problem.empty()) throw std::logic_error("events: " + problem);
-                // An event that stayed on its frame changed its picture (a view, a pause): the
-                // frame's PNG is the picture after it, as a live session shows it.
-                if (shown == 0 && pending_png && pending_png->frame == session.frame()) {
-                    render::FrameOptions frame_options = session.frameOptions();
-                    frame_options.hud_text = hudText(!session.playing());
-                    pending_png->image = std::make_shared<const render::Image>(
-                        renderer.render(world, session.camera(), frame_options));
-                }
-                if (e.commands.dump) dumpFrame();
-                if (e.commands.wait_s > 0) holdFrame(double(e.commands.wait_s));
+        // The track as playDemo plays it (a run without one just plays): the frames it shows,
+        // each entry's picture, dump and wait.
+        DemoPlaybackHooks hooks;
+        hooks.frame_shown = showFrame;
+        hooks.event_applied = [&](const engine::DemoEvent& e) {
+            // An entry that stayed on its frame changed its picture (a view, a pause): the
+            // frame's PNG is the picture after it, as a live session shows it. (One that steps
+            // or seeks showed its frames, the last with its view.)
+            if (!e.commands.step && !e.commands.seek && pending_png &&
+                pending_png->frame == session.frame()) {
+                render::FrameOptions frame_options = session.frameOptions();
+                frame_options.hud_text = hudText(!session.playing());
+                pending_png->image = std::make_shared<const render::Image>(
+                    renderer.render(world, session.camera(), frame_options));
             }
-            // A track that ends paused ends the run there (checkEventTrack: nothing follows).
-            if (!session.playing()) break;
-            bool moved = false;
-            simulate([&] { moved = session.advance(); });
-            if (!moved) break;
-            showFrame();
+            if (e.commands.dump) dumpFrame();
+            if (e.commands.wait_s > 0) holdFrame(double(e.commands.wait_s));
+        };
+        try {
+            playDemo(session, events, hooks);
+        } catch (const engine::SimulationError& e) {
+            throw StepFailure("frame " + std::to_string(session.frame() + 1) + ": " + e.what());
         }
         flushPng();
         writer.finish();
