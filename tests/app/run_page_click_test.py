@@ -11,35 +11,12 @@ import json
 import shutil
 import subprocess
 import sys
-from pathlib import Path
 
-from selenium import webdriver
-from selenium.webdriver.chrome.service import Service
-from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import WebDriverWait
 
-failures = []
-
-
-def check(condition, what):
-    if not condition:
-        failures.append(what)
-    return condition
-
-
-def browser():
-    options = webdriver.ChromeOptions()
-    options.binary_location = "/usr/bin/chromium"
-    for flag in ("--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-                 "--window-size=1280,900", "--force-device-scale-factor=1", "--hide-scrollbars"):
-        options.add_argument(flag)
-    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    return webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
-
-
-def script_errors(driver):
-    return [e["message"] for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+from page_test_tools import (arguments, browser, check, click_picture, lone_body, report,
+                             script_errors)
 
 
 def detail_text(article):
@@ -56,26 +33,12 @@ def shows(text, body_id, name):
     return ("\n%d %s (" % (body_id, name)) in ("\n" + text)
 
 
-def body_at(rects, x, y):
-    """The body the page picks at picture pixel (x, y): the smallest rectangle holding it."""
-    best, area = -1, float("inf")
-    for i, r in enumerate(rects):
-        if r is None or not (r[0] <= x <= r[2] and r[1] <= y <= r[3]):
-            continue
-        a = (r[2] - r[0]) * (r[3] - r[1])
-        if a < area:
-            best, area = i, a
-    return best
-
-
 def main():
-    cdlab, source, work = Path(sys.argv[1]), Path(sys.argv[2]), Path(sys.argv[3])
-    shutil.rmtree(work, ignore_errors=True)
-    work.mkdir(parents=True)
+    cdlab, source, work = arguments()
     out = work / "out"
     # The coursework with a k-DOP drawn: each body's detail then lists its 14-DOP too.
     run = subprocess.run(
-        [str(cdlab), "run", str(source / "scenes" / "coursework.yaml"), "--html", "--no-video",
+        [cdlab, "run", str(source / "scenes" / "coursework.yaml"), "--html", "--no-video",
          "--quiet", "--frames", "45", "--pause-at", "20", "--pause-at", "41",
          "--set", "draw.volumes=[sphere, aabb, obb, kdop14]", "--out", str(out)],
         capture_output=True, text=True, timeout=300)
@@ -83,7 +46,7 @@ def main():
         print("cdlab run failed:", run.returncode, run.stderr)
         return 1
 
-    driver = browser()
+    driver = browser(1280, 900, hide_scrollbars=True)
     try:
         driver.get((out / "index.html").resolve().as_uri())
         WebDriverWait(driver, 30).until(
@@ -125,20 +88,10 @@ def main():
             # picks there (the smallest rectangle holding the point) is the one shown.
             img = article.find_element(By.CSS_SELECTOR, "div.picture img")
             driver.execute_script("arguments[0].scrollIntoView({block: 'center'})", img)
-            size = img.size
-            target = None
-            for i, r in enumerate(pause["rects"]):
-                if r is None:
-                    continue
-                cx, cy = (r[0] + r[2]) / 2, (r[1] + r[3]) / 2
-                if body_at(pause["rects"], cx, cy) == i:
-                    target = (i, cx, cy)
-                    break
+            target = lone_body(pause["rects"])
             if check(target is not None, "frame %d: some body is alone at its centre" % frame):
                 i, cx, cy = target
-                ox = int(cx * size["width"] / data["width"] - size["width"] / 2)
-                oy = int(cy * size["height"] / data["height"] - size["height"] / 2)
-                ActionChains(driver).move_to_element_with_offset(img, ox, oy).click().perform()
+                click_picture(driver, img, cx, cy, data["width"], data["height"])
                 check(shows(detail_text(article), i, names[i]) and
                       highlighted(article) == [i],
                       "frame %d: clicking body %d in the picture shows it" % (frame, i))
@@ -149,11 +102,10 @@ def main():
     finally:
         driver.quit()
 
-    for f in failures:
-        print("FAILED:", f)
-    if not failures:
+    status = report()
+    if status == 0:
         shutil.rmtree(work, ignore_errors=True)
-    return 1 if failures else 0
+    return status
 
 
 if __name__ == "__main__":

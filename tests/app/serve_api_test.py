@@ -11,55 +11,33 @@ frame's PNG, byte for byte.
 Exit 0 when every check holds; 1 with the failed checks listed otherwise.
 """
 import json
-import shutil
-import signal
 import socket
 import subprocess
 import sys
 import threading
 import time
-import urllib.error
-import urllib.request
-from pathlib import Path
 
-failures = []
-
-
-def check(condition, what):
-    if not condition:
-        failures.append(what)
-    return condition
+from page_test_tools import Server, arguments, check, get, post, report, server_state
 
 
 def main():
-    cdlab, source, work = sys.argv[1], Path(sys.argv[2]), Path(sys.argv[3])
-    shutil.rmtree(work, ignore_errors=True)
-    work.mkdir(parents=True)
+    cdlab, source, work = arguments()
     scene = str(source / "scenes" / "coursework.yaml")
     live = work / "live"
     log = work / "session.yaml"
-    server = subprocess.Popen(
-        [cdlab, "serve", scene, "--port", "0", "--paused", "--out", str(live), "--session",
-         str(log)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
-        first = server.stdout.readline()
-        if not check(first.startswith("cdlab serve: http://127.0.0.1:"), "URL line: " + first):
+    with Server([cdlab, "serve", scene, "--port", "0", "--paused", "--out", str(live),
+                 "--session", str(log)]) as server:
+        url = server.url
+        if url is None:
             return
-        url = first.split()[2]
         exercise(url, live, work)
         shown = SHOWN
         before_stop = get(url + "api/session.yaml")[1].decode()
-        server.send_signal(signal.SIGTERM)
-        out, err = server.communicate(timeout=20)
-        check(server.returncode == 0, "SIGTERM: exit %s, stderr %s" % (server.returncode, err))
+        out, err = server.stop()
         check("stopped; session log" in out, "the stop is said: " + out)
         check(log.read_text() == before_stop,
               "the log on disk is the log the server gave last:\n%s\n---\n%s"
               % (log.read_text(), before_stop))
-    finally:
-        if server.poll() is None:
-            server.kill()
-            server.wait()
 
     replay = work / "replay"
     r = subprocess.run([cdlab, "run", scene, "--events", str(log), "--no-hud-timing",
@@ -81,24 +59,6 @@ def main():
 SHOWN = {}  # frame -> the last picture the server showed of it (fetched while paused)
 
 
-def get(address):
-    try:
-        with urllib.request.urlopen(address, timeout=20) as r:
-            return r.status, r.read(), dict(r.headers)
-    except urllib.error.HTTPError as e:
-        return e.code, e.read(), dict(e.headers)
-
-
-def post(url, body):
-    data = body if isinstance(body, bytes) else json.dumps(body).encode()
-    request = urllib.request.Request(url + "api/command", data=data, method="POST")
-    try:
-        with urllib.request.urlopen(request, timeout=20) as r:
-            return r.status, json.loads(r.read())
-    except urllib.error.HTTPError as e:
-        return e.code, json.loads(e.read())
-
-
 def command(url, body, expect_frame=None):
     """Applies one command that must succeed; records the picture shown after it when paused."""
     status, answer = post(url, body)
@@ -107,7 +67,7 @@ def command(url, body, expect_frame=None):
     if expect_frame is not None:
         check(answer["frame"] == expect_frame,
               "%s: frame %s, expected %s" % (body, answer["frame"], expect_frame))
-    state = json.loads(get(url + "api/state.json")[1])
+    state = server_state(url)
     if not state["session"]["playing"]:
         status, png, headers = get(url + "api/frame.png?version=%d" % state["session"]["version"])
         check(status == 200 and headers.get("Content-Type") == "image/png", "frame.png answered")
@@ -122,7 +82,7 @@ def exercise(url, live, work):
     check(status == 200 and b"serve-data" in page, "the page is served")
     check(b"<script src" not in page and b"<link" not in page, "the page needs no other file")
 
-    state = json.loads(get(url + "api/state.json")[1])
+    state = server_state(url)
     check(state["frame"] == 0 and not state["session"]["playing"], "starts paused at frame 0")
     names = [b["name"] for b in state["bodies"]]
 
@@ -212,6 +172,4 @@ def exercise(url, live, work):
 
 if __name__ == "__main__":
     main()
-    for f in failures:
-        print("FAILED:", f)
-    sys.exit(1 if failures else 0)
+    sys.exit(report())

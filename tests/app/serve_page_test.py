@@ -11,47 +11,15 @@ Exit 0 when every check holds; 1 with the failed checks listed otherwise.
 """
 import base64
 import json
-import shutil
-import signal
-import subprocess
 import sys
 import time
 import urllib.parse
-import urllib.request
-from pathlib import Path
 
-from selenium import webdriver
-from selenium.webdriver.chrome.service import Service
-from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import Select, WebDriverWait
 
-failures = []
-
-
-def check(condition, what):
-    if not condition:
-        failures.append(what)
-    return condition
-
-
-def browser():
-    options = webdriver.ChromeOptions()
-    options.binary_location = "/usr/bin/chromium"
-    for flag in ("--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-                 "--window-size=1500,1000", "--force-device-scale-factor=1"):
-        options.add_argument(flag)
-    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    return webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
-
-
-def get(address):
-    with urllib.request.urlopen(address, timeout=20) as r:
-        return r.read()
-
-
-def state(url):
-    return json.loads(get(url + "api/state.json"))
+from page_test_tools import (Server, arguments, browser, check, click_picture, get, lone_body,
+                             report, script_errors, server_state)
 
 
 # The bytes of the picture the page shows, fetched by the page itself from its own src.
@@ -68,7 +36,7 @@ fetch(img.src).then(r => r.arrayBuffer()).then(b => {
 
 def settled(driver, url, what):
     """Waits until the page shows the server's newest picture, then checks it is that PNG."""
-    s = state(url)
+    s = server_state(url)
     version = s["session"]["version"]
     try:
         WebDriverWait(driver, 10).until(
@@ -79,7 +47,7 @@ def settled(driver, url, what):
             what, version, driver.find_element(By.ID, "frame-view").get_attribute("src")))
         return s
     src, data, width = driver.execute_async_script(SHOWN_BYTES)
-    served = get(url + "api/frame.png?version=%d" % version)
+    served = get(url + "api/frame.png?version=%d" % version)[1]
     check(base64.b64decode(data) == served, "%s: the picture shown is the server's PNG" % what)
     check(width == PAGE["width"], "%s: the picture loaded (%s wide)" % (what, width))
     WebDriverWait(driver, 10).until(
@@ -88,19 +56,15 @@ def settled(driver, url, what):
 
 
 def main():
-    cdlab, source, work = sys.argv[1], Path(sys.argv[2]), Path(sys.argv[3])
-    shutil.rmtree(work, ignore_errors=True)
-    work.mkdir(parents=True)
-    server = subprocess.Popen(
-        [cdlab, "serve", str(source / "scenes" / "coursework.yaml"), "--port", "0",
-         "--out", str(work / "live")], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    cdlab, source, work = arguments()
+    server = Server([cdlab, "serve", str(source / "scenes" / "coursework.yaml"), "--port", "0",
+                     "--out", str(work / "live")])
     drivers = []
     try:
-        first = server.stdout.readline()
-        if not check(first.startswith("cdlab serve: http://"), "URL line: " + first):
+        url = server.url
+        if url is None:
             return
-        url = first.split()[2]
-        drivers = [browser(), browser()]
+        drivers = [browser(1500, 1000), browser(1500, 1000)]
         for d in drivers:
             d.get(url)
         main_tab, other = drivers
@@ -110,57 +74,45 @@ def main():
             main_tab.find_element(By.ID, "serve-data").get_attribute("textContent")))
 
         main_tab.find_element(By.ID, "cmd-pause").click()
-        WebDriverWait(main_tab, 10).until(lambda d: not state(url)["session"]["playing"])
+        WebDriverWait(main_tab, 10).until(lambda d: not server_state(url)["session"]["playing"])
         s = settled(main_tab, url, "pause")
         check("PAUSED" in main_tab.find_element(By.ID, "hud").text, "pause: the HUD says PAUSED")
         paused_at = s["frame"]
 
         main_tab.find_element(By.ID, "cmd-step").click()
-        WebDriverWait(main_tab, 10).until(lambda d: state(url)["frame"] == paused_at + 1)
+        WebDriverWait(main_tab, 10).until(lambda d: server_state(url)["frame"] == paused_at + 1)
         settled(main_tab, url, "step")
 
         box = main_tab.find_element(By.ID, "layer-obb")
         was = box.is_selected()
         box.click()
         WebDriverWait(main_tab, 10).until(
-            lambda d: ("obb" in state(url)["session"]["layers"]) != was)
+            lambda d: ("obb" in server_state(url)["session"]["layers"]) != was)
         s = settled(main_tab, url, "toggle obb")
         check(main_tab.find_element(By.ID, "layer-obb").is_selected() == ("obb" in s["session"]["layers"]),
               "toggle obb: the box shows the layer's state")
 
         Select(main_tab.find_element(By.ID, "broadphase")).select_by_value("hgrid")
-        WebDriverWait(main_tab, 10).until(lambda d: state(url)["broadphase"] == "hgrid")
+        WebDriverWait(main_tab, 10).until(lambda d: server_state(url)["broadphase"] == "hgrid")
         s = settled(main_tab, url, "broad phase")
 
         # A body in the picture, clicked at the centre of its rectangle where it is the
         # smallest there: it becomes the selection, named in the page.
-        img = main_tab.find_element(By.ID, "frame-view")
-        size = img.size
-        target = None
-        rects = s["session"]["rects"]
-        for i, r in enumerate(rects):
-            if r is None or r[0] < 0 or r[1] < 0 or r[2] > PAGE["width"] or r[3] > PAGE["height"]:
-                continue
-            cx, cy = (r[0] + r[2]) / 2, (r[1] + r[3]) / 2
-            holding = [j for j, q in enumerate(rects)
-                       if q and q[0] <= cx <= q[2] and q[1] <= cy <= q[3]]
-            if min(holding, key=lambda j: (rects[j][2] - rects[j][0]) * (rects[j][3] - rects[j][1])) == i:
-                target = (i, cx, cy)
-                break
+        target = lone_body(s["session"]["rects"], PAGE["width"], PAGE["height"])
         if check(target is not None, "some body is alone at its centre"):
             i, cx, cy = target
             name = s["bodies"][i]["name"]
-            ActionChains(main_tab).move_to_element_with_offset(
-                img, int(cx * size["width"] / PAGE["width"] - size["width"] / 2),
-                int(cy * size["height"] / PAGE["height"] - size["height"] / 2)).click().perform()
-            WebDriverWait(main_tab, 10).until(lambda d: state(url)["session"]["selected"] == name)
+            click_picture(main_tab, main_tab.find_element(By.ID, "frame-view"), cx, cy,
+                          PAGE["width"], PAGE["height"])
+            WebDriverWait(main_tab, 10).until(
+                lambda d: server_state(url)["session"]["selected"] == name)
             settled(main_tab, url, "select")
             check(("selected: " + name) in main_tab.find_element(By.ID, "selected").text,
                   "select: the page names %s" % name)
 
         # The other tab follows what the first one did.
         settled(other, url, "the second tab")
-        s = state(url)
+        s = server_state(url)
         names = [b["name"] for b in s["bodies"]]
         shown = other.find_element(By.ID, "flagged-pairs").text
         for a, b in s["flagged_pairs"][:20]:
@@ -177,7 +129,7 @@ def main():
                 lambda d: d.find_element(By.ID, "pair-history").is_displayed())
             shown = other.find_element(By.ID, "pair-history").text
             query = urllib.parse.urlencode({"a": a, "b": b})
-            h = json.loads(get(url + "api/pair.json?" + query))
+            h = json.loads(get(url + "api/pair.json?" + query)[1])
             check("pair %s \u2013 %s" % (a, b) in shown, "the history names the pair: " + shown)
             buttons = other.find_elements(By.CSS_SELECTOR, "#pair-history .flagged-ranges button")
             texts = [("%d" % f if f == l else "%d\u2013%d" % (f, l)) for f, l in h["flagged"]]
@@ -186,7 +138,7 @@ def main():
             if buttons:
                 buttons[0].click()
                 WebDriverWait(other, 10).until(
-                    lambda d: state(url)["frame"] == h["flagged"][0][0])
+                    lambda d: server_state(url)["frame"] == h["flagged"][0][0])
                 settled(other, url, "seek from a pair's history")
 
         # Playing, one tab closed mid-stream: the other keeps receiving pictures.
@@ -194,30 +146,22 @@ def main():
         time.sleep(0.5)
         other.quit()
         drivers.remove(other)
-        before = state(url)["session"]["version"]
+        before = server_state(url)["session"]["version"]
         time.sleep(1.0)
-        check(state(url)["session"]["version"] > before + 5, "playing on after a tab closed")
+        check(server_state(url)["session"]["version"] > before + 5, "playing on after a tab closed")
         main_tab.find_element(By.ID, "cmd-pause").click()
-        WebDriverWait(main_tab, 10).until(lambda d: not state(url)["session"]["playing"])
+        WebDriverWait(main_tab, 10).until(lambda d: not server_state(url)["session"]["playing"])
         settled(main_tab, url, "pause again")
-        errors = [e["message"] for e in main_tab.get_log("browser") if e["level"] == "SEVERE"]
+        errors = script_errors(main_tab)
         check(not errors, "no script error in the browser: %s" % errors)
     finally:
         for d in drivers:
             d.quit()
-        server.send_signal(signal.SIGTERM)
-        try:
-            server.communicate(timeout=20)
-        except subprocess.TimeoutExpired:
-            server.kill()
-            check(False, "the server stops on SIGTERM")
-    check(server.returncode == 0, "the server exits 0 (%s)" % server.returncode)
+        server.stop()
 
 
 PAGE = {}  # the page's own data: the picture's size, the layers, the broad phases
 
 if __name__ == "__main__":
     main()
-    for f in failures:
-        print("FAILED:", f)
-    sys.exit(1 if failures else 0)
+    sys.exit(report())

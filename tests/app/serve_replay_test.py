@@ -11,41 +11,13 @@ requests are refused with the name that is wrong.
 Exit 0 when every check holds; 1 with the failed checks listed otherwise.
 """
 import json
-import shutil
-import signal
 import subprocess
 import sys
-import urllib.error
 import urllib.parse
-import urllib.request
-from pathlib import Path
 
-failures = []
+from page_test_tools import Server, arguments, check, failures, get, post, report, server_state
+
 FRAMES = 90
-
-
-def check(condition, what):
-    if not condition:
-        failures.append(what)
-    return condition
-
-
-def get(address):
-    try:
-        with urllib.request.urlopen(address, timeout=20) as r:
-            return r.status, r.read(), dict(r.headers)
-    except urllib.error.HTTPError as e:
-        return e.code, e.read(), dict(e.headers)
-
-
-def post(url, body):
-    request = urllib.request.Request(url + "api/command", data=json.dumps(body).encode(),
-                                     method="POST")
-    try:
-        with urllib.request.urlopen(request, timeout=20) as r:
-            return r.status, json.loads(r.read())
-    except urllib.error.HTTPError as e:
-        return e.code, json.loads(e.read())
 
 
 def ranges(frames):
@@ -64,25 +36,8 @@ def history(url, a, b):
     return status, json.loads(body)
 
 
-class Server:
-    def __init__(self, args):
-        self.p = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        first = self.p.stdout.readline()
-        self.url = first.split()[2] if first.startswith("cdlab serve: http://") else None
-        check(self.url is not None, "URL line: %r %s" % (first, self.p.stderr.read()
-                                                          if self.p.poll() is not None else ""))
-
-    def stop(self):
-        if self.p.poll() is None:
-            self.p.send_signal(signal.SIGTERM)
-            out, err = self.p.communicate(timeout=20)
-            check(self.p.returncode == 0, "SIGTERM: exit %s, %s" % (self.p.returncode, err))
-
-
 def main():
-    cdlab, source, work = sys.argv[1], Path(sys.argv[2]), Path(sys.argv[3])
-    shutil.rmtree(work, ignore_errors=True)
-    work.mkdir(parents=True)
+    cdlab, source, work = arguments()
     scene = str(source / "scenes" / "coursework.yaml")
     run, rec, trace = work / "run", work / "c.rec", work / "trace.jsonl"
     r = subprocess.run([cdlab, "run", scene, "--frames", str(FRAMES), "--no-video", "--quiet",
@@ -109,9 +64,8 @@ def main():
                      if t["frame"] <= last and list(pair) in t["colliding_names"]]
         return ranges(flagged), ranges(colliding)
 
-    replay = Server([cdlab, "serve", "--replay", str(rec), "--port", "0", "--paused", "--out",
-                     str(work / "live")])
-    try:
+    with Server([cdlab, "serve", "--replay", str(rec), "--port", "0", "--paused", "--out",
+                 str(work / "live")]) as replay:
         url = replay.url
         if url is None:
             return
@@ -120,7 +74,7 @@ def main():
         for frame in [37, 0, 89, 12, 13, 64]:
             status, answer = post(url, {"seek": {"frame": frame}})
             check(status == 200 and answer["frame"] == frame, "seek %d: %s" % (frame, answer))
-            state = json.loads(get(url + "api/state.json")[1])
+            state = server_state(url)
             status, png, headers = get(url + "api/frame.png?version=%d" % state["session"]["version"])
             check(int(headers["X-Cdlab-Frame"]) == frame, "frame %d shown" % frame)
             check(png == (run / ("frame_%05d.png" % frame)).read_bytes(),
@@ -153,13 +107,10 @@ def main():
             answer = json.loads(body)
             check(status == 400 and wrong in answer.get("error", ""),
                   "pair.json %s refused: %s %s" % (query, status, answer))
-    finally:
-        replay.stop()
 
     # A live session: the history of the frames simulated so far.
-    live = Server([cdlab, "serve", scene, "--port", "0", "--paused", "--out",
-                   str(work / "live2"), "--set", "draw.hud=false"])
-    try:
+    with Server([cdlab, "serve", scene, "--port", "0", "--paused", "--out",
+                 str(work / "live2"), "--set", "draw.hud=false"]) as live:
         url = live.url
         if url is None:
             return
@@ -172,8 +123,6 @@ def main():
             check(status == 200 and h["frames"] == 51 and h["flagged"] == flagged and
                   h["colliding"] == colliding,
                   "history of %s live: %s, the trace says %s %s" % (pair, h, flagged, colliding))
-    finally:
-        live.stop()
 
 
 if __name__ == "__main__":
@@ -181,6 +130,4 @@ if __name__ == "__main__":
         main()
     except Exception as e:  # a crash of the test is a failure with its reason
         failures.append("the test stopped: %r" % e)
-    for f in failures:
-        print("FAIL:", f)
-    sys.exit(1 if failures else 0)
+    sys.exit(report("FAIL:"))
