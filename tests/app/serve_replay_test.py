@@ -130,4 +130,4 @@ if __name__ == "__main__":
         main()
     except Exception as e:  # a crash of the test is a failure with its reason
         failures.append("the test stopped: %r" % e)
-    sys.exit(report("FAIL:"))
+    sys.exit(report())
