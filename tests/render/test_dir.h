@@ -35,15 +35,13 @@ private:
     std::filesystem::path path_;
 };
 
-/// A fake `ffmpeg` first on PATH for the object's lifetime, in `dir`: a shell script with
-/// `body` (by default one that exits 3); PATH is restored on destruction, also when the test
-/// fails early.
+/// A fake `ffmpeg` (a shell script that exits 3) first on PATH for the object's lifetime, in
+/// `dir`; PATH is restored on destruction, also when the test fails early.
 class DeadFfmpegOnPath {
 public:
-    explicit DeadFfmpegOnPath(const std::filesystem::path& dir,
-                              const std::string& body = "exit 3\n") {
+    explicit DeadFfmpegOnPath(const std::filesystem::path& dir) {
         const std::filesystem::path fake = dir / "ffmpeg";
-        std::ofstream(fake) << "#!/bin/sh\n" << body;
+        std::ofstream(fake) << "#!/bin/sh\nexit 3\n";
         std::filesystem::permissions(fake, std::filesystem::perms::owner_all);
         const char* old_path = std::getenv("PATH");
         saved_ = old_path ? old_path : "";
