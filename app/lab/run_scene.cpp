@@ -340,7 +340,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         const engine::World& world = session.world();
         if (options.record) {
             recorder.emplace(*options.record,
-                             recordingHeader(options.scene, options.overrides, scene), world);
+                             engine::recordingHeader(options.scene, options.overrides, scene), world);
         }
         render::Renderer renderer(scene.output.width, scene.output.height);
         std::unique_ptr<render::VideoWriter> video;

@@ -230,6 +230,24 @@ std::string frameBytes(const RecordedFrame& f) {
 
 }  // namespace
 
+RecordingHeader recordingHeader(const std::filesystem::path& scene_file,
+                                const std::vector<SceneOverride>& overrides, const Scene& scene) {
+    RecordingHeader h;
+    std::error_code ec;
+    const std::filesystem::path absolute = std::filesystem::absolute(scene_file, ec);
+    h.scene = (ec ? scene_file : absolute).lexically_normal();
+    h.scene_hash = fileHash(scene_file);
+    h.overrides = overrides;
+    h.frames = scene.frames;
+    h.broad_phase = scene.world.broad_phase;
+    h.pair_order = scene.world.pair_order;
+    h.steps_per_frame = scene.steps_per_frame;
+    h.time_step = scene.world.time_step;
+    h.bodies = scene.bodies.size();
+    h.chains = scene.chains.size();
+    return h;
+}
+
 RecordedFrame recordFrame(const World& world, int frame) {
     RecordedFrame f;
     f.frame = frame;

@@ -63,20 +63,6 @@ std::vector<fs::path> shippedScenes() {
     return scenes;
 }
 
-engine::RecordingHeader headerOf(const fs::path& file, const engine::Scene& scene) {
-    engine::RecordingHeader h;
-    h.scene = file;
-    h.scene_hash = engine::fileHash(file);
-    h.frames = scene.frames;
-    h.broad_phase = scene.world.broad_phase;
-    h.pair_order = scene.world.pair_order;
-    h.steps_per_frame = scene.steps_per_frame;
-    h.time_step = scene.world.time_step;
-    h.bodies = scene.bodies.size();
-    h.chains = scene.chains.size();
-    return h;
-}
-
 class Recording : public ::testing::Test {
 protected:
     void SetUp() override { render::installOcclusionQueryOracle(); }  // cullide.yaml
@@ -95,7 +81,7 @@ TEST_F(Recording, APlacedFrameIsTheFrameTheRunShowed) {
         std::vector<Shown> run;
         {
             engine::World world = engine::makeWorld(scene);
-            engine::RecordingWriter writer(rec_file, headerOf(file, scene));
+            engine::RecordingWriter writer(rec_file, engine::recordingHeader(file, {}, scene));
             for (int f = 0; f < kFrames; ++f) {
                 if (f > 0) {
                     for (int s = 0; s < scene.steps_per_frame; ++s) world.step();

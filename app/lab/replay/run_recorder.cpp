@@ -7,25 +7,6 @@ namespace app {
 
 namespace fs = std::filesystem;
 
-engine::RecordingHeader recordingHeader(const fs::path& scene_file,
-                                        const std::vector<engine::SceneOverride>& overrides,
-                                        const engine::Scene& scene) {
-    engine::RecordingHeader h;
-    std::error_code ec;
-    const fs::path absolute = fs::absolute(scene_file, ec);
-    h.scene = (ec ? scene_file : absolute).lexically_normal();
-    h.scene_hash = engine::fileHash(scene_file);
-    h.overrides = overrides;
-    h.frames = scene.frames;
-    h.broad_phase = scene.world.broad_phase;
-    h.pair_order = scene.world.pair_order;
-    h.steps_per_frame = scene.steps_per_frame;
-    h.time_step = scene.world.time_step;
-    h.bodies = scene.bodies.size();
-    h.chains = scene.chains.size();
-    return h;
-}
-
 std::string recordRefusal(const engine::Scene& scene, const std::vector<engine::DemoEvent>& events) {
     if (scene.world.pair_order != collision::PairOrder::Found) return "";
     for (const engine::DemoEvent& e : events) {

@@ -16,13 +16,6 @@
 
 namespace app {
 
-/// The header of a recording of `scene`, loaded from `scene_file` with `overrides` and then
-/// --frames, --broadphase and --pair-order applied (the values the scene holds now). Throws
-/// engine::RecordingError when the scene file cannot be read for its hash.
-engine::RecordingHeader recordingHeader(const std::filesystem::path& scene_file,
-                                        const std::vector<engine::SceneOverride>& overrides,
-                                        const engine::Scene& scene);
-
 /// Why a run of `scene` following `events` cannot be recorded, or "": with pair_order: found a
 /// broad-phase switch changes the order of the pairs and so the motion, which `cdlab replay
 /// --check` (the scene simulated again, without the events) could not reproduce.

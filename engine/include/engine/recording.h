@@ -65,6 +65,12 @@ struct RecordedFrame {
     StepStats counters;
 };
 
+/// The header of a recording of `scene`, loaded from `scene_file` with `overrides` and then
+/// given its run's frame count, broad phase and pair order (the values `scene` holds now).
+/// Throws RecordingError when the scene file cannot be read for its hash.
+RecordingHeader recordingHeader(const std::filesystem::path& scene_file,
+                                const std::vector<SceneOverride>& overrides, const Scene& scene);
+
 /// The frame `frame` of `world` now: its state, pairs, hash, broad phase and last step's counters.
 RecordedFrame recordFrame(const World& world, int frame);
 
