@@ -39,7 +39,8 @@ private:
     std::mutex mutex_;  ///< guards everything below
     std::condition_variable stopped_;
     std::uint64_t newest_ = 0;  ///< the newest version the waiting thread has seen
-    std::multimap<std::uint64_t, std::function<void()>> waiting_;  ///< by the version they wait past
+    /// The wake-ups, by the version they wait past.
+    std::multimap<std::uint64_t, std::function<void()>> waiting_;
     bool stopping_ = false;
     std::thread thread_;
 };

@@ -97,9 +97,9 @@ std::multimap<std::string, std::string> parseQuery(std::string_view query) {
         query = amp == std::string_view::npos ? std::string_view() : query.substr(amp + 1);
         if (item.empty()) continue;
         const std::size_t eq = item.find('=');
-        params.emplace(decodeUrl(item.substr(0, eq), true),
-                       eq == std::string_view::npos ? std::string()
-                                                    : decodeUrl(item.substr(eq + 1), true));
+        params.emplace(
+            decodeUrl(item.substr(0, eq), true),
+            eq == std::string_view::npos ? std::string() : decodeUrl(item.substr(eq + 1), true));
     }
     return params;
 }
@@ -235,8 +235,7 @@ private:
                             "pair.json: give the two bodies' names, ?a=NAME&b=NAME");
             } else {
                 try {
-                    setBody(*res_, http::status::ok, "application/json",
-                            s.pairHistoryJson(*a, *b));
+                    setBody(*res_, http::status::ok, "application/json", s.pairHistoryJson(*a, *b));
                 } catch (const std::invalid_argument& e) {
                     errorAnswer(*res_, http::status::bad_request,
                                 std::string("pair.json: ") + e.what());
@@ -264,9 +263,9 @@ private:
         std::uint64_t v = 0;
         const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
         if (ec != std::errc() || end != text.data() + text.size() || text.empty()) {
-            errorAnswer(*res_, http::status::bad_request,
-                        std::string("query parameter '") + name +
-                            "': expected a whole number >= 0");
+            errorAnswer(
+                *res_, http::status::bad_request,
+                std::string("query parameter '") + name + "': expected a whole number >= 0");
             return false;
         }
         value = v;
@@ -285,13 +284,13 @@ private:
                         {"frame", f ? f->frame : 0}});
             return send();
         }
-        net::post(shared_.commands, [self = shared_from_this(),
-                                     body = std::move(parser_->get().body())] {
-            LiveAnswer a = self->shared_.session.command(body);
-            --self->shared_.commands_waiting;
-            net::post(self->stream_.get_executor(),
-                      [self, a = std::move(a)] { self->commandAnswered(a); });
-        });
+        net::post(shared_.commands,
+                  [self = shared_from_this(), body = std::move(parser_->get().body())] {
+                      LiveAnswer a = self->shared_.session.command(body);
+                      --self->shared_.commands_waiting;
+                      net::post(self->stream_.get_executor(),
+                                [self, a = std::move(a)] { self->commandAnswered(a); });
+                  });
     }
 
     void commandAnswered(const LiveAnswer& a) {
@@ -299,11 +298,11 @@ private:
             jsonAnswer(*res_, http::status::ok,
                        {{"ok", true}, {"at_frame", a.at_frame}, {"frame", a.frame}});
         } else {
-            const http::status status =
-                a.error.rfind("busy:", 0) == 0 ? http::status::too_many_requests
-                : a.error.rfind("the session has stopped", 0) == 0
-                    ? http::status::service_unavailable
-                    : http::status::bad_request;
+            const http::status status = a.error.rfind("busy:", 0) == 0
+                                            ? http::status::too_many_requests
+                                        : a.error.rfind("the session has stopped", 0) == 0
+                                            ? http::status::service_unavailable
+                                            : http::status::bad_request;
             jsonAnswer(*res_, status, {{"ok", false}, {"error", a.error}, {"frame", a.frame}});
         }
         send();
@@ -378,19 +377,19 @@ private:
         stream_.socket().shutdown(tcp::socket::shutdown_send, ec);
         if (ec) return stream_.close();
         stream_.expires_after(kIoTimeout);
-        stream_.async_read_some(
-            net::buffer(drain_), [self = shared_from_this()](beast::error_code e, std::size_t) {
-                if (e) return self->stream_.close();
-                self->drain();
-            });
+        stream_.async_read_some(net::buffer(drain_),
+                                [self = shared_from_this()](beast::error_code e, std::size_t) {
+                                    if (e) return self->stream_.close();
+                                    self->drain();
+                                });
     }
 
     void drain() {
-        stream_.async_read_some(
-            net::buffer(drain_), [self = shared_from_this()](beast::error_code e, std::size_t) {
-                if (e) return self->stream_.close();
-                self->drain();
-            });
+        stream_.async_read_some(net::buffer(drain_),
+                                [self = shared_from_this()](beast::error_code e, std::size_t) {
+                                    if (e) return self->stream_.close();
+                                    self->drain();
+                                });
     }
 
     beast::tcp_stream stream_;
@@ -447,9 +446,8 @@ HttpServer::~HttpServer() {
 int HttpServer::listen(const std::string& host, int port) {
     beast::error_code ec;
     tcp::resolver resolver(impl_->ioc);
-    const auto endpoints = resolver.resolve(host, std::to_string(port),
-                                            tcp::resolver::passive | tcp::resolver::numeric_service,
-                                            ec);
+    const auto endpoints = resolver.resolve(
+        host, std::to_string(port), tcp::resolver::passive | tcp::resolver::numeric_service, ec);
     if (ec) return 0;
     tcp::acceptor& a = impl_->acceptor;
     for (const auto& entry : endpoints) {
