@@ -8,7 +8,8 @@
 //     thread waits on the session for every new picture and cancels (through the strand) the
 //     timers of those waiting past an older version, so any number of long-polls hold no thread;
 //   - a command (LiveSession::command waits for the next frame boundary) runs on a pool of
-//     kCommandThreads threads, its answer posted back to the connection's strand; at most
+//     kCommandThreads threads, which start writing the answer (the connection idle meanwhile,
+//     so the strand is not needed to start it; the write completes on the strand); at most
 //     kMaxCommandsWaiting are handed to the pool at once, more are "busy" (429).
 // Deadlines: reading a request (its wait, header and body) has 5 s from its start, however often
 // bytes trickle in; writing an answer has 5 s. A connection past either is closed.
@@ -288,8 +289,10 @@ private:
                   [self = shared_from_this(), body = std::move(parser_->get().body())] {
                       LiveAnswer a = self->shared_.session.command(body);
                       --self->shared_.commands_waiting;
-                      net::post(self->stream_.get_executor(),
-                                [self, a = std::move(a)] { self->commandAnswered(a); });
+                      // Written from this thread, without a hop back to the strand: the
+                      // connection has no other operation in flight while its command waits
+                      // (nothing reads, no timer runs), and the write completes on the strand.
+                      self->commandAnswered(a);
                   });
     }
 
