@@ -1,7 +1,13 @@
 // app/lab/output_files.cpp -- see output_files.h.
 #include "output_files.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <string_view>
@@ -48,6 +54,28 @@ void prepareOutputDir(const fs::path& dir) {
         if (!f) throw render::RenderError("output directory " + dir.string() + " is not writable");
     }
     fs::remove(probe, ec);
+}
+
+OutputLock::OutputLock(const fs::path& dir) {
+    fd_ = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd_ < 0) {
+        throw render::RenderError("cannot open output directory " + dir.string() + ": " +
+                                  std::strerror(errno));
+    }
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+        const int e = errno;
+        ::close(fd_);
+        fd_ = -1;
+        throw render::RenderError(
+            "output directory " + dir.string() +
+            (e == EWOULDBLOCK ? std::string(" is being written by another cdlab run; wait for it "
+                                            "or choose another --out")
+                              : ": cannot be locked (" + std::string(std::strerror(e)) + ")"));
+    }
+}
+
+OutputLock::~OutputLock() {
+    if (fd_ >= 0) ::close(fd_);  // closing releases the flock
 }
 
 namespace {

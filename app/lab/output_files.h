@@ -26,6 +26,24 @@ bool writeTextReporting(const std::filesystem::path& file, const std::string& te
 /// Throws render::RenderError naming the directory on failure.
 void prepareOutputDir(const std::filesystem::path& dir);
 
+/// One run's hold on its output folder: an exclusive flock(2) on the folder itself (no file is
+/// made), released when the object goes. A second run into the same folder while the first
+/// writes would delete the first's partial files (its video among them) and leave it saying
+/// complete; it is refused instead. Throws render::RenderError naming the folder when another
+/// process holds it.
+class OutputLock {
+public:
+    explicit OutputLock(const std::filesystem::path& dir);
+    ~OutputLock();
+    OutputLock(OutputLock&& other) noexcept : fd_(other.fd_) { other.fd_ = -1; }
+    OutputLock(const OutputLock&) = delete;
+    OutputLock& operator=(const OutputLock&) = delete;
+    OutputLock& operator=(OutputLock&&) = delete;
+
+private:
+    int fd_ = -1;
+};
+
 /// Removes what an earlier run left in `dir`, so a rerun with fewer frames never shows the old
 /// ones beside the new summary: cdlab's own outputs only (frame_NNNNN.png, pause_N.png and .json,
 /// summary.json, index.html, and *.partial files of a killed run), and only regular files. Other files stay.

@@ -284,9 +284,12 @@ std::optional<collision::Pose> parsePose(std::string_view text, std::string* err
         return std::nullopt;
     }
     const collision::Quat q(v[3], v[4], v[5], v[6]);
+    // As the scene loader's orientation_wxyz: a length that overflows (1e200 components) would
+    // normalise to the zero quaternion and answer for another pose.
     const double norm = q.norm();
-    if (!(norm > 1e-12)) {
-        *error = "the quaternion (qw,qx,qy,qz) is zero";
+    if (!(norm > 1e-12) || !std::isfinite(norm)) {
+        *error = "the quaternion (qw,qx,qy,qz) must have a non-zero, finite length (it is "
+                 "normalised); this one's is " + std::string(std::isfinite(norm) ? "zero" : "too large to compute");
         return std::nullopt;
     }
     return collision::Pose{collision::Vec3(v[0], v[1], v[2]), q.normalized()};

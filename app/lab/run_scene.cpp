@@ -210,10 +210,12 @@ int loadRunScene(const RunOptions& options, std::ostream& err, engine::Scene& sc
 
 // Every output folder made and every output path proven writable (and not a device, FIFO, link
 // or directory) before the first step, not after the whole simulation; an earlier run's outputs
-// in `out_dir` cleared. Throws render::RenderError.
-void prepareOutputs(const RunOptions& options, const fs::path& out_dir, bool want_video,
-                    const fs::path& video_path) {
+// in `out_dir` cleared, and the folder held for this run (OutputLock) until the returned lock
+// goes. Throws render::RenderError.
+OutputLock prepareOutputs(const RunOptions& options, const fs::path& out_dir, bool want_video,
+                          const fs::path& video_path) {
     prepareOutputDir(out_dir);
+    OutputLock lock(out_dir);
     if (want_video && video_path.has_parent_path()) prepareOutputDir(video_path.parent_path());
     if (options.stats_csv && options.stats_csv->has_parent_path()) {
         prepareOutputDir(options.stats_csv->parent_path());
@@ -225,6 +227,7 @@ void prepareOutputs(const RunOptions& options, const fs::path& out_dir, bool wan
     if (options.stats_csv) render::checkOutputWritable(*options.stats_csv);
     if (want_video) render::checkOutputWritable(video_path);
     clearPreviousRun(out_dir);
+    return lock;
 }
 
 // What summary.json records of a run that completed.
@@ -332,7 +335,7 @@ int runScene(const RunOptions& options, std::ostream& out, std::ostream& err) {
         }
     };
     try {
-        prepareOutputs(options, out_dir, want_video, video_path);
+        const OutputLock out_lock = prepareOutputs(options, out_dir, want_video, video_path);
         DemoSession session(scene, options.draw_structure);
         const engine::World& world = session.world();
         if (options.record) {

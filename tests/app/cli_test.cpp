@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "cli_run.h"
+#include "output_files.h"
 #include "render/image.h"
 
 namespace {
@@ -146,6 +147,31 @@ TEST(Cli, RunWritesFramesPauseDumpsAndSummary) {
 
 // The video as a browser needs it (H.264 in yuv420p) with one picture per frame, read back by
 // ffprobe, which the ffmpeg package always brings along.
+// Two runs into one folder: the second once deleted the first's partial video while the first
+// still wrote it, and the first then said complete. The second is refused, touching nothing.
+TEST(Cli, ASecondRunIntoAFolderBeingWrittenIsRefused) {
+    const fs::path work = cdlab_test::tempDir("cdlab_cli_", "lock");
+    const fs::path out = work / "out";
+    fs::create_directories(out);
+    std::ofstream(out / "frame_00000.png") << "the first run's";
+    {
+        const app::OutputLock first(out);
+        EXPECT_THROW(app::OutputLock second(out), std::runtime_error);
+        const auto r = runCdlab("run " + kTiny + " --no-video --out " + out.string(), work);
+        EXPECT_EQ(r.exit_code, 1);
+        EXPECT_NE(r.err.find("output directory " + out.string() +
+                             " is being written by another cdlab run"),
+                  std::string::npos)
+            << r.err;
+        EXPECT_EQ(slurp(out / "frame_00000.png"), "the first run's");
+        EXPECT_FALSE(fs::exists(out / "summary.json"));
+    }
+    const auto after = runCdlab("run " + kTiny + " --no-video --out " + out.string(), work);
+    EXPECT_EQ(after.exit_code, 0) << after.err;
+    EXPECT_TRUE(fs::exists(out / "summary.json"));
+    fs::remove_all(work);
+}
+
 TEST(Cli, RunWritesAnH264Yuv420pVideoWithEveryFrame) {
     if (!haveFfprobe()) GTEST_SKIP() << "ffprobe not on PATH (Debian package ffmpeg)";
     const fs::path work = cliDir("video");

@@ -99,6 +99,24 @@ TEST(DemoSession, LayersAndBroadPhaseSwitchAsAsked) {
     EXPECT_FALSE(session.playing());
 }
 
+// Switching the broad phase redraws the volume it tests and nothing else: labels, contacts and
+// the hierarchy shown before stay (they were once reset to the scene's with the volumes).
+TEST(DemoSession, ABroadPhaseSwitchKeepsTheLayersShown) {
+    engine::Scene scene = coursework();
+    scene.draw.volumes_given = false;
+    app::DemoSession session(scene, false);
+    ASSERT_EQ(session.apply(command(scene, "{show: [labels, contacts, hierarchy], hide: [hud]}")),
+              "");
+    ASSERT_EQ(session.apply(command(scene, "{broadphase: sphere}")), "");
+    EXPECT_TRUE(session.view().draw.sphere);
+    EXPECT_FALSE(session.view().draw.aabb);
+    for (const engine::DemoLayer l : {engine::DemoLayer::Labels, engine::DemoLayer::Contacts,
+                                      engine::DemoLayer::Hierarchy}) {
+        EXPECT_TRUE(session.shows(l)) << engine::demoLayerName(l);
+    }
+    EXPECT_FALSE(session.shows(engine::DemoLayer::Hud));
+}
+
 // A switch takes effect on the frame it is made: the pairs and states shown at once are the new
 // broad phase's on the current state (those of a session that ran it from the start), at a frame
 // where the two broad phases' volumes flag different pairs; and again after stepping back.

@@ -246,6 +246,9 @@ TEST(Query, ParsePose) {
     EXPECT_NE(error.find("zero"), std::string::npos);
     EXPECT_FALSE(app::parsePose("1,2,x,1,0,0,0", &error).has_value());
     EXPECT_FALSE(app::parsePose("1,2,inf,1,0,0,0", &error).has_value());
+    // Finite components whose length overflows were once normalised to the zero quaternion.
+    EXPECT_FALSE(app::parsePose("0,0,0,1e200,1e200,0,0", &error).has_value());
+    EXPECT_NE(error.find("too large"), std::string::npos) << error;
 }
 
 // --unit-cost-tests sizes the batches the unit costs are timed over (at least that many volume

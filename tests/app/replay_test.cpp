@@ -213,6 +213,26 @@ TEST(Replay, ASessionOfARecordingShowsTheSimulatedSessionsFrames) {
         ASSERT_EQ(replay.apply(c), "") << text;
         expectSame(text);
     }
+    // A recording's own broad-phase switch (frame by frame) keeps the layers shown too.
+    {
+        const fs::path walk = work / "walk.rec";
+        ASSERT_EQ(runCdlab("run scenes/coursework.yaml --no-video --no-frames --out " +
+                               (work / "walk").string() +
+                               " --events scenes/events/coursework_walkthrough.yaml --record " +
+                               walk.string(),
+                           work)
+                      .exit_code,
+                  0);
+        const engine::Recording walked = engine::Recording::open(walk);
+        engine::Scene free_volumes = scene;
+        free_volumes.draw.volumes_given = false;
+        app::DemoSession viewer(free_volumes, false, walked);
+        ASSERT_EQ(viewer.apply(engine::parseDemoCommands("{show: [labels], seek: {frame: 62}}",
+                                                         "test", scene)),
+                  "");
+        EXPECT_EQ(viewer.world().broadPhase().name(), "hgrid-levels");
+        EXPECT_TRUE(viewer.shows(engine::DemoLayer::Labels));
+    }
     // The replay ends where the recording does.
     const engine::DemoCommands past = engine::parseDemoCommands("{step: 1}", "test", scene);
     EXPECT_NE(replay.apply(past), "");

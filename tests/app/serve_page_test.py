@@ -3,7 +3,9 @@
 python3-selenium), two tabs at once: press pause, step, toggle OBBs, switch the broad phase,
 click a body in the picture; after each, the picture the page shows is the server's PNG of the
 newest version byte for byte, and the page's state (frame, layers, broad phase, selection,
-pairs by name) is the server's state.json. One tab is closed mid-stream; the other goes on.
+pairs by name) is the server's state.json; a click on a pair shows its history and seeks. One
+tab is closed mid-stream; the other goes on. Then the session log, replayed by `cdlab run
+--events`, gives every frame's PNG equal to the last picture the page showed of it.
 
     serve_page_test.py CDLAB SOURCE_DIR WORK_DIR
 
@@ -11,6 +13,7 @@ Exit 0 when every check holds; 1 with the failed checks listed otherwise.
 """
 import base64
 import json
+import subprocess
 import sys
 import time
 import urllib.parse
@@ -50,6 +53,8 @@ def settled(driver, url, what):
     served = get(url + "api/frame.png?version=%d" % version)[1]
     check(base64.b64decode(data) == served, "%s: the picture shown is the server's PNG" % what)
     check(width == PAGE["width"], "%s: the picture loaded (%s wide)" % (what, width))
+    if not s["session"]["playing"]:
+        SHOWN[s["frame"]] = served
     WebDriverWait(driver, 10).until(
         lambda d: d.find_element(By.ID, "seek").get_attribute("value") == str(s["frame"]))
     return s
@@ -142,6 +147,7 @@ def main():
                 settled(other, url, "seek from a pair's history")
 
         # Playing, one tab closed mid-stream: the other keeps receiving pictures.
+        played_from = server_state(url)["frame"]
         main_tab.find_element(By.ID, "cmd-play").click()
         time.sleep(0.5)
         other.quit()
@@ -151,7 +157,18 @@ def main():
         check(server_state(url)["session"]["version"] > before + 5, "playing on after a tab closed")
         main_tab.find_element(By.ID, "cmd-pause").click()
         WebDriverWait(main_tab, 10).until(lambda d: not server_state(url)["session"]["playing"])
+        # The frames played through were shown again, playing: their last pictures are those.
+        for frame in [f for f in SHOWN if f >= played_from]:
+            del SHOWN[frame]
         settled(main_tab, url, "pause again")
+        # Back a frame and then ten, paused, and an orbit there: more frames' last pictures.
+        for button, what in [("cmd-back", "back 1"), ("cmd-back10", "back 10"),
+                             ("cam-left", "orbit")]:
+            version = server_state(url)["session"]["version"]
+            main_tab.find_element(By.ID, button).click()
+            WebDriverWait(main_tab, 10).until(
+                lambda d: server_state(url)["session"]["version"] > version)
+            settled(main_tab, url, what)
         errors = script_errors(main_tab)
         check(not errors, "no script error in the browser: %s" % errors)
     finally:
@@ -159,8 +176,22 @@ def main():
             d.quit()
         server.stop()
 
+    # The session log replayed by `cdlab run --events`: every frame's PNG is the last picture
+    # the page showed of it.
+    replay = work / "replay"
+    r = subprocess.run([cdlab, "run", str(source / "scenes" / "coursework.yaml"), "--events",
+                        str(work / "live" / "session.yaml"), "--no-hud-timing", "--no-video",
+                        "--quiet", "--out", str(replay)], capture_output=True, text=True)
+    if check(r.returncode == 0, "replay: exit %d: %s" % (r.returncode, r.stderr)):
+        for frame, png in sorted(SHOWN.items()):
+            written = replay / ("frame_%05d.png" % frame)
+            check(written.is_file() and written.read_bytes() == png,
+                  "frame %d: the page's last picture equals the replay's %s" % (frame, written.name))
+        check(len(SHOWN) >= 3, "pictures compared with the replay: %d" % len(SHOWN))
+
 
 PAGE = {}  # the page's own data: the picture's size, the layers, the broad phases
+SHOWN = {}  # frame -> the last picture the page showed of it while paused
 
 if __name__ == "__main__":
     main()

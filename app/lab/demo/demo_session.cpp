@@ -32,7 +32,7 @@ void DemoSession::placeRecorded(int frame) {
     if (!broad_phase_chosen_ && f.broad_phase != broad_phase_) {
         world_.setBroadPhase(f.broad_phase);
         broad_phase_ = f.broad_phase;
-        if (!view_.volumes_chosen) view_.draw = engine::drawSettingsFor(scene_.draw, world_);
+        followBroadPhase();
     }
     // After a command chose another broad phase, the recorded counters (of the recorded one's
     // step) are not this one's: the HUD shows the detection's, and the pairs, and so the hash,
@@ -47,6 +47,12 @@ void DemoSession::placeRecorded(int frame) {
             "recording of another build of cdlab, whose detection differs)");
     }
     frame_ = frame;
+}
+
+void DemoSession::followBroadPhase() {
+    // Only the volumes follow the broad phase: the layers a user switched on (labels, contacts,
+    // the hierarchy) stay as they are.
+    if (!view_.volumes_chosen) view_.draw = engine::drawSettingsFor(view_.draw, world_);
 }
 
 engine::CameraSettings DemoSession::camera() const {
@@ -199,7 +205,7 @@ std::string DemoSession::apply(const engine::DemoCommands& c,
         broad_phase_ = *c.broad_phase;
         // The frames ahead were simulated with the other broad phase: their snapshots go.
         snapshots_.erase(snapshots_.upper_bound(frame_), snapshots_.end());
-        if (!view_.volumes_chosen) view_.draw = engine::drawSettingsFor(scene_.draw, world_);
+        followBroadPhase();
     }
     for (const engine::DemoLayer l : c.show) show(l, true);
     for (const engine::DemoLayer l : c.hide) show(l, false);

@@ -100,6 +100,8 @@ public:
 private:
     void keepSnapshot();
     void placeRecorded(int frame);
+    /// After a broad-phase switch: unless volumes were chosen, draw the one it tests.
+    void followBroadPhase();
     void show(engine::DemoLayer layer, bool on);
     void moveCamera(const engine::CameraCommand& c);
 
