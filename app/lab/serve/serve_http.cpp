@@ -1,15 +1,13 @@
-// app/lab/serve/serve_http.cpp -- see serve_http.h.
-// cpp-httplib (Debian's libcpp-httplib-dev 0.11): a thread pool answering requests, each handler
-// touching the session only through LiveSession's thread-safe calls, so a slow or vanished
-// client holds one pool thread for at most its timeouts and never the simulation.
+// app/lab/serve/serve_http.cpp -- see serve_http.h: the flags checked, the session started, the
+// page made, and the HTTP server (http_server.h) run until a signal. Its requests touch the
+// session only through LiveSession's thread-safe calls, so a slow or vanished client never
+// holds the simulation.
 #include "serve/serve_http.h"
 
-#include <httplib.h>
 #include <pthread.h>
 #include <signal.h>
 
 #include <atomic>
-#include <charconv>
 #include <functional>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -24,41 +22,12 @@
 #include "html_page.h"
 #include "output_files.h"
 #include "page_assets.h"
+#include "serve/http_server.h"
 #include "serve/live_session.h"
 
 namespace app {
 
 namespace {
-
-constexpr std::size_t kMaxRequestBytes = 64 * 1024;
-constexpr auto kLongPoll = std::chrono::seconds(2);
-
-void jsonAnswer(httplib::Response& res, int status, const nlohmann::ordered_json& body) {
-    res.status = status;
-    res.set_header("Cache-Control", "no-store");
-    res.set_content(body.dump(), "application/json");
-}
-
-void errorAnswer(httplib::Response& res, int status, const std::string& what) {
-    jsonAnswer(res, status, {{"ok", false}, {"error", what}});
-}
-
-// A query parameter that must be an unsigned integer, or none; false when it is malformed
-// (the answer is then written).
-bool unsignedParam(const httplib::Request& req, httplib::Response& res, const char* name,
-                   std::optional<std::uint64_t>& value) {
-    if (!req.has_param(name)) return true;
-    const std::string text = req.get_param_value(name);
-    std::uint64_t v = 0;
-    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-    if (ec != std::errc() || end != text.data() + text.size() || text.empty()) {
-        errorAnswer(res, 400, std::string("query parameter '") + name +
-                                  "': expected a whole number >= 0");
-        return false;
-    }
-    value = v;
-    return true;
-}
 
 // `replay`: the recording shown, or "" for a live simulation.
 std::string servePage(const engine::Scene& scene, const std::string& scene_name,
@@ -225,116 +194,9 @@ int serveScene(const ServeOptions& options, std::ostream& out, std::ostream& err
         return kExitFailure;
     }
 
-    httplib::Server server;
-    server.set_payload_max_length(kMaxRequestBytes);
-    server.set_read_timeout(5, 0);
-    server.set_write_timeout(5, 0);
-    server.set_keep_alive_timeout(5);
-    // cpp-httplib writes a header and a small body in two sends, and Nagle's algorithm holds the
-    // second until the client acknowledges the first: 41 ms on every command answer over a
-    // kept-alive connection (tests/bench/http_servers). And 0.11 closes a kept-alive connection
-    // after 5 requests, so a watching page reconnects behind whatever holds the pool.
-    server.set_tcp_nodelay(true);
-    server.set_keep_alive_max_count(std::size_t(1) << 20);
-    const std::string page =
-        servePage(scene, scene_name, recording ? recording->file().filename().string() : "");
-    LiveSession& s = *session;
-
-    server.Get("/", [&](const httplib::Request&, httplib::Response& res) {
-        res.set_header("Cache-Control", "no-store");
-        res.set_content(page, "text/html; charset=utf-8");
-    });
-    // Browsers ask for an icon; there is none (204), and no error is logged for it.
-    server.Get("/favicon.ico", [](const httplib::Request&, httplib::Response& res) {
-        res.status = 204;
-    });
-    server.Post("/api/command", [&](const httplib::Request& req, httplib::Response& res) {
-        const LiveAnswer a = s.command(req.body);
-        if (a.ok) {
-            jsonAnswer(res, 200, {{"ok", true}, {"at_frame", a.at_frame}, {"frame", a.frame}});
-            return;
-        }
-        const int status = a.error.rfind("busy:", 0) == 0                    ? 429
-                           : a.error.rfind("the session has stopped", 0) == 0 ? 503
-                                                                              : 400;
-        jsonAnswer(res, status, {{"ok", false}, {"error", a.error}, {"frame", a.frame}});
-    });
-    // The newest picture, or one newer than ?after, or the one of ?version.
-    const auto picked = [&](const httplib::Request& req, httplib::Response& res)
-        -> std::shared_ptr<const LiveFrame> {
-        std::optional<std::uint64_t> after, version;
-        if (!unsignedParam(req, res, "after", after) ||
-            !unsignedParam(req, res, "version", version)) {
-            return nullptr;
-        }
-        std::shared_ptr<const LiveFrame> f;
-        if (version) f = s.frameAt(*version);
-        if (!f) f = s.frame(after, kLongPoll);
-        if (!f) errorAnswer(res, 503, "no picture yet");
-        return f;
-    };
-    server.Get("/api/frame.png", [&](const httplib::Request& req, httplib::Response& res) {
-        const auto f = picked(req, res);
-        if (!f) return;
-        res.set_header("Cache-Control", "no-store");
-        res.set_header("X-Cdlab-Frame", std::to_string(f->frame));
-        res.set_header("X-Cdlab-Version", std::to_string(f->version));
-        res.set_content(f->png, "image/png");
-    });
-    server.Get("/api/state.json", [&](const httplib::Request& req, httplib::Response& res) {
-        const auto f = picked(req, res);
-        if (!f) return;
-        res.set_header("Cache-Control", "no-store");
-        res.set_content(f->state, "application/json");
-    });
-    server.Get("/api/session.yaml", [&](const httplib::Request&, httplib::Response& res) {
-        res.set_header("Cache-Control", "no-store");
-        res.set_content(s.logYaml(), "text/yaml; charset=utf-8");
-    });
-    server.Get("/api/timeline.json", [&](const httplib::Request& req, httplib::Response& res) {
-        std::optional<std::uint64_t> from;
-        if (!unsignedParam(req, res, "from", from)) return;
-        res.set_header("Cache-Control", "no-store");
-        res.set_content(s.timelineJson(std::size_t(from.value_or(0))), "application/json");
-    });
-    server.Get("/api/pair.json", [&](const httplib::Request& req, httplib::Response& res) {
-        if (!req.has_param("a") || !req.has_param("b")) {
-            errorAnswer(res, 400, "pair.json: give the two bodies' names, ?a=NAME&b=NAME");
-            return;
-        }
-        try {
-            res.set_header("Cache-Control", "no-store");
-            res.set_content(s.pairHistoryJson(req.get_param_value("a"), req.get_param_value("b")),
-                            "application/json");
-        } catch (const std::invalid_argument& e) {
-            errorAnswer(res, 400, std::string("pair.json: ") + e.what());
-        }
-    });
-    server.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
-        if (!res.body.empty()) return;
-        const std::string what = res.status == 404 ? "no such page: " + req.method + " " + req.path
-                                 : res.status == 413 ? "request larger than 64 KiB"
-                                                     : "HTTP " + std::to_string(res.status);
-        errorAnswer(res, res.status, what);
-    });
-    server.set_exception_handler(
-        [](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
-            std::string what = "internal error";
-            try {
-                if (ep) std::rethrow_exception(ep);
-            } catch (const std::exception& e) {
-                what += std::string(": ") + e.what();
-            } catch (...) {
-            }
-            errorAnswer(res, 500, what);
-        });
-
-    int port = options.port;
-    if (port == 0) {
-        port = server.bind_to_any_port(options.host);
-    } else if (!server.bind_to_port(options.host, port)) {
-        port = -1;
-    }
+    HttpServer server(*session, servePage(scene, scene_name,
+                                          recording ? recording->file().filename().string() : ""));
+    const int port = server.listen(options.host, options.port);
     if (port <= 0) {
         err << "cdlab serve: cannot listen on " << options.host << ":" << options.port
             << " (in use, or not an address of this machine)\n";
@@ -350,15 +212,11 @@ int serveScene(const ServeOptions& options, std::ostream& out, std::ostream& err
         options.host.find(':') != std::string::npos ? "[" + options.host + "]" : options.host;
     out << "cdlab serve: http://" << shown_host << ":" << port << "/ (Ctrl-C stops; session log "
         << live.log_file->string() << ")" << std::endl;
-    const bool listened = server.listen_after_bind();
+    server.run();
     session->stop();
     const std::string failure = session->failure();
     if (!failure.empty()) {
         err << "cdlab serve: the session stopped: " << failure << "\n";
-        return kExitFailure;
-    }
-    if (!listened) {
-        err << "cdlab serve: the server stopped with an error\n";
         return kExitFailure;
     }
     out << "cdlab serve: stopped; session log " << live.log_file->string() << "\n" << "replay: "

@@ -1,6 +1,6 @@
-// app/lab/serve/serve_http.h -- `cdlab serve SCENE` (or `--replay RECORDING`): a live session (live_session.h) behind a
-// local web server (cpp-httplib, Debian's libcpp-httplib-dev) with a page to drive it and a
-// plain HTTP API for scripts:
+// app/lab/serve/serve_http.h -- `cdlab serve SCENE` (or `--replay RECORDING`): a live session
+// (live_session.h) behind a local web server (http_server.h: Boost.Beast's asynchronous sessions,
+// Debian's libboost-dev, header-only) with a page to drive it and a plain HTTP API for scripts:
 //
 //   GET  /                      the page (self-contained: style, scripts and Chart.js inlined)
 //   POST /api/command           one command as JSON or YAML ({"pause": true}); answer
@@ -15,10 +15,12 @@
 //   GET  /api/timeline.json     frames reached, from ?from=K on
 //   GET  /api/pair.json         ?a=NAME&b=NAME: the frames that pair was flagged and confirmed in
 //
-// Nothing a request carries names a file; bodies over 64 KiB are refused (413), a client silent
-// for 5 s is dropped, commands beyond the queue's bound are "busy". Answers go out without
-// Nagle's delay (TCP_NODELAY) and a kept-alive connection serves any number of requests
-// (docs/serve.md: "Why cpp-httplib").
+// Nothing a request carries names a file; bodies over 64 KiB are refused (413), a request not
+// read whole within 5 s of the connection waiting for it is dropped (a client trickling bytes
+// included), commands beyond the queue's bound are "busy". No connection holds a thread, so a
+// client holding many open delays no one else. Answers go out without Nagle's delay
+// (TCP_NODELAY) and a kept-alive connection serves any number of requests (docs/serve.md: "Why
+// Boost.Beast").
 #pragma once
 
 #include <filesystem>
