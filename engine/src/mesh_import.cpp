@@ -403,8 +403,10 @@ MeshImportOutput importMesh(const std::filesystem::path& file, collision::Real s
     Assimp::Importer importer;
     auto* io = new CheckedIoSystem;
     importer.SetIOHandler(io);  // the importer owns it
-    // Only positions matter: drop normals, UVs and colours before JoinIdenticalVertices so that
-    // vertices split at normal seams are joined again, and drop point and line primitives.
+    // Only positions matter: drop normals, UVs and colours, and point and line primitives.
+    // No JoinIdenticalVertices: it joins positions within an absolute 1e-5 of each other, which
+    // merges the corners of a mesh a few micrometres across; mergeMeshes welds exactly equal
+    // positions itself, which is all a vertex split at a normal seam needs.
     importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS,
                                 aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
                                     aiComponent_COLORS | aiComponent_TEXCOORDS |
@@ -414,8 +416,8 @@ MeshImportOutput importMesh(const std::filesystem::path& file, collision::Real s
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
                                 aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     const unsigned flags = aiProcess_RemoveComponent | aiProcess_Triangulate |
-                           aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices |
-                           aiProcess_SortByPType | aiProcess_ValidateDataStructure;
+                           aiProcess_PreTransformVertices | aiProcess_SortByPType |
+                           aiProcess_ValidateDataStructure;
     // Text formats: the coordinates in double, to measure the rounding and, far from the origin,
     // to hand assimp the text recentred on the bounding box (every other byte unchanged).
     MeshImportReport& report = out.report;

@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -128,6 +129,53 @@ f 6 8 7
     ASSERT_TRUE(out.ok) << out.error;
     EXPECT_EQ(out.mesh.triangles.size(), 8u);
     EXPECT_EQ(out.mesh.vertices.size(), 7u);
+}
+
+// Small meshes keep every vertex: nothing but exactly equal positions is welded (a join within a
+// fixed distance, such as assimp's 1e-5, merges the corners of a mesh a few micrometres across).
+TEST_F(MeshImport, AMicrometreTetrahedronKeepsItsFourVertices) {
+    const std::string text =
+        "v 0 0 0\nv 3e-6 0 0\nv 0 3e-6 0\nv 0 0 3e-6\n"
+        "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    const MeshImportOutput out = importMesh(write("tiny.obj", text), 1);
+    ASSERT_TRUE(out.ok) << out.error;
+    EXPECT_EQ(out.mesh.vertices.size(), 4u);
+    EXPECT_EQ(out.mesh.triangles.size(), 4u);
+    EXPECT_TRUE(closedAndOriented(out.mesh));
+    EXPECT_FALSE(out.report.changed()) << describeImportChanges(out.report);
+}
+
+// A cube of side 2^-26 (exact in float and in the text): eight vertices, twelve triangles, and a
+// report that says nothing changed.
+TEST_F(MeshImport, ACubeOfSideTwoToTheMinus26KeepsItsEightVertices) {
+    const double side = std::ldexp(1.0, -26);
+    char value[64];
+    std::snprintf(value, sizeof value, "%.17g", side);
+    std::string text = kCubeObj;
+    std::string scaled;
+    // kCubeObj's coordinates are 0 and 1 on the vertex lines: 1 becomes the side.
+    for (std::size_t at = 0, end; at < text.size(); at = end + 1) {
+        end = text.find('\n', at);
+        if (end == std::string::npos) end = text.size();
+        std::string line = text.substr(at, end - at);
+        if (line.rfind("v ", 0) == 0) {
+            std::string out = "v";
+            for (std::size_t k = 2; k < line.size(); k += 2) {
+                out += line[k] == '1' ? std::string(" ") + value : std::string(" 0");
+            }
+            line = out;
+        }
+        scaled += line + "\n";
+    }
+    const MeshImportOutput out = importMesh(write("small_cube.obj", scaled), 1);
+    ASSERT_TRUE(out.ok) << out.error;
+    EXPECT_EQ(out.mesh.vertices.size(), 8u);
+    EXPECT_EQ(out.mesh.triangles.size(), 12u);
+    EXPECT_TRUE(closedAndOriented(out.mesh));
+    for (const Vec3& v : out.mesh.vertices) {
+        for (int a = 0; a < 3; ++a) EXPECT_TRUE(v[a] == 0 || v[a] == side) << v.transpose();
+    }
+    EXPECT_FALSE(out.report.changed()) << describeImportChanges(out.report);
 }
 
 TEST_F(MeshImport, DegenerateTrianglesAreDropped) {
