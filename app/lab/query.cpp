@@ -66,6 +66,8 @@ nlohmann::json importJson(const engine::MeshImportReport& r) {
     if (r.coordinates_checked) {
         j["vertices_merged"] = r.vertices_merged;
         j["max_rounding"] = r.max_rounding;
+        j["degenerate_in_file"] = r.degenerate_in_file;
+        j["degenerate_by_rounding"] = r.degenerate_by_rounding;
     }
     if (r.changed()) j["warning"] = engine::describeImportChanges(r);
     return j;

@@ -20,6 +20,7 @@
 #include <exception>
 #include <fstream>
 #include <iomanip>
+#include <limits>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -235,14 +236,27 @@ private:
     std::string refused_;
 };
 
+// A triangle with a repeated corner or no area: its cross product below kDegenerateArea times
+// its longest edge squared (relative, so the same at every scale).
+bool degenerate(const std::array<Vec3, 3>& t) {
+    const Vec3& a = t[0];
+    const Vec3& b = t[1];
+    const Vec3& c = t[2];
+    if (a == b || b == c || a == c) return true;
+    const Real longest2 =
+        std::max({(b - a).squaredNorm(), (c - a).squaredNorm(), (c - b).squaredNorm()});
+    return !((b - a).cross(c - a).norm() > kDegenerateArea * longest2);
+}
+
 // Every triangle of every mesh of `scene` into `mesh`, scaled, welding equal positions across
 // meshes too (exact comparison: the file's shared vertices are bit-identical after the same
-// transform and scale) and dropping degenerate triangles. Returns an error, or "".
+// transform and scale) and dropping degenerate triangles, whose corners go to `dropped`.
+// Returns an error, or "".
 // `offset` is added (in double) to assimp's coordinates before scaling: the file's text was handed
 // to assimp recentred by it. Counts the triangles read and dropped in `report`.
 std::string mergeMeshes(const aiScene& scene, Real scale, const Vec3& offset,
                         const std::filesystem::path& file, collision::TriangleMesh& mesh,
-                        MeshImportReport& report) {
+                        MeshImportReport& report, std::vector<std::array<Vec3, 3>>& dropped) {
     std::map<std::array<Real, 3>, std::int32_t> index_of;
     for (unsigned mi = 0; mi < scene.mNumMeshes; ++mi) {
         const aiMesh* am = scene.mMeshes[mi];
@@ -275,17 +289,11 @@ std::string mergeMeshes(const aiScene& scene, Real scale, const Vec3& offset,
             }
             if (!valid) continue;
             ++report.triangles_read;
-            if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) {
+            const std::array<Vec3, 3> corners = {mesh.vertices[tri[0]], mesh.vertices[tri[1]],
+                                                 mesh.vertices[tri[2]]};
+            if (degenerate(corners)) {
                 ++report.degenerate_dropped;
-                continue;
-            }
-            const Vec3& a = mesh.vertices[tri[0]];
-            const Vec3& b = mesh.vertices[tri[1]];
-            const Vec3& c = mesh.vertices[tri[2]];
-            const Real longest2 =
-                std::max({(b - a).squaredNorm(), (c - a).squaredNorm(), (c - b).squaredNorm()});
-            if (!((b - a).cross(c - a).norm() > kDegenerateArea * longest2)) {
-                ++report.degenerate_dropped;
+                dropped.push_back(corners);
                 continue;
             }
             mesh.triangles.push_back(tri);
@@ -325,6 +333,40 @@ void measureRounding(const std::vector<Vec3>& points, const Vec3& offset,
         return std::unique(v.begin(), v.end()) - v.begin();
     };
     report.vertices_merged = distinct(read) - distinct(rounded);
+}
+
+// The triangles mergeMeshes dropped, told apart by the file's own coordinates: each corner is
+// matched to the text point that imports as exactly that position (rounded to float relative to
+// `offset`, then scaled, as mergeMeshes computes it; the model measureRounding uses), and the
+// triangle of those points in double is degenerate or not. A corner two text points import as,
+// or none (assimp's parse was not correctly rounded), leaves its triangle unmatched.
+void classifyDropped(const std::vector<Vec3>& points, Real scale, const Vec3& offset,
+                     const std::vector<std::array<Vec3, 3>>& dropped, MeshImportReport& report) {
+    constexpr std::size_t kAmbiguous = std::numeric_limits<std::size_t>::max();
+    std::map<std::array<Real, 3>, std::size_t> point_of;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        Vec3 r;
+        for (int a = 0; a < 3; ++a) r[a] = roundedToFloat(points[i][a] - offset[a]);
+        const Vec3 imported = (r + offset) * scale;
+        const auto [it, inserted] =
+            point_of.emplace(std::array<Real, 3>{imported.x(), imported.y(), imported.z()}, i);
+        if (!inserted && points[it->second] != points[i]) it->second = kAmbiguous;
+    }
+    for (const std::array<Vec3, 3>& t : dropped) {
+        std::array<Vec3, 3> in_file;
+        bool matched = true;
+        for (int k = 0; k < 3 && matched; ++k) {
+            const auto it = point_of.find({t[k].x(), t[k].y(), t[k].z()});
+            matched = it != point_of.end() && it->second != kAmbiguous;
+            if (matched) in_file[k] = points[it->second] * scale;
+        }
+        if (!matched) continue;
+        if (degenerate(in_file)) {
+            ++report.degenerate_in_file;
+        } else {
+            ++report.degenerate_by_rounding;
+        }
+    }
 }
 
 // Largest |coordinate| and bounding-box diagonal of `points`.
@@ -386,7 +428,18 @@ std::string describeImportChanges(const MeshImportReport& r) {
                "cause: " + way_out;
     }
     if (r.vertices_merged == 0 && !rounding) {
-        return what + "; they are degenerate in the file itself (nothing was lost to rounding)";
+        if (r.degenerate_by_rounding > 0) {
+            return what + "; " + std::to_string(r.degenerate_by_rounding) +
+                   " of them have area in the file's coordinates and none in float's (slivers "
+                   "thinner than float resolves at this size, not a matter of where the mesh "
+                   "lies)";
+        }
+        if (r.degenerate_in_file == r.degenerate_dropped) {
+            return what + "; they are degenerate in the file itself (nothing was lost to rounding)";
+        }
+        return what + "; " + std::to_string(r.degenerate_dropped - r.degenerate_in_file) +
+               " of them could not be matched to the file's coordinates (assimp read them "
+               "differently from a correctly rounded parse), so rounding may be the cause";
     }
     return what + ": " + way_out;
 }
@@ -464,10 +517,14 @@ MeshImportOutput importMesh(const std::filesystem::path& file, collision::Real s
     }
 
     collision::TriangleMesh& mesh = out.mesh;
-    out.error = mergeMeshes(*scene, scale, report.offset, file, mesh, report);
+    std::vector<std::array<Vec3, 3>> dropped;
+    out.error = mergeMeshes(*scene, scale, report.offset, file, mesh, report, dropped);
     if (!out.error.empty()) {
         mesh = {};
         return out;
+    }
+    if (report.coordinates_checked) {
+        classifyDropped(text.points, scale, report.offset, dropped, report);
     }
     if (!report.coordinates_checked) measureExtent(mesh.vertices, scale, report);
     if (mesh.triangles.empty()) {

@@ -16,6 +16,11 @@ namespace engine {
 struct MeshImportReport {
     std::int64_t triangles_read = 0;      ///< the file's faces, triangulated
     std::int64_t degenerate_dropped = 0;  ///< of those, dropped: a repeated vertex or no area
+    /// Of those dropped, when the coordinates were checked (below): degenerate in the file's own
+    /// coordinates too, or only after rounding to float. A triangle whose corners cannot be
+    /// matched to the file's points is in neither.
+    std::int64_t degenerate_in_file = 0;
+    std::int64_t degenerate_by_rounding = 0;
     /// The file's coordinates were read in double too (OBJ, OFF, ASCII PLY, ASCII STL), so the
     /// figures below are measured; else they are 0 and unknown.
     bool coordinates_checked = false;
