@@ -14,7 +14,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
@@ -286,8 +288,17 @@ VideoWriter::VideoWriter(const fs::path& file, int width, int height, int fps,
     argv.insert(argv.end(), container->codec_args.begin(), container->codec_args.end());
     argv.push_back(out.c_str());
     argv.push_back(nullptr);
+    log_ = std::tmpfile();
+    if (log_ == nullptr) {
+        const int err = errno;
+        ::close(fds[0]);
+        ::close(fds[1]);
+        throw RenderError(file.string() + ": cannot make a file for ffmpeg's messages: " +
+                          errnoText(err));
+    }
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_adddup2(&actions, ::fileno(log_), STDERR_FILENO);
     // dup2 clears close-on-exec on fd 0 only; the child never holds our write end, so closing
     // it is the end-of-stream that lets ffmpeg finish.
     posix_spawn_file_actions_adddup2(&actions, fds[0], STDIN_FILENO);
@@ -328,6 +339,10 @@ void VideoWriter::abandon() noexcept {
         pid_ = -1;
     }
     if (!partial_.empty()) removeQuietly(partial_);
+    if (log_ != nullptr) {
+        std::fclose(log_);
+        log_ = nullptr;
+    }
 }
 
 void VideoWriter::addFrame(const Image& image) {
@@ -397,15 +412,28 @@ void VideoWriter::finish() {
     const bool exited_ok = waited > 0 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
     std::error_code ec;
     const bool has_output = fs::file_size(partial_, ec) > 0 && !ec;
-    if (!closed || !exited_ok || !has_output) {
+    // What ffmpeg said (at most 1 KiB of it, on one line).
+    std::string said;
+    if (log_ != nullptr) {
+        std::rewind(log_);
+        char buffer[1024];
+        said.assign(buffer, std::fread(buffer, 1, sizeof buffer, log_));
+        std::fclose(log_);
+        log_ = nullptr;
+        while (!said.empty() && std::isspace(static_cast<unsigned char>(said.back()))) said.pop_back();
+        for (char& c : said) c = c == '\n' ? ';' : c;
+    }
+    if (!closed || !exited_ok || !has_output || !said.empty()) {
         removeQuietly(partial_);
         std::string why =
             !closed      ? "the pipe to ffmpeg broke"
             : !exited_ok ? (WIFEXITED(status)
                                 ? "ffmpeg exited with status " + std::to_string(WEXITSTATUS(status))
                                 : std::string("ffmpeg was killed by a signal"))
-                         : std::string("ffmpeg wrote no output");
-        throw RenderError(file_.string() + ": video failed: " + why);
+                         : !has_output ? std::string("ffmpeg wrote no output")
+                                       : std::string("ffmpeg reported an error");
+        throw RenderError(file_.string() + ": video failed: " + why +
+                          (said.empty() ? "" : " (ffmpeg: " + said + ")"));
     }
     const fs::path partial = partial_;
     partial_.clear();

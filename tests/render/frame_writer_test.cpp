@@ -183,6 +183,34 @@ TEST(FrameWriter, AnEncoderThatDiesIsAnError) {
     EXPECT_FALSE(fs::exists(dir.path() / "dead.partial.mp4"));
 }
 
+// ffmpeg 5.1 exits 0 after "Error writing trailer ...: No space left on device" and leaves a
+// truncated file, which was once renamed into place as complete. An encoder that reads every
+// frame, writes a file, prints that and exits 0 is a failure naming what it said.
+TEST(FrameWriter, AnEncoderThatReportsAnErrorAndExitsZeroIsAnError) {
+    FrameWriterDir dir;
+    const cdlab_test::DeadFfmpegOnPath lying_ffmpeg(
+        dir.path(),
+        "cat > /dev/null\n"
+        "for last in \"$@\"; do :; done\n"
+        "printf 'half a video' > \"$last\"\n"
+        "echo \"[mp4 @ 0x55] Error writing trailer of $last: No space left on device\" >&2\n"
+        "exit 0\n");
+    std::string message;
+    try {
+        render::FrameWriter writer(
+            std::make_unique<render::VideoWriter>(dir.path() / "full.mp4", kW, kH, 30), 1, 2);
+        for (int k = 0; k < 6; ++k) writer.submit(testFrame(k), fs::path(), 1);
+        writer.finish();
+    } catch (const render::RenderError& e) {
+        message = e.what();
+    }
+    EXPECT_NE(message.find("full.mp4: video failed: ffmpeg reported an error"), std::string::npos)
+        << message;
+    EXPECT_NE(message.find("No space left on device"), std::string::npos) << message;
+    EXPECT_FALSE(fs::exists(dir.path() / "full.mp4"));
+    EXPECT_FALSE(fs::exists(dir.path() / "full.partial.mp4"));
+}
+
 // Images handed out for rendering come back for reuse once every writer is done with them.
 TEST(FrameWriter, BlankFramesAreRecycled) {
     render::FrameWriter writer(nullptr, 1, 1);

@@ -35,17 +35,20 @@ private:
     std::filesystem::path path_;
 };
 
-/// A fake `ffmpeg` (a shell script that exits 3) first on PATH for the object's lifetime, in
-/// `dir`; PATH is restored on destruction, also when the test fails early.
+/// A fake `ffmpeg` first on PATH (before the rest of it) for the object's lifetime, in `dir`: a
+/// shell script with `body` (by default one that exits 3); PATH is restored on destruction, also
+/// when the test fails early.
 class DeadFfmpegOnPath {
 public:
-    explicit DeadFfmpegOnPath(const std::filesystem::path& dir) {
+    explicit DeadFfmpegOnPath(const std::filesystem::path& dir,
+                              const std::string& body = "exit 3\n") {
         const std::filesystem::path fake = dir / "ffmpeg";
-        std::ofstream(fake) << "#!/bin/sh\nexit 3\n";
+        std::ofstream(fake) << "#!/bin/sh\n" << body;
         std::filesystem::permissions(fake, std::filesystem::perms::owner_all);
         const char* old_path = std::getenv("PATH");
         saved_ = old_path ? old_path : "";
-        ::setenv("PATH", dir.c_str(), 1);
+        // Put first, not alone: the fake's body may use the system's tools (cat, printf).
+        ::setenv("PATH", (dir.string() + (saved_.empty() ? "" : ":" + saved_)).c_str(), 1);
     }
     ~DeadFfmpegOnPath() { ::setenv("PATH", saved_.c_str(), 1); }
     DeadFfmpegOnPath(const DeadFfmpegOnPath&) = delete;

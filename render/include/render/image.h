@@ -45,7 +45,8 @@ bool isSupportedVideoFile(const std::filesystem::path& file);
 
 /// Pipes raw frames to ffmpeg, the codec chosen by the file's extension: H.264 yuv420p for .mp4,
 /// .mov (+faststart, so browsers play the file) and .mkv; VP9 for .webm; GIF with one palette
-/// for .gif. Any other extension is a RenderError before ffmpeg starts.
+/// for .gif. Any other extension is a RenderError before ffmpeg starts. A video ffmpeg printed an
+/// error about is a failure, whatever its exit status, with ffmpeg's words in the message.
 /// The output appears under its final name only after finish() succeeded. An ffmpeg that stops
 /// reading (or never exits) is an error after `stall_timeout` without progress, not a hang.
 class VideoWriter {
@@ -74,6 +75,10 @@ private:
     std::chrono::milliseconds stall_timeout_;
     int pipe_fd_ = -1;  ///< write end of ffmpeg's stdin, non-blocking
     int pid_ = -1;      ///< ffmpeg's process id while it runs
+    /// ffmpeg's stderr: an unnamed temporary file, read at finish(). With -loglevel error,
+    /// anything in it is an error, even when ffmpeg exits 0 (ffmpeg 5.1 does after "Error
+    /// writing trailer ...: No space left on device", leaving a truncated file).
+    std::FILE* log_ = nullptr;
     double encoder_cpu_s_ = 0;
 };
 
