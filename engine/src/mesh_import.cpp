@@ -523,7 +523,7 @@ MeshImportOutput importMesh(const std::filesystem::path& file, collision::Real s
         mesh = {};
         return out;
     }
-    if (report.coordinates_checked) {
+    if (report.coordinates_checked && !dropped.empty()) {
         classifyDropped(text.points, scale, report.offset, dropped, report);
     }
     if (!report.coordinates_checked) measureExtent(mesh.vertices, scale, report);
